@@ -1,0 +1,67 @@
+// Step 1 of the paper: scan one concentric border of the image and turn its line crossings
+// into sub-pixel feature points.
+//
+// The border at distance d is the closed rectangle of pixels with u in {d, W-1-d} or
+// v in {d, H-1-d}. It is walked clockwise as one loop (top row left to right, right column
+// down, bottom row right to left, left column up), so a run that wraps around a corner of
+// the rectangle stays one run.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "detector/image_view.h"
+#include "detector/line.h"
+#include "detector/options.h"
+
+namespace oal {
+
+/// Bits naming the sides of a border rectangle a point lies on (a corner lies on two).
+enum BorderSide : std::uint8_t { kTop = 1, kRight = 2, kBottom = 4, kLeft = 8 };
+
+struct BorderRect {
+  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;  ///< inclusive pixel bounds
+
+  int Width() const { return u1 - u0 + 1; }
+  int Height() const { return v1 - v0 + 1; }
+  bool Valid() const { return Width() >= 2 && Height() >= 2; }
+  /// Number of pixels on the loop.
+  int Perimeter() const { return 2 * Width() + 2 * Height() - 4; }
+
+  /// Pixel position of loop coordinate s (pixel i of the loop is at s = i; fractional s
+  /// interpolates along the loop, wrapping at Perimeter()).
+  Point2d ToPixel(double s) const;
+  /// Sides holding loop coordinate s; within `corner_px` of a corner both sides are set.
+  std::uint8_t Sides(double s, double corner_px = 0.5) const;
+};
+
+/// The border at distance d from the edges of a width x height image (may be invalid).
+BorderRect BorderAt(int width, int height, int d);
+
+/// A feature point found on a border.
+struct BorderPoint {
+  Point2d pixel;             ///< sub-pixel image position
+  double run_px = 0.0;       ///< length of the run along the loop (0 for edges)
+  std::uint8_t sides = 0;    ///< BorderSide bits
+  bool straight = true;      ///< the run lies on one side (its width can be measured)
+};
+
+/// Copies the loop's pixels, in loop order, into `samples` (resized; no allocation once it
+/// has the capacity).
+void GatherBorder(const GrayImageView& image, const BorderRect& rect,
+                  std::vector<std::uint8_t>* samples);
+
+/// Otsu's threshold of `samples`; `contrast` receives the difference of the two class means.
+int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast);
+
+/// Finds the feature points of one border's samples (as GatherBorder wrote them) and appends
+/// them to `points`, at most options.max_points_per_border. Returns the number appended.
+/// Runs shorter than min_width_px are dropped and light gaps shorter than min_width_px are
+/// bridged, so dead pixels and noise give no point. A straight run's point is its
+/// intensity-weighted centroid; a run that wraps a corner gives the midpoint of its two
+/// sub-pixel ends, which lies on the centre line of a stripe with parallel edges.
+int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect& rect,
+                     int threshold, const DetectorOptions& options,
+                     std::vector<BorderPoint>* points);
+
+}  // namespace oal

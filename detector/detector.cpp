@@ -1,0 +1,233 @@
+#include "detector/detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace oal {
+namespace {
+
+constexpr double kDegToRad = kPi / 180.0;
+
+int MaxPairs(int points) { return points * (points - 1) / 2; }
+
+int BorderCount(int width, int height, const DetectorOptions& options) {
+  int count = 0;
+  for (int d = options.start_px; BorderAt(width, height, d).Valid(); d += options.step_px) ++count;
+  return count;
+}
+
+// Where `line` enters and leaves the closed polygon `outline` (first and last crossing
+// along the line); false if it misses it.
+bool ClipToOutline(const LineParams& line, const std::vector<Point2d>& outline, Point2d* a,
+                   Point2d* b) {
+  const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
+  double t_min = std::numeric_limits<double>::infinity();
+  double t_max = -t_min;
+  for (std::size_t i = 0; i < outline.size(); ++i) {
+    const Point2d& p = outline[i];
+    const Point2d& q = outline[(i + 1) % outline.size()];
+    const double fp = p.u * c + p.v * s - line.rho_px;
+    const double fq = q.u * c + q.v * s - line.rho_px;
+    if ((fp > 0.0) == (fq > 0.0)) continue;
+    const double k = fp / (fp - fq);
+    const Point2d x{p.u + k * (q.u - p.u), p.v + k * (q.v - p.v)};
+    const double t = -x.u * s + x.v * c;  // position along the line direction (-s, c)
+    t_min = std::min(t_min, t);
+    t_max = std::max(t_max, t);
+  }
+  if (t_min > t_max) return false;
+  const Point2d foot{line.rho_px * c, line.rho_px * s};
+  *a = Point2d{foot.u - t_min * s, foot.v + t_min * c};
+  *b = Point2d{foot.u - t_max * s, foot.v + t_max * c};
+  return true;
+}
+
+// A loop of points around the rectangle, `per_side` per side, clockwise from the top-left.
+void RectangleOutline(const BorderRect& rect, int per_side, std::vector<Point2d>* outline) {
+  outline->clear();
+  const double u0 = rect.u0, v0 = rect.v0, u1 = rect.u1, v1 = rect.v1;
+  const Point2d corners[4] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
+  for (int k = 0; k < 4; ++k) {
+    const Point2d& p = corners[k];
+    const Point2d& q = corners[(k + 1) % 4];
+    for (int i = 0; i < per_side; ++i) {
+      const double t = static_cast<double>(i) / per_side;
+      outline->push_back(Point2d{p.u + t * (q.u - p.u), p.v + t * (q.v - p.v)});
+    }
+  }
+}
+
+}  // namespace
+
+OalDetector::OalDetector(const DetectorOptions& options)
+    : options_((options.Check(), options)),
+      oal_(options.angle_change_deg * kDegToRad, options.r_change_px, options.max_lines,
+           options.max_lines + MaxPairs(options.max_points_per_border)) {}
+
+OalDetector::OalDetector(const DetectorOptions& options, const vpCameraParameters& camera)
+    : OalDetector(options) {
+  PointUndistorter undistorter(camera);
+  if (undistorter.active()) undistorter_ = undistorter;
+}
+
+Point2d OalDetector::ToWorking(const Point2d& pixel) const {
+  return undistorter_ ? undistorter_->Undistort(pixel) : pixel;
+}
+
+void OalDetector::PrepareFor(int width, int height) {
+  if (width == width_ && height == height_) return;
+  width_ = width;
+  height_ = height;
+  centre_u_ = 0.5 * (width - 1);
+  centre_v_ = 0.5 * (height - 1);
+  const int borders = BorderCount(width, height, options_);
+  samples_.reserve(static_cast<std::size_t>(2 * (width + height)));
+  border_points_.reserve(static_cast<std::size_t>(options_.max_points_per_border));
+  frame_points_.reserve(static_cast<std::size_t>(borders * options_.max_points_per_border));
+  border_outline_.reserve(32);
+  candidates_.reserve(static_cast<std::size_t>(oal_.capacity()));
+  lines_.reserve(static_cast<std::size_t>(options_.max_output_lines));
+}
+
+const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image) {
+  if (image.empty() || image.stride < image.width) {
+    throw std::invalid_argument("OalDetector::Detect: empty image or stride < width");
+  }
+  PrepareFor(image.width, image.height);
+  oal_.Clear();
+  frame_points_.clear();
+  lines_.clear();
+  int border = 0;
+  for (int d = options_.start_px;; d += options_.step_px, ++border) {
+    const BorderRect rect = BorderAt(image.width, image.height, d);
+    if (!rect.Valid()) break;
+    ScanBorder(image, border, rect);
+  }
+  ReadOff(image.width, image.height);
+  return lines_;
+}
+
+void OalDetector::ScanBorder(const GrayImageView& image, int border, const BorderRect& rect) {
+  GatherBorder(image, rect, &samples_);
+  int threshold = options_.fixed_threshold;
+  bool has_contrast = true;
+  if (options_.threshold_mode == ThresholdMode::kOtsu) {
+    int contrast = 0;
+    threshold = OtsuThreshold(samples_, &contrast);
+    has_contrast = contrast >= options_.min_contrast;
+  }
+  const std::size_t first_point = frame_points_.size();
+  if (has_contrast) {
+    border_points_.clear();
+    FindBorderPoints(samples_, rect, threshold, options_, &border_points_);
+    for (const BorderPoint& point : border_points_) {
+      frame_points_.push_back(FramePoint{ToWorking(point.pixel), static_cast<float>(point.run_px),
+                                         point.sides, point.straight,
+                                         static_cast<std::int16_t>(border)});
+    }
+    VotePairs(border, first_point);
+  }
+
+  if (!options_.count_visible_borders_only) {
+    oal_.EndBorder([](const OalEntry&) { return true; });
+    return;
+  }
+  // The border's outline in working coordinates: its corners, and with distortion also the
+  // middles of its sides, which undistortion bends outward or inward.
+  RectangleOutline(rect, undistorter_ ? 2 : 1, &border_outline_);
+  for (Point2d& p : border_outline_) {
+    p = ToWorking(p);
+    p.u -= centre_u_;
+    p.v -= centre_v_;
+  }
+  oal_.EndBorder([this](const OalEntry& entry) { return LineCrossesBorder(entry); });
+}
+
+void OalDetector::VotePairs(int border, std::size_t first_point) {
+  const std::size_t end = frame_points_.size();
+  for (std::size_t i = first_point; i < end; ++i) {
+    const FramePoint& a = frame_points_[i];
+    for (std::size_t j = i + 1; j < end; ++j) {
+      const FramePoint& b = frame_points_[j];
+      if (options_.skip_same_side_pairs && (a.sides & b.sides) != 0) continue;
+      const double du = b.p.u - a.p.u, dv = b.p.v - a.p.v;
+      const double length_sq = du * du + dv * dv;
+      if (length_sq < 1e-6) continue;
+      const double inverse = 1.0 / std::sqrt(length_sq);
+      const double c = -dv * inverse, s = du * inverse;  // unit normal of the chord
+      const double rho = c * (a.p.u - centre_u_) + s * (a.p.v - centre_v_);
+      oal_.Vote(c, s, rho, border);
+    }
+  }
+}
+
+bool OalDetector::LineCrossesBorder(const OalEntry& entry) const {
+  bool positive = false, negative = false;
+  for (const Point2d& p : border_outline_) {
+    const double f = p.u * entry.cos_theta + p.v * entry.sin_theta - entry.rho_px;
+    positive |= f > 0.0;
+    negative |= f < 0.0;
+  }
+  return positive && negative;
+}
+
+void OalDetector::ReadOff(int width, int height) {
+  const double tolerance = options_.support_tolerance_px;
+  candidates_.clear();
+  for (const OalEntry& entry : oal_.entries()) {
+    if (entry.weight < options_.min_votes) continue;
+    // From the list's centred origin to the image's top-left origin.
+    const double rho = entry.rho_px + centre_u_ * entry.cos_theta + centre_v_ * entry.sin_theta;
+    DetectedLine line;
+    line.line = Normalized(rho, entry.theta_rad);
+    if (options_.refit_lines) {
+      const double wide = std::max(options_.r_change_px, 2.0 * tolerance);
+      line.line = RefitLine(line.line, frame_points_, wide);
+      line.line = RefitLine(line.line, frame_points_, tolerance);
+    }
+    const SupportStats stats = MeasureSupport(line.line, frame_points_, tolerance);
+    if (options_.rank_by_support && stats.points < options_.min_support) continue;
+    line.votes = entry.weight;
+    line.count = entry.count;
+    line.borders = stats.borders;
+    line.support = stats.points;
+    line.width_px = stats.width_px;
+    candidates_.push_back(line);
+  }
+  const bool by_support = options_.rank_by_support;
+  std::stable_sort(candidates_.begin(), candidates_.end(),
+                   [by_support](const DetectedLine& a, const DetectedLine& b) {
+                     if (by_support && a.support != b.support) return a.support > b.support;
+                     return a.votes > b.votes;
+                   });
+
+  const double duplicate_angle = options_.duplicate_angle_deg * kDegToRad;
+  for (const DetectedLine& candidate : candidates_) {
+    if (static_cast<int>(lines_.size()) >= options_.max_output_lines) break;
+    const bool duplicate =
+        std::any_of(lines_.begin(), lines_.end(), [&](const DetectedLine& kept) {
+          return AngleBetween(kept.line, candidate.line) <= duplicate_angle &&
+                 std::fabs(RhoAlignedTo(kept.line, candidate.line) - kept.line.rho_px) <=
+                     options_.duplicate_r_px;
+        });
+    if (!duplicate) lines_.push_back(candidate);
+  }
+
+  // End points on the image border (the undistorted image border when correcting).
+  const BorderRect image_rect = BorderAt(width, height, 0);
+  if (undistorter_) {
+    RectangleOutline(image_rect, 8, &border_outline_);
+    for (Point2d& p : border_outline_) p = ToWorking(p);
+  }
+  for (DetectedLine& line : lines_) {
+    if (undistorter_) {
+      ClipToOutline(line.line, border_outline_, &line.end_a, &line.end_b);
+    } else {
+      ClipToRect(line.line, 0.0, 0.0, width - 1.0, height - 1.0, &line.end_a, &line.end_b);
+    }
+  }
+}
+
+}  // namespace oal

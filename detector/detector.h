@@ -1,0 +1,89 @@
+// The ordered-accumulator-list (OAL) line detector of shared/paper/ordered-list-hough.md,
+// sections 2 and 3, with the remedies of shared/paper/NOTES.md behind switches
+// (DetectorOptions::Paper() turns them all off).
+//
+//   for each border d = start, start + step, ... until the centre:
+//     1. scan the border, feature points = middles of line runs     (border_scan.h)
+//     2. every pair of the border's points -> a line (rho, theta)
+//     3. vote into the ordered accumulator list, Eq. 1 and 2        (accumulator_list.h)
+//     4. count, reorder by weight - count/2 (Eq. 3)
+//     5. cull entries with weight - count/2 < 0 beyond max_lines (Eq. 4)
+//   6. read off the best lines, dropping near-duplicates          (line_fit.h for the refit)
+//
+// Lines are reported in the convention of line.h. With a camera that has distortion, the
+// feature points are undistorted before step 2 and the lines are in undistorted pixel
+// coordinates (the pixels an ideal pinhole camera with the same intrinsics would see).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <visp3/core/vpCameraParameters.h>
+
+#include "detector/accumulator_list.h"
+#include "detector/border_scan.h"
+#include "detector/image_view.h"
+#include "detector/lens.h"
+#include "detector/line.h"
+#include "detector/line_fit.h"
+#include "detector/options.h"
+
+namespace oal {
+
+struct DetectedLine {
+  LineParams line;        ///< rho, theta (line.h); undistorted if Undistorts()
+  int votes = 0;          ///< OAL weight
+  int count = 0;          ///< OAL count (borders counted since the entry was created)
+  int borders = 0;        ///< borders with at least one feature point on the line
+  int support = 0;        ///< feature points of all borders within support_tolerance_px
+  double width_px = 0.0;  ///< mean line thickness across the line (0 for edges)
+  Point2d end_a, end_b;   ///< where the line meets the image border
+};
+
+class OalDetector {
+ public:
+  /// Throws std::invalid_argument if `options` fail DetectorOptions::Check().
+  explicit OalDetector(const DetectorOptions& options = DetectorOptions());
+  /// As above; feature points are undistorted with `camera`'s kdu when its model has
+  /// distortion.
+  OalDetector(const DetectorOptions& options, const vpCameraParameters& camera);
+
+  /// Detects the lines of `image`, best first. The returned reference stays valid until the
+  /// next call. An image smaller than the first border gives no line; an empty view throws
+  /// std::invalid_argument. After the first frame of a given size nothing is allocated.
+  const std::vector<DetectedLine>& Detect(const GrayImageView& image);
+  const std::vector<DetectedLine>& Detect(const vpImage<unsigned char>& image) {
+    return Detect(ViewOf(image));
+  }
+
+  bool Undistorts() const { return undistorter_.has_value(); }
+  const DetectorOptions& options() const { return options_; }
+  /// The feature points of the last frame, border by border (for display and diagnosis).
+  const std::vector<FramePoint>& feature_points() const { return frame_points_; }
+  /// The accumulator list as the last frame left it.
+  const OrderedAccumulatorList& accumulator_list() const { return oal_; }
+
+ private:
+  void PrepareFor(int width, int height);
+  void ScanBorder(const GrayImageView& image, int border, const BorderRect& rect);
+  void VotePairs(int border, std::size_t first_point);
+  bool LineCrossesBorder(const OalEntry& entry) const;
+  void ReadOff(int width, int height);
+  Point2d ToWorking(const Point2d& pixel) const;
+
+  DetectorOptions options_;
+  std::optional<PointUndistorter> undistorter_;
+  OrderedAccumulatorList oal_;
+
+  // Working memory, sized once per image size (no allocation per frame after that).
+  int width_ = 0, height_ = 0;
+  double centre_u_ = 0.0, centre_v_ = 0.0;
+  std::vector<std::uint8_t> samples_;
+  std::vector<BorderPoint> border_points_;
+  std::vector<FramePoint> frame_points_;
+  std::vector<Point2d> border_outline_;  ///< current border's outline, centred coordinates
+  std::vector<DetectedLine> candidates_;
+  std::vector<DetectedLine> lines_;
+};
+
+}  // namespace oal

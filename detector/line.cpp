@@ -1,0 +1,71 @@
+#include "detector/line.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace oal {
+
+LineParams Normalized(double rho_px, double theta_rad) {
+  double theta = std::fmod(theta_rad, 2.0 * kPi);
+  if (theta < 0.0) theta += 2.0 * kPi;
+  double rho = rho_px;
+  if (theta >= kPi) {
+    theta -= kPi;
+    rho = -rho;
+  }
+  if (theta >= kPi) theta = 0.0;  // guards theta == pi after rounding
+  return LineParams{rho, theta};
+}
+
+LineParams LineThrough(const Point2d& a, const Point2d& b) {
+  const double du = b.u - a.u;
+  const double dv = b.v - a.v;
+  // The normal of direction (du, dv) is (-dv, du).
+  const double theta = std::atan2(du, -dv);
+  const double rho = a.u * std::cos(theta) + a.v * std::sin(theta);
+  return Normalized(rho, theta);
+}
+
+double AngleBetween(const LineParams& a, const LineParams& b) {
+  double d = std::fabs(a.theta_rad - b.theta_rad);
+  d = std::fmod(d, kPi);
+  return std::min(d, kPi - d);
+}
+
+double RhoAlignedTo(const LineParams& a, const LineParams& b) {
+  return std::fabs(a.theta_rad - b.theta_rad) > kPi / 2.0 ? -b.rho_px : b.rho_px;
+}
+
+bool Intersect(const LineParams& a, const LineParams& b, Point2d* out, double eps_rad) {
+  const double ca = std::cos(a.theta_rad), sa = std::sin(a.theta_rad);
+  const double cb = std::cos(b.theta_rad), sb = std::sin(b.theta_rad);
+  const double det = ca * sb - sa * cb;  // sin(theta_b - theta_a)
+  if (std::fabs(det) < std::sin(eps_rad)) return false;
+  out->u = (a.rho_px * sb - b.rho_px * sa) / det;
+  out->v = (ca * b.rho_px - cb * a.rho_px) / det;
+  return true;
+}
+
+bool ClipToRect(const LineParams& line, double u0, double v0, double u1, double v1, Point2d* a,
+                Point2d* b) {
+  // Parametrise the line as foot + t * dir and clip t against the four slabs.
+  const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
+  const Point2d foot{line.rho_px * c, line.rho_px * s};
+  const Point2d dir{-s, c};
+  double t_min = -std::numeric_limits<double>::infinity();
+  double t_max = std::numeric_limits<double>::infinity();
+  auto clip = [&](double p, double d, double lo, double hi) {
+    if (std::fabs(d) < 1e-12) return p >= lo && p <= hi;
+    double t0 = (lo - p) / d, t1 = (hi - p) / d;
+    if (t0 > t1) std::swap(t0, t1);
+    t_min = std::max(t_min, t0);
+    t_max = std::min(t_max, t1);
+    return t_min <= t_max;
+  };
+  if (!clip(foot.u, dir.u, u0, u1) || !clip(foot.v, dir.v, v0, v1)) return false;
+  *a = Point2d{foot.u + t_min * dir.u, foot.v + t_min * dir.v};
+  *b = Point2d{foot.u + t_max * dir.u, foot.v + t_max * dir.v};
+  return true;
+}
+
+}  // namespace oal

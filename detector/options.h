@@ -1,0 +1,95 @@
+// Parameters of the OAL detector, with the paper's values as defaults where it gives them.
+#pragma once
+
+#include <string>
+
+namespace oal {
+
+/// What a feature point on a border is.
+enum class Polarity {
+  kDarkLines,   ///< middle of a dark run on a light background (the paper's case)
+  kLightLines,  ///< middle of a light run on a dark background
+  kEdges,       ///< a light/dark transition (e.g. ViSP's real `line/` sequence)
+};
+
+enum class ThresholdMode {
+  kFixed,  ///< `fixed_threshold` on every border
+  kOtsu,   ///< Otsu's threshold on each border's own pixels
+};
+
+/// The one place where enums meet strings ("dark", "light", "edges"; "fixed", "otsu").
+std::string ToString(Polarity polarity);
+std::string ToString(ThresholdMode mode);
+/// Throw std::invalid_argument naming the accepted values.
+Polarity PolarityFromString(const std::string& text);
+ThresholdMode ThresholdModeFromString(const std::string& text);
+
+struct DetectorOptions {
+  // --- Step 1: concentric border scans -------------------------------------------------
+  /// Distance of the first border from the image edge, pixels. Paper: 10. Range [0, 1000].
+  int start_px = 10;
+  /// Distance between successive borders, pixels. Paper: 5. Range [1, 1000].
+  int step_px = 5;
+  Polarity polarity = Polarity::kDarkLines;
+  ThresholdMode threshold_mode = ThresholdMode::kOtsu;
+  /// Grey level separating line from background with kFixed. Range [1, 255].
+  int fixed_threshold = 128;
+  /// With kOtsu, a border whose two classes differ by fewer grey levels holds no line.
+  /// Range [0, 255].
+  int min_contrast = 40;
+  /// Runs narrower than this (along the border) are noise or dead pixels, pixels. Range (0, 1000].
+  double min_width_px = 2.0;
+  /// Widest line, measured across the line, pixels. Range [min_width_px, 1000].
+  double max_width_px = 40.0;
+  /// A line crossing a border at angle a gives a run of width / sin(a): runs up to
+  /// max_width_px / sin(min_crossing_angle_deg) are kept (NOTES 2). 90 keeps the paper's
+  /// fixed maximum. Range [1, 90].
+  double min_crossing_angle_deg = 15.0;
+  /// Runs beyond this many on one border are ignored (a textured border). Range [2, 64].
+  int max_points_per_border = 24;
+
+  // --- Step 2: pairwise correlation ------------------------------------------------------
+  /// Two points on the same side of a border rectangle span that side, never a line that
+  /// crosses the rectangle: such pairs are skipped. false correlates every pair (paper).
+  bool skip_same_side_pairs = true;
+
+  // --- Step 3: matching against the ordered accumulator list (Eq. 1, 2) -----------------
+  /// anglechange of Eq. 1, degrees. Range (0, 45].
+  double angle_change_deg = 2.0;
+  /// rchange of Eq. 2, pixels; rho measured from the image centre. Range (0, 1000].
+  double r_change_px = 4.0;
+
+  // --- Step 5: culling -------------------------------------------------------------------
+  /// Entries with weight - count/2 < 0 are culled only while the list is longer. Paper: 20.
+  /// Range [1, 1000].
+  int max_lines = 20;
+
+  // --- Remedies for the weak points in shared/paper/NOTES.md (false = the paper) --------
+  /// Increment `count` only on borders the line crosses (NOTES 1).
+  bool count_visible_borders_only = true;
+  /// Refit each read-off line to the feature points of all borders by least squares (NOTES 3).
+  bool refit_lines = true;
+  /// Rank read-off lines by the number of feature points on them, not by votes (NOTES 4).
+  bool rank_by_support = true;
+  /// A feature point within this distance of a line supports it, pixels. Range (0, 100].
+  double support_tolerance_px = 1.5;
+
+  // --- Step 6: read-off ------------------------------------------------------------------
+  /// At most this many lines are returned. Range [1, 1000].
+  int max_output_lines = 10;
+  /// Lines with fewer votes are not returned. Range [1, 100000].
+  int min_votes = 3;
+  /// With rank_by_support, lines with fewer supporting points are not returned. Range [2, 100000].
+  int min_support = 6;
+  /// Two read-off lines closer than both of these are one line; the better one is kept.
+  double duplicate_angle_deg = 3.0;  ///< Range (0, 90].
+  double duplicate_r_px = 8.0;       ///< Range (0, 1000].
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+
+  /// The algorithm exactly as written in the paper: every remedy switched off.
+  static DetectorOptions Paper();
+};
+
+}  // namespace oal

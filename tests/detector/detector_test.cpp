@@ -1,0 +1,207 @@
+#include "detector/detector.h"
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "scene/scene.h"
+#include "test_images.h"
+
+// Counts heap allocations so a test can check that steady-state detection allocates nothing.
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace oal {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / kPi;
+
+struct LineError {
+  double angle_deg = 1e9;
+  double offset_px = 1e9;  ///< largest distance of the truth chord's ends from the line
+};
+
+LineError ErrorOf(const LineParams& detected, const LineParams& truth, const Point2d& a,
+                  const Point2d& b) {
+  LineError error;
+  error.angle_deg = AngleBetween(detected, truth) * kRadToDeg;
+  error.offset_px = std::max(std::fabs(detected.SignedDistance(a.u, a.v)),
+                             std::fabs(detected.SignedDistance(b.u, b.v)));
+  return error;
+}
+
+TEST(OalDetector, EmptyViewThrows) {
+  OalDetector detector;
+  EXPECT_THROW(detector.Detect(GrayImageView{}), std::invalid_argument);
+}
+
+TEST(OalDetector, InvalidOptionsThrowNamingTheField) {
+  DetectorOptions options;
+  options.step_px = 0;
+  try {
+    OalDetector detector(options);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("step_px = 0"), std::string::npos) << error.what();
+  }
+}
+
+TEST(OalDetector, ImageSmallerThanFirstBorderGivesNoLine) {
+  testing::TestImage image(15, 15, 200);
+  OalDetector detector;
+  EXPECT_TRUE(detector.Detect(image.View()).empty());
+}
+
+TEST(OalDetector, UniformAndNoiseOnlyImagesGiveNoLine) {
+  OalDetector detector;
+  testing::TestImage flat(320, 240, 128);
+  EXPECT_TRUE(detector.Detect(flat.View()).empty());
+  testing::TestImage noisy(320, 240, 128);
+  testing::AddNoise(&noisy, 8.0, 7);
+  EXPECT_TRUE(detector.Detect(noisy.View()).empty());
+}
+
+TEST(OalDetector, FindsTwoStripesWithSubPixelAccuracyAndWidth) {
+  testing::TestImage image(320, 240, 210);
+  const LineParams first{100.0, 0.2}, second = Normalized(-60.0, 2.5);
+  testing::PaintStripe(&image, first, 8.0, 30);
+  testing::PaintStripe(&image, second, 5.0, 30);
+  testing::AddNoise(&image, 4.0, 3);
+
+  OalDetector detector;
+  const auto& lines = detector.Detect(image.View());
+  ASSERT_GE(lines.size(), 2u);
+  for (const auto& [truth, width] : {std::pair{first, 8.0}, std::pair{second, 5.0}}) {
+    const auto found = std::find_if(lines.begin(), lines.begin() + 2, [&](const DetectedLine& l) {
+      return AngleBetween(l.line, truth) < 0.5 / kRadToDeg;
+    });
+    ASSERT_NE(found, lines.begin() + 2) << "no line near theta " << truth.theta_rad;
+    Point2d a, b;
+    ASSERT_TRUE(ClipToRect(truth, 0, 0, 319, 239, &a, &b));
+    const LineError error = ErrorOf(found->line, truth, a, b);
+    EXPECT_LT(error.angle_deg, 0.2);
+    EXPECT_LT(error.offset_px, 0.5);
+    EXPECT_NEAR(found->width_px, width, 1.0);
+    EXPECT_GT(found->support, 20);
+    EXPECT_NEAR(found->end_a.u, a.u, 2.0);
+  }
+}
+
+TEST(OalDetector, PaperModeFindsCleanStripes) {
+  testing::TestImage image(320, 240, 210);
+  const LineParams first{120.0, 0.1}, second{200.0, 0.1};
+  testing::PaintStripe(&image, first, 6.0, 30);
+  testing::PaintStripe(&image, second, 6.0, 30);
+  OalDetector detector(DetectorOptions::Paper());
+  const auto& lines = detector.Detect(image.View());
+  ASSERT_GE(lines.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    const LineParams& truth = std::fabs(lines[i].line.rho_px - 120.0) < 10.0 ? first : second;
+    EXPECT_LT(AngleBetween(lines[i].line, truth) * kRadToDeg, 1.0);
+    EXPECT_NEAR(lines[i].line.rho_px, truth.rho_px, 2.0);
+  }
+}
+
+TEST(OalDetector, LightLinesOnDark) {
+  testing::TestImage image(320, 240, 40);
+  const LineParams truth{150.0, 1.2};
+  testing::PaintStripe(&image, truth, 6.0, 220);
+  DetectorOptions options;
+  options.polarity = Polarity::kLightLines;
+  OalDetector detector(options);
+  const auto& lines = detector.Detect(image.View());
+  ASSERT_FALSE(lines.empty());
+  EXPECT_LT(AngleBetween(lines[0].line, truth) * kRadToDeg, 0.3);
+  EXPECT_NEAR(lines[0].line.rho_px, truth.rho_px, 0.5);
+}
+
+TEST(OalDetector, SteadyStateAllocatesNothing) {
+  testing::TestImage image(320, 240, 210);
+  testing::PaintStripe(&image, LineParams{100.0, 0.3}, 6.0, 30);
+  testing::PaintStripe(&image, LineParams{50.0, 1.4}, 6.0, 30);
+  testing::AddNoise(&image, 6.0, 11);
+  OalDetector detector;
+  detector.Detect(image.View());  // first frame of this size sizes the working memory
+  const long before = g_allocations.load();
+  for (int i = 0; i < 5; ++i) detector.Detect(image.View());
+  EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// Rendered frames of the shipped targets at random poses, with and without lens distortion:
+// every target line must be among the first N lines, within 0.5 deg and 1 px.
+struct RenderedCase {
+  const char* target;
+  double kdu;
+  bool correct_distortion;
+};
+
+class RenderedFrames : public ::testing::TestWithParam<RenderedCase> {};
+
+TEST_P(RenderedFrames, EveryTargetLineWithinHalfDegreeAndOnePixel) {
+  const RenderedCase& param = GetParam();
+  RenderOptions render;
+  render.camera.initPersProjWithDistortion(600.0, 600.0, 319.5, 239.5, 0.0, param.kdu);
+  render.camera.set_kud(0.0);
+  render.noise_sigma = 4.0;
+  render.blur_sigma_px = 0.8;
+  const SceneRenderer renderer(TargetByName(param.target), render);
+  PoseSampling sampling;
+  sampling.max_tilt_deg = 25.0;
+  sampling.min_visible_length_px = 250.0;
+  std::uint64_t state = 20261123;
+
+  OalDetector detector = param.correct_distortion
+                             ? OalDetector(DetectorOptions(), render.camera)
+                             : OalDetector(DetectorOptions());
+  const int frames = 12;
+  for (int frame = 0; frame < frames; ++frame) {
+    const RenderedFrame rendered = renderer.Render(SamplePose(renderer, sampling, &state), frame);
+    const auto& lines = detector.Detect(rendered.image);
+    const std::size_t n = rendered.truth.size();
+    ASSERT_GE(lines.size(), n) << "frame " << frame;
+    for (const TruthLine& truth : rendered.truth) {
+      const LineParams& reference = param.correct_distortion ? truth.ideal : truth.distorted_fit;
+      // With correction the chord ends are compared in undistorted coordinates.
+      Point2d a = truth.end_a, b = truth.end_b;
+      if (param.correct_distortion) {
+        const PointUndistorter undistorter(render.camera);
+        a = undistorter.Undistort(a);
+        b = undistorter.Undistort(b);
+      }
+      LineError best;
+      for (std::size_t i = 0; i < n; ++i) {
+        const LineError error = ErrorOf(lines[i].line, reference, a, b);
+        if (error.angle_deg + error.offset_px < best.angle_deg + best.offset_px) best = error;
+      }
+      EXPECT_LT(best.angle_deg, 0.5) << "frame " << frame << " line " << truth.index;
+      EXPECT_LT(best.offset_px, 1.0) << "frame " << frame << " line " << truth.index;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Targets, RenderedFrames,
+    ::testing::Values(RenderedCase{"two-line", 0.0, false}, RenderedCase{"four-line", 0.0, false},
+                      RenderedCase{"two-line", 0.33, true}, RenderedCase{"four-line", 0.33, true}),
+    [](const ::testing::TestParamInfo<RenderedCase>& info) {
+      std::string name = std::string(info.param.target) +
+                         (info.param.correct_distortion ? "_distorted_corrected" : "_pinhole");
+      for (char& c : name)
+        if (c == '-') c = '_';
+      return name;
+    });
+
+}  // namespace
+}  // namespace oal

@@ -1,0 +1,71 @@
+#include "detector/line.h"
+
+#include <gtest/gtest.h>
+
+namespace oal {
+namespace {
+
+constexpr double kTol = 1e-9;
+
+TEST(Line, VerticalLineHasThetaZero) {
+  const LineParams line = LineThrough({10.0, 0.0}, {10.0, 50.0});
+  EXPECT_NEAR(line.theta_rad, 0.0, kTol);
+  EXPECT_NEAR(line.rho_px, 10.0, kTol);
+}
+
+TEST(Line, HorizontalLineHasThetaHalfPi) {
+  const LineParams line = LineThrough({0.0, 7.0}, {30.0, 7.0});
+  EXPECT_NEAR(line.theta_rad, kPi / 2.0, kTol);
+  EXPECT_NEAR(line.rho_px, 7.0, kTol);
+}
+
+TEST(Line, PointOrderDoesNotMatter) {
+  const LineParams ab = LineThrough({3.0, 4.0}, {20.0, -9.0});
+  const LineParams ba = LineThrough({20.0, -9.0}, {3.0, 4.0});
+  EXPECT_NEAR(ab.theta_rad, ba.theta_rad, kTol);
+  EXPECT_NEAR(ab.rho_px, ba.rho_px, kTol);
+}
+
+TEST(Line, ThetaStaysInHalfOpenRangeWithNegativeRho) {
+  // A line through the origin's left side at a small angle past vertical: theta near pi.
+  const LineParams line = LineThrough({-5.0, 0.0}, {-5.0 + 0.01, 100.0});
+  EXPECT_GE(line.theta_rad, 0.0);
+  EXPECT_LT(line.theta_rad, kPi);
+  EXPECT_NEAR(line.SignedDistance(-5.0, 0.0), 0.0, kTol);
+  EXPECT_NEAR(line.SignedDistance(-4.99, 100.0), 0.0, kTol);
+}
+
+TEST(Line, NormalizedFlipsRhoWhenMovingByPi) {
+  const LineParams line = Normalized(4.0, kPi + 0.25);
+  EXPECT_NEAR(line.theta_rad, 0.25, kTol);
+  EXPECT_NEAR(line.rho_px, -4.0, kTol);
+  const LineParams negative = Normalized(4.0, -0.25);
+  EXPECT_NEAR(negative.theta_rad, kPi - 0.25, kTol);
+  EXPECT_NEAR(negative.rho_px, -4.0, kTol);
+}
+
+TEST(Line, AngleAndRhoAcrossTheWrap) {
+  const LineParams a{10.0, 0.01};
+  const LineParams b{-10.0, kPi - 0.01};  // the same line family seen across theta = 0/pi
+  EXPECT_NEAR(AngleBetween(a, b), 0.02, kTol);
+  EXPECT_NEAR(RhoAlignedTo(a, b), 10.0, kTol);
+}
+
+TEST(Line, IntersectAndParallel) {
+  Point2d x;
+  ASSERT_TRUE(Intersect({3.0, 0.0}, {5.0, kPi / 2.0}, &x));
+  EXPECT_NEAR(x.u, 3.0, kTol);
+  EXPECT_NEAR(x.v, 5.0, kTol);
+  EXPECT_FALSE(Intersect({3.0, 0.2}, {5.0, 0.2}, &x));
+}
+
+TEST(Line, ClipToRectGivesBorderPoints) {
+  Point2d a, b;
+  ASSERT_TRUE(ClipToRect(LineThrough({0.0, 0.0}, {10.0, 10.0}), 0, 0, 99, 49, &a, &b));
+  EXPECT_NEAR(std::min(a.u, b.u), 0.0, 1e-9);
+  EXPECT_NEAR(std::max(a.v, b.v), 49.0, 1e-9);
+  EXPECT_FALSE(ClipToRect(LineParams{500.0, 0.0}, 0, 0, 99, 49, &a, &b));
+}
+
+}  // namespace
+}  // namespace oal
