@@ -61,7 +61,8 @@ int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, doubl
     const float dot = match_cos_[i] * c + match_sin_[i] * s;
     if (std::fabs(dot) < cos_limit) continue;  // Eq. 1
     // A negative dot is the same line with its normal reversed: theta +- pi, -rho.
-    if (std::fabs(std::copysign(rho, dot) - match_rho_[i]) > r_limit) continue;  // Eq. 2
+    const float aligned_rho = dot < 0.0f ? -rho : rho;
+    if (std::fabs(aligned_rho - match_rho_[i]) > r_limit) continue;  // Eq. 2
     return i;
   }
   return -1;

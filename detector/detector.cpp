@@ -196,12 +196,19 @@ void OalDetector::ReadOff(int width, int height) {
     line.width_px = stats.width_px;
     candidates_.push_back(line);
   }
+  // Best first; an insertion sort because it is stable and, unlike std::stable_sort,
+  // allocates nothing.
   const bool by_support = options_.rank_by_support;
-  std::stable_sort(candidates_.begin(), candidates_.end(),
-                   [by_support](const DetectedLine& a, const DetectedLine& b) {
-                     if (by_support && a.support != b.support) return a.support > b.support;
-                     return a.votes > b.votes;
-                   });
+  auto better = [by_support](const DetectedLine& a, const DetectedLine& b) {
+    if (by_support && a.support != b.support) return a.support > b.support;
+    return a.votes > b.votes;
+  };
+  for (std::size_t i = 1; i < candidates_.size(); ++i) {
+    const DetectedLine moving = candidates_[i];
+    std::size_t j = i;
+    for (; j > 0 && better(moving, candidates_[j - 1]); --j) candidates_[j] = candidates_[j - 1];
+    candidates_[j] = moving;
+  }
 
   const double duplicate_angle = options_.duplicate_angle_deg * kDegToRad;
   for (const DetectedLine& candidate : candidates_) {

@@ -153,7 +153,6 @@ TEST_P(RenderedFrames, EveryTargetLineWithinHalfDegreeAndOnePixel) {
   const RenderedCase& param = GetParam();
   RenderOptions render;
   render.camera.initPersProjWithDistortion(600.0, 600.0, 319.5, 239.5, 0.0, param.kdu);
-  render.camera.set_kud(0.0);
   render.noise_sigma = 4.0;
   render.blur_sigma_px = 0.8;
   const SceneRenderer renderer(TargetByName(param.target), render);
@@ -195,9 +194,9 @@ INSTANTIATE_TEST_SUITE_P(
     Targets, RenderedFrames,
     ::testing::Values(RenderedCase{"two-line", 0.0, false}, RenderedCase{"four-line", 0.0, false},
                       RenderedCase{"two-line", 0.33, true}, RenderedCase{"four-line", 0.33, true}),
-    [](const ::testing::TestParamInfo<RenderedCase>& info) {
-      std::string name = std::string(info.param.target) +
-                         (info.param.correct_distortion ? "_distorted_corrected" : "_pinhole");
+    [](const ::testing::TestParamInfo<RenderedCase>& test) {
+      std::string name = std::string(test.param.target) +
+                         (test.param.correct_distortion ? "_distorted_corrected" : "_pinhole");
       for (char& c : name)
         if (c == '-') c = '_';
       return name;

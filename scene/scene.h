@@ -1,0 +1,153 @@
+// Synthetic scenes for testing and simulation: planar line targets seen by a pinhole camera
+// with ViSP's lens model, rendered with ground truth.
+//
+// Frames: the target (object) frame o has the board in its z = 0 plane, centred on the
+// origin; the camera frame c has z along the optical axis, x to the right, y down (ViSP).
+// cMo maps object coordinates to camera coordinates.
+//
+// Lens: the image is formed with ViSP's `kdu` model, i.e. a distorted pixel (u, v) sees the
+// ray x = (u - u0)(1 + kdu r^2)/px, y = (v - v0)(1 + kdu r^2)/py with r^2 from the distorted
+// pixel (vpPixelMeterConversion). A camera calibrated with that kdu undistorts the frames
+// exactly; kud is only written for ViSP's metre -> pixel direction. A cheap wide lens is
+// kdu ≈ +0.33 at 640x480, px = 600 (barrel, k1 ≈ -0.25 in the undistorted -> distorted sense).
+//
+// Rendering: each pixel integrates the scene over its square (box filter). A pixel crossed by
+// one edge, or by the two sides of one stripe, gets its exact coverage from the local affine
+// map pixel -> board plane; a pixel where edges meet (corners, crossings, stripe ends) is split
+// into supersample x supersample sub-squares treated the same way. The board is printed on both
+// sides; the camera sees its front when the object z axis points away from the camera.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+#include <visp3/core/vpImage.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "detector/line.h"
+
+namespace oal {
+
+/// A straight stripe on the target plane, metres in the object frame.
+struct TargetLine {
+  double x1_m = 0.0, y1_m = 0.0;  ///< one end of the centre line
+  double x2_m = 0.0, y2_m = 0.0;  ///< the other end
+  double width_m = 0.01;          ///< printed width, > 0
+};
+
+/// A light board with dark stripes, centred on the object origin.
+struct LineTarget {
+  std::string name;
+  double board_width_m = 2.0;     ///< along x, > 0
+  double board_height_m = 2.0;    ///< along y, > 0
+  int board_grey = 215;           ///< [0, 255]
+  int line_grey = 35;             ///< [0, 255]
+  std::vector<TargetLine> lines;  ///< may be empty (a blank board)
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+/// Two parallel stripes (the paper's line-detection target).
+LineTarget TwoLineTarget();
+/// Four stripes in a '#' whose asymmetric spacing and widths make lines 1-4 identifiable
+/// (the paper's pose target, Figure 2). Line 1 is the widest.
+LineTarget FourLineTarget();
+/// "two-line" or "four-line"; throws std::invalid_argument otherwise.
+LineTarget TargetByName(const std::string& name);
+
+struct RenderOptions {
+  int width = 640;                                        ///< pixels, [16, 8192]
+  int height = 480;                                       ///< pixels, [16, 8192]
+  vpCameraParameters camera{600.0, 600.0, 319.5, 239.5};  ///< with or without distortion
+  double noise_sigma = 0.0;                               ///< Gaussian noise, grey levels, [0, 100]
+  double blur_sigma_px = 0.0;                             ///< Gaussian blur, pixels, [0, 20]
+  /// Illumination falls linearly by this fraction across the image along gradient_angle_rad.
+  double illumination_gradient = 0.0;  ///< [0, 0.9]
+  double gradient_angle_rad = 0.0;
+  /// Grey image shown around the board (any size, tiled); empty: uniform background_grey.
+  /// It is pasted on the board plane around the board (one texel = 2 mm, tiles repeat from the
+  /// object origin), so it moves with the board; rays that miss the plane see background_grey.
+  std::string background_image;
+  int background_grey = 90;  ///< [0, 255]
+  int supersample = 4;       ///< anti-aliasing factor per axis where edges meet, [1, 8]
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+/// Ground truth of one target line in one frame (pixel conventions of detector/line.h).
+struct TruthLine {
+  int index = 0;             ///< 0-based index in LineTarget::lines
+  bool visible = false;      ///< some of its centre line is inside the image
+  LineParams ideal;          ///< projection of the centre line, undistorted pixels (always set
+                             ///< unless the line passes through the centre of projection)
+  LineParams distorted_fit;  ///< total-least-squares line through its distorted image, pixels
+  Point2d end_a, end_b;      ///< ends of its visible part in the distorted image
+  double visible_length_px = 0.0;  ///< |end_b - end_a|, pixels
+  double width_px = 0.0;  ///< apparent width in the middle of the visible part, ideal pixels
+};
+
+struct RenderedFrame {
+  vpImage<unsigned char> image;
+  vpHomogeneousMatrix cMo;
+  std::vector<TruthLine> truth;
+};
+
+class SceneRenderer {
+ public:
+  /// Throws std::invalid_argument if the target or the options fail Check(), or the
+  /// background image cannot be read.
+  SceneRenderer(LineTarget target, RenderOptions options);
+
+  /// Renders the target seen from `cMo`; `noise_seed` makes the noise reproducible.
+  RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed) const;
+  /// Ground truth only (no image), e.g. for a pose that is not rendered.
+  std::vector<TruthLine> Truth(const vpHomogeneousMatrix& cMo) const;
+
+  const LineTarget& target() const { return target_; }
+  const RenderOptions& options() const { return options_; }
+
+ private:
+  LineTarget target_;
+  RenderOptions options_;
+  // Per-pixel ideal normalised coordinates of the distorted image (computed once).
+  std::vector<float> ray_x_, ray_y_;
+  vpImage<unsigned char> background_;
+};
+
+/// Distorted pixel of an ideal normalised point (x, y) under the kdu model (numerical
+/// inverse of vpPixelMeterConversion); exact to 1e-9 px. With kdu < 0 the model cannot reach
+/// points beyond a radius; they come back as NaN.
+Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y);
+
+/// The kud that best inverts `kdu` over a width x height image (least squares), so a
+/// camera file written with both is consistent in ViSP's two directions.
+double FitKud(const vpCameraParameters& camera, int width, int height);
+
+/// Random camera poses looking at the target for data sets and tests.
+/// The optical axis meets the board at a point drawn uniformly in a disc of radius
+/// max_offset_m; the camera centre lies on the front side (object z < 0) at a distance drawn
+/// uniformly in [min_distance_m, max_distance_m] from that point, measured along the axis.
+struct PoseSampling {
+  double min_distance_m = 0.4, max_distance_m = 0.9;  ///< 0 < min <= max
+  double max_tilt_deg = 30.0;  ///< angle between optical axis and board normal, [0, 80]
+  double max_offset_m = 0.05;  ///< where the optical axis meets the board, from its centre, >= 0
+  bool any_roll = true;        ///< roll uniform in [0, 360) deg; else within +-max_tilt_deg
+  /// Every target line must cross the image over at least this length (0: no check).
+  double min_visible_length_px = 0.0;
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+/// A pose drawn from `sampling` with the pseudo-random generator state `*state`
+/// (deterministic: the same state gives the same pose, and *state is advanced so that calls in
+/// a row give a reproducible sequence). Retries until the visibility requirement holds (at
+/// most 1000 draws, then throws std::runtime_error).
+vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling& sampling,
+                               std::uint64_t* state);
+
+}  // namespace oal

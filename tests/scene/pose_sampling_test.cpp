@@ -1,0 +1,148 @@
+// SamplePose: reproducible, within its bounds, facing the front of the board.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "scene/scene.h"
+#include "tests/scene/scene_test_util.h"
+
+namespace oal {
+namespace {
+
+using testing::Project;
+
+constexpr double kDeg = kPi / 180.0;
+
+// The camera centre and optical axis in the object frame.
+struct CameraInObject {
+  double centre[3];
+  double axis[3];
+};
+
+CameraInObject Locate(const vpHomogeneousMatrix& cMo) {
+  const vpHomogeneousMatrix oMc = cMo.inverse();
+  return {{oMc[0][3], oMc[1][3], oMc[2][3]}, {oMc[0][2], oMc[1][2], oMc[2][2]}};
+}
+
+bool SamePose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      if (a[r][c] != b[r][c]) return false;
+    }
+  }
+  return true;
+}
+
+TEST(SamplePose, SameStateGivesTheSameSequence) {
+  const SceneRenderer renderer(FourLineTarget(), RenderOptions());
+  PoseSampling sampling;
+  sampling.min_visible_length_px = 150.0;
+  std::uint64_t a = 12345, b = 12345;
+  for (int i = 0; i < 5; ++i) {
+    const vpHomogeneousMatrix pa = SamplePose(renderer, sampling, &a);
+    const vpHomogeneousMatrix pb = SamplePose(renderer, sampling, &b);
+    EXPECT_TRUE(SamePose(pa, pb)) << i;
+    EXPECT_EQ(a, b);
+  }
+  std::uint64_t c = 12345;
+  const vpHomogeneousMatrix first = SamplePose(renderer, sampling, &c);
+  EXPECT_NE(c, 12345u);
+  EXPECT_FALSE(SamePose(first, SamplePose(renderer, sampling, &c)));
+  std::uint64_t d = 12346;
+  EXPECT_FALSE(SamePose(first, SamplePose(renderer, sampling, &d)));
+}
+
+TEST(SamplePose, RespectsDistanceTiltOffsetAndRollBounds) {
+  const SceneRenderer renderer(TwoLineTarget(), RenderOptions());
+  PoseSampling sampling;
+  sampling.min_distance_m = 0.5;
+  sampling.max_distance_m = 0.8;
+  sampling.max_tilt_deg = 20.0;
+  sampling.max_offset_m = 0.04;
+  sampling.any_roll = false;
+  std::uint64_t state = 7;
+  double max_tilt = 0.0, max_roll = 0.0, min_distance = 1e9, max_distance = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
+    ASSERT_TRUE(cMo.isAnHomogeneousMatrix());
+    const CameraInObject cam = Locate(cMo);
+    // In front of the board (object z < 0), looking towards +z.
+    ASSERT_LT(cam.centre[2], 0.0);
+    ASSERT_GT(cam.axis[2], 0.0);
+    const double t = -cam.centre[2] / cam.axis[2];
+    const double hit_x = cam.centre[0] + t * cam.axis[0], hit_y = cam.centre[1] + t * cam.axis[1];
+    EXPECT_LE(std::hypot(hit_x, hit_y), sampling.max_offset_m + 1e-12);
+    min_distance = std::min(min_distance, t);
+    max_distance = std::max(max_distance, t);
+    max_tilt = std::max(max_tilt, std::acos(cam.axis[2]));
+    // Roll: the camera x axis against object x made orthogonal to the optical axis.
+    const double* z = cam.axis;
+    double x0[3] = {1.0 - z[0] * z[0], -z[0] * z[1], -z[0] * z[2]};
+    const double norm = std::sqrt(x0[0] * x0[0] + x0[1] * x0[1] + x0[2] * x0[2]);
+    const double cos_roll = (cMo[0][0] * x0[0] + cMo[0][1] * x0[1] + cMo[0][2] * x0[2]) / norm;
+    max_roll = std::max(max_roll, std::acos(std::min(1.0, cos_roll)));
+  }
+  EXPECT_GE(min_distance, sampling.min_distance_m - 1e-12);
+  EXPECT_LE(max_distance, sampling.max_distance_m + 1e-12);
+  EXPECT_LT(min_distance, 0.53);  // the whole range is used
+  EXPECT_GT(max_distance, 0.77);
+  EXPECT_LE(max_tilt, sampling.max_tilt_deg * kDeg + 1e-9);
+  EXPECT_GT(max_tilt, 0.8 * sampling.max_tilt_deg * kDeg);
+  EXPECT_LE(max_roll, sampling.max_tilt_deg * kDeg + 1e-9);
+  EXPECT_GT(max_roll, 0.8 * sampling.max_tilt_deg * kDeg);
+}
+
+TEST(SamplePose, EveryLineIsLongEnough) {
+  const SceneRenderer renderer(FourLineTarget(), RenderOptions());
+  PoseSampling sampling;
+  sampling.max_tilt_deg = 40.0;
+  sampling.min_visible_length_px = 300.0;
+  std::uint64_t state = 3;
+  for (int i = 0; i < 40; ++i) {
+    for (const TruthLine& line : renderer.Truth(SamplePose(renderer, sampling, &state))) {
+      EXPECT_TRUE(line.visible);
+      EXPECT_GE(line.visible_length_px, 300.0);
+    }
+  }
+  sampling.min_visible_length_px = 5000.0;  // longer than the image diagonal
+  EXPECT_THROW(SamplePose(renderer, sampling, &state), std::runtime_error);
+}
+
+// The camera sees the printed side, unmirrored: the stripes are dark on the light board, and
+// the object x and y axes appear in the image with the same handedness as u and v.
+TEST(SamplePose, CameraSeesTheFrontOfTheBoard) {
+  const LineTarget target = FourLineTarget();
+  RenderOptions options;
+  const SceneRenderer renderer(target, options);
+  PoseSampling sampling;
+  sampling.min_visible_length_px = 200.0;
+  std::uint64_t state = 11;
+  for (int i = 0; i < 6; ++i) {
+    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
+    const RenderedFrame frame = renderer.Render(cMo, 1);
+    Point2d origin, x_end, y_end;
+    ASSERT_TRUE(Project(cMo, options.camera, 0.0, 0.0, &origin));
+    ASSERT_TRUE(Project(cMo, options.camera, 0.01, 0.0, &x_end));
+    ASSERT_TRUE(Project(cMo, options.camera, 0.0, 0.01, &y_end));
+    const double handedness =
+        (x_end.u - origin.u) * (y_end.v - origin.v) - (x_end.v - origin.v) * (y_end.u - origin.u);
+    EXPECT_GT(handedness, 0.0);
+    // Middle of each stripe's visible part: dark.
+    for (const TruthLine& line : frame.truth) {
+      const int u = static_cast<int>(std::lround(0.5 * (line.end_a.u + line.end_b.u)));
+      const int v = static_cast<int>(std::lround(0.5 * (line.end_a.v + line.end_b.v)));
+      EXPECT_LT(frame.image[v][u], 60) << "pose " << i << " line " << line.index;
+    }
+    // A board point inside the '#', away from every stripe: light.
+    Point2d bare;
+    ASSERT_TRUE(Project(cMo, options.camera, 0.01, -0.005, &bare));
+    ASSERT_TRUE(bare.u >= 0 && bare.u < 640 && bare.v >= 0 && bare.v < 480);
+    EXPECT_EQ(
+        frame.image[static_cast<int>(std::lround(bare.v))][static_cast<int>(std::lround(bare.u))],
+        target.board_grey);
+  }
+}
+
+}  // namespace
+}  // namespace oal

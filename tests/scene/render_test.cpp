@@ -1,0 +1,284 @@
+// Rendering: anti-aliased stripes where the truth says, noise, blur, illumination, background.
+#include <gtest/gtest.h>
+#include <visp3/core/vpPixelMeterConversion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "scene/scene.h"
+#include "tests/scene/scene_test_util.h"
+
+namespace oal {
+namespace {
+
+using testing::Darkness;
+using testing::FrontoParallel;
+using testing::ReferenceGrey;
+using testing::SameImage;
+
+// Coverage is read back from 8-bit grey levels with 180 levels of contrast.
+constexpr double kEdgeTolerancePx = 0.02;
+constexpr double kCentreTolerancePx = 0.05;
+
+// Sub-pixel edges of the dark run of row v between columns [u_begin, u_end) of a stripe whose
+// edges are not parallel to the row: a = left edge, b = right edge. The coverage of a partly
+// dark pixel gives the edge position inside it.
+void VerticalStripeEdges(const RenderedFrame& frame, const LineTarget& target, int v, int u_begin,
+                         int u_end, double* a, double* b) {
+  int first = -1, last = -1;
+  for (int u = u_begin; u < u_end; ++u) {
+    if (Darkness(frame.image, target, u, v) <= 0.0) continue;
+    if (first < 0) first = u;
+    last = u;
+  }
+  ASSERT_GE(first, 0);
+  *a = first + 0.5 - Darkness(frame.image, target, first, v);
+  *b = last - 0.5 + Darkness(frame.image, target, last, v);
+}
+
+// Darkness-weighted mean column of row v over [u_begin, u_end).
+double RowCentroid(const RenderedFrame& frame, const LineTarget& target, int v, int u_begin,
+                   int u_end) {
+  double sum = 0.0, weighted = 0.0;
+  for (int u = u_begin; u < u_end; ++u) {
+    const double d = Darkness(frame.image, target, u, v);
+    sum += d;
+    weighted += d * u;
+  }
+  return weighted / sum;
+}
+
+TEST(Render, FrontoParallelStripeEdgesAreWhereTheTruthSays) {
+  const LineTarget target = TwoLineTarget();
+  const SceneRenderer renderer(target, RenderOptions());
+  // Off-centre so the stripe edges fall at fractional pixels.
+  const RenderedFrame frame = renderer.Render(FrontoParallel(0.5, 0.0123, 0.0), 1);
+  ASSERT_EQ(frame.truth.size(), 2u);
+  const double width_px = 600.0 * 0.02 / 0.5;
+  for (const TruthLine& truth : frame.truth) {
+    ASSERT_TRUE(truth.visible);
+    ASSERT_NEAR(truth.ideal.theta_rad, 0.0, 1e-12);
+    const double centre = truth.ideal.rho_px;
+    const int u_begin = static_cast<int>(centre - 30), u_end = static_cast<int>(centre + 30);
+    for (int v : {0, 77, 240, 479}) {
+      double a = 0.0, b = 0.0;
+      VerticalStripeEdges(frame, target, v, u_begin, u_end, &a, &b);
+      EXPECT_NEAR(0.5 * (a + b), centre, kEdgeTolerancePx)
+          << "line " << truth.index << " row " << v;
+      EXPECT_NEAR(b - a, width_px, kEdgeTolerancePx) << "line " << truth.index << " row " << v;
+    }
+    EXPECT_NEAR(truth.width_px, width_px, 1e-9);
+  }
+  // Between the stripes: bare board.
+  EXPECT_EQ(frame.image[240][320], target.board_grey);
+}
+
+TEST(Render, RolledStripeRowCentroidsLieOnTheIdealLine) {
+  const LineTarget target = TwoLineTarget();
+  const SceneRenderer renderer(target, RenderOptions());
+  const RenderedFrame frame = renderer.Render(FrontoParallel(0.6, 0.004, -0.01, 0.35), 1);
+  for (const TruthLine& truth : frame.truth) {
+    ASSERT_TRUE(truth.visible);
+    const double c = std::cos(truth.ideal.theta_rad), s = std::sin(truth.ideal.theta_rad);
+    for (int v = 40; v < 440; v += 37) {
+      const double expected = (truth.ideal.rho_px - v * s) / c;
+      const double centroid = RowCentroid(frame, target, v, static_cast<int>(expected) - 30,
+                                          static_cast<int>(expected) + 30);
+      EXPECT_NEAR(centroid, expected, kCentreTolerancePx) << "line " << truth.index << " row " << v;
+    }
+  }
+}
+
+TEST(Render, DistortedStripeCentresUndistortOntoTheIdealLine) {
+  RenderOptions options;
+  options.camera.initPersProjWithDistortion(600.0, 600.0, 319.5, 239.5, 0.0, 0.33);
+  const LineTarget target = TwoLineTarget();
+  const SceneRenderer renderer(target, options);
+  // The left stripe lies far right of the centre, where the distortion bends it most.
+  const RenderedFrame frame = renderer.Render(FrontoParallel(0.6, -0.22, 0.0), 1);
+  const TruthLine& truth = frame.truth[0];
+  ASSERT_TRUE(truth.visible);
+  for (int v = 0; v < 480; v += 40) {
+    // Search around the straight line fitted to the distorted stripe (a few pixels off).
+    const LineParams& fit = truth.distorted_fit;
+    const int guess =
+        static_cast<int>((fit.rho_px - v * std::sin(fit.theta_rad)) / std::cos(fit.theta_rad));
+    const double centroid = RowCentroid(frame, target, v, guess - 25, guess + 25);
+    double x = 0.0, y = 0.0;
+    vpPixelMeterConversion::convertPoint(options.camera, centroid, v, x, y);
+    const double distance = truth.ideal.SignedDistance(319.5 + 600.0 * x, 239.5 + 600.0 * y);
+    EXPECT_NEAR(distance, 0.0, kCentreTolerancePx) << "row " << v;
+  }
+}
+
+// Every pixel that is neither bare board nor full stripe in a tilted, rolled four-line view
+// (edges at all angles, stripe crossings, a board corner, perspective, with and without lens
+// distortion) against 32 x 32 point samples; plus a sparse grid of the other pixels.
+class PixelsMatchDenseSampling : public ::testing::TestWithParam<double> {};
+
+TEST_P(PixelsMatchDenseSampling, UnderPerspective) {
+  const LineTarget target = FourLineTarget();
+  RenderOptions options;
+  options.width = 320;
+  options.height = 240;
+  options.camera.initPersProjWithDistortion(300.0, 300.0, 159.5, 119.5, 0.0, GetParam());
+  const SceneRenderer renderer(target, options);
+  vpHomogeneousMatrix tilt;
+  tilt.buildFrom(0.0, 0.0, 0.0, 0.45, -0.3, 0.0);
+  const vpHomogeneousMatrix cMo = tilt * FrontoParallel(0.55, 0.01, 0.0, 0.5);
+  const RenderedFrame frame = renderer.Render(cMo, 1);
+  const double contrast = target.board_grey - target.line_grey;
+  int checked = 0, background = 0;
+  double worst = 0.0, total_error = 0.0;
+  for (int v = 0; v < options.height; ++v) {
+    for (int u = 0; u < options.width; ++u) {
+      const int grey = frame.image[v][u];
+      const bool mixed = grey != target.board_grey && grey != target.line_grey;
+      if (!mixed && (u % 9 != 0 || v % 9 != 0)) continue;
+      const double error = (grey - ReferenceGrey(target, options, cMo, u, v, 32)) / contrast;
+      worst = std::max(worst, std::fabs(error));
+      total_error += error;
+      ++checked;
+      background += grey == options.background_grey;
+    }
+  }
+  EXPECT_GT(checked, 1500);
+  EXPECT_GT(background, 10);  // the view includes a corner of the board
+  EXPECT_LT(worst, 0.025);
+  // No bias: the summed error (an area, pixels^2) is small.
+  EXPECT_LT(std::fabs(total_error), 0.5);
+}
+
+INSTANTIATE_TEST_SUITE_P(Lenses, PixelsMatchDenseSampling, ::testing::Values(0.0, 0.33),
+                         [](const ::testing::TestParamInfo<double>& param) {
+                           return param.param == 0.0 ? std::string("pinhole")
+                                                     : std::string("barrel");
+                         });
+
+TEST(Render, NoiseIsReproducibleFromTheSeed) {
+  RenderOptions options;
+  options.width = 160;
+  options.height = 120;
+  options.noise_sigma = 5.0;
+  const SceneRenderer renderer(TwoLineTarget(), options);
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.5);
+  const RenderedFrame a = renderer.Render(cMo, 42);
+  const RenderedFrame b = renderer.Render(cMo, 42);
+  const RenderedFrame c = renderer.Render(cMo, 43);
+  EXPECT_TRUE(SameImage(a.image, b.image));
+  EXPECT_FALSE(SameImage(a.image, c.image));
+}
+
+TEST(Render, NoiseHasTheRequestedStandardDeviation) {
+  LineTarget blank = TwoLineTarget();
+  blank.lines.clear();
+  RenderOptions options;
+  options.width = 200;
+  options.height = 150;
+  options.noise_sigma = 6.0;
+  const SceneRenderer renderer(blank, options);
+  const RenderedFrame frame = renderer.Render(FrontoParallel(0.5), 7);
+  double sum = 0.0, sum2 = 0.0;
+  const double n = frame.image.getSize();
+  for (unsigned i = 0; i < frame.image.getSize(); ++i) {
+    sum += frame.image.bitmap[i];
+    sum2 += frame.image.bitmap[i] * static_cast<double>(frame.image.bitmap[i]);
+  }
+  const double mean = sum / n;
+  const double sigma = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_NEAR(mean, blank.board_grey, 0.1);
+  // Rounding to integers adds 1/12 to the variance.
+  EXPECT_NEAR(sigma, std::sqrt(36.0 + 1.0 / 12.0), 0.15);
+}
+
+TEST(Render, BlurSoftensEdgesWithoutMovingTheStripe) {
+  const LineTarget target = TwoLineTarget();
+  RenderOptions options;
+  options.blur_sigma_px = 1.5;
+  const SceneRenderer sharp_renderer(target, RenderOptions());
+  const SceneRenderer blurred_renderer(target, options);
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.5, 0.0123, 0.0);
+  const RenderedFrame sharp = sharp_renderer.Render(cMo, 1);
+  const RenderedFrame blurred = blurred_renderer.Render(cMo, 1);
+  const double centre = sharp.truth[0].ideal.rho_px;
+  const int begin = static_cast<int>(centre) - 25, end = static_cast<int>(centre) + 25;
+  int max_step_sharp = 0, max_step_blurred = 0;
+  for (int u = begin; u < end; ++u) {
+    max_step_sharp =
+        std::max(max_step_sharp, std::abs(sharp.image[200][u + 1] - sharp.image[200][u]));
+    max_step_blurred =
+        std::max(max_step_blurred, std::abs(blurred.image[200][u + 1] - blurred.image[200][u]));
+  }
+  EXPECT_LT(max_step_blurred, 0.5 * max_step_sharp);
+  EXPECT_NEAR(RowCentroid(blurred, target, 200, begin, end), centre, kCentreTolerancePx);
+}
+
+TEST(Render, IlluminationFallsAlongTheGradientDirection) {
+  LineTarget blank = TwoLineTarget();
+  blank.lines.clear();
+  RenderOptions options;
+  options.width = 100;
+  options.height = 80;
+  options.illumination_gradient = 0.5;
+  {
+    const RenderedFrame frame = SceneRenderer(blank, options).Render(FrontoParallel(0.5), 1);
+    EXPECT_EQ(frame.image[40][0], blank.board_grey);
+    EXPECT_NEAR(frame.image[40][99], 0.5 * blank.board_grey, 0.51);
+    EXPECT_NEAR(frame.image[0][50], frame.image[79][50], 0.51);  // constant along v
+  }
+  options.gradient_angle_rad = kPi / 2.0;
+  {
+    const RenderedFrame frame = SceneRenderer(blank, options).Render(FrontoParallel(0.5), 1);
+    EXPECT_EQ(frame.image[0][50], blank.board_grey);
+    EXPECT_NEAR(frame.image[79][50], 0.5 * blank.board_grey, 0.51);
+  }
+}
+
+TEST(Render, UniformBackgroundAroundTheBoard) {
+  const LineTarget target = TwoLineTarget();
+  RenderOptions options;
+  const SceneRenderer renderer(target, options);
+  // At 5 m the 2 m board covers 240 x 240 pixels in the middle.
+  const RenderedFrame frame = renderer.Render(FrontoParallel(5.0), 1);
+  EXPECT_EQ(frame.image[5][5], options.background_grey);
+  EXPECT_EQ(frame.image[470][630], options.background_grey);
+  EXPECT_EQ(frame.image[239][200], target.board_grey);
+  // The board edge at u = 319.5 - 120 = 199.5 falls between pixels 199 and 200.
+  EXPECT_EQ(frame.image[150][199], options.background_grey);
+}
+
+TEST(Render, BackgroundImageIsShownAroundTheBoardOnly) {
+  const std::string path = std::string(OAL_VISP_IMAGES_DIR) + "/Klimt/Klimt.pgm";
+  if (!std::ifstream(path).good()) GTEST_SKIP() << "ViSP test image missing: " << path;
+  const LineTarget target = TwoLineTarget();
+  RenderOptions options;
+  options.background_image = path;
+  const SceneRenderer renderer(target, options);
+  const vpHomogeneousMatrix cMo = FrontoParallel(5.0);
+  const RenderedFrame frame = renderer.Render(cMo, 1);
+  int lo = 255, hi = 0;
+  for (int v = 0; v < 100; ++v) {
+    for (int u = 0; u < 150; ++u) {
+      lo = std::min<int>(lo, frame.image[v][u]);
+      hi = std::max<int>(hi, frame.image[v][u]);
+    }
+  }
+  EXPECT_GT(hi - lo, 50) << "the background should be textured";
+  EXPECT_EQ(frame.image[239][200], target.board_grey);
+  // The background is fixed to the board plane: moving the camera moves it in the image.
+  const RenderedFrame moved = renderer.Render(FrontoParallel(5.0, 0.1, 0.0), 1);
+  EXPECT_FALSE(SameImage(frame.image, moved.image));
+}
+
+TEST(Render, NothingIsSeenWhenTheBoardIsBehindTheCamera) {
+  const SceneRenderer renderer(FourLineTarget(), RenderOptions());
+  const RenderedFrame frame = renderer.Render(FrontoParallel(-0.5), 1);
+  for (unsigned i = 0; i < frame.image.getSize(); ++i) {
+    ASSERT_EQ(frame.image.bitmap[i], RenderOptions().background_grey) << i;
+  }
+  for (const TruthLine& truth : frame.truth) EXPECT_FALSE(truth.visible);
+}
+
+}  // namespace
+}  // namespace oal
