@@ -1,0 +1,186 @@
+#include "app/camera_file.h"
+
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+#include <visp3/core/vpXmlParserCamera.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "app/atomic_file.h"
+
+namespace oal {
+namespace {
+
+constexpr const char* kWithDistortion = "perspectiveProjWithDistortion";
+constexpr const char* kWithoutDistortion = "perspectiveProjWithoutDistortion";
+
+// vpXmlParserCamera prints to std::cout ("Found camera with name ...") and std::cerr; the
+// detect command writes JSON lines to stdout, so both are muted while it runs.
+class MuteStandardStreams {
+ public:
+  MuteStandardStreams()
+      : out_(std::cout.rdbuf(sink_.rdbuf())), err_(std::cerr.rdbuf(sink_.rdbuf())) {}
+  ~MuteStandardStreams() {
+    std::cout.rdbuf(out_);
+    std::cerr.rdbuf(err_);
+  }
+  MuteStandardStreams(const MuteStandardStreams&) = delete;
+  MuteStandardStreams& operator=(const MuteStandardStreams&) = delete;
+
+ private:
+  std::ostringstream sink_;
+  std::streambuf* out_;
+  std::streambuf* err_;
+};
+
+// What the file says about one <camera>, enough to ask vpXmlParserCamera for it.
+struct CameraEntry {
+  std::string name;
+  unsigned int width = 0, height = 0;
+  bool with_distortion = false, without_distortion = false;
+};
+
+struct XmlDocFree {
+  void operator()(xmlDoc* doc) const { xmlFreeDoc(doc); }
+};
+
+struct XmlStringFree {
+  void operator()(xmlChar* text) const { xmlFree(text); }
+};
+
+std::string ChildText(const xmlNode* node) {
+  const std::unique_ptr<xmlChar, XmlStringFree> text(xmlNodeGetContent(node));
+  return text ? std::string(reinterpret_cast<const char*>(text.get())) : std::string();
+}
+
+bool Named(const xmlNode* node, const char* name) {
+  return node->type == XML_ELEMENT_NODE &&
+         xmlStrcmp(node->name, reinterpret_cast<const xmlChar*>(name)) == 0;
+}
+
+unsigned int ToUnsigned(const std::string& text) {
+  try {
+    return static_cast<unsigned int>(std::stoul(text));
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
+// Trims the whitespace pugixml would also ignore around element text.
+std::string Trimmed(const std::string& text) {
+  const auto begin = text.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(" \t\r\n") - begin + 1);
+}
+
+CameraEntry ReadEntry(const xmlNode* camera) {
+  CameraEntry entry;
+  for (const xmlNode* child = camera->children; child != nullptr; child = child->next) {
+    if (Named(child, "name")) entry.name = Trimmed(ChildText(child));
+    if (Named(child, "image_width")) entry.width = ToUnsigned(ChildText(child));
+    if (Named(child, "image_height")) entry.height = ToUnsigned(ChildText(child));
+    if (!Named(child, "model")) continue;
+    for (const xmlNode* field = child->children; field != nullptr; field = field->next) {
+      if (!Named(field, "type")) continue;
+      const std::string type = Trimmed(ChildText(field));
+      entry.with_distortion |= type == kWithDistortion;
+      entry.without_distortion |= type == kWithoutDistortion;
+    }
+  }
+  return entry;
+}
+
+std::vector<CameraEntry> ListCameras(const std::string& path) {
+  std::unique_ptr<xmlDoc, XmlDocFree> doc(xmlReadFile(
+      path.c_str(), nullptr, XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING));
+  if (!doc) {
+    const xmlError* error = xmlGetLastError();
+    std::string reason =
+        error != nullptr && error->message != nullptr ? Trimmed(error->message) : "not well-formed";
+    if (error != nullptr) reason += " at line " + std::to_string(error->line);
+    throw std::runtime_error("camera file '" + path + "' is not valid XML: " + reason);
+  }
+  std::vector<CameraEntry> cameras;
+  const xmlNode* root = xmlDocGetRootElement(doc.get());
+  for (const xmlNode* node = root ? root->children : nullptr; node != nullptr; node = node->next) {
+    if (Named(node, "camera")) cameras.push_back(ReadEntry(node));
+  }
+  return cameras;
+}
+
+const CameraEntry& ChooseCamera(const std::vector<CameraEntry>& cameras, const std::string& path,
+                                const std::string& camera_name) {
+  if (cameras.empty()) throw std::runtime_error("camera file '" + path + "' has no <camera>");
+  if (camera_name.empty()) return cameras.front();
+  std::string names;
+  for (const CameraEntry& entry : cameras) {
+    if (entry.name == camera_name) return entry;
+    names += (names.empty() ? "'" : ", '") + entry.name + "'";
+  }
+  throw std::runtime_error("camera file '" + path + "' has no camera named '" + camera_name +
+                           "' (cameras: " + names + ")");
+}
+
+}  // namespace
+
+CameraFile LoadCameraFile(const std::string& path, const std::string& camera_name) {
+  if (!std::filesystem::is_regular_file(path)) {
+    throw std::runtime_error("camera file '" + path + "' does not exist or is not a file");
+  }
+  const std::vector<CameraEntry> cameras = ListCameras(path);
+  const CameraEntry& entry = ChooseCamera(cameras, path, camera_name);
+  const std::string label = "camera '" + entry.name + "' in '" + path + "'";
+  if (!entry.with_distortion && !entry.without_distortion) {
+    throw std::runtime_error(label + " has no model of type " + kWithDistortion + " or " +
+                             kWithoutDistortion);
+  }
+  const auto model = entry.with_distortion ? vpCameraParameters::perspectiveProjWithDistortion
+                                           : vpCameraParameters::perspectiveProjWithoutDistortion;
+  CameraFile result;
+  int status = vpXmlParserCamera::SEQUENCE_ERROR;
+  {
+    MuteStandardStreams mute;
+    vpXmlParserCamera parser;
+    status = parser.parse(result.camera, path, entry.name, model, entry.width, entry.height);
+  }
+  if (status != vpXmlParserCamera::SEQUENCE_OK) {
+    throw std::runtime_error("vpXmlParserCamera cannot read " + label +
+                             " (a model with missing parameters, or several cameras of that "
+                             "name and image size)");
+  }
+  if (!(result.camera.get_px() > 0.0 && result.camera.get_py() > 0.0)) {
+    throw std::runtime_error(label + " has px or py <= 0");
+  }
+  result.name = entry.name;
+  result.width = entry.width;
+  result.height = entry.height;
+  return result;
+}
+
+void SaveCameraFile(const std::string& path, const vpCameraParameters& camera,
+                    const std::string& name, unsigned int width, unsigned int height) {
+  // vpXmlParserCamera::save adds to an existing file, so it writes a fresh temporary file
+  // that then replaces `path`.
+  const std::filesystem::path temp = TempPathFor(path);
+  RemoveQuietly(temp);
+  int status = vpXmlParserCamera::SEQUENCE_ERROR;
+  {
+    MuteStandardStreams mute;
+    vpXmlParserCamera parser;
+    status = parser.save(camera, temp.string(), name, width, height);
+  }
+  std::error_code error;
+  if (status == vpXmlParserCamera::SEQUENCE_OK && std::filesystem::is_regular_file(temp)) {
+    std::filesystem::rename(temp, path, error);
+    if (!error) return;
+  }
+  RemoveQuietly(temp);
+  throw std::runtime_error("cannot write camera file '" + path + "'" +
+                           (error ? ": " + error.message() : std::string()));
+}
+
+}  // namespace oal

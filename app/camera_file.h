@@ -1,0 +1,35 @@
+// ViSP camera XML files (what vpXmlParserCamera reads and writes).
+//
+// vpXmlParserCamera::parse(cam, file, name, model, width, height) accepts a <camera> only if
+// its <name> equals `name` exactly (an empty name matches only unnamed cameras), its image
+// size is within 15 px of width x height (0 = any) and it has a <model> of type `model`; it
+// fails unless exactly one camera matches. To pick "the first camera" when the user names
+// none, the file is listed first (libxml2), then the chosen camera is parsed by ViSP with its
+// own name and size.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+
+#include <string>
+#include <vector>
+
+namespace oal {
+
+struct CameraFile {
+  vpCameraParameters camera;
+  std::string name;         ///< <name>, may be empty
+  unsigned int width = 0;   ///< <image_width>, 0 if absent
+  unsigned int height = 0;  ///< <image_height>, 0 if absent
+};
+
+/// Reads camera `camera_name` from `path`, or the first camera of the file when the name is
+/// empty. The model perspectiveProjWithDistortion is used when the camera has one, else
+/// perspectiveProjWithoutDistortion. Throws std::runtime_error naming the file when it is
+/// missing, is not XML, or holds no usable camera.
+CameraFile LoadCameraFile(const std::string& path, const std::string& camera_name = "");
+
+/// Writes `camera` with vpXmlParserCamera::save to `path`, atomically (replacing `path`).
+void SaveCameraFile(const std::string& path, const vpCameraParameters& camera,
+                    const std::string& name, unsigned int width, unsigned int height);
+
+}  // namespace oal

@@ -1,0 +1,44 @@
+// What every `oalservo` subcommand shares: the command table entry, the two kinds of error
+// main() tells apart, and CLI11 parsing that turns --help into a normal exit.
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace CLI {
+class App;
+}  // namespace CLI
+
+namespace oal {
+
+/// One row of main()'s command table. `run` gets argv with argv[0] = the command name and
+/// returns the process exit code; it throws on error (main() prints and maps the error).
+struct Command {
+  const char* name;
+  int (*run)(int argc, char** argv);
+  const char* help;  ///< one line, shown by `oalservo --help`
+};
+
+/// Exit codes of `oalservo`.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitError = 1,  ///< bad input, bad configuration, I/O failure
+  kExitUsage = 2,  ///< bad command line
+};
+
+/// A bad command line (unknown option, missing argument...): exit code 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Parses argv into `cli`. Returns an exit code when the command should stop here (--help
+/// was printed: kExitOk), std::nullopt to go on. Throws UsageError on a bad command line.
+std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv);
+
+/// A warning for the user on stderr: "oalservo <command>: warning: <message>". Libraries
+/// never print; commands report through this.
+void Warn(const std::string& command, const std::string& message);
+
+}  // namespace oal

@@ -1,0 +1,34 @@
+// oalservo's YAML configuration. Only the app reads YAML: this file fills the libraries'
+// Options structs and rejects what it does not understand, naming the file, the line and
+// the key (config/detector.yaml documents every key).
+//
+//   detector:            # oal::DetectorOptions; keys are exactly its field names
+//     paper: true        # start from DetectorOptions::Paper() instead of the defaults
+//     step_px: 5
+//
+// Sections reserved for later versions (camera, servo, robot, pose, render) are rejected
+// with a message saying so, rather than silently ignored.
+#pragma once
+
+#include <string>
+
+#include "detector/options.h"
+
+namespace oal {
+
+/// Everything a configuration file can set. A new section is a member here plus one row in
+/// config.cpp's section table.
+struct AppConfig {
+  DetectorOptions detector;
+};
+
+/// Applies the YAML file at `path` to `base` and checks the result. Throws
+/// std::runtime_error "FILE:LINE: ..." for a missing or malformed file, an unknown section
+/// or key, a value of the wrong type, and a value that fails the Options' Check().
+AppConfig LoadConfig(const std::string& path, const AppConfig& base = AppConfig());
+
+/// As LoadConfig, from YAML text; `file_name` stands for the file in messages.
+AppConfig ParseConfig(const std::string& yaml_text, const std::string& file_name,
+                      const AppConfig& base = AppConfig());
+
+}  // namespace oal

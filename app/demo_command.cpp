@@ -1,0 +1,208 @@
+#include "app/demo_command.h"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+#include "app/annotate.h"
+#include "app/atomic_file.h"
+#include "app/command_line.h"
+#include "app/json_io.h"
+#include "app/render_command.h"
+#include "detector/detector.h"
+#include "detector/lens.h"
+#include "scene/scene.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kRadToDeg = 180.0 / kPi;
+// A detected line further than this from a true line (in angle) is not its match.
+constexpr double kMaxMatchAngleDeg = 10.0;
+
+// The cheap-camera preset: a wide lens (kdu 0.33 at 640x480, px 600), sensor noise, a soft
+// focus and light falling off by 30 % across the image.
+RenderOptions CheapCamera() {
+  RenderOptions options;
+  options.width = 640;
+  options.height = 480;
+  options.camera = RenderCamera(options.width, options.height, 600.0, 0.33);
+  options.noise_sigma = 8.0;
+  options.blur_sigma_px = 1.0;
+  options.illumination_gradient = 0.3;
+  options.gradient_angle_rad = 0.5;
+  return options;
+}
+
+struct Candidate {
+  DemoMatch match;
+  bool taken = false;
+};
+
+DemoMatch Compare(const TruthLine& truth, int detected_index, const DetectedLine& detected,
+                  const PointUndistorter& undistorter) {
+  // Distance to a line is linear along a segment, so its maximum over the chord is at an end.
+  const Point2d a = undistorter.Undistort(truth.end_a);
+  const Point2d b = undistorter.Undistort(truth.end_b);
+  DemoMatch match;
+  match.truth_index = truth.index;
+  match.detected_index = detected_index;
+  match.angle_error_deg = AngleBetween(detected.line, truth.ideal) * kRadToDeg;
+  match.max_offset_px = std::max(std::abs(detected.line.SignedDistance(a.u, a.v)),
+                                 std::abs(detected.line.SignedDistance(b.u, b.v)));
+  return match;
+}
+
+// Greedy one-to-one matching, closest pairs first.
+std::vector<DemoMatch> MatchLines(const std::vector<TruthLine>& truth,
+                                  const std::vector<DetectedLine>& detected,
+                                  const vpCameraParameters& camera) {
+  const PointUndistorter undistorter(camera);
+  std::vector<DemoMatch> pairs;
+  for (const TruthLine& line : truth) {
+    if (!line.visible) continue;
+    for (std::size_t d = 0; d < detected.size(); ++d) {
+      const DemoMatch pair = Compare(line, static_cast<int>(d), detected[d], undistorter);
+      if (pair.angle_error_deg <= kMaxMatchAngleDeg) pairs.push_back(pair);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const DemoMatch& x, const DemoMatch& y) {
+    return x.max_offset_px < y.max_offset_px;
+  });
+  std::vector<DemoMatch> matches;
+  std::vector<bool> truth_done(truth.size(), false), detected_done(detected.size(), false);
+  for (const DemoMatch& pair : pairs) {
+    const auto t = static_cast<std::size_t>(pair.truth_index);
+    const auto d = static_cast<std::size_t>(pair.detected_index);
+    if (truth_done[t] || detected_done[d]) continue;
+    truth_done[t] = detected_done[d] = true;
+    matches.push_back(pair);
+  }
+  for (const TruthLine& line : truth) {
+    if (line.visible && !truth_done[static_cast<std::size_t>(line.index)]) {
+      DemoMatch missed;
+      missed.truth_index = line.index;
+      matches.push_back(missed);
+    }
+  }
+  std::sort(matches.begin(), matches.end(),
+            [](const DemoMatch& x, const DemoMatch& y) { return x.truth_index < y.truth_index; });
+  return matches;
+}
+
+Json MatchJson(const DemoMatch& match) {
+  Json json{{"truth_index", match.truth_index}, {"detected_index", match.detected_index}};
+  if (match.detected_index >= 0) {
+    json["angle_error_deg"] = match.angle_error_deg;
+    json["max_offset_px"] = match.max_offset_px;
+  }
+  return json;
+}
+
+Json DemoJson(const RenderOptions& render, const RenderedFrame& frame,
+              const std::vector<DetectedLine>& lines, const DemoReport& report) {
+  Json truth = Json::array(), detected = Json::array(), matches = Json::array();
+  for (const TruthLine& line : frame.truth) truth.push_back(TruthLineJson(line));
+  for (const DetectedLine& line : lines) detected.push_back(DetectedLineJson(line));
+  for (const DemoMatch& match : report.matches) matches.push_back(MatchJson(match));
+  return Json{{"camera", CameraJson(render.camera, render.width, render.height)},
+              {"noise_sigma", render.noise_sigma},
+              {"blur_sigma_px", render.blur_sigma_px},
+              {"illumination_gradient", render.illumination_gradient},
+              {"cMo", PoseJson(frame.cMo)},
+              {"coordinates", "undistorted"},
+              {"time_us", report.time_us},
+              {"truth", std::move(truth)},
+              {"detected", std::move(detected)},
+              {"matches", std::move(matches)}};
+}
+
+void PrintTable(const DemoReport& report, const std::vector<TruthLine>& truth,
+                const std::vector<DetectedLine>& lines, std::ostream& out) {
+  char row[160];
+  out << "target  true rho(px) theta(deg)  found  rho(px) theta(deg)  angle err(deg)  max "
+         "offset(px)\n";
+  int found = 0;
+  for (const DemoMatch& match : report.matches) {
+    const LineParams& ideal = truth[static_cast<std::size_t>(match.truth_index)].ideal;
+    if (match.detected_index < 0) {
+      std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5s\n", match.truth_index, ideal.rho_px,
+                    ideal.theta_rad * kRadToDeg, "-");
+    } else {
+      ++found;
+      const LineParams& line = lines[static_cast<std::size_t>(match.detected_index)].line;
+      std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5d  %7.1f %10.2f  %14.3f  %15.2f\n",
+                    match.truth_index, ideal.rho_px, ideal.theta_rad * kRadToDeg,
+                    match.detected_index, line.rho_px, line.theta_rad * kRadToDeg,
+                    match.angle_error_deg, match.max_offset_px);
+    }
+    out << row;
+  }
+  out << found << " of " << report.matches.size() << " target lines found; the detector returned "
+      << report.detected << " lines in " << std::lround(report.time_us) << " us\n";
+}
+
+}  // namespace
+
+void DemoCommandOptions::Check() const {
+  if (out_dir.empty()) throw std::invalid_argument("DemoCommandOptions::out_dir is empty");
+}
+
+DemoReport RunDemoScene(const DemoCommandOptions& options, std::ostream& out) {
+  options.Check();
+  const RenderOptions render = CheapCamera();
+  const SceneRenderer renderer(FourLineTarget(), render);
+  PoseSampling sampling;
+  sampling.min_visible_length_px = 150.0;  // every line well inside the picture
+  std::uint64_t state = options.seed;
+  const RenderedFrame frame = renderer.Render(SamplePose(renderer, sampling, &state), options.seed);
+
+  OalDetector detector(DetectorOptions(), render.camera);
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<DetectedLine>& lines = detector.Detect(frame.image);
+  const auto stop = std::chrono::steady_clock::now();
+
+  DemoReport report;
+  report.detected = static_cast<int>(lines.size());
+  report.time_us = std::chrono::duration<double, std::micro>(stop - start).count();
+  report.matches = MatchLines(frame.truth, lines, render.camera);
+
+  const fs::path dir(options.out_dir);
+  fs::create_directories(dir);
+  const cv::Mat image(static_cast<int>(frame.image.getHeight()),
+                      static_cast<int>(frame.image.getWidth()), CV_8UC1, frame.image.bitmap);
+  WritePng(dir / "frame.png", image);
+  WritePng(dir / "demo.png", AnnotateLines(image, lines, render.camera));
+  WriteFileAtomically(dir / "lines.json", DemoJson(render, frame, lines, report).dump(2) + "\n");
+
+  out << "Cheap camera: 640x480, px = py = 600, kdu = 0.33, noise 8, blur 1 px, light -30 %, "
+         "seed "
+      << options.seed << "\nLines in undistorted pixels (rho from the top-left pixel):\n";
+  PrintTable(report, frame.truth, lines, out);
+  out << "Wrote " << (dir / "frame.png").string() << ", " << (dir / "demo.png").string() << ", "
+      << (dir / "lines.json").string() << '\n';
+  return report;
+}
+
+int RunDemo(int argc, char** argv) {
+  DemoCommandOptions options;
+  CLI::App cli(
+      "Render one frame of a cheap camera (wide lens, noise, blur, uneven light), detect "
+      "its lines with point undistortion and compare them with the truth.",
+      "oalservo demo");
+  cli.add_option("--out", options.out_dir, "output directory (created if missing)")
+      ->capture_default_str();
+  cli.add_option("--seed", options.seed, "seed of the pose and the noise")->capture_default_str();
+  if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  RunDemoScene(options, std::cout);
+  return kExitOk;
+}
+
+}  // namespace oal

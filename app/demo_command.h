@@ -1,0 +1,42 @@
+// `oalservo demo`: one frame of a cheap camera (wide lens, noise, blur, uneven light)
+// rendered, detected with point undistortion and compared with the truth. Writes
+// DIR/frame.png (raw), DIR/demo.png (lines drawn), DIR/lines.json and prints a table.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace oal {
+
+struct DemoCommandOptions {
+  std::string out_dir = "out/demo";  ///< created if missing
+  std::uint64_t seed = 1;            ///< pose and noise
+
+  void Check() const;
+};
+
+/// How well one target line was found.
+struct DemoMatch {
+  int truth_index = 0;      ///< index of the target line
+  int detected_index = -1;  ///< index in the detector's output; -1: not found
+  double angle_error_deg = 0.0;
+  /// Largest distance of the detected line from the true line over the visible chord,
+  /// undistorted pixels.
+  double max_offset_px = 0.0;
+};
+
+struct DemoReport {
+  int detected = 0;  ///< lines the detector returned
+  double time_us = 0.0;
+  std::vector<DemoMatch> matches;  ///< one per visible target line
+};
+
+/// Renders, detects, compares and writes the files; prints the table to `out`.
+DemoReport RunDemoScene(const DemoCommandOptions& options, std::ostream& out);
+
+/// `oalservo demo ...`; argv[0] is "demo".
+int RunDemo(int argc, char** argv);
+
+}  // namespace oal

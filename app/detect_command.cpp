@@ -1,0 +1,187 @@
+#include "app/detect_command.h"
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "app/annotate.h"
+#include "app/atomic_file.h"
+#include "app/camera_file.h"
+#include "app/command_line.h"
+#include "app/config.h"
+#include "app/image_source.h"
+#include "app/json_io.h"
+#include "detector/detector.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+
+DetectorOptions LoadDetectorOptions(const DetectCommandOptions& options) {
+  AppConfig config;
+  if (options.paper) config.detector = DetectorOptions::Paper();
+  if (!options.config_path.empty()) config = LoadConfig(options.config_path, config);
+  config.detector.Check();
+  return config.detector;
+}
+
+std::string AnnotationName(int frame) {
+  std::string number = std::to_string(frame);
+  if (number.size() < 4) number.insert(0, 4 - number.size(), '0');
+  return "lines_" + number + ".png";
+}
+
+// Everything one run needs, opened before any output is started so that a bad input or
+// configuration fails early.
+struct DetectRun {
+  OalDetector detector;
+  std::optional<CameraFile> camera;
+  std::vector<std::unique_ptr<ImageSource>> sources;
+  std::optional<vpCameraParameters> undistorted_by;  ///< set when lines are undistorted
+};
+
+OalDetector MakeDetector(const DetectorOptions& options, const std::optional<CameraFile>& camera) {
+  return camera ? OalDetector(options, camera->camera) : OalDetector(options);
+}
+
+std::optional<CameraFile> LoadCamera(const DetectCommandOptions& options) {
+  if (options.camera_path.empty()) return std::nullopt;
+  return LoadCameraFile(options.camera_path, options.camera_name);
+}
+
+void CheckCameraSize(const DetectRun& run, const Frame& frame, DetectSummary* summary) {
+  const CameraFile& camera = *run.camera;
+  if (camera.width == 0 || camera.height == 0) return;
+  if (static_cast<int>(camera.width) == frame.gray.cols &&
+      static_cast<int>(camera.height) == frame.gray.rows) {
+    return;
+  }
+  summary->warnings.push_back("camera '" + camera.name + "' is calibrated for " +
+                              std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                              " but '" + frame.source + "' is " + std::to_string(frame.gray.cols) +
+                              "x" + std::to_string(frame.gray.rows));
+}
+
+Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,
+               const std::vector<DetectedLine>& lines) {
+  Json json_lines = Json::array();
+  for (const DetectedLine& line : lines) json_lines.push_back(DetectedLineJson(line));
+  return Json{{"frame", index},
+              {"source", frame.source},
+              {"width", frame.gray.cols},
+              {"height", frame.gray.rows},
+              {"time_us", time_us},
+              {"coordinates", undistorted ? "undistorted" : "image"},
+              {"lines", std::move(json_lines)}};
+}
+
+// Runs the detector over every frame, writing to `sink`; returns when the sources end or
+// max_frames is reached.
+void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ostream& sink,
+                   bool flush_each, DetectSummary* summary) {
+  const bool undistorted = run->detector.Undistorts();
+  Frame frame;
+  for (auto& source : run->sources) {
+    while (options.max_frames == 0 || summary->frames < options.max_frames) {
+      if (!source->Next(&frame)) break;
+      if (summary->frames == 0 && run->camera) CheckCameraSize(*run, frame, summary);
+      const auto start = std::chrono::steady_clock::now();
+      const std::vector<DetectedLine>& lines = run->detector.Detect(frame.view());
+      const auto stop = std::chrono::steady_clock::now();
+      const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
+      sink << FrameJson(summary->frames, frame, time_us, undistorted, lines).dump() << '\n';
+      if (flush_each) sink.flush();
+      if (!sink) throw std::runtime_error("cannot write the output");
+      if (!options.annotate_dir.empty()) {
+        WritePng(fs::path(options.annotate_dir) / AnnotationName(summary->frames),
+                 AnnotateLines(frame.gray, lines, run->undistorted_by));
+      }
+      summary->lines += static_cast<int>(lines.size());
+      ++summary->frames;
+    }
+  }
+}
+
+}  // namespace
+
+void DetectCommandOptions::Check() const {
+  if (inputs.empty()) throw std::invalid_argument("DetectCommandOptions::inputs is empty");
+  if (max_frames < 0) {
+    throw std::invalid_argument("DetectCommandOptions::max_frames = " + std::to_string(max_frames) +
+                                ". Violated constraint: max_frames >= 0");
+  }
+  if (!out_path.empty()) {
+    const fs::path parent = fs::path(out_path).parent_path();
+    if (!parent.empty() && !fs::is_directory(parent)) {
+      throw std::invalid_argument("output directory '" + parent.string() + "' does not exist");
+    }
+    if (fs::is_directory(out_path)) {
+      throw std::invalid_argument("output '" + out_path + "' is a directory, not a file");
+    }
+  }
+}
+
+DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& out) {
+  options.Check();
+  DetectSummary summary;
+  std::optional<CameraFile> camera = LoadCamera(options);
+  DetectRun run{MakeDetector(LoadDetectorOptions(options), camera), std::move(camera), {}, {}};
+  if (run.detector.Undistorts()) run.undistorted_by = run.camera->camera;
+  for (const std::string& input : options.inputs) {
+    run.sources.push_back(OpenImageSource(input, &summary.warnings));
+  }
+  if (!options.annotate_dir.empty()) fs::create_directories(options.annotate_dir);
+  if (options.out_path.empty()) {
+    ProcessFrames(options, &run, out, true, &summary);
+    return summary;
+  }
+  AtomicFile file(options.out_path);  // removed on any exception below
+  ProcessFrames(options, &run, file.stream(), false, &summary);
+  file.Commit();
+  return summary;
+}
+
+int RunDetect(int argc, char** argv) {
+  DetectCommandOptions options;
+  CLI::App cli(
+      "Detect lines with the OAL detector. Prints one JSON object per frame (JSON "
+      "Lines) to stdout, or writes them to --out.",
+      "oalservo detect");
+  cli.add_option("INPUT", options.inputs,
+                 "image, directory of images, printf pattern (frames/img%04d.png), video file, "
+                 "or V4L2 device /dev/videoN")
+      ->required();
+  cli.add_option("--config", options.config_path, "YAML configuration (see config/detector.yaml)");
+  cli.add_flag("--paper", options.paper,
+               "start from the paper's algorithm (every remedy off); --config still overrides");
+  cli.add_option("--camera", options.camera_path,
+                 "ViSP camera XML; with distortion (kdu), lines are in undistorted pixels");
+  cli.add_option("--camera-name", options.camera_name,
+                 "camera to read from --camera (default: the first in the file)");
+  cli.add_option("--out", options.out_path, "JSON Lines output file (written atomically)");
+  cli.add_option("--annotate", options.annotate_dir,
+                 "directory for one PNG per frame with the lines drawn (created if missing)");
+  cli.add_option("--max-frames", options.max_frames, "stop after N frames (0: all)");
+  cli.footer(
+      "Examples:\n"
+      "  oalservo detect frames/ --out lines.jsonl --annotate annotated/\n"
+      "  oalservo detect data/ --camera data/camera.xml\n"
+      "  oalservo detect '/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm' "
+      "--config edges.yaml\n"
+      "  oalservo detect /dev/video0 --max-frames 100");
+  if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  const DetectSummary summary = DetectImages(options, std::cout);
+  for (const std::string& warning : summary.warnings) Warn("detect", warning);
+  if (!options.out_path.empty()) {
+    std::cerr << "oalservo detect: " << summary.frames << " frames, " << summary.lines
+              << " lines written to " << options.out_path << '\n';
+  }
+  return kExitOk;
+}
+
+}  // namespace oal

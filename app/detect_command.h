@@ -1,0 +1,55 @@
+// `oalservo detect`: the OAL detector over images, a directory, a printf pattern, a video or
+// a V4L2 camera, one JSON object per frame (JSON Lines).
+//
+//   {"frame":0,"source":"x.png","width":640,"height":480,"time_us":312.5,
+//    "coordinates":"image","lines":[{"rho":..,"theta":..,"votes":..,"count":..,"borders":..,
+//    "support":..,"width":..,"end_a":[u,v],"end_b":[u,v]}, ...]}
+//
+// `coordinates` is "undistorted" when a camera with distortion (kdu != 0) was given: the
+// lines are then those an ideal pinhole camera would see (detector.h).
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace oal {
+
+struct DetectCommandOptions {
+  /// Image, directory, printf pattern, video or /dev/videoN; read one after the other.
+  std::vector<std::string> inputs;
+  /// YAML configuration (config/detector.yaml); empty: none.
+  std::string config_path;
+  /// Start from DetectorOptions::Paper() instead of the defaults; the config still overrides.
+  bool paper = false;
+  /// ViSP camera XML; empty: no camera (lines in image coordinates).
+  std::string camera_path;
+  /// Camera to read from camera_path; empty: the first camera of the file.
+  std::string camera_name;
+  /// JSON Lines output, written atomically; empty: the stream passed to DetectImages().
+  std::string out_path;
+  /// Directory for one annotated PNG per frame (lines_0000.png...); empty: none.
+  std::string annotate_dir;
+  /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
+  int max_frames = 0;
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+struct DetectSummary {
+  int frames = 0;
+  int lines = 0;
+  /// For the user (skipped files, camera size mismatch); the caller prints them.
+  std::vector<std::string> warnings;
+};
+
+/// Detects lines in every frame of every input. Output goes to options.out_path (atomically:
+/// nothing is left there on error) or, without one, to `out`, flushed after each frame.
+/// Throws std::runtime_error / std::invalid_argument on bad input or configuration.
+DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& out);
+
+/// `oalservo detect ...`; argv[0] is "detect".
+int RunDetect(int argc, char** argv);
+
+}  // namespace oal

@@ -1,0 +1,123 @@
+#include "app/detector_accuracy_command.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/atomic_file.h"
+#include "app/command_line.h"
+#include "app/config.h"
+#include "app/detector_accuracy.h"
+
+namespace oal {
+namespace {
+
+std::string Table(const AccuracyReport& report) {
+  std::ostringstream out;
+  out << std::fixed;
+  out << "| method | compared with | frames | failed | failure rate | angle err median / p95 (deg) "
+         "| offset err median / p95 (px) | time median (us) |\n"
+      << "|---|---|---:|---:|---:|---:|---:|---:|\n";
+  for (const MethodAccuracy& m : report.methods) {
+    out << "| " << m.name << " | " << m.reference << " | " << m.frames << " | " << m.failed_frames
+        << " | " << std::setprecision(1) << 100.0 * m.FailureRate() << " % | "
+        << std::setprecision(3) << Quantile(m.angle_error_deg, 0.5) << " / "
+        << Quantile(m.angle_error_deg, 0.95) << " | " << Quantile(m.offset_error_px, 0.5) << " / "
+        << Quantile(m.offset_error_px, 0.95) << " | " << std::setprecision(1)
+        << Quantile(m.time_us, 0.5) << " |\n";
+  }
+  return out.str();
+}
+
+nlohmann::json ToJson(const AccuracyReport& report) {
+  const AccuracyOptions& o = report.options;
+  nlohmann::json json;
+  json["options"] = {{"target", o.target},
+                     {"frames", o.frames},
+                     {"seed", o.seed},
+                     {"width", o.width},
+                     {"height", o.height},
+                     {"focal_px", o.focal_px},
+                     {"kdu", o.kdu},
+                     {"noise_sigma", o.noise_sigma},
+                     {"blur_sigma_px", o.blur_sigma_px},
+                     {"illumination_gradient", o.illumination_gradient},
+                     {"max_angle_deg", o.max_angle_deg},
+                     {"max_offset_px", o.max_offset_px},
+                     {"min_visible_length_px", o.sampling.min_visible_length_px}};
+  for (const MethodAccuracy& m : report.methods) {
+    json["methods"].push_back({{"name", m.name},
+                               {"reference", m.reference},
+                               {"frames", m.frames},
+                               {"failed_frames", m.failed_frames},
+                               {"failure_rate", m.FailureRate()},
+                               {"angle_error_deg_median", Quantile(m.angle_error_deg, 0.5)},
+                               {"angle_error_deg_p95", Quantile(m.angle_error_deg, 0.95)},
+                               {"offset_error_px_median", Quantile(m.offset_error_px, 0.5)},
+                               {"offset_error_px_p95", Quantile(m.offset_error_px, 0.95)},
+                               {"time_us_median", Quantile(m.time_us, 0.5)},
+                               {"failed_frame_indices", m.failed_frame_indices}});
+  }
+  return json;
+}
+
+}  // namespace
+
+int RunDetectAccuracy(int argc, char** argv) {
+  CLI::App cli{
+      "Accuracy of the detector on rendered frames with ground truth (fixed seeds): our "
+      "detector with and without point undistortion, the paper's algorithm, and OpenCV "
+      "HoughLines on the same frames. A frame fails when any target line is missing from the "
+      "first N lines or is off by more than --max-angle-deg or --max-offset-px (offset: the "
+      "largest distance of the true visible chord's ends from the detected line).",
+      "oalservo detect-accuracy"};
+  AccuracyOptions options;
+  std::string config_path, out_path;
+  cli.add_option("--target", options.target, "two-line or four-line")->capture_default_str();
+  cli.add_option("--frames", options.frames, "number of rendered frames")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  cli.add_option("--seed", options.seed, "seed of poses and noise")->capture_default_str();
+  cli.add_option("--kdu", options.kdu, "lens distortion (ViSP kdu; 0.33 = cheap wide lens)")
+      ->capture_default_str();
+  cli.add_option("--noise", options.noise_sigma, "noise sigma, grey levels")->capture_default_str();
+  cli.add_option("--blur", options.blur_sigma_px, "blur sigma, pixels")->capture_default_str();
+  cli.add_option("--gradient", options.illumination_gradient, "illumination fall-off, 0..0.9")
+      ->capture_default_str();
+  cli.add_option("--min-visible-px", options.sampling.min_visible_length_px,
+                 "every target line crosses at least this much of the image")
+      ->capture_default_str();
+  cli.add_option("--max-tilt-deg", options.sampling.max_tilt_deg, "camera tilt bound")
+      ->capture_default_str();
+  cli.add_option("--max-angle-deg", options.max_angle_deg, "failure bound on angle")
+      ->capture_default_str();
+  cli.add_option("--max-offset-px", options.max_offset_px, "failure bound on offset")
+      ->capture_default_str();
+  cli.add_option("--config", config_path, "YAML config (detector section) for our detector")
+      ->check(CLI::ExistingFile);
+  cli.add_option("--out", out_path, "write the report as JSON to this file");
+  if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+
+  if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
+  const bool tty = isatty(fileno(stderr));
+  const AccuracyReport report = EvaluateDetectorAccuracy(options, [&](int done, int total) {
+    if (tty && (done % 20 == 0 || done == total)) {
+      std::cerr << "\rframe " << done << " / " << total << std::flush;
+      if (done == total) std::cerr << '\n';
+    }
+  });
+  std::cout << Table(report);
+  if (!out_path.empty()) {
+    AtomicFile file(out_path);
+    file.stream() << ToJson(report).dump(2) << '\n';
+    file.Commit();
+  }
+  return kExitOk;
+}
+
+}  // namespace oal

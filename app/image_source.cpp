@@ -1,0 +1,296 @@
+#include "app/image_source.h"
+
+#include <visp3/core/vpConfig.h>
+#include <visp3/core/vpException.h>
+#include <visp3/core/vpImage.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <optional>
+#include <stdexcept>
+#ifdef VISP_HAVE_V4L2
+#include <visp3/sensor/vpV4l2Grabber.h>
+#endif
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Quoted(const fs::path& path) {
+  return "'" + path.string() + "'";
+}
+
+std::string LowerExtension(const std::string& path) {
+  std::string extension = fs::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+bool OneOf(const std::string& value, std::initializer_list<const char*> choices) {
+  return std::any_of(choices.begin(), choices.end(),
+                     [&value](const char* choice) { return value == choice; });
+}
+
+cv::Mat DecodeGray(const fs::path& path) {
+  if (!fs::exists(path)) throw std::runtime_error("no such file " + Quoted(path));
+  cv::Mat gray = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  if (gray.empty()) {
+    throw std::runtime_error("cannot decode image " + Quoted(path) +
+                             " (not an image, truncated, or a format OpenCV cannot read)");
+  }
+  return gray;
+}
+
+// A list of image files, decoded one at a time.
+class ImageListSource : public ImageSource {
+ public:
+  ImageListSource(std::string name, std::vector<fs::path> paths, cv::Mat first = cv::Mat())
+      : name_(std::move(name)), paths_(std::move(paths)), first_(std::move(first)) {}
+
+  bool Next(Frame* frame) override {
+    if (next_ >= paths_.size()) return false;
+    const fs::path& path = paths_[next_];
+    frame->gray = (next_ == 0 && !first_.empty()) ? first_ : DecodeGray(path);
+    frame->source = path.string();
+    ++next_;
+    return true;
+  }
+  std::string Name() const override { return name_; }
+
+ private:
+  std::string name_;
+  std::vector<fs::path> paths_;
+  cv::Mat first_;  ///< decoded at open time to report a bad single image early
+  std::size_t next_ = 0;
+};
+
+std::unique_ptr<ImageSource> OpenImageFile(const std::string& spec) {
+  // Decoded now, so a bad image fails before any output is started.
+  cv::Mat first = DecodeGray(spec);
+  return std::make_unique<ImageListSource>("image " + Quoted(spec), std::vector<fs::path>{spec},
+                                           std::move(first));
+}
+
+std::string SkippedWarning(const fs::path& directory, const std::vector<std::string>& skipped) {
+  constexpr std::size_t kListed = 3;
+  std::string names;
+  for (std::size_t i = 0; i < skipped.size() && i < kListed; ++i) {
+    names += (i == 0 ? "" : ", ") + skipped[i];
+  }
+  if (skipped.size() > kListed) names += ", ...";
+  return "skipped " + std::to_string(skipped.size()) + " non-image entr" +
+         (skipped.size() == 1 ? "y" : "ies") + " in " + Quoted(directory) + ": " + names;
+}
+
+std::unique_ptr<ImageSource> OpenDirectory(const fs::path& directory,
+                                           std::vector<std::string>* warnings) {
+  std::vector<fs::path> images;
+  std::vector<std::string> skipped;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory)) {
+    if (entry.is_regular_file() && HasImageExtension(entry.path().string())) {
+      images.push_back(entry.path());
+    } else {
+      skipped.push_back(entry.path().filename().string());
+    }
+  }
+  if (images.empty()) throw std::runtime_error("directory " + Quoted(directory) + " has no images");
+  std::sort(images.begin(), images.end(), [](const fs::path& a, const fs::path& b) {
+    return a.filename().string() < b.filename().string();
+  });
+  std::sort(skipped.begin(), skipped.end());
+  if (!skipped.empty() && warnings != nullptr)
+    warnings->push_back(SkippedWarning(directory, skipped));
+  return std::make_unique<ImageListSource>("directory " + Quoted(directory), std::move(images));
+}
+
+std::unique_ptr<ImageSource> OpenPattern(const std::string& pattern) {
+  int index = 0;
+  if (!fs::exists(ExpandPattern(pattern, 0))) index = 1;
+  if (!fs::exists(ExpandPattern(pattern, index))) {
+    throw std::runtime_error("no file matches the pattern '" + pattern + "' (tried '" +
+                             ExpandPattern(pattern, 0) + "' and '" + ExpandPattern(pattern, 1) +
+                             "')");
+  }
+  std::vector<fs::path> paths;
+  for (; fs::exists(ExpandPattern(pattern, index)); ++index) {
+    paths.emplace_back(ExpandPattern(pattern, index));
+  }
+  return std::make_unique<ImageListSource>("pattern '" + pattern + "'", std::move(paths));
+}
+
+cv::Mat ToGray(const cv::Mat& image) {
+  if (image.channels() == 1) return image;
+  cv::Mat gray;
+  cv::cvtColor(image, gray, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return gray;
+}
+
+class VideoSource : public ImageSource {
+ public:
+  explicit VideoSource(const std::string& path) : path_(path) {
+    if (!capture_.open(path) || !capture_.isOpened()) {
+      throw std::runtime_error("cannot open video " + Quoted(path) +
+                               " (not a video, or no decoder for it)");
+    }
+    // The first frame is read now, so an empty video fails before any output is started.
+    if (!capture_.read(buffer_) || buffer_.empty()) {
+      throw std::runtime_error("video " + Quoted(path) + " has no frames");
+    }
+    pending_ = true;
+  }
+
+  bool Next(Frame* frame) override {
+    if (!pending_ && (!capture_.read(buffer_) || buffer_.empty())) return false;
+    pending_ = false;
+    frame->gray = ToGray(buffer_);
+    frame->source = path_ + "#" + std::to_string(index_++);
+    return true;
+  }
+  std::string Name() const override { return "video " + Quoted(path_); }
+
+ private:
+  std::string path_;
+  cv::VideoCapture capture_;
+  cv::Mat buffer_;
+  bool pending_ = false;
+  int index_ = 0;
+};
+
+#ifdef VISP_HAVE_V4L2
+class V4l2Source : public ImageSource {
+ public:
+  explicit V4l2Source(const std::string& device) : device_(device) {
+    grabber_.setDevice(device);
+    grabber_.setInput(0);  // USB cameras have one input; ViSP's default (2) is for TV boards
+    grabber_.setScale(1);  // full resolution; ViSP's default halves it
+    try {
+      grabber_.open(image_);
+    } catch (const vpException& error) {
+      throw std::runtime_error("cannot open V4L2 device '" + device +
+                               "': " + error.getStringMessage());
+    }
+  }
+
+  bool Next(Frame* frame) override {
+    try {
+      grabber_.acquire(image_);
+    } catch (const vpException& error) {
+      throw std::runtime_error("cannot grab from V4L2 device '" + device_ +
+                               "': " + error.getStringMessage());
+    }
+    // A header over ViSP's buffer: no copy, valid until the next acquire.
+    frame->gray = cv::Mat(static_cast<int>(image_.getHeight()), static_cast<int>(image_.getWidth()),
+                          CV_8UC1, image_.bitmap);
+    frame->source = device_ + "#" + std::to_string(index_++);
+    return true;
+  }
+  std::string Name() const override { return "V4L2 device '" + device_ + "'"; }
+
+ private:
+  std::string device_;
+  vpV4l2Grabber grabber_;
+  vpImage<unsigned char> image_;
+  int index_ = 0;
+};
+#endif
+
+std::unique_ptr<ImageSource> OpenDevice(const std::string& device) {
+  if (!fs::exists(device)) throw std::runtime_error("no V4L2 device at " + device);
+#ifdef VISP_HAVE_V4L2
+  return std::make_unique<V4l2Source>(device);
+#else
+  throw std::runtime_error("cannot read " + device + ": this ViSP build has no V4L2 support");
+#endif
+}
+
+bool IsDevicePath(const std::string& spec) {
+  return spec.rfind("/dev/video", 0) == 0 || spec.rfind("/dev/v4l/", 0) == 0;
+}
+
+// Parsed "prefix%0<width>dsuffix"; "%%" stands for a literal '%'.
+struct Pattern {
+  std::string prefix, suffix;
+  int width = 0;
+  bool zero_pad = false;
+};
+
+Pattern ParsePattern(const std::string& text) {
+  Pattern pattern;
+  bool found = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    std::string& out = found ? pattern.suffix : pattern.prefix;
+    if (text[i] != '%') {
+      out += text[i];
+      continue;
+    }
+    if (i + 1 < text.size() && text[i + 1] == '%') {
+      out += '%';
+      ++i;
+      continue;
+    }
+    std::size_t j = i + 1;
+    const bool zero = j < text.size() && text[j] == '0';
+    if (zero) ++j;
+    int width = 0;
+    for (; j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])) && width < 100;
+         ++j) {
+      width = width * 10 + (text[j] - '0');
+    }
+    if (found || j >= text.size() || text[j] != 'd') {
+      throw std::runtime_error("pattern '" + text +
+                               "' must have exactly one %d conversion, e.g. img%04d.png");
+    }
+    pattern.zero_pad = zero;
+    pattern.width = width;
+    found = true;
+    i = j;
+  }
+  if (!found) throw std::runtime_error("pattern '" + text + "' has no %d conversion");
+  return pattern;
+}
+
+}  // namespace
+
+bool HasImageExtension(const std::string& path) {
+  return OneOf(LowerExtension(path),
+               {".png", ".pgm", ".ppm",  ".pnm",  ".pbm", ".pam", ".jpg", ".jpeg", ".jpe", ".bmp",
+                ".dib", ".tif", ".tiff", ".webp", ".jp2", ".sr",  ".ras", ".exr",  ".hdr", ".pic"});
+}
+
+bool HasVideoExtension(const std::string& path) {
+  return OneOf(LowerExtension(path),
+               {".avi", ".mp4", ".mkv", ".mov", ".webm", ".mpg", ".mpeg", ".m4v", ".wmv", ".flv",
+                ".ogv", ".3gp", ".mjpg", ".mjpeg", ".h264", ".ts"});
+}
+
+std::string ExpandPattern(const std::string& text, int index) {
+  const Pattern pattern = ParsePattern(text);
+  std::string number = std::to_string(index);
+  if (static_cast<int>(number.size()) < pattern.width) {
+    number.insert(0, static_cast<std::size_t>(pattern.width) - number.size(),
+                  pattern.zero_pad ? '0' : ' ');
+  }
+  return pattern.prefix + number + pattern.suffix;
+}
+
+std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
+                                             std::vector<std::string>* warnings) {
+  if (spec.empty()) throw std::runtime_error("empty input name");
+  if (IsDevicePath(spec)) return OpenDevice(spec);
+  if (spec.find('%') != std::string::npos && !fs::exists(spec)) return OpenPattern(spec);
+  if (!fs::exists(spec)) throw std::runtime_error("no such file or directory '" + spec + "'");
+  if (fs::is_directory(spec)) return OpenDirectory(spec, warnings);
+  if (HasVideoExtension(spec)) return std::make_unique<VideoSource>(spec);
+  if (HasImageExtension(spec) || cv::haveImageReader(spec)) return OpenImageFile(spec);
+  throw std::runtime_error("unsupported input '" + spec +
+                           "' (expected an image, a directory of images, a printf pattern such "
+                           "as img%04d.png, a video or /dev/videoN)");
+}
+
+}  // namespace oal

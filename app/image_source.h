@@ -1,0 +1,58 @@
+// Where `oalservo detect` gets its frames. One spec names one source:
+//
+//   x.png                 one image (any format OpenCV decodes)
+//   frames/               the images of a directory, sorted by file name; other files are
+//                         skipped with a warning
+//   frames/img%04d.png    a printf pattern: indices from 0 (or 1 if there is no 0) until the
+//                         first missing file; only one %d conversion (with optional 0 and width)
+//   x.avi, x.mp4, ...     a video (cv::VideoCapture)
+//   /dev/videoN           a V4L2 camera (vpV4l2Grabber), until stopped
+//
+// Frames come out as 8-bit grey cv::Mat, viewed by the detector without a copy.
+#pragma once
+
+#include <memory>
+#include <opencv2/core/mat.hpp>
+#include <string>
+#include <vector>
+
+#include "detector/image_view.h"
+
+namespace oal {
+
+struct Frame {
+  cv::Mat gray;        ///< CV_8UC1; may share memory with the source until its next Next()
+  std::string source;  ///< image path, or "<video or device>#<index in that source>"
+
+  GrayImageView view() const {
+    return GrayImageView{gray.data, gray.cols, gray.rows, static_cast<std::ptrdiff_t>(gray.step)};
+  }
+};
+
+class ImageSource {
+ public:
+  virtual ~ImageSource() = default;
+  /// Reads the next frame into `frame`; false at the end of the source. Throws
+  /// std::runtime_error naming the file when a frame cannot be read or decoded.
+  virtual bool Next(Frame* frame) = 0;
+  /// What is being read, for messages, e.g. "directory 'frames'".
+  virtual std::string Name() const = 0;
+};
+
+/// Opens the source named by `spec` (see the file comment). Throws std::runtime_error with
+/// the reason for a missing file, an undecodable image ("cannot decode image 'x.png'"), a
+/// video without frames, a missing device and an unsupported input. Files skipped in a
+/// directory are reported in `warnings` (if given).
+std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
+                                             std::vector<std::string>* warnings = nullptr);
+
+/// True if `path` has the extension of an image format OpenCV reads (case-insensitive).
+bool HasImageExtension(const std::string& path);
+/// True if `path` has the extension of a video container.
+bool HasVideoExtension(const std::string& path);
+
+/// Expands a printf pattern with one %d conversion ("img%04d.png", 7 -> "img0007.png").
+/// Throws std::runtime_error if `pattern` has no such conversion or more than one.
+std::string ExpandPattern(const std::string& pattern, int index);
+
+}  // namespace oal

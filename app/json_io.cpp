@@ -1,0 +1,62 @@
+#include "app/json_io.h"
+
+#include <visp3/core/vpThetaUVector.h>
+#include <visp3/core/vpTranslationVector.h>
+
+namespace oal {
+
+Json PointJson(const Point2d& point) {
+  return Json::array({point.u, point.v});
+}
+
+Json LineJson(const LineParams& line) {
+  return Json{{"rho", line.rho_px}, {"theta", line.theta_rad}};
+}
+
+Json DetectedLineJson(const DetectedLine& line) {
+  return Json{{"rho", line.line.rho_px},       {"theta", line.line.theta_rad},
+              {"votes", line.votes},           {"count", line.count},
+              {"borders", line.borders},       {"support", line.support},
+              {"width", line.width_px},        {"end_a", PointJson(line.end_a)},
+              {"end_b", PointJson(line.end_b)}};
+}
+
+Json TruthLineJson(const TruthLine& line) {
+  return Json{{"index", line.index},
+              {"visible", line.visible},
+              {"ideal", LineJson(line.ideal)},
+              {"distorted_fit", LineJson(line.distorted_fit)},
+              {"end_a", PointJson(line.end_a)},
+              {"end_b", PointJson(line.end_b)},
+              {"visible_length_px", line.visible_length_px},
+              {"width_px", line.width_px}};
+}
+
+Json PoseJson(const vpHomogeneousMatrix& cMo) {
+  Json matrix = Json::array();
+  for (unsigned int row = 0; row < 4; ++row) {
+    matrix.push_back(Json::array({cMo[row][0], cMo[row][1], cMo[row][2], cMo[row][3]}));
+  }
+  const vpTranslationVector t = cMo.getTranslationVector();
+  const vpThetaUVector tu = cMo.getThetaUVector();
+  return Json{{"matrix", matrix},
+              {"translation_m", Json::array({t[0], t[1], t[2]})},
+              {"theta_u_rad", Json::array({tu[0], tu[1], tu[2]})}};
+}
+
+Json CameraJson(const vpCameraParameters& camera, int width, int height) {
+  const bool distortion =
+      camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion;
+  return Json{
+      {"model", distortion ? "perspectiveProjWithDistortion" : "perspectiveProjWithoutDistortion"},
+      {"px", camera.get_px()},
+      {"py", camera.get_py()},
+      {"u0", camera.get_u0()},
+      {"v0", camera.get_v0()},
+      {"kud", distortion ? camera.get_kud() : 0.0},
+      {"kdu", distortion ? camera.get_kdu() : 0.0},
+      {"width", width},
+      {"height", height}};
+}
+
+}  // namespace oal

@@ -1,0 +1,31 @@
+// JSON forms of the detector's and the renderer's results, shared by the commands so that a
+// line, a pose or a camera reads the same in every file oalservo writes.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <nlohmann/json.hpp>
+
+#include "detector/detector.h"
+#include "scene/scene.h"
+
+namespace oal {
+
+/// Keys keep the order they are written in, so files read naturally.
+using Json = nlohmann::ordered_json;
+
+/// [u, v]
+Json PointJson(const Point2d& point);
+/// {rho, theta}: pixels, radians (detector/line.h convention).
+Json LineJson(const LineParams& line);
+/// {rho, theta, votes, count, borders, support, width, end_a, end_b}
+Json DetectedLineJson(const DetectedLine& line);
+/// {index, visible, ideal, distorted_fit, end_a, end_b, visible_length_px, width_px}
+Json TruthLineJson(const TruthLine& line);
+/// {matrix: 4x4 rows, translation_m: [x,y,z], theta_u_rad: [tux,tuy,tuz]}
+Json PoseJson(const vpHomogeneousMatrix& cMo);
+/// {model, px, py, u0, v0, kud, kdu, width, height}
+Json CameraJson(const vpCameraParameters& camera, int width, int height);
+
+}  // namespace oal

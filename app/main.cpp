@@ -1,0 +1,88 @@
+// oalservo: one executable, one subcommand per task (like colmap's exe). This file is only
+// the command table, --help and --version; each command lives in app/<name>_command.cpp,
+// whose Run* function parses its arguments and calls a plain function that tests call
+// directly. To add a command: include its header and add one row to kCommands.
+#include <cstring>
+#include <exception>
+#include <iomanip>
+#include <iostream>
+#include <opencv2/core/utils/logger.hpp>
+#include <string>
+
+#include "app/command_line.h"
+#include "app/demo_command.h"
+#include "app/detect_command.h"
+#include "app/detector_accuracy_command.h"
+#include "app/render_command.h"
+
+#ifndef OAL_VERSION
+#define OAL_VERSION "unknown"
+#endif
+
+namespace {
+
+constexpr oal::Command kCommands[] = {
+    {"detect", &oal::RunDetect, "detect lines in images, a directory, a video or a V4L2 camera"},
+    {"detect-accuracy", &oal::RunDetectAccuracy,
+     "accuracy of the detector on rendered frames, against the paper and OpenCV"},
+    {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
+    {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
+};
+
+void PrintUsage(std::ostream& out) {
+  out << "oalservo " << OAL_VERSION << ": OAL Hough line detection and visual servoing\n\n"
+      << "Usage: oalservo <command> [options]\n"
+      << "       oalservo --help | --version\n\nCommands:\n";
+  for (const oal::Command& command : kCommands) {
+    out << "  " << std::left << std::setw(18) << command.name << command.help << '\n';
+  }
+  out << "\nRun 'oalservo <command> --help' for the options of a command.\n";
+}
+
+const oal::Command* FindCommand(const std::string& name) {
+  for (const oal::Command& command : kCommands) {
+    if (name == command.name) return &command;
+  }
+  return nullptr;
+}
+
+int RunCommand(const oal::Command& command, int argc, char** argv) {
+  try {
+    return command.run(argc, argv);
+  } catch (const oal::UsageError& error) {
+    std::cerr << "oalservo " << command.name << ": error: " << error.what() << '\n';
+    return oal::kExitUsage;
+  } catch (const std::exception& error) {
+    std::cerr << "oalservo " << command.name << ": error: " << error.what() << '\n';
+    return oal::kExitError;
+  } catch (...) {
+    std::cerr << "oalservo " << command.name << ": error: unknown exception\n";
+    return oal::kExitError;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // OpenCV's own warnings ("imread_(...): can't open/read file") would repeat our errors.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  if (argc < 2) {
+    PrintUsage(std::cerr);
+    return oal::kExitUsage;
+  }
+  const std::string first = argv[1];
+  if (first == "--help" || first == "-h" || first == "help") {
+    PrintUsage(std::cout);
+    return oal::kExitOk;
+  }
+  if (first == "--version") {
+    std::cout << "oalservo " << OAL_VERSION << '\n';
+    return oal::kExitOk;
+  }
+  const oal::Command* command = FindCommand(first);
+  if (command == nullptr) {
+    std::cerr << "oalservo: error: unknown command '" << first << "' (run 'oalservo --help')\n";
+    return oal::kExitUsage;
+  }
+  return RunCommand(*command, argc - 1, argv + 1);
+}

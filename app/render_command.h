@@ -1,0 +1,49 @@
+// `oalservo render`: a synthetic data set with ground truth, laid out so that
+// `oalservo detect DIR --camera DIR/camera.xml` runs on it:
+//
+//   DIR/frame_0000.png    8-bit grey frame
+//   DIR/frame_0000.json   ground truth: pose cMo, camera, one entry per target line
+//   DIR/camera.xml        ViSP camera file, camera "oal-render", perspectiveProjWithDistortion
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+
+#include <cstdint>
+#include <string>
+
+namespace oal {
+
+struct RenderCommandOptions {
+  std::string target = "four-line";  ///< "two-line" or "four-line"
+  int count = 10;                    ///< frames, [1, 100000]
+  std::uint64_t seed = 1;            ///< poses and noise are a function of it
+  std::string out_dir;               ///< created if missing; required
+  int width = 640;                   ///< pixels, [16, 8192]
+  int height = 480;                  ///< pixels, [16, 8192]
+  double fx_px = 600.0;              ///< focal length, pixels (fy = fx), > 0
+  double kdu = 0.0;                  ///< ViSP distortion, distorted -> undistorted; 0: none
+  double noise_sigma = 0.0;          ///< Gaussian noise, grey levels, [0, 100]
+  double blur_sigma_px = 0.0;        ///< Gaussian blur, pixels, [0, 20]
+  double gradient = 0.0;             ///< illumination fall-off across the image, [0, 0.9]
+  std::string background_image;      ///< grey image around the board; empty: uniform
+  double min_distance_m = 0.4;       ///< camera to board, metres, > 0
+  double max_distance_m = 0.9;       ///< metres, >= min_distance_m
+  double max_tilt_deg = 30.0;        ///< optical axis to board normal, degrees, [0, 80]
+  double min_visible_px = 0.0;       ///< each line's visible length at least this, pixels
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// The camera of a rendered data set: fx = fy = `fx_px`, principal point at the image centre
+/// ((w-1)/2, (h-1)/2), model perspectiveProjWithDistortion with `kdu` and kud = FitKud().
+vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu);
+
+/// Renders options.count frames into options.out_dir (every file written atomically).
+/// Returns the number of frames written; throws on bad options or I/O errors.
+int RenderDataset(const RenderCommandOptions& options);
+
+/// `oalservo render ...`; argv[0] is "render".
+int RunRender(int argc, char** argv);
+
+}  // namespace oal

@@ -1,0 +1,125 @@
+#include "app/render_command.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "app/camera_file.h"
+#include "scene/scene.h"
+#include "tests/app/test_util.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+RenderCommandOptions SmallRender(const std::string& out_dir) {
+  RenderCommandOptions options;
+  options.out_dir = out_dir;
+  options.count = 3;
+  options.seed = 3;
+  options.width = 160;
+  options.height = 120;
+  options.fx_px = 150.0;
+  options.kdu = 0.2;
+  options.noise_sigma = 3.0;
+  options.min_visible_px = 30.0;
+  return options;
+}
+
+TEST(Render, WritesFramesTruthAndCamera) {
+  test::TestDir dir;
+  const RenderCommandOptions options = SmallRender(dir / "data");
+  EXPECT_EQ(RenderDataset(options), 3);
+  for (int i = 0; i < 3; ++i) {
+    const std::string stem = options.out_dir + "/frame_000" + std::to_string(i);
+    const cv::Mat image = cv::imread(stem + ".png", cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << stem;
+    EXPECT_EQ(image.type(), CV_8UC1);
+    EXPECT_EQ(image.cols, 160);
+    EXPECT_EQ(image.rows, 120);
+    const json truth = json::parse(test::ReadText(stem + ".json"));
+    EXPECT_EQ(truth.at("frame"), i);
+    EXPECT_EQ(truth.at("image"), "frame_000" + std::to_string(i) + ".png");
+    EXPECT_EQ(truth.at("cMo").at("matrix").size(), 4u);
+    EXPECT_EQ(truth.at("cMo").at("matrix")[3], json::array({0.0, 0.0, 0.0, 1.0}));
+    EXPECT_EQ(truth.at("cMo").at("translation_m").size(), 3u);
+    EXPECT_EQ(truth.at("cMo").at("theta_u_rad").size(), 3u);
+    EXPECT_EQ(truth.at("camera").at("kdu"), 0.2);
+    EXPECT_EQ(truth.at("camera").at("u0"), 79.5);
+    ASSERT_EQ(truth.at("lines").size(), 4u);  // the four-line target
+    for (const json& line : truth.at("lines")) {
+      EXPECT_TRUE(line.at("visible").get<bool>());
+      EXPECT_GE(line.at("visible_length_px").get<double>(), 30.0);
+      for (const char* key : {"index", "ideal", "distorted_fit", "end_a", "end_b", "width_px"}) {
+        EXPECT_TRUE(line.contains(key)) << key;
+      }
+    }
+  }
+  const CameraFile camera = LoadCameraFile(options.out_dir + "/camera.xml");
+  EXPECT_EQ(camera.name, "oal-render");
+  EXPECT_EQ(camera.width, 160u);
+  EXPECT_EQ(camera.height, 120u);
+  EXPECT_EQ(camera.camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
+  EXPECT_DOUBLE_EQ(camera.camera.get_kdu(), 0.2);
+  EXPECT_NEAR(camera.camera.get_kud(), FitKud(camera.camera, 160, 120), 1e-9);
+  EXPECT_LT(camera.camera.get_kud(), 0.0);  // barrel: the inverse of a positive kdu
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+TEST(Render, SameSeedSameFiles) {
+  test::TestDir dir;
+  RenderCommandOptions a = SmallRender(dir / "a"), b = SmallRender(dir / "b");
+  a.count = b.count = 2;
+  RenderDataset(a);
+  RenderDataset(b);
+  for (const char* name : {"frame_0000.png", "frame_0001.png", "frame_0001.json"}) {
+    EXPECT_EQ(test::ReadText(dir / (std::string("a/") + name)),
+              test::ReadText(dir / (std::string("b/") + name)))
+        << name;
+  }
+  RenderCommandOptions c = SmallRender(dir / "c");
+  c.count = 1;
+  c.seed = 4;
+  RenderDataset(c);
+  EXPECT_NE(test::ReadText(dir / "a/frame_0000.json"), test::ReadText(dir / "c/frame_0000.json"));
+}
+
+TEST(Render, CameraHasThePrincipalPointAtTheCentre) {
+  const vpCameraParameters camera = RenderCamera(640, 480, 600.0, 0.0);
+  EXPECT_EQ(camera.get_u0(), 319.5);
+  EXPECT_EQ(camera.get_v0(), 239.5);
+  EXPECT_EQ(camera.get_px(), 600.0);
+  EXPECT_EQ(camera.get_py(), 600.0);
+  EXPECT_EQ(camera.get_kdu(), 0.0);
+  EXPECT_EQ(camera.get_kud(), 0.0);
+}
+
+TEST(Render, BadOptionsNameTheField) {
+  test::TestDir dir;
+  RenderCommandOptions options = SmallRender(dir / "data");
+  options.count = 0;
+  try {
+    RenderDataset(options);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("RenderCommandOptions::count = 0"));
+  }
+  options = SmallRender(dir / "data");
+  options.target = "three-line";
+  EXPECT_THROW(RenderDataset(options), std::invalid_argument);
+  options = SmallRender(dir / "data");
+  options.background_image = dir / "missing.png";
+  EXPECT_THROW(RenderDataset(options), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(dir / "data"));
+}
+
+}  // namespace
+}  // namespace oal
