@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <iterator>
+#include <limits>
 
 namespace oal {
 namespace {
@@ -26,6 +29,13 @@ void RotateSmall(double a, double* c, double* s) {
   *s = new_s * norm;
 }
 
+// FirstMatch tests kMatchLanes entries per vector, two vectors per loop iteration; the
+// match arrays are padded to whole iterations.
+constexpr int kMatchLanes = 4;  // one 16-byte SIMD register of floats
+constexpr int kMatchBlock = 2 * kMatchLanes;  // entries tested per loop iteration
+
+int RoundUpToBlocks(int n) { return (n + kMatchBlock - 1) / kMatchBlock * kMatchBlock; }
+
 }  // namespace
 
 OrderedAccumulatorList::OrderedAccumulatorList(double angle_change_rad, double r_change_px,
@@ -35,10 +45,15 @@ OrderedAccumulatorList::OrderedAccumulatorList(double angle_change_rad, double r
       r_change_px_(r_change_px),
       max_lines_(max_lines),
       capacity_(std::max(capacity, max_lines)) {
-  entries_.reserve(static_cast<std::size_t>(capacity_));
-  match_cos_.assign(static_cast<std::size_t>(capacity_), 0.0f);
-  match_sin_.assign(static_cast<std::size_t>(capacity_), 0.0f);
-  match_rho_.assign(static_cast<std::size_t>(capacity_), 0.0f);
+  const auto reserved = static_cast<std::size_t>(capacity_);
+  entries_.reserve(reserved);
+  order_.reserve(reserved);
+  merged_order_.reserve(reserved);
+  reordered_.reserve(reserved);
+  const auto padded = static_cast<std::size_t>(RoundUpToBlocks(capacity_));
+  match_cos_.assign(padded, 0.0f);
+  match_sin_.assign(padded, 0.0f);
+  match_rho_.assign(padded, 0.0f);
 }
 
 void OrderedAccumulatorList::Mirror(std::size_t i) {
@@ -51,6 +66,64 @@ void OrderedAccumulatorList::MirrorAll() {
   for (std::size_t i = 0; i < entries_.size(); ++i) Mirror(i);
 }
 
+#if defined(__GNUC__)
+// The scalar loop below, kMatchBlock entries at a time (GCC/Clang vector extensions: SSE2 on
+// x86-64, NEON on ARM). The lanes compute exactly the scalar loop's float expressions.
+int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, double rho_px) const {
+  typedef float Floats __attribute__((vector_size(4 * kMatchLanes)));
+  typedef std::int32_t Ints __attribute__((vector_size(4 * kMatchLanes)));
+  static_assert(kMatchLanes == 4, "broadcast below lists the lanes");
+  auto broadcast = [](float x) { return Floats{x, x, x, x}; };
+  auto load = [](const std::vector<float>& array, int i) {
+    Floats v;
+    std::memcpy(&v, array.data() + i, sizeof(v));
+    return v;
+  };
+  // fabs and sign flips as bit operations on the IEEE sign bit.
+  auto bits = [](Floats v) {
+    Ints b;
+    std::memcpy(&b, &v, sizeof(b));
+    return b;
+  };
+  auto floats = [](Ints b) {
+    Floats v;
+    std::memcpy(&v, &b, sizeof(v));
+    return v;
+  };
+  constexpr std::int32_t kSignBit = INT32_MIN;
+  const Floats c = broadcast(static_cast<float>(cos_theta));
+  const Floats s = broadcast(static_cast<float>(sin_theta));
+  const Ints rho = bits(broadcast(static_cast<float>(rho_px)));
+  const Floats cos_limit = broadcast(static_cast<float>(cos_angle_change_));
+  const Floats r_limit = broadcast(static_cast<float>(r_change_px_));
+  const Floats zero = broadcast(0.0f);
+  // Eq. 1 and 2 for entries [i, i + kMatchLanes): all-ones lanes match.
+  auto matches = [&](int i) {
+    const Floats dot = load(match_cos_, i) * c + load(match_sin_, i) * s;
+    const Floats abs_dot = floats(bits(dot) & ~kSignBit);
+    // A negative dot is the same line with its normal reversed: theta +- pi, -rho. (A dot
+    // of -0 would flip rho where the scalar loop does not, but it fails Eq. 1 anyway.)
+    const Floats aligned_rho = floats(rho ^ ((dot < zero) & kSignBit));
+    const Floats rho_gap = floats(bits(aligned_rho - load(match_rho_, i)) & ~kSignBit);
+    return ~(abs_dot < cos_limit) & ~(rho_gap > r_limit);
+  };
+  const int size = static_cast<int>(entries_.size());
+  for (int i = 0; i < size; i += kMatchBlock) {
+    const Ints low = matches(i), high = matches(i + kMatchLanes);
+    std::uint64_t words[2];  // one OR of both halves tells whether any lane matched
+    std::memcpy(words, &low, sizeof(words));
+    std::uint64_t any = words[0] | words[1];
+    std::memcpy(words, &high, sizeof(words));
+    if ((any | words[0] | words[1]) == 0) continue;
+    for (int k = 0; k < kMatchBlock; ++k) {
+      const bool match = k < kMatchLanes ? low[k] != 0 : high[k - kMatchLanes] != 0;
+      // Lanes past the end hold stale values: a match there means no match.
+      if (match) return i + k < size ? i + k : -1;
+    }
+  }
+  return -1;
+}
+#else
 int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, double rho_px) const {
   const float c = static_cast<float>(cos_theta), s = static_cast<float>(sin_theta);
   const float rho = static_cast<float>(rho_px);
@@ -67,6 +140,7 @@ int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, doubl
   }
   return -1;
 }
+#endif
 
 int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_px, int border) {
   const int size = static_cast<int>(entries_.size());
@@ -98,39 +172,79 @@ int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_
     return i;
   }
   if (size >= capacity_) return -1;
-  OalEntry entry;
   if (sin_theta < 0.0 || (sin_theta == 0.0 && cos_theta < 0.0)) {
     cos_theta = -cos_theta;
     sin_theta = -sin_theta;
     rho_px = -rho_px;
   }
+  // Built in place: a local entry copied in was written field by field and read back in
+  // wider moves, which stalled on store forwarding.
+  entries_.emplace_back();
+  OalEntry& entry = entries_.back();
   entry.cos_theta = cos_theta;
   entry.sin_theta = sin_theta;
   entry.theta_rad = std::atan2(sin_theta, cos_theta);
   if (entry.theta_rad >= kPi) entry.theta_rad = 0.0;
   entry.rho_px = rho_px;
   entry.last_border = border;
-  entries_.push_back(entry);
   Mirror(entries_.size() - 1);
   return size;
 }
 
+bool OrderedAccumulatorList::InsertionSort(std::vector<SortKey>::iterator first,
+                                           std::vector<SortKey>::iterator last) {
+  bool moved = false;
+  for (auto it = first == last ? last : first + 1; it != last; ++it) {
+    if (!Higher(*it, *(it - 1))) continue;  // already in place: the common case
+    // After every key at least as high (stability).
+    std::rotate(std::upper_bound(first, it, *it, Higher), it, it + 1);
+    moved = true;
+  }
+  return moved;
+}
+
+bool OrderedAccumulatorList::SortOrder() {
+  // Filled field by field: push_back of the small struct went through a stack copy that
+  // stalled on store forwarding.
+  order_.resize(entries_.size());  // within the reserved capacity
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    order_[i].double_score = entries_[i].DoubleScore();
+    order_[i].index = static_cast<int>(i);
+  }
+  // The entries that were in order after the last border are still nearly so (the paper's
+  // argument for reordering each border): only the ones voted for or not counted move.
+  // The entries new on this border are sorted apart and merged in, rather than each being
+  // inserted past the older entries.
+  const auto old_end = order_.begin() + static_cast<std::ptrdiff_t>(sorted_size_);
+  bool moved = InsertionSort(order_.begin(), old_end);
+  moved |= InsertionSort(old_end, order_.end());
+  if (old_end != order_.begin() && old_end != order_.end() && Higher(*old_end, *(old_end - 1))) {
+    merged_order_.clear();
+    // std::merge is stable: of equal keys, the older entry stays first.
+    std::merge(order_.begin(), old_end, old_end, order_.end(),
+               std::back_inserter(merged_order_), Higher);
+    order_.swap(merged_order_);
+    moved = true;
+  }
+  return moved;
+}
+
 void OrderedAccumulatorList::SortAndCull() {
-  // Insertion sort: stable, allocation-free, and near-linear because the order changes
-  // little from one border to the next (the paper's argument for reordering each border).
-  for (std::size_t i = 1; i < entries_.size(); ++i) {
-    OalEntry moving = entries_[i];
-    std::size_t j = i;
-    while (j > 0 && entries_[j - 1].Score() < moving.Score()) {
-      entries_[j] = entries_[j - 1];
-      --j;
+  const bool moved = SortOrder();
+  // Entries past the culling point are never copied.
+  std::size_t keep = order_.size();
+  while (static_cast<int>(keep) > max_lines_ && order_[keep - 1].double_score < 0) --keep;
+  if (moved) {
+    reordered_.clear();
+    for (std::size_t k = 0; k < keep; ++k) {
+      reordered_.push_back(entries_[static_cast<std::size_t>(order_[k].index)]);
     }
-    entries_[j] = moving;
+    entries_.swap(reordered_);
+    MirrorAll();
+  } else {
+    entries_.resize(keep);  // only shrinks: no allocation
   }
-  while (static_cast<int>(entries_.size()) > max_lines_ && entries_.back().Score() < 0.0) {
-    entries_.pop_back();
-  }
-  MirrorAll();
+  sorted_size_ = keep;
 }
 
 }  // namespace oal

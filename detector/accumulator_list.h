@@ -26,6 +26,8 @@ struct OalEntry {
   LineParams Line() const { return LineParams{rho_px, theta_rad}; }
   /// Ordering measure of Eq. 3.
   double Score() const { return weight - 0.5 * count; }
+  /// 2 * Score(), exactly, as an integer sort key.
+  int DoubleScore() const { return 2 * weight - count; }
 };
 
 class OrderedAccumulatorList {
@@ -36,7 +38,10 @@ class OrderedAccumulatorList {
   OrderedAccumulatorList(double angle_change_rad, double r_change_px, int max_lines,
                          int capacity);
 
-  void Clear() { entries_.clear(); }
+  void Clear() {
+    entries_.clear();
+    sorted_size_ = 0;
+  }
 
   /// Step 3 for one pair-line of border `border`, given as its unit normal (cos, sin) and
   /// rho. The entries are tried best first; the first one within anglechange and rchange
@@ -57,6 +62,7 @@ class OrderedAccumulatorList {
     SortAndCull();
   }
 
+  /// The entries, best first.
   const std::vector<OalEntry>& entries() const { return entries_; }
   int capacity() const { return capacity_; }
 
@@ -67,14 +73,36 @@ class OrderedAccumulatorList {
   void Mirror(std::size_t i);
   void MirrorAll();
 
+  struct SortKey {
+    int double_score;
+    int index;
+  };
+  static bool Higher(const SortKey& a, const SortKey& b) {
+    return a.double_score > b.double_score;
+  }
+
+  /// Sorts order_ by Eq. 3; false if the entries are already in that order.
+  bool SortOrder();
+  /// Stable binary insertion sort of [first, last) by descending score; false if it was sorted.
+  static bool InsertionSort(std::vector<SortKey>::iterator first,
+                            std::vector<SortKey>::iterator last);
+
   double cos_angle_change_;
   double sin_angle_change_;
   double r_change_px_;
   int max_lines_;
   int capacity_;
   std::vector<OalEntry> entries_;
-  // The entries' normals and rho in float, in list order (capacity-sized): matching, the
-  // detector's hottest loop, scans these compact arrays rather than the entries.
+  /// Entries [0, sorted_size_) were in order after the last SortAndCull; the rest were
+  /// appended since.
+  std::size_t sorted_size_ = 0;
+  // SortAndCull's working memory (capacity reserved): the order is found on small keys and
+  // the entries are moved once, into reordered_, which is then swapped in.
+  std::vector<SortKey> order_, merged_order_;
+  std::vector<OalEntry> reordered_;
+  // The entries' normals and rho in float, in list order (capacity rounded up to whole
+  // SIMD blocks): matching, the detector's hottest loop, scans these compact arrays rather
+  // than the entries.
   std::vector<float> match_cos_, match_sin_, match_rho_;
 };
 

@@ -15,14 +15,17 @@ std::array<int, 4> Corners(const BorderRect& r) {
 }
 
 double WrapLoop(double s, int perimeter) {
+  if (s >= 0.0 && s < perimeter) return s;  // the common case, without fmod
   s = std::fmod(s, static_cast<double>(perimeter));
   return s < 0.0 ? s + perimeter : s;
 }
 
 // A run of "on" pixels in unwrapped loop coordinates: pixels first..last (last may be >= P).
+// (No member initialisers: FindBorderPoints keeps an array of them that is never read
+// before it is written, and should not be zeroed on every border.)
 struct Run {
-  int first = 0;
-  int last = 0;
+  int first;
+  int last;
 };
 
 }  // namespace
@@ -56,44 +59,104 @@ std::uint8_t BorderRect::Sides(double s, double corner_px) const {
   return sides;
 }
 
+namespace {
+
+// std::reverse_copy of [first, last) to out, eight bytes at a time: a byte swap of a
+// 64-bit word reverses the bytes' memory order on any endianness.
+void ReverseCopy(const std::uint8_t* first, const std::uint8_t* last, std::uint8_t* out) {
+  for (; last - first >= 8; last -= 8, out += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, last - 8, sizeof(word));
+#if defined(__GNUC__)
+    word = __builtin_bswap64(word);
+#else
+    std::uint64_t swapped = 0;
+    for (int k = 0; k < 8; ++k) swapped = (swapped << 8) | ((word >> (8 * k)) & 0xFF);
+    word = swapped;
+#endif
+    std::memcpy(out, &word, sizeof(word));
+  }
+  std::reverse_copy(first, last, out);
+}
+
+}  // namespace
+
 void GatherBorder(const GrayImageView& image, const BorderRect& rect,
                   std::vector<std::uint8_t>* samples) {
-  samples->resize(static_cast<std::size_t>(rect.Perimeter()));
+  const int perimeter = rect.Perimeter();
+  samples->resize(static_cast<std::size_t>(perimeter));
   std::uint8_t* out = samples->data();
   const std::uint8_t* top = image.data + rect.v0 * image.stride;
   std::memcpy(out, top + rect.u0, static_cast<std::size_t>(rect.Width()));
-  out += rect.Width();
-  for (int v = rect.v0 + 1; v <= rect.v1; ++v) *out++ = image.at(rect.u1, v);
-  const std::uint8_t* bottom = image.data + rect.v1 * image.stride;
-  out = std::reverse_copy(bottom + rect.u0, bottom + rect.u1, out);
-  for (int v = rect.v1 - 1; v > rect.v0; --v) *out++ = image.at(rect.u0, v);
+  // Both columns in one pass over the rows: the right column fills the loop downwards after
+  // the top row, the left column fills it upwards from the end. (Locals, because the byte
+  // stores could alias rect and image and would force reloads.)
+  const int u0 = rect.u0, u1 = rect.u1, inner_rows = rect.Height() - 2;
+  const std::ptrdiff_t stride = image.stride;
+  std::uint8_t* right = out + rect.Width();
+  std::uint8_t* left = out + perimeter - 1;
+  const std::uint8_t* row = top + stride;
+  for (int k = 0; k < inner_rows; ++k, row += stride) {
+    *right++ = row[u1];
+    *left-- = row[u0];
+  }
+  *right++ = row[u1];  // the bottom-right corner, row v1
+  ReverseCopy(row + u0, row + u1, right);
 }
+
+namespace {
+
+// Histogram of every fourth sample in kBins bins of 2^kShift grey levels. Four interleaved
+// partial histograms let consecutive increments of the same bin (the background's) proceed
+// without waiting for each other.
+template <int kBins, int kShift>
+std::array<int, kBins> SampledHistogram(const std::vector<std::uint8_t>& samples) {
+  std::array<std::array<int, kBins>, 4> partial{};
+  const std::uint8_t* s = samples.data();
+  const std::size_t n = samples.size();
+  std::size_t i = 0;
+  for (; i + 16 <= n; i += 16) {
+    ++partial[0][s[i] >> kShift];
+    ++partial[1][s[i + 4] >> kShift];
+    ++partial[2][s[i + 8] >> kShift];
+    ++partial[3][s[i + 12] >> kShift];
+  }
+  for (; i < n; i += 4) ++partial[0][s[i] >> kShift];
+  std::array<int, kBins> histogram{};
+  for (const auto& part : partial) {
+    for (int b = 0; b < kBins; ++b) histogram[b] += part[b];
+  }
+  return histogram;
+}
+
+}  // namespace
 
 int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
   // A histogram of every fourth pixel in 32 bins of 8 grey levels is plenty: the threshold
   // only has to fall between the two classes, and the sub-pixel run ends interpolate grey
   // levels anyway.
   constexpr int kBins = 32, kShift = 3;
-  std::array<int, kBins> histogram{};
-  for (std::size_t i = 0; i < samples.size(); i += 4) ++histogram[samples[i] >> kShift];
-  std::int64_t total = 0, sum_all = 0;
+  const std::array<int, kBins> histogram = SampledHistogram<kBins, kShift>(samples);
+  // Counts and sums are whole numbers far below 2^53, so double arithmetic on them is exact
+  // (and needs no int-to-double conversions in the loop).
+  double total = 0.0, sum_all = 0.0;
   for (int b = 0; b < kBins; ++b) {
     total += histogram[b];
-    sum_all += static_cast<std::int64_t>(b) * histogram[b];
+    sum_all += static_cast<double>(b) * histogram[b];
   }
   // Between-class variance ∝ (sum_all·w_low − sum_low·total)² / (w_low·w_high); candidates
   // are compared by cross-multiplication, so the loop has no division.
   double best_numerator = -1.0, best_denominator = 1.0;
-  std::int64_t weight_low = 0, sum_low = 0, best_weight_low = 0, best_sum_low = 0;
+  double weight_low = 0.0, sum_low = 0.0, best_weight_low = 0.0, best_sum_low = 0.0;
   int best = kBins / 2;
   for (int b = 0; b + 1 < kBins; ++b) {
     weight_low += histogram[b];
-    sum_low += static_cast<std::int64_t>(b) * histogram[b];
-    const std::int64_t weight_high = total - weight_low;
-    if (weight_low == 0 || weight_high == 0) continue;
-    const double spread = static_cast<double>(sum_all * weight_low - sum_low * total);
+    sum_low += static_cast<double>(b) * histogram[b];
+    const double weight_high = total - weight_low;
+    if (weight_low == 0.0 || weight_high == 0.0) continue;
+    const double spread = sum_all * weight_low - sum_low * total;
     const double numerator = spread * spread;
-    const double denominator = static_cast<double>(weight_low) * static_cast<double>(weight_high);
+    const double denominator = weight_low * weight_high;
     if (numerator * best_denominator > best_numerator * denominator) {
       best_numerator = numerator;
       best_denominator = denominator;
@@ -104,9 +167,9 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
   }
   if (contrast) {
     *contrast = 0;
-    if (best_weight_low > 0 && best_weight_low < total) {
-      const double gap = static_cast<double>(sum_all - best_sum_low) / (total - best_weight_low) -
-                         static_cast<double>(best_sum_low) / best_weight_low;
+    if (best_weight_low > 0.0 && best_weight_low < total) {
+      const double gap =
+          (sum_all - best_sum_low) / (total - best_weight_low) - best_sum_low / best_weight_low;
       *contrast = static_cast<int>(gap * (1 << kShift));
     }
   }
@@ -115,55 +178,144 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
 
 namespace {
 
-// True if no pixel of s[0, 16) is on the line side of the threshold: the common case, so it
-// is tested 16 pixels at a time (GCC/Clang vector extensions: SSE2 on x86-64, NEON on ARM).
+// Bit k of the result is set if pixel s[k] of s[0, n) is on the line side of the threshold.
 template <bool kLight>
-bool BlockIsBackground(const std::uint8_t* s, int threshold) {
+std::uint64_t LineMaskScalar(const std::uint8_t* s, int n, int threshold) {
+  std::uint64_t mask = 0;
+  for (int k = 0; k < n; ++k) {
+    const bool on = kLight ? s[k] > threshold : s[k] < threshold;
+    mask |= static_cast<std::uint64_t>(on) << k;
+  }
+  return mask;
+}
+
+// LineMaskScalar for 64 pixels, 16 at a time (GCC/Clang vector extensions: SSE2 on x86-64,
+// NEON on ARM). Needs 0 <= threshold <= 255.
+template <bool kLight>
+std::uint64_t LineMask64(const std::uint8_t* s, int threshold) {
 #if defined(__GNUC__)
   typedef std::uint8_t Bytes16 __attribute__((vector_size(16)));
-  typedef std::uint64_t Words2 __attribute__((vector_size(16)));
-  Bytes16 block;
-  std::memcpy(&block, s, sizeof(block));
-  const auto t = static_cast<std::uint8_t>(std::clamp(threshold, 0, 255));
-  // A threshold of 0 (dark) or 255 (light) can mark no pixel.
-  if (kLight ? threshold >= 255 : threshold <= 0) return true;
-  const Bytes16 on = kLight ? (block > t) : (block < t);
-  Words2 words;
-  std::memcpy(&words, &on, sizeof(words));
-  return (words[0] | words[1]) == 0;
-#else
-  for (int k = 0; k < 16; ++k) {
-    if (kLight ? s[k] > threshold : s[k] < threshold) return false;
+  const auto t = static_cast<std::uint8_t>(threshold);
+  const Bytes16 lane_bit = {1, 2, 4, 8, 16, 32, 64, 128, 1, 2, 4, 8, 16, 32, 64, 128};
+  std::uint64_t mask = 0;
+  for (int block = 0; block < 4; ++block) {
+    Bytes16 pixels;
+    std::memcpy(&pixels, s + 16 * block, sizeof(pixels));
+    const Bytes16 on = (kLight ? (pixels > t) : (pixels < t)) & lane_bit;
+    // Each half holds eight distinct bits in eight bytes; multiplying by 0x0101...01 sums
+    // the bytes into the top byte, whatever the byte order.
+    std::uint64_t halves[2];
+    std::memcpy(halves, &on, sizeof(halves));
+    constexpr std::uint64_t kSumBytes = 0x0101010101010101ULL;
+    const std::uint64_t low8 = (halves[0] * kSumBytes) >> 56;
+    const std::uint64_t high8 = (halves[1] * kSumBytes) >> 56;
+    mask |= (low8 | high8 << 8) << (16 * block);
   }
-  return true;
+  return mask;
+#else
+  return LineMaskScalar<kLight>(s, 64, threshold);
 #endif
 }
 
-// Runs of line pixels in s[0, p), in order, bridging gaps narrower than min_gap.
+int CountTrailingZeros(std::uint64_t x) {  // x != 0
+#if defined(__GNUC__)
+  return __builtin_ctzll(x);
+#else
+  int n = 0;
+  for (; (x & 1) == 0; x >>= 1) ++n;
+  return n;
+#endif
+}
+
+// Collects runs of line pixels in order, bridging gaps narrower than min_gap; at most
+// max_runs (later runs are dropped, but may still be bridged into the last one kept).
+class RunCollector {
+ public:
+  RunCollector(int min_gap, Run* runs, int max_runs)
+      : min_gap_(min_gap), runs_(runs), max_runs_(max_runs) {}
+  void Add(int first, int last) {
+    if (count_ > 0 && first - runs_[count_ - 1].last - 1 < min_gap_) {
+      runs_[count_ - 1].last = last;
+    } else if (count_ < max_runs_) {
+      runs_[count_++] = Run{first, last};
+    }
+  }
+  int count() const { return count_; }
+
+ private:
+  int min_gap_;
+  Run* runs_;
+  int max_runs_;
+  int count_ = 0;
+};
+
+// Runs of line pixels in s[0, p). The border is turned into 64-pixel bit masks, and run
+// ends are found as the next set or clear bit, so background costs no per-pixel branch.
 template <bool kLight>
 int ScanRuns(const std::uint8_t* s, int p, int threshold, int min_gap, Run* runs, int max_runs) {
-  auto on = [&](int i) { return kLight ? s[i] > threshold : s[i] < threshold; };
-  int count = 0;
-  int i = 0;
-  while (i < p) {
-    if (i + 16 <= p && BlockIsBackground<kLight>(s + i, threshold)) {
-      i += 16;
-      continue;
+  RunCollector collector(min_gap, runs, max_runs);
+  const bool vector_ok = threshold >= 0 && threshold <= 255;
+  bool in_run = false;
+  int run_first = 0;
+  for (int base = 0; base < p; base += 64) {
+    const int n = std::min(64, p - base);
+    const std::uint64_t mask = n == 64 && vector_ok
+                                   ? LineMask64<kLight>(s + base, threshold)
+                                   : LineMaskScalar<kLight>(s + base, n, threshold);
+    const std::uint64_t valid = n == 64 ? ~0ULL : (1ULL << n) - 1;
+    for (int k = 0; k < n;) {
+      // In a run look for its end (a clear bit), outside for the next start (a set bit).
+      const std::uint64_t wanted = (in_run ? ~mask : mask) & valid & (~0ULL << k);
+      if (wanted == 0) break;
+      k = CountTrailingZeros(wanted);
+      if (in_run) {
+        collector.Add(run_first, base + k - 1);
+      } else {
+        run_first = base + k;
+      }
+      in_run = !in_run;
+      ++k;
     }
-    if (!on(i)) {
-      ++i;
-      continue;
-    }
-    int j = i;
-    while (j + 1 < p && on(j + 1)) ++j;
-    if (count > 0 && i - runs[count - 1].last - 1 < min_gap) {
-      runs[count - 1].last = j;
-    } else if (count < max_runs) {
-      runs[count++] = Run{i, j};
-    }
-    i = j + 1;
   }
-  return count;
+  if (in_run) collector.Add(run_first, p - 1);
+  return collector.count();
+}
+
+// Adds the contrast weights of loop coordinates [lo, hi], stored at samples s[i + shift].
+// Chunks of kChunk pixels are summed in 32-bit integers, relative to the chunk's start,
+// which cannot overflow (255 * 2048 * 2047 / 2 < 2^31) and lets the compiler vectorise.
+template <bool kLight>
+void AddWeights(const std::uint8_t* s, int lo, int hi, int shift, int threshold,
+                std::int64_t* weight_sum, std::int64_t* weighted) {
+  constexpr int kChunk = 2048;
+  for (int start = lo; start <= hi; start += kChunk) {
+    const std::uint8_t* chunk = s + start + shift;
+    const int n = std::min(kChunk, hi - start + 1);
+    std::int32_t chunk_weight = 0, chunk_weighted = 0;
+    for (int k = 0; k < n; ++k) {
+      const int value = chunk[k];
+      const std::int32_t weight = std::max(0, kLight ? value - threshold : threshold - value);
+      chunk_weight += weight;
+      chunk_weighted += weight * k;
+    }
+    *weight_sum += chunk_weight;
+    *weighted += chunk_weighted + static_cast<std::int64_t>(chunk_weight) * start;
+  }
+}
+
+// The contrast-weighted centre of a run in loop coordinates (its midpoint if it has no
+// contrast). Weights are integers, so integer sums give the double sums exactly, faster.
+// A run across the loop's seam is summed in contiguous pieces.
+template <bool kLight>
+double WeightedCentre(const std::uint8_t* s, int p, const Run& run, int threshold, double s_a,
+                      double s_b) {
+  std::int64_t weight_sum = 0, weighted = 0;
+  AddWeights<kLight>(s, run.first, std::min(run.last, -1), p, threshold, &weight_sum, &weighted);
+  AddWeights<kLight>(s, std::max(run.first, 0), std::min(run.last, p - 1), 0, threshold,
+                     &weight_sum, &weighted);
+  AddWeights<kLight>(s, std::max(run.first, p), run.last, -p, threshold, &weight_sum, &weighted);
+  return weight_sum > 0 ? static_cast<double>(weighted) / static_cast<double>(weight_sum)
+                        : 0.5 * (s_a + s_b);
 }
 
 }  // namespace
@@ -199,9 +351,15 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
       options.max_width_px / std::sin(options.min_crossing_angle_deg * kPi / 180.0);
   const bool edges = options.polarity == Polarity::kEdges;
   int added = 0;
-  auto push = [&](const BorderPoint& point) {
+  // Appends a point, built in place (copying in a just-built local point stalled on store
+  // forwarding); false once the border has its maximum.
+  auto push = [&](const Point2d& pixel, double run_px, std::uint8_t sides, bool straight) {
     if (added >= options.max_points_per_border) return false;
-    points->push_back(point);
+    BorderPoint& point = points->emplace_back();
+    point.pixel = pixel;
+    point.run_px = run_px;
+    point.sides = sides;
+    point.straight = straight;
     ++added;
     return true;
   };
@@ -218,8 +376,8 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
 
     if (edges) {
       if (length >= p - options.min_width_px) continue;
-      if (!push({rect.ToPixel(s_a), 0.0, rect.Sides(s_a), true})) break;
-      if (!push({rect.ToPixel(s_b), 0.0, rect.Sides(s_b), true})) break;
+      if (!push(rect.ToPixel(s_a), 0.0, rect.Sides(s_a), true)) break;
+      if (!push(rect.ToPixel(s_b), 0.0, rect.Sides(s_b), true)) break;
       continue;
     }
     if (length > max_run) continue;
@@ -230,25 +388,20 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
         if (run.first < c + shift && c + shift < run.last) straight = false;
       }
     }
-    BorderPoint point;
-    point.run_px = length;
-    point.straight = straight;
+    Point2d pixel;
+    std::uint8_t sides = 0;
     if (straight) {
-      double weight_sum = 0.0, weighted = 0.0;
-      for (int i = run.first; i <= run.last; ++i) {
-        const double weight = std::max(0.0, f(i));
-        weight_sum += weight;
-        weighted += weight * i;
-      }
-      const double centre = weight_sum > 0.0 ? weighted / weight_sum : 0.5 * (s_a + s_b);
-      point.pixel = rect.ToPixel(centre);
-      point.sides = rect.Sides(centre);
+      const double centre =
+          light ? WeightedCentre<true>(samples.data(), p, run, threshold, s_a, s_b)
+                : WeightedCentre<false>(samples.data(), p, run, threshold, s_a, s_b);
+      pixel = rect.ToPixel(centre);
+      sides = rect.Sides(centre);
     } else {
       const Point2d a = rect.ToPixel(s_a), b = rect.ToPixel(s_b);
-      point.pixel = Point2d{0.5 * (a.u + b.u), 0.5 * (a.v + b.v)};
-      point.sides = rect.Sides(s_a) | rect.Sides(s_b);
+      pixel = Point2d{0.5 * (a.u + b.u), 0.5 * (a.v + b.v)};
+      sides = rect.Sides(s_a) | rect.Sides(s_b);
     }
-    if (!push(point)) break;
+    if (!push(pixel, length, sides, straight)) break;
   }
   return added;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -123,9 +124,13 @@ void OalDetector::ScanBorder(const GrayImageView& image, int border, const Borde
     border_points_.clear();
     FindBorderPoints(samples_, rect, threshold, options_, &border_points_);
     for (const BorderPoint& point : border_points_) {
-      frame_points_.push_back(FramePoint{ToWorking(point.pixel), static_cast<float>(point.run_px),
-                                         point.sides, point.straight,
-                                         static_cast<std::int16_t>(border)});
+      // Built in place: copying in a just-built local stalled on store forwarding.
+      FramePoint& frame_point = frame_points_.emplace_back();
+      frame_point.p = ToWorking(point.pixel);
+      frame_point.run_px = static_cast<float>(point.run_px);
+      frame_point.sides = point.sides;
+      frame_point.straight = point.straight;
+      frame_point.border = static_cast<std::int16_t>(border);
     }
     VotePairs(border, first_point);
   }
@@ -138,9 +143,14 @@ void OalDetector::ScanBorder(const GrayImageView& image, int border, const Borde
   // middles of its sides, which undistortion bends outward or inward.
   RectangleOutline(rect, undistorter_ ? 2 : 1, &border_outline_);
   for (Point2d& p : border_outline_) {
-    p = ToWorking(p);
-    p.u -= centre_u_;
-    p.v -= centre_v_;
+    const Point2d working = ToWorking(p);  // (updating p in place stalled on store forwarding)
+    p.u = working.u - centre_u_;
+    p.v = working.v - centre_v_;
+  }
+  for (std::size_t k = 0; k < outline_u_.size(); ++k) {
+    const Point2d& p = border_outline_[std::min(k, border_outline_.size() - 1)];
+    outline_u_[k] = p.u;
+    outline_v_[k] = p.v;
   }
   oal_.EndBorder([this](const OalEntry& entry) { return LineCrossesBorder(entry); });
 }
@@ -164,13 +174,35 @@ void OalDetector::VotePairs(int border, std::size_t first_point) {
 }
 
 bool OalDetector::LineCrossesBorder(const OalEntry& entry) const {
+  // The line crosses the outline if some corner is strictly on each side of it.
+#if defined(__GNUC__)
+  // Two corners at a time (GCC/Clang vector extensions: SSE2 on x86-64, NEON on ARM).
+  typedef double Doubles2 __attribute__((vector_size(16)));
+  using Masks2 = decltype(Doubles2{} > Doubles2{});  // the comparisons' lane masks
+  const Doubles2 c = {entry.cos_theta, entry.cos_theta};
+  const Doubles2 s = {entry.sin_theta, entry.sin_theta};
+  const Doubles2 rho = {entry.rho_px, entry.rho_px};
+  const Doubles2 zero = {0.0, 0.0};
+  Masks2 positive = {0, 0}, negative = {0, 0};
+  for (int k = 0; k < kOutlinePoints; k += 2) {
+    Doubles2 u, v;
+    std::memcpy(&u, &outline_u_[static_cast<std::size_t>(k)], sizeof(u));
+    std::memcpy(&v, &outline_v_[static_cast<std::size_t>(k)], sizeof(v));
+    const Doubles2 f = u * c + v * s - rho;
+    positive |= f > zero;
+    negative |= f < zero;
+  }
+  return (positive[0] | positive[1]) != 0 && (negative[0] | negative[1]) != 0;
+#else
   bool positive = false, negative = false;
-  for (const Point2d& p : border_outline_) {
-    const double f = p.u * entry.cos_theta + p.v * entry.sin_theta - entry.rho_px;
+  for (int k = 0; k < kOutlinePoints; ++k) {
+    const double f = outline_u_[k] * entry.cos_theta + outline_v_[k] * entry.sin_theta -
+                     entry.rho_px;
     positive |= f > 0.0;
     negative |= f < 0.0;
   }
   return positive && negative;
+#endif
 }
 
 void OalDetector::ReadOff(int width, int height) {

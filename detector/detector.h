@@ -15,6 +15,7 @@
 // coordinates (the pixels an ideal pinhole camera with the same intrinsics would see).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -82,6 +83,10 @@ class OalDetector {
   std::vector<BorderPoint> border_points_;
   std::vector<FramePoint> frame_points_;
   std::vector<Point2d> border_outline_;  ///< current border's outline, centred coordinates
+  /// border_outline_ as fixed-size coordinate arrays, padded by repeating its last point,
+  /// so that LineCrossesBorder is a short loop the compiler unrolls and vectorises.
+  static constexpr int kOutlinePoints = 8;  // even: LineCrossesBorder takes two at a time
+  std::array<double, kOutlinePoints> outline_u_{}, outline_v_{};
   std::vector<DetectedLine> candidates_;
   std::vector<DetectedLine> lines_;
 };

@@ -7,25 +7,30 @@ namespace oal {
 LineParams RefitLine(const LineParams& line, const std::vector<FramePoint>& points,
                      double tolerance_px) {
   const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
-  double n = 0.0, su = 0.0, sv = 0.0;
+  // One pass: sums of the close points' offsets from the first close point (a reference
+  // inside the cloud keeps the second moments well conditioned), centred afterwards.
+  double n = 0.0, su = 0.0, sv = 0.0, suu = 0.0, svv = 0.0, suv = 0.0;
+  double ref_u = 0.0, ref_v = 0.0;
   for (const FramePoint& point : points) {
     if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) > tolerance_px) continue;
+    if (n == 0.0) {
+      ref_u = point.p.u;
+      ref_v = point.p.v;
+    }
+    const double du = point.p.u - ref_u, dv = point.p.v - ref_v;
     n += 1.0;
-    su += point.p.u;
-    sv += point.p.v;
-  }
-  if (n < 2.0) return line;
-  const double mu = su / n, mv = sv / n;
-  double suu = 0.0, svv = 0.0, suv = 0.0;
-  for (const FramePoint& point : points) {
-    if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) > tolerance_px) continue;
-    const double du = point.p.u - mu, dv = point.p.v - mv;
+    su += du;
+    sv += dv;
     suu += du * du;
     svv += dv * dv;
     suv += du * dv;
   }
+  if (n < 2.0) return line;
+  const double mean_du = su / n, mean_dv = sv / n;
+  const double cuu = suu - su * mean_du, cvv = svv - sv * mean_dv, cuv = suv - su * mean_dv;
+  const double mu = ref_u + mean_du, mv = ref_v + mean_dv;
   // Direction of largest spread; the normal is perpendicular to it.
-  const double direction = 0.5 * std::atan2(2.0 * suv, suu - svv);
+  const double direction = 0.5 * std::atan2(2.0 * cuv, cuu - cvv);
   const double theta = direction + kPi / 2.0;
   return Normalized(mu * std::cos(theta) + mv * std::sin(theta), theta);
 }
