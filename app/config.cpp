@@ -166,6 +166,7 @@ const std::vector<Field<DetectorOptions>>& DetectorFields() {
       DoubleField("min_crossing_angle_deg", &O::min_crossing_angle_deg),
       IntField("max_points_per_border", &O::max_points_per_border),
       BoolField("skip_same_side_pairs", &O::skip_same_side_pairs),
+      DoubleField("max_pair_width_ratio", &O::max_pair_width_ratio),
       DoubleField("angle_change_deg", &O::angle_change_deg),
       DoubleField("r_change_px", &O::r_change_px),
       IntField("max_lines", &O::max_lines),

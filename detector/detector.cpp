@@ -167,10 +167,23 @@ void OalDetector::VotePairs(int border, std::size_t first_point) {
       if (length_sq < 1e-6) continue;
       const double inverse = 1.0 / std::sqrt(length_sq);
       const double c = -dv * inverse, s = du * inverse;  // unit normal of the chord
+      if (!WidthsAgree(a, b, c, s)) continue;
       const double rho = c * (a.p.u - centre_u_) + s * (a.p.v - centre_v_);
       oal_.Vote(c, s, rho, border);
     }
   }
+}
+
+bool OalDetector::WidthsAgree(const FramePoint& a, const FramePoint& b, double cos_theta,
+                              double sin_theta) const {
+  const double ratio = options_.max_pair_width_ratio;
+  if (ratio == 0.0 || options_.polarity == Polarity::kEdges) return true;
+  const double width_a = WidthAcross(a, cos_theta, sin_theta);
+  const double width_b = WidthAcross(b, cos_theta, sin_theta);
+  if (width_a <= 0.0 || width_b <= 0.0) return true;  // a corner run: width unknown
+  if (std::max(width_a, width_b) > options_.max_width_px) return false;
+  // The min_width_px slack keeps thin lines, whose widths are a pixel or two, comparable.
+  return std::max(width_a, width_b) <= ratio * std::min(width_a, width_b) + options_.min_width_px;
 }
 
 bool OalDetector::LineCrossesBorder(const OalEntry& entry) const {

@@ -68,6 +68,8 @@ class OalDetector {
   void PrepareFor(int width, int height);
   void ScanBorder(const GrayImageView& image, int border, const BorderRect& rect);
   void VotePairs(int border, std::size_t first_point);
+  bool WidthsAgree(const FramePoint& a, const FramePoint& b, double cos_theta,
+                   double sin_theta) const;
   bool LineCrossesBorder(const OalEntry& entry) const;
   void ReadOff(int width, int height);
   Point2d ToWorking(const Point2d& pixel) const;

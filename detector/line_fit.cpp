@@ -48,12 +48,9 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
       ++stats.borders;
       last_border = point.border;
     }
-    const bool horizontal = (point.sides & 0x5) != 0;  // kTop | kBottom
-    const bool vertical = (point.sides & 0xA) != 0;    // kRight | kLeft
-    if (point.run_px > 0.0f && point.straight && horizontal != vertical) {
-      // A stripe of width w crosses a horizontal side in a run of w / |cos theta| and a
-      // vertical side in a run of w / |sin theta|.
-      width_sum += point.run_px * (horizontal ? std::fabs(c) : std::fabs(s));
+    const double width = WidthAcross(point, c, s);
+    if (width > 0.0) {
+      width_sum += width;
       ++width_n;
     }
   }

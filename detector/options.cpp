@@ -58,6 +58,9 @@ void DetectorOptions::Check() const {
           min_crossing_angle_deg, "1 <= min_crossing_angle_deg <= 90");
   Require(max_points_per_border >= 2 && max_points_per_border <= 64, "max_points_per_border",
           max_points_per_border, "2 <= max_points_per_border <= 64");
+  Require(max_pair_width_ratio == 0.0 || (max_pair_width_ratio >= 1.0 && max_pair_width_ratio <= 100.0),
+          "max_pair_width_ratio", max_pair_width_ratio,
+          "max_pair_width_ratio == 0 or 1 <= max_pair_width_ratio <= 100");
   Require(angle_change_deg > 0 && angle_change_deg <= 45, "angle_change_deg", angle_change_deg,
           "0 < angle_change_deg <= 45");
   Require(r_change_px > 0 && r_change_px <= 1000, "r_change_px", r_change_px,
@@ -81,6 +84,7 @@ DetectorOptions DetectorOptions::Paper() {
   DetectorOptions options;
   options.min_crossing_angle_deg = 90.0;
   options.skip_same_side_pairs = false;
+  options.max_pair_width_ratio = 0.0;
   options.count_visible_borders_only = false;
   options.refit_lines = false;
   options.rank_by_support = false;

@@ -53,6 +53,12 @@ struct DetectorOptions {
   /// Two points on the same side of a border rectangle span that side, never a line that
   /// crosses the rectangle: such pairs are skipped. false correlates every pair (paper).
   bool skip_same_side_pairs = true;
+  /// A pair is voted only if the widths across its chord of the two runs that gave its
+  /// points agree: the larger at most this many times the smaller, plus min_width_px, and
+  /// at most max_width_px. Points of two different lines rarely agree, so most of the
+  /// hypotheses that the paper's list must carry and cull never enter it (NOTES 2, 4).
+  /// 0 votes every pair (paper). Range 0 or [1, 100].
+  double max_pair_width_ratio = 1.6;
 
   // --- Step 3: matching against the ordered accumulator list (Eq. 1, 2) -----------------
   /// anglechange of Eq. 1, degrees. Range (0, 45].

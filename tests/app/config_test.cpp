@@ -35,6 +35,7 @@ void ExpectSameOptions(const DetectorOptions& a, const DetectorOptions& b) {
   EXPECT_EQ(a.min_crossing_angle_deg, b.min_crossing_angle_deg);
   EXPECT_EQ(a.max_points_per_border, b.max_points_per_border);
   EXPECT_EQ(a.skip_same_side_pairs, b.skip_same_side_pairs);
+  EXPECT_EQ(a.max_pair_width_ratio, b.max_pair_width_ratio);
   EXPECT_EQ(a.angle_change_deg, b.angle_change_deg);
   EXPECT_EQ(a.r_change_px, b.r_change_px);
   EXPECT_EQ(a.max_lines, b.max_lines);
@@ -63,7 +64,7 @@ TEST(Config, ReadsEveryKey) {
       "  start_px: 4\n  step_px: 3\n  polarity: edges\n  threshold_mode: fixed\n"
       "  fixed_threshold: 100\n  min_contrast: 20\n  min_width_px: 1.5\n  max_width_px: 30\n"
       "  min_crossing_angle_deg: 20\n  max_points_per_border: 16\n"
-      "  skip_same_side_pairs: false\n  angle_change_deg: 1.5\n  r_change_px: 3.5\n"
+      "  skip_same_side_pairs: false\n  max_pair_width_ratio: 2.5\n  angle_change_deg: 1.5\n  r_change_px: 3.5\n"
       "  max_lines: 30\n  count_visible_borders_only: false\n  refit_lines: false\n"
       "  rank_by_support: false\n  support_tolerance_px: 2.5\n  max_output_lines: 5\n"
       "  min_votes: 4\n  min_support: 8\n  duplicate_angle_deg: 4\n  duplicate_r_px: 9\n",
@@ -80,6 +81,7 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_EQ(o.min_crossing_angle_deg, 20.0);
   EXPECT_EQ(o.max_points_per_border, 16);
   EXPECT_FALSE(o.skip_same_side_pairs);
+  EXPECT_EQ(o.max_pair_width_ratio, 2.5);
   EXPECT_EQ(o.angle_change_deg, 1.5);
   EXPECT_EQ(o.r_change_px, 3.5);
   EXPECT_EQ(o.max_lines, 30);

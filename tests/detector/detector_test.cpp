@@ -204,3 +204,44 @@ INSTANTIATE_TEST_SUITE_P(
 
 }  // namespace
 }  // namespace oal
+
+namespace oal {
+namespace {
+
+// Two parallel stripes of very different widths: the pairs that join a point of one with a
+// point of the other are tilted chords, and their runs' widths across those chords differ
+// five-fold, so with the width check none of them enters the list.
+TEST(OalDetector, PairWidthCheckKeepsCrossPairsOutOfTheList) {
+  testing::TestImage image(320, 240, 210);
+  testing::PaintStripe(&image, LineParams{100.0, 0.0}, 4.0, 30);
+  testing::PaintStripe(&image, LineParams{200.0, 0.0}, 20.0, 30);
+  auto tilted_entries = [&](double ratio) {
+    DetectorOptions options;
+    options.max_pair_width_ratio = ratio;
+    OalDetector detector(options);
+    detector.Detect(image.View());
+    int tilted = 0;
+    for (const OalEntry& entry : detector.accumulator_list().entries()) {
+      tilted += AngleBetween(entry.Line(), LineParams{0.0, 0.0}) > 2.0 / kRadToDeg;
+    }
+    return tilted;
+  };
+  EXPECT_GT(tilted_entries(0.0), 0);  // without the check the cross pairs are there
+  EXPECT_EQ(tilted_entries(1.6), 0);
+}
+
+TEST(LineFit, WidthAcrossUsesTheSideTheRunLiesOn) {
+  FramePoint top;
+  top.run_px = 10.0f;
+  top.sides = kTop;
+  EXPECT_NEAR(WidthAcross(top, std::cos(0.5), std::sin(0.5)), 10.0 * std::cos(0.5), 1e-6);
+  FramePoint left = top;
+  left.sides = kLeft;
+  EXPECT_NEAR(WidthAcross(left, std::cos(0.5), std::sin(0.5)), 10.0 * std::sin(0.5), 1e-6);
+  FramePoint corner = top;
+  corner.sides = kTop | kLeft;
+  EXPECT_EQ(WidthAcross(corner, 1.0, 0.0), 0.0);
+}
+
+}  // namespace
+}  // namespace oal
