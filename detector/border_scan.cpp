@@ -5,6 +5,10 @@
 #include <cmath>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace oal {
 namespace {
 
@@ -104,6 +108,68 @@ void GatherBorder(const GrayImageView& image, const BorderRect& rect,
   ReverseCopy(row + u0, row + u1, right);
 }
 
+void BorderColumns::Prepare(int width, int height, int first_px, int step_px) {
+  if (width == width_ && height == height_ && first_px == first_px_ && step_px == step_px_) {
+    return;
+  }
+  width_ = width;
+  height_ = height;
+  first_px_ = first_px;
+  step_px_ = step_px;
+  start_.clear();
+  std::ptrdiff_t size = 0;
+  for (int d = first_px; BorderAt(width, height, d).Valid(); d += step_px) {
+    start_.push_back(size - (d + 1));  // inner rows d + 1 .. height - 2 - d
+    size += height - 2 - 2 * d;
+  }
+  left_.assign(static_cast<std::size_t>(size), 0);
+  right_.assign(static_cast<std::size_t>(size), 0);
+}
+
+void BorderColumns::Read(const GrayImageView& image) {
+  // Locals, because the byte stores could alias the members and would force reloads.
+  const int first = first_px_, step = step_px_, count = this->count();
+  const std::ptrdiff_t* start = start_.data();
+  std::uint8_t* left = left_.data();
+  std::uint8_t* right = right_.data();
+  // Rows in pairs the same distance from the top and the bottom edge (the middle row of an
+  // odd height twice, harmlessly): both are inner rows of the same borders, those with
+  // d < top, so one pass over those borders serves four pixels.
+  for (int top = first + 1, bottom = height_ - 2 - first; top <= bottom; ++top, --bottom) {
+    const int active = std::min(count, (top - first + step - 1) / step);
+    const std::uint8_t* top_row = image.data + top * image.stride;
+    const std::uint8_t* bottom_row = image.data + bottom * image.stride;
+    int u_left = first, u_right = width_ - 1 - first;
+    for (int k = 0; k < active; ++k, u_left += step, u_right -= step) {
+      const std::ptrdiff_t i = start[k] + top, j = start[k] + bottom;
+      left[i] = top_row[u_left];
+      right[i] = top_row[u_right];
+      left[j] = bottom_row[u_left];
+      right[j] = bottom_row[u_right];
+    }
+  }
+}
+
+void BorderColumns::GatherBorder(const GrayImageView& image, int k,
+                                 std::vector<std::uint8_t>* samples) const {
+  const BorderRect rect = Rect(k);
+  const int perimeter = rect.Perimeter(), width = rect.Width(), inner_rows = rect.Height() - 2;
+  samples->resize(static_cast<std::size_t>(perimeter));
+  std::uint8_t* out = samples->data();
+  const std::uint8_t* top = image.data + rect.v0 * image.stride;
+  const std::uint8_t* bottom = image.data + rect.v1 * image.stride;
+  const std::ptrdiff_t first_inner = start_[static_cast<std::size_t>(k)] + rect.v0 + 1;
+  // Loop order: top row, right column down, bottom row leftwards, left column up.
+  std::memcpy(out, top + rect.u0, static_cast<std::size_t>(width));
+  out += width;
+  std::memcpy(out, right_.data() + first_inner, static_cast<std::size_t>(inner_rows));
+  out += inner_rows;
+  *out++ = bottom[rect.u1];
+  ReverseCopy(bottom + rect.u0, bottom + rect.u1, out);
+  out += width - 1;
+  ReverseCopy(left_.data() + first_inner, left_.data() + first_inner + inner_rows, out);
+}
+
 namespace {
 
 // Histogram of every fourth sample in kBins bins of 2^kShift grey levels. Four interleaved
@@ -144,16 +210,19 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
     total += histogram[b];
     sum_all += static_cast<double>(b) * histogram[b];
   }
+  int lowest = 0, highest = kBins - 1;  // the occupied bins (none: lowest > highest)
+  while (lowest < kBins && histogram[lowest] == 0) ++lowest;
+  while (highest > lowest && histogram[highest] == 0) --highest;
   // Between-class variance ∝ (sum_all·w_low − sum_low·total)² / (w_low·w_high); candidates
   // are compared by cross-multiplication, so the loop has no division.
   double best_numerator = -1.0, best_denominator = 1.0;
   double weight_low = 0.0, sum_low = 0.0, best_weight_low = 0.0, best_sum_low = 0.0;
   int best = kBins / 2;
-  for (int b = 0; b + 1 < kBins; ++b) {
+  // Splits below the lowest or from the highest occupied bin leave a class empty.
+  for (int b = lowest; b < highest; ++b) {
     weight_low += histogram[b];
     sum_low += static_cast<double>(b) * histogram[b];
     const double weight_high = total - weight_low;
-    if (weight_low == 0.0 || weight_high == 0.0) continue;
     const double spread = sum_all * weight_low - sum_low * total;
     const double numerator = spread * spread;
     const double denominator = weight_low * weight_high;
@@ -189,27 +258,46 @@ std::uint64_t LineMaskScalar(const std::uint8_t* s, int n, int threshold) {
   return mask;
 }
 
+#if defined(__GNUC__)
+typedef std::uint8_t Bytes16 __attribute__((vector_size(16)));
+typedef std::int8_t ByteMasks16 __attribute__((vector_size(16)));  // comparison results
+
+// Bit k of the result is the top bit of byte k of `on`.
+std::uint32_t MoveMask(ByteMasks16 on) {
+#if defined(__SSE2__)
+  __m128i bytes;
+  std::memcpy(&bytes, &on, sizeof(bytes));
+  return static_cast<std::uint32_t>(_mm_movemask_epi8(bytes));
+#else
+  const Bytes16 lane_bit = {1, 2, 4, 8, 16, 32, 64, 128, 1, 2, 4, 8, 16, 32, 64, 128};
+  Bytes16 bits;
+  std::memcpy(&bits, &on, sizeof(bits));
+  bits &= lane_bit;
+  // Each half holds eight distinct bits in eight bytes; multiplying by 0x0101...01 sums
+  // the bytes into the top byte, whatever the byte order.
+  std::uint64_t halves[2];
+  std::memcpy(halves, &bits, sizeof(halves));
+  constexpr std::uint64_t kSumBytes = 0x0101010101010101ULL;
+  const std::uint64_t low8 = (halves[0] * kSumBytes) >> 56;
+  const std::uint64_t high8 = (halves[1] * kSumBytes) >> 56;
+  return static_cast<std::uint32_t>(low8 | high8 << 8);
+#endif
+}
+#endif
+
 // LineMaskScalar for 64 pixels, 16 at a time (GCC/Clang vector extensions: SSE2 on x86-64,
-// NEON on ARM). Needs 0 <= threshold <= 255.
+// where one instruction gathers the 16 comparison bits, NEON on ARM). Needs
+// 0 <= threshold <= 255.
 template <bool kLight>
 std::uint64_t LineMask64(const std::uint8_t* s, int threshold) {
 #if defined(__GNUC__)
-  typedef std::uint8_t Bytes16 __attribute__((vector_size(16)));
   const auto t = static_cast<std::uint8_t>(threshold);
-  const Bytes16 lane_bit = {1, 2, 4, 8, 16, 32, 64, 128, 1, 2, 4, 8, 16, 32, 64, 128};
   std::uint64_t mask = 0;
   for (int block = 0; block < 4; ++block) {
     Bytes16 pixels;
     std::memcpy(&pixels, s + 16 * block, sizeof(pixels));
-    const Bytes16 on = (kLight ? (pixels > t) : (pixels < t)) & lane_bit;
-    // Each half holds eight distinct bits in eight bytes; multiplying by 0x0101...01 sums
-    // the bytes into the top byte, whatever the byte order.
-    std::uint64_t halves[2];
-    std::memcpy(halves, &on, sizeof(halves));
-    constexpr std::uint64_t kSumBytes = 0x0101010101010101ULL;
-    const std::uint64_t low8 = (halves[0] * kSumBytes) >> 56;
-    const std::uint64_t high8 = (halves[1] * kSumBytes) >> 56;
-    mask |= (low8 | high8 << 8) << (16 * block);
+    const ByteMasks16 on = kLight ? (pixels > t) : (pixels < t);
+    mask |= static_cast<std::uint64_t>(MoveMask(on)) << (16 * block);
   }
   return mask;
 #else
@@ -279,6 +367,19 @@ int ScanRuns(const std::uint8_t* s, int p, int threshold, int min_gap, Run* runs
   }
   if (in_run) collector.Add(run_first, p - 1);
   return collector.count();
+}
+
+// Whether a corner of the loop lies strictly inside the run. Runs start in [-p, p) and end
+// before p, so it is enough to compare the end with the first corner after the start
+// (corners[0] = 0 comes back as p).
+bool HasCornerInside(const Run& run, const std::array<int, 4>& corners, int p) {
+  const int offset = run.first < 0 ? -p : 0;
+  const int start = run.first - offset;  // in [0, p)
+  const int next = start < corners[1]   ? corners[1]
+                   : start < corners[2] ? corners[2]
+                   : start < corners[3] ? corners[3]
+                                        : p;
+  return next + offset < run.last;
 }
 
 // Adds the contrast weights of loop coordinates [lo, hi], stored at samples s[i + shift].
@@ -382,12 +483,7 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
     }
     if (length > max_run) continue;
 
-    bool straight = true;
-    for (int c : corners) {
-      for (int shift : {-p, 0, p}) {
-        if (run.first < c + shift && c + shift < run.last) straight = false;
-      }
-    }
+    const bool straight = !HasCornerInside(run, corners, p);
     Point2d pixel;
     std::uint8_t sides = 0;
     if (straight) {

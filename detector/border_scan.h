@@ -7,6 +7,7 @@
 // the rectangle stays one run.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -50,6 +51,31 @@ struct BorderPoint {
 /// has the capacity).
 void GatherBorder(const GrayImageView& image, const BorderRect& rect,
                   std::vector<std::uint8_t>* samples);
+
+/// The left and right columns of a frame's concentric borders d = first_px, first_px +
+/// step_px, ... (while valid), read in one pass over the image's rows. Read column by column,
+/// every pixel costs a cache line for one border; read row by row, one cache line serves the
+/// columns of all the borders that cross it (about 64 / step_px of them).
+class BorderColumns {
+ public:
+  /// Sizes the buffers for width x height images; allocates only when the size changes.
+  void Prepare(int width, int height, int first_px, int step_px);
+  /// Reads the inner rows (all but the top and bottom one) of every border's two columns.
+  /// `image` must have the size given to Prepare.
+  void Read(const GrayImageView& image);
+  /// GatherBorder of border k (0 = outermost), its columns taken from the last Read.
+  void GatherBorder(const GrayImageView& image, int k, std::vector<std::uint8_t>* samples) const;
+  /// Number of borders.
+  int count() const { return static_cast<int>(start_.size()); }
+  /// The rectangle of border k.
+  BorderRect Rect(int k) const { return BorderAt(width_, height_, first_px_ + k * step_px_); }
+
+ private:
+  int width_ = 0, height_ = 0, first_px_ = 0, step_px_ = 1;
+  /// Row v of border k's columns is at left_[start_[k] + v] and right_[start_[k] + v].
+  std::vector<std::ptrdiff_t> start_;
+  std::vector<std::uint8_t> left_, right_;
+};
 
 /// Otsu's threshold of `samples`; `contrast` receives the difference of the two class means.
 int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast);

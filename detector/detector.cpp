@@ -1,10 +1,14 @@
 #include "detector/detector.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace oal {
 namespace {
@@ -12,12 +16,6 @@ namespace {
 constexpr double kDegToRad = kPi / 180.0;
 
 int MaxPairs(int points) { return points * (points - 1) / 2; }
-
-int BorderCount(int width, int height, const DetectorOptions& options) {
-  int count = 0;
-  for (int d = options.start_px; BorderAt(width, height, d).Valid(); d += options.step_px) ++count;
-  return count;
-}
 
 // Where `line` enters and leaves the closed polygon `outline` (first and last crossing
 // along the line); false if it misses it.
@@ -60,6 +58,52 @@ void RectangleOutline(const BorderRect& rect, int per_side, std::vector<Point2d>
   }
 }
 
+// A border's outline points as fixed-size coordinate arrays, padded by repeating the last
+// point, so that Crossed is a short loop, unrolled and two points at a time with SSE2.
+struct OutlineArrays {
+  static constexpr std::size_t kPoints = 8;  // even: Crossed takes two at a time
+  std::array<double, kPoints> u, v;
+
+  explicit OutlineArrays(const std::vector<Point2d>& outline) {  // outline not empty
+    for (std::size_t k = 0; k < kPoints; ++k) {
+      const Point2d& p = outline[std::min(k, outline.size() - 1)];
+      u[k] = p.u;
+      v[k] = p.v;
+    }
+  }
+
+  // Whether the entry's line crosses the outline: some point is strictly on each side of
+  // it, that is the highest distance of a point along the line's normal is above rho and
+  // the lowest below (the same decisions as testing each point's sign of distance - rho).
+  bool Crossed(const OalEntry& entry) const {
+#if defined(__SSE2__)
+    // Two points at a time.
+    const __m128d c = _mm_set1_pd(entry.cos_theta), s = _mm_set1_pd(entry.sin_theta);
+    auto distances = [&](std::size_t k) {
+      return _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(&u[k]), c), _mm_mul_pd(_mm_loadu_pd(&v[k]), s));
+    };
+    __m128d highest = distances(0), lowest = highest;
+    for (std::size_t k = 2; k < kPoints; k += 2) {
+      const __m128d distance = distances(k);
+      highest = _mm_max_pd(highest, distance);
+      lowest = _mm_min_pd(lowest, distance);
+    }
+    const __m128d rho = _mm_set1_pd(entry.rho_px);
+    const int above = _mm_movemask_pd(_mm_cmpgt_pd(highest, rho));  // a bit per lane
+    const int below = _mm_movemask_pd(_mm_cmplt_pd(lowest, rho));
+    return (above != 0) & (below != 0);  // (& rather than &&: no branch)
+#else
+    double highest = u[0] * entry.cos_theta + v[0] * entry.sin_theta, lowest = highest;
+    for (std::size_t k = 1; k < kPoints; ++k) {
+      const double distance = u[k] * entry.cos_theta + v[k] * entry.sin_theta;
+      highest = std::max(highest, distance);
+      lowest = std::min(lowest, distance);
+    }
+    return highest > entry.rho_px && lowest < entry.rho_px;
+#endif
+  }
+};
+
 }  // namespace
 
 OalDetector::OalDetector(const DetectorOptions& options)
@@ -83,7 +127,8 @@ void OalDetector::PrepareFor(int width, int height) {
   height_ = height;
   centre_u_ = 0.5 * (width - 1);
   centre_v_ = 0.5 * (height - 1);
-  const int borders = BorderCount(width, height, options_);
+  columns_.Prepare(width, height, options_.start_px, options_.step_px);
+  const int borders = columns_.count();
   samples_.reserve(static_cast<std::size_t>(2 * (width + height)));
   border_points_.reserve(static_cast<std::size_t>(options_.max_points_per_border));
   frame_points_.reserve(static_cast<std::size_t>(borders * options_.max_points_per_border));
@@ -100,18 +145,15 @@ const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image)
   oal_.Clear();
   frame_points_.clear();
   lines_.clear();
-  int border = 0;
-  for (int d = options_.start_px;; d += options_.step_px, ++border) {
-    const BorderRect rect = BorderAt(image.width, image.height, d);
-    if (!rect.Valid()) break;
-    ScanBorder(image, border, rect);
-  }
+  columns_.Read(image);
+  for (int border = 0; border < columns_.count(); ++border) ScanBorder(image, border);
   ReadOff(image.width, image.height);
   return lines_;
 }
 
-void OalDetector::ScanBorder(const GrayImageView& image, int border, const BorderRect& rect) {
-  GatherBorder(image, rect, &samples_);
+void OalDetector::ScanBorder(const GrayImageView& image, int border) {
+  const BorderRect rect = columns_.Rect(border);
+  columns_.GatherBorder(image, border, &samples_);
   int threshold = options_.fixed_threshold;
   bool has_contrast = true;
   if (options_.threshold_mode == ThresholdMode::kOtsu) {
@@ -147,12 +189,10 @@ void OalDetector::ScanBorder(const GrayImageView& image, int border, const Borde
     p.u = working.u - centre_u_;
     p.v = working.v - centre_v_;
   }
-  for (std::size_t k = 0; k < outline_u_.size(); ++k) {
-    const Point2d& p = border_outline_[std::min(k, border_outline_.size() - 1)];
-    outline_u_[k] = p.u;
-    outline_v_[k] = p.v;
-  }
-  oal_.EndBorder([this](const OalEntry& entry) { return LineCrossesBorder(entry); });
+  // A local copy, captured by value: the compiler keeps it in registers across the entries
+  // (it would reload member arrays after every count update, which might alias them).
+  const OutlineArrays outline(border_outline_);
+  oal_.EndBorder([outline](const OalEntry& entry) { return outline.Crossed(entry); });
 }
 
 void OalDetector::VotePairs(int border, std::size_t first_point) {
@@ -184,38 +224,6 @@ bool OalDetector::WidthsAgree(const FramePoint& a, const FramePoint& b, double c
   if (std::max(width_a, width_b) > options_.max_width_px) return false;
   // The min_width_px slack keeps thin lines, whose widths are a pixel or two, comparable.
   return std::max(width_a, width_b) <= ratio * std::min(width_a, width_b) + options_.min_width_px;
-}
-
-bool OalDetector::LineCrossesBorder(const OalEntry& entry) const {
-  // The line crosses the outline if some corner is strictly on each side of it.
-#if defined(__GNUC__)
-  // Two corners at a time (GCC/Clang vector extensions: SSE2 on x86-64, NEON on ARM).
-  typedef double Doubles2 __attribute__((vector_size(16)));
-  using Masks2 = decltype(Doubles2{} > Doubles2{});  // the comparisons' lane masks
-  const Doubles2 c = {entry.cos_theta, entry.cos_theta};
-  const Doubles2 s = {entry.sin_theta, entry.sin_theta};
-  const Doubles2 rho = {entry.rho_px, entry.rho_px};
-  const Doubles2 zero = {0.0, 0.0};
-  Masks2 positive = {0, 0}, negative = {0, 0};
-  for (int k = 0; k < kOutlinePoints; k += 2) {
-    Doubles2 u, v;
-    std::memcpy(&u, &outline_u_[static_cast<std::size_t>(k)], sizeof(u));
-    std::memcpy(&v, &outline_v_[static_cast<std::size_t>(k)], sizeof(v));
-    const Doubles2 f = u * c + v * s - rho;
-    positive |= f > zero;
-    negative |= f < zero;
-  }
-  return (positive[0] | positive[1]) != 0 && (negative[0] | negative[1]) != 0;
-#else
-  bool positive = false, negative = false;
-  for (int k = 0; k < kOutlinePoints; ++k) {
-    const double f = outline_u_[k] * entry.cos_theta + outline_v_[k] * entry.sin_theta -
-                     entry.rho_px;
-    positive |= f > 0.0;
-    negative |= f < 0.0;
-  }
-  return positive && negative;
-#endif
 }
 
 void OalDetector::ReadOff(int width, int height) {

@@ -15,7 +15,6 @@
 // coordinates (the pixels an ideal pinhole camera with the same intrinsics would see).
 #pragma once
 
-#include <array>
 #include <optional>
 #include <vector>
 
@@ -66,11 +65,10 @@ class OalDetector {
 
  private:
   void PrepareFor(int width, int height);
-  void ScanBorder(const GrayImageView& image, int border, const BorderRect& rect);
+  void ScanBorder(const GrayImageView& image, int border);
   void VotePairs(int border, std::size_t first_point);
   bool WidthsAgree(const FramePoint& a, const FramePoint& b, double cos_theta,
                    double sin_theta) const;
-  bool LineCrossesBorder(const OalEntry& entry) const;
   void ReadOff(int width, int height);
   Point2d ToWorking(const Point2d& pixel) const;
 
@@ -81,14 +79,11 @@ class OalDetector {
   // Working memory, sized once per image size (no allocation per frame after that).
   int width_ = 0, height_ = 0;
   double centre_u_ = 0.0, centre_v_ = 0.0;
+  BorderColumns columns_;
   std::vector<std::uint8_t> samples_;
   std::vector<BorderPoint> border_points_;
   std::vector<FramePoint> frame_points_;
   std::vector<Point2d> border_outline_;  ///< current border's outline, centred coordinates
-  /// border_outline_ as fixed-size coordinate arrays, padded by repeating its last point,
-  /// so that LineCrossesBorder is a short loop the compiler unrolls and vectorises.
-  static constexpr int kOutlinePoints = 8;  // even: LineCrossesBorder takes two at a time
-  std::array<double, kOutlinePoints> outline_u_{}, outline_v_{};
   std::vector<DetectedLine> candidates_;
   std::vector<DetectedLine> lines_;
 };
