@@ -13,7 +13,10 @@ LineParams Normalized(double rho_px, double theta_rad) {
     theta -= kPi;
     rho = -rho;
   }
-  if (theta >= kPi) theta = 0.0;  // guards theta == pi after rounding
+  if (theta >= kPi) {  // theta == pi after rounding: a tiny negative angle became 2 pi - pi.
+    theta = 0.0;       // (rho, pi) is (-rho, 0)
+    rho = -rho;
+  }
   return LineParams{rho, theta};
 }
 
@@ -66,6 +69,16 @@ bool ClipToRect(const LineParams& line, double u0, double v0, double u1, double 
   *a = Point2d{foot.u + t_min * dir.u, foot.v + t_min * dir.v};
   *b = Point2d{foot.u + t_max * dir.u, foot.v + t_max * dir.v};
   return true;
+}
+
+LineParams ToMeLineConvention(const LineParams& line) {
+  // u = j, v = i: j·cos(t) + i·sin(t) = rho  <=>  i·cos(pi/2 - t) + j·sin(pi/2 - t) = rho.
+  return Normalized(line.rho_px, kPi / 2.0 - line.theta_rad);
+}
+
+LineParams FromMeLineConvention(const LineParams& me_line) {
+  // The map theta -> pi/2 - theta is its own inverse.
+  return Normalized(me_line.rho_px, kPi / 2.0 - me_line.theta_rad);
 }
 
 }  // namespace oal

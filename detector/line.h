@@ -4,7 +4,8 @@
 // the centre of the top-left pixel. A line is the set of points with
 //     u·cos(theta) + v·sin(theta) = rho,     theta in [0, pi), rho in pixels (may be < 0),
 // which is OpenCV's HoughLines convention. ViSP's vpMeLine uses (i = row, j = column)
-// with i·cos(theta) + j·sin(theta) = rho; conversions live in the tracker, not here.
+// with i·cos(theta) + j·sin(theta) = rho; ToMeLineConvention / FromMeLineConvention at the
+// end of this file are the one place that converts between the two.
 #pragma once
 
 #include <cmath>
@@ -49,5 +50,15 @@ bool Intersect(const LineParams& a, const LineParams& b, Point2d* out, double ep
 /// misses the rectangle.
 bool ClipToRect(const LineParams& line, double u0, double v0, double u1, double v1, Point2d* a,
                 Point2d* b);
+
+/// The same line in vpMeLine's convention, i·cos(theta) + j·sin(theta) = rho with i = row,
+/// j = column (pixels): theta_me = pi/2 - theta, rho unchanged, then brought into [0, pi) with
+/// Normalized(). The result holds vpMeLine's rho and theta, so its SignedDistance() takes
+/// (row, column). vpMeLine's theta spans [0, 2 pi) to encode edge polarity; ours has none.
+LineParams ToMeLineConvention(const LineParams& line);
+
+/// The inverse: vpMeLine's (rho, theta), theta anywhere (e.g. [0, 2 pi) as vpMeLine::getTheta
+/// gives it), to our convention with theta in [0, pi).
+LineParams FromMeLineConvention(const LineParams& me_line);
 
 }  // namespace oal

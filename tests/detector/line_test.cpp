@@ -67,5 +67,12 @@ TEST(Line, ClipToRectGivesBorderPoints) {
   EXPECT_FALSE(ClipToRect(LineParams{500.0, 0.0}, 0, 0, 99, 49, &a, &b));
 }
 
+TEST(Line, NormalizedTinyNegativeAngleKeepsRho) {
+  // -1e-17 + 2 pi rounds to 2 pi: the line is still (rho, 0), not (-rho, 0).
+  const LineParams line = Normalized(5.0, -1e-17);
+  EXPECT_EQ(line.theta_rad, 0.0);
+  EXPECT_EQ(line.rho_px, 5.0);
+}
+
 }  // namespace
 }  // namespace oal
