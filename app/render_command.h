@@ -4,6 +4,12 @@
 //   DIR/frame_0000.png    8-bit grey frame
 //   DIR/frame_0000.json   ground truth: pose cMo, camera, one entry per target line
 //   DIR/camera.xml        ViSP camera file, camera "oal-render", perspectiveProjWithDistortion
+//
+// With a sequence (`--sequence KIND`, scene/sequence.h) the frames are a reproducible camera
+// motion with per-frame effects instead of independent random poses, and two more things are
+// written: each frame's JSON gains "sequence", "effects" (gain, offset, occluders) and a
+// per-line "occluded_fraction", and DIR/sequence.json (kind, seed, count, target, description,
+// render settings) is written last, so its presence means the sequence is complete.
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
@@ -14,6 +20,10 @@
 namespace oal {
 
 struct RenderCommandOptions {
+  /// Empty: independent random poses from the options below. Otherwise a sequence name
+  /// (SequenceKindNames()); the sequence then sets the image size, camera, noise, blur,
+  /// illumination and poses, and only target, count, seed and out_dir are used.
+  std::string sequence;
   std::string target = "four-line";  ///< "two-line" or "four-line"
   int count = 10;                    ///< frames, [1, 100000]
   std::uint64_t seed = 1;            ///< poses and noise are a function of it
@@ -38,6 +48,9 @@ struct RenderCommandOptions {
 /// The camera of a rendered data set: fx = fy = `fx_px`, principal point at the image centre
 /// ((w-1)/2, (h-1)/2), model perspectiveProjWithDistortion with `kdu` and kud = FitKud().
 vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu);
+
+/// Frames of a sequence when `--sequence` is given without `--count`.
+constexpr int kDefaultSequenceFrames = 60;
 
 /// Renders options.count frames into options.out_dir (every file written atomically).
 /// Returns the number of frames written; throws on bad options or I/O errors.

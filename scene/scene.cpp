@@ -192,7 +192,7 @@ double ApparentWidth(const TargetLine& line, const vpHomogeneousMatrix& cMo,
 }
 
 TruthLine LineTruth(const TargetLine& line, int index, const vpHomogeneousMatrix& cMo,
-                    const RenderOptions& options) {
+                    const RenderOptions& options, const std::vector<Occluder>& occluders) {
   TruthLine truth;
   truth.index = index;
   const Vec3 c1 = ToCamera(cMo, line.x1_m, line.y1_m);
@@ -216,6 +216,13 @@ TruthLine LineTruth(const TargetLine& line, int index, const vpHomogeneousMatrix
   truth.visible_length_px =
       std::hypot(truth.end_b.u - truth.end_a.u, truth.end_b.v - truth.end_a.v);
   truth.width_px = ApparentWidth(line, cMo, options.camera, 0.5 * (t_a + t_b));
+  if (!occluders.empty()) {
+    const auto hidden = std::count_if(points.begin(), points.end(), [&](const Point2d& p) {
+      return std::any_of(occluders.begin(), occluders.end(),
+                         [&](const Occluder& o) { return o.Contains(p.u, p.v); });
+    });
+    truth.occluded_fraction = static_cast<double>(hidden) / static_cast<double>(points.size());
+  }
   return truth;
 }
 
@@ -488,6 +495,48 @@ void ApplyIllumination(double gradient, double angle_rad, cv::Mat1f* image) {
   }
 }
 
+// Fraction of the pixel square [lo, lo + 1] inside [a, b] (one axis).
+double Overlap(double lo, double a, double b) {
+  return std::clamp(std::min(lo + 1.0, b) - std::max(lo, a), 0.0, 1.0);
+}
+
+// Fraction of pixel (u, v) covered by `o`: exact for a rectangle, from the distance to the rim
+// for a disc (exact for a straight rim; the error is second order in 1 / radius).
+double OccluderCoverage(const Occluder& o, int u, int v) {
+  if (o.shape == Occluder::Shape::kRectangle) {
+    return Overlap(u - 0.5, o.centre_u_px - o.half_width_px, o.centre_u_px + o.half_width_px) *
+           Overlap(v - 0.5, o.centre_v_px - o.half_height_px, o.centre_v_px + o.half_height_px);
+  }
+  const double distance = std::hypot(u - o.centre_u_px, v - o.centre_v_px);
+  return std::clamp(o.half_width_px - distance + 0.5, 0.0, 1.0);
+}
+
+// Paints the occluders over the radiance, blending by coverage at their rims.
+void PaintOccluders(const std::vector<Occluder>& occluders, cv::Mat1f* image) {
+  for (const Occluder& o : occluders) {
+    const double half_v = o.shape == Occluder::Shape::kDisc ? o.half_width_px : o.half_height_px;
+    const int u_begin = std::max(0, static_cast<int>(std::floor(o.centre_u_px - o.half_width_px)));
+    const int u_end =
+        std::min(image->cols - 1, static_cast<int>(std::ceil(o.centre_u_px + o.half_width_px)));
+    const int v_begin = std::max(0, static_cast<int>(std::floor(o.centre_v_px - half_v)));
+    const int v_end =
+        std::min(image->rows - 1, static_cast<int>(std::ceil(o.centre_v_px + half_v)));
+    for (int v = v_begin; v <= v_end; ++v) {
+      float* row = image->ptr<float>(v);
+      for (int u = u_begin; u <= u_end; ++u) {
+        const double c = OccluderCoverage(o, u, v);
+        row[u] = static_cast<float>(row[u] * (1.0 - c) + o.grey * c);
+      }
+    }
+  }
+}
+
+// Maps every grey level g to gain * g + offset.
+void ApplyGainOffset(double gain, double offset, cv::Mat1f* image) {
+  if (gain == 1.0 && offset == 0.0) return;
+  image->convertTo(*image, CV_32F, gain, offset);
+}
+
 // SplitMix64, to spread nearby seeds over the generator's state space.
 std::uint64_t Mix(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ull;
@@ -648,6 +697,34 @@ void RenderOptions::Check() const {
           "1 <= supersample <= 8");
 }
 
+bool Occluder::Contains(double u, double v) const {
+  if (shape == Shape::kRectangle) {
+    return std::fabs(u - centre_u_px) <= half_width_px &&
+           std::fabs(v - centre_v_px) <= half_height_px;
+  }
+  return std::hypot(u - centre_u_px, v - centre_v_px) <= half_width_px;
+}
+
+void Occluder::Check() const {
+  Require(std::isfinite(centre_u_px), "Occluder::centre_u_px", centre_u_px,
+          "centre_u_px is finite");
+  Require(std::isfinite(centre_v_px), "Occluder::centre_v_px", centre_v_px,
+          "centre_v_px is finite");
+  Require(half_width_px > 0.0 && half_width_px < 1e6, "Occluder::half_width_px", half_width_px,
+          "0 < half_width_px < 1e6");
+  if (shape == Shape::kRectangle) {
+    Require(half_height_px > 0.0 && half_height_px < 1e6, "Occluder::half_height_px",
+            half_height_px, "0 < half_height_px < 1e6");
+  }
+  Require(InRange(grey, 0, 255), "Occluder::grey", grey, "0 <= grey <= 255");
+}
+
+void FrameEffects::Check() const {
+  Require(InRange(gain, 0.0, 10.0), "FrameEffects::gain", gain, "0 <= gain <= 10");
+  Require(InRange(offset, -255.0, 255.0), "FrameEffects::offset", offset, "-255 <= offset <= 255");
+  for (const Occluder& occluder : occluders) occluder.Check();
+}
+
 void PoseSampling::Check() const {
   Require(min_distance_m > 0.0, "PoseSampling::min_distance_m", min_distance_m,
           "min_distance_m > 0");
@@ -697,6 +774,12 @@ SceneRenderer::SceneRenderer(LineTarget target, RenderOptions options)
 
 RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo,
                                     std::uint64_t noise_seed) const {
+  return Render(cMo, noise_seed, FrameEffects());
+}
+
+RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed,
+                                    const FrameEffects& effects) const {
+  effects.Check();
   const PlaneProjector projector(cMo, options_.camera);
   PixelCoverage coverage(BuildRegions(target_), options_.supersample);
   const BackgroundShade background(background_, options_.background_grey);
@@ -718,7 +801,9 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo,
           static_cast<float>(around * (1.0 - c.board) + board * (c.board - c.dark) + line * c.dark);
     }
   }
+  PaintOccluders(effects.occluders, &radiance);
   ApplyIllumination(options_.illumination_gradient, options_.gradient_angle_rad, &radiance);
+  ApplyGainOffset(effects.gain, effects.offset, &radiance);
   if (options_.blur_sigma_px > 0.0) {
     cv::GaussianBlur(radiance, radiance, cv::Size(), options_.blur_sigma_px, options_.blur_sigma_px,
                      cv::BORDER_REFLECT);
@@ -730,15 +815,21 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo,
   cv::Mat out(options_.height, options_.width, CV_8U, frame.image.bitmap);
   radiance.convertTo(out, CV_8U);  // rounds and saturates to [0, 255]
   frame.cMo = cMo;
-  frame.truth = Truth(cMo);
+  frame.truth = Truth(cMo, effects);
   return frame;
 }
 
 std::vector<TruthLine> SceneRenderer::Truth(const vpHomogeneousMatrix& cMo) const {
+  return Truth(cMo, FrameEffects());
+}
+
+std::vector<TruthLine> SceneRenderer::Truth(const vpHomogeneousMatrix& cMo,
+                                            const FrameEffects& effects) const {
   std::vector<TruthLine> truth;
   truth.reserve(target_.lines.size());
   for (std::size_t i = 0; i < target_.lines.size(); ++i) {
-    truth.push_back(LineTruth(target_.lines[i], static_cast<int>(i), cMo, options_));
+    truth.push_back(
+        LineTruth(target_.lines[i], static_cast<int>(i), cMo, options_, effects.occluders));
   }
   return truth;
 }

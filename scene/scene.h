@@ -78,6 +78,36 @@ struct RenderOptions {
   void Check() const;
 };
 
+/// An opaque shape in front of the board, given in image pixels (distorted image, pixel
+/// centres at integer coordinates): it hides whatever lies behind it, is anti-aliased at its
+/// rim, and is lit like the scene (gradient, gain and offset apply to it too).
+struct Occluder {
+  enum class Shape { kRectangle, kDisc };
+  Shape shape = Shape::kRectangle;
+  double centre_u_px = 0.0;     ///< centre column, pixels, finite (may lie outside the image)
+  double centre_v_px = 0.0;     ///< centre row, pixels, finite
+  double half_width_px = 0.0;   ///< rectangle: half extent along u; disc: radius; pixels, > 0
+  double half_height_px = 0.0;  ///< rectangle: half extent along v, pixels, > 0; disc: unused
+  int grey = 128;               ///< uniform grey level, [0, 255]
+
+  /// True when the point (u, v) (pixels) lies inside the shape.
+  bool Contains(double u, double v) const;
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+/// What changes from one frame of a sequence to the next besides the pose: a global
+/// illumination change and occluders. The default is a frame rendered as by Render(cMo, seed).
+struct FrameEffects {
+  /// Scene radiance (after the illumination gradient) is mapped to gain * radiance + offset.
+  double gain = 1.0;                ///< [0, 10]
+  double offset = 0.0;              ///< grey levels, [-255, 255]
+  std::vector<Occluder> occluders;  ///< drawn in order, the last one in front
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
 /// Ground truth of one target line in one frame (pixel conventions of detector/line.h).
 struct TruthLine {
   int index = 0;             ///< 0-based index in LineTarget::lines
@@ -88,6 +118,9 @@ struct TruthLine {
   Point2d end_a, end_b;      ///< ends of its visible part in the distorted image
   double visible_length_px = 0.0;  ///< |end_b - end_a|, pixels
   double width_px = 0.0;  ///< apparent width in the middle of the visible part, ideal pixels
+  /// Fraction of the visible part of the centre line hidden by occluders, [0, 1]. Occlusion
+  /// never makes a line invisible: `visible` and the fields above ignore occluders.
+  double occluded_fraction = 0.0;
 };
 
 struct RenderedFrame {
@@ -104,8 +137,15 @@ class SceneRenderer {
 
   /// Renders the target seen from `cMo`; `noise_seed` makes the noise reproducible.
   RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed) const;
+  /// The same with per-frame effects: occluders are painted over the scene, then the
+  /// illumination gradient, gain and offset, blur and noise are applied in that order. Throws
+  /// std::invalid_argument if `effects` fails Check().
+  RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed,
+                       const FrameEffects& effects) const;
   /// Ground truth only (no image), e.g. for a pose that is not rendered.
   std::vector<TruthLine> Truth(const vpHomogeneousMatrix& cMo) const;
+  /// Ground truth with the occluded fraction of each line under `effects`.
+  std::vector<TruthLine> Truth(const vpHomogeneousMatrix& cMo, const FrameEffects& effects) const;
 
   const LineTarget& target() const { return target_; }
   const RenderOptions& options() const { return options_; }

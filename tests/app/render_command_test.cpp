@@ -8,8 +8,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "app/camera_file.h"
+#include "app/command_line.h"
 #include "scene/scene.h"
 #include "tests/app/test_util.h"
 
@@ -119,6 +121,103 @@ TEST(Render, BadOptionsNameTheField) {
   options.background_image = dir / "missing.png";
   EXPECT_THROW(RenderDataset(options), std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir / "data"));
+}
+
+TEST(RenderSequence, WritesFramesTruthAndSequenceJson) {
+  test::TestDir dir;
+  RenderCommandOptions options;
+  options.out_dir = dir / "occlusion";
+  options.sequence = "occlusion";
+  options.count = 10;
+  options.seed = 5;
+  EXPECT_EQ(RenderDataset(options), 10);
+  int frames_with_occluder = 0;
+  for (int i = 0; i < 10; ++i) {
+    const std::string stem = options.out_dir + "/frame_000" + std::to_string(i);
+    const cv::Mat image = cv::imread(stem + ".png", cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << stem;
+    EXPECT_EQ(image.type(), CV_8UC1);
+    EXPECT_EQ(image.cols, 640);
+    EXPECT_EQ(image.rows, 480);
+    const json truth = json::parse(test::ReadText(stem + ".json"));
+    EXPECT_EQ(truth.at("frame"), i);
+    EXPECT_EQ(truth.at("sequence"), "occlusion");
+    EXPECT_EQ(truth.at("seed"), 5);
+    EXPECT_EQ(truth.at("cMo").at("matrix").size(), 4u);
+    EXPECT_EQ(truth.at("effects").at("gain"), 1.0);
+    frames_with_occluder += truth.at("effects").at("occluders").empty() ? 0 : 1;
+    ASSERT_EQ(truth.at("lines").size(), 4u);
+    for (const json& line : truth.at("lines")) {
+      EXPECT_TRUE(line.at("visible").get<bool>());
+      EXPECT_TRUE(line.contains("occluded_fraction"));
+    }
+  }
+  EXPECT_GT(frames_with_occluder, 0);
+  EXPECT_FALSE(fs::exists(options.out_dir + "/frame_0010.png"));
+  const json sequence = json::parse(test::ReadText(options.out_dir + "/sequence.json"));
+  EXPECT_EQ(sequence.at("kind"), "occlusion");
+  EXPECT_EQ(sequence.at("seed"), 5);
+  EXPECT_EQ(sequence.at("count"), 10);
+  EXPECT_EQ(sequence.at("target"), "four-line");
+  EXPECT_THAT(sequence.at("description").get<std::string>(), HasSubstr("rectangle"));
+  const CameraFile camera = LoadCameraFile(options.out_dir + "/camera.xml");
+  EXPECT_EQ(camera.width, 640u);
+  EXPECT_EQ(camera.height, 480u);
+  EXPECT_EQ(camera.camera.get_px(), 600.0);
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+TEST(RenderSequence, SameSeedSameFilesAndDistortionCamera) {
+  test::TestDir dir;
+  RenderCommandOptions a;
+  a.sequence = "distortion";
+  a.count = 2;
+  a.seed = 9;
+  RenderCommandOptions b = a;
+  a.out_dir = dir / "a";
+  b.out_dir = dir / "b";
+  RenderDataset(a);
+  RenderDataset(b);
+  for (const char* name : {"frame_0001.png", "frame_0001.json", "sequence.json", "camera.xml"}) {
+    EXPECT_EQ(test::ReadText(dir / (std::string("a/") + name)),
+              test::ReadText(dir / (std::string("b/") + name)))
+        << name;
+  }
+  const CameraFile camera = LoadCameraFile(a.out_dir + "/camera.xml");
+  EXPECT_EQ(camera.camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
+  EXPECT_NEAR(camera.camera.get_kdu(), 0.47, 1e-12);
+}
+
+TEST(RenderSequence, UnknownSequenceNamesTheValidOnes) {
+  test::TestDir dir;
+  RenderCommandOptions options;
+  options.out_dir = dir / "data";
+  options.sequence = "wobbly";
+  try {
+    RenderDataset(options);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("RenderCommandOptions::sequence = wobbly"));
+    EXPECT_THAT(error.what(), HasSubstr("leave-reenter"));
+  }
+  EXPECT_FALSE(fs::exists(dir / "data"));
+}
+
+TEST(RenderSequence, CommandLineDefaultsAndConflicts) {
+  test::TestDir dir;
+  const std::string out = dir / "slow";
+  std::vector<std::string> args = {"render", "--sequence", "slow", "--count", "3", "--out", out};
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  EXPECT_EQ(RunRender(static_cast<int>(argv.size()), argv.data()), 0);
+  EXPECT_TRUE(fs::exists(out + "/frame_0002.png"));
+  EXPECT_FALSE(fs::exists(out + "/frame_0003.png"));
+  EXPECT_EQ(json::parse(test::ReadText(out + "/sequence.json")).at("count"), 3);
+
+  std::vector<std::string> bad = {"render", "--sequence", "slow", "--kdu", "0.3", "--out", out};
+  std::vector<char*> bad_argv;
+  for (std::string& arg : bad) bad_argv.push_back(arg.data());
+  EXPECT_THROW(RunRender(static_cast<int>(bad_argv.size()), bad_argv.data()), UsageError);
 }
 
 }  // namespace

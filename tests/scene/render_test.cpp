@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <stdexcept>
+#include <string>
 
 #include "scene/scene.h"
 #include "tests/scene/scene_test_util.h"
@@ -278,6 +280,78 @@ TEST(Render, NothingIsSeenWhenTheBoardIsBehindTheCamera) {
     ASSERT_EQ(frame.image.bitmap[i], RenderOptions().background_grey) << i;
   }
   for (const TruthLine& truth : frame.truth) EXPECT_FALSE(truth.visible);
+}
+
+TEST(RenderEffects, NoEffectsIsThePlainRender) {
+  RenderOptions options;
+  options.noise_sigma = 4.0;
+  const SceneRenderer renderer(FourLineTarget(), options);
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.6, 0.01, -0.02, 0.2);
+  EXPECT_TRUE(
+      SameImage(renderer.Render(cMo, 3).image, renderer.Render(cMo, 3, FrameEffects()).image));
+}
+
+TEST(RenderEffects, GainAndOffsetMapEveryGreyLevel) {
+  const LineTarget target = TwoLineTarget();
+  const SceneRenderer renderer(target, RenderOptions());
+  FrameEffects effects;
+  effects.gain = 0.5;
+  effects.offset = 10.2;
+  const RenderedFrame frame = renderer.Render(FrontoParallel(0.5), 1, effects);
+  EXPECT_EQ(frame.image[240][320], 118);  // 0.5 * 215 + 10.2 = 117.7
+  const int line_u = static_cast<int>(std::lround(frame.truth[0].ideal.rho_px));
+  EXPECT_EQ(frame.image[240][line_u], 28);  // 0.5 * 35 + 10.2 = 27.7
+}
+
+TEST(RenderEffects, OccludersHideAndAreCountedInTheTruth) {
+  const LineTarget target = TwoLineTarget();
+  const SceneRenderer renderer(target, RenderOptions());
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.5);  // vertical lines over the full height
+  const double u_line = renderer.Truth(cMo)[0].ideal.rho_px;
+  FrameEffects effects;
+  Occluder rectangle;  // covers line 0 from the top to row 239.5: half its visible part
+  rectangle.centre_u_px = u_line;
+  rectangle.centre_v_px = 59.75;
+  rectangle.half_width_px = 30.0;
+  rectangle.half_height_px = 180.0;
+  rectangle.grey = 100;
+  Occluder disc;
+  disc.shape = Occluder::Shape::kDisc;
+  disc.centre_u_px = 320.0;
+  disc.centre_v_px = 400.0;
+  disc.half_width_px = 20.0;
+  disc.grey = 160;
+  effects.occluders = {rectangle, disc};
+  const RenderedFrame frame = renderer.Render(cMo, 1, effects);
+  const int u = static_cast<int>(std::lround(u_line));
+  EXPECT_EQ(frame.image[100][u], 100);
+  EXPECT_EQ(frame.image[239][u + 29], 100);
+  EXPECT_EQ(frame.image[300][u], target.line_grey);
+  EXPECT_EQ(frame.image[400][320], 160);
+  EXPECT_EQ(frame.image[400][345], target.board_grey);
+  EXPECT_GT(frame.image[400][340], 160);  // rim: partly covered
+  EXPECT_LT(frame.image[400][340], target.board_grey);
+  ASSERT_EQ(frame.truth.size(), 2u);
+  EXPECT_TRUE(frame.truth[0].visible);
+  EXPECT_NEAR(frame.truth[0].occluded_fraction, 0.5, 0.01);
+  EXPECT_EQ(frame.truth[1].occluded_fraction, 0.0);
+  EXPECT_EQ(renderer.Truth(cMo)[0].occluded_fraction, 0.0);
+}
+
+TEST(RenderEffects, BadEffectsNameTheField) {
+  const SceneRenderer renderer(TwoLineTarget(), RenderOptions());
+  FrameEffects effects;
+  effects.gain = -1.0;
+  try {
+    renderer.Render(FrontoParallel(0.5), 1, effects);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("FrameEffects::gain = -1"), std::string::npos)
+        << error.what();
+  }
+  effects.gain = 1.0;
+  effects.occluders.push_back(Occluder{});  // zero size
+  EXPECT_THROW(renderer.Render(FrontoParallel(0.5), 1, effects), std::invalid_argument);
 }
 
 }  // namespace
