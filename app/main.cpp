@@ -10,6 +10,7 @@
 #include <string>
 
 #include "app/command_line.h"
+#include "app/compare_command.h"
 #include "app/demo_command.h"
 #include "app/detect_command.h"
 #include "app/detector_accuracy_command.h"
@@ -26,6 +27,8 @@ constexpr oal::Command kCommands[] = {
     {"detect-accuracy", &oal::RunDetectAccuracy,
      "accuracy of the detector on rendered frames, against the paper and OpenCV"},
     {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
+    {"compare", &oal::RunCompare,
+     "our detector, vpMeLine and OpenCV line detectors against ground truth"},
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
 };
 

@@ -1,0 +1,211 @@
+// `oalservo compare`: line detectors and trackers head to head on the same frames (issue 3).
+//
+// Methods (LineMethod below), each timed per frame with the steady clock around its
+// detection or tracking call only (no image loading, no conversion, no scoring):
+//
+//   oal               our OalDetector (with --camera: points undistorted, lines in undistorted
+//                     pixels, scored against the truth's `ideal` lines; else `distorted_fit`)
+//   vpMeLine          ViSP 3.5 moving edges, initialised from the first frame's truth (or
+//                     from our first detection without truth) and re-initialised "as a user
+//                     would" after a failure (see VpMeLineOptions)
+//   HoughLines Canny  OpenCV: 5x5 Gaussian blur (sigma 1.2), Canny(50, 150), HoughLines
+//   HoughLines Otsu   OpenCV: Otsu threshold (stripes vote with their whole width; for edge
+//                     targets the boundary of the binary image votes), HoughLines
+//   HoughLinesP       OpenCV: the same Canny edges, HoughLinesP, segments merged into lines
+//   LSD               OpenCV createLineSegmentDetector(LSD_REFINE_STD), segments merged
+//   FLD               OpenCV contrib ximgproc::createFastLineDetector() (defaults), merged
+//
+// Segments -> lines: segments are taken longest first; a segment joins the first line whose
+// angle is within 1.5 deg and from which both its ends are within 1.5 px (the line is then
+// refit by total least squares to the ends of its segments, weighted by segment length);
+// otherwise it starts a new line. Lines are ranked by their total segment length.
+//
+// Edges vs centre lines: a stripe has two edges, and every method except oal and
+// HoughLines Otsu finds edges. On stripe targets (TargetKind::kStripes) the edge lines of
+// those methods are paired into centre lines: taking lines best first, a line is paired with
+// the closest later line that is within 2 deg and max_stripe_width_px of it (distance of the
+// two lines at the image centre, at least 1 px), and the pair is reported as its midline in
+// the rank of its better line; an unpaired line is reported as it is. vpMeLine tracks the two
+// edges of a stripe with two trackers and reports their midline. On edge targets nothing is
+// paired. So every method is scored against the same centre-line truth with the same
+// tolerances.
+//
+// Truth, per frame, either
+//   - JSON (default): `<image stem>.json` next to each image (what `oalservo render` writes:
+//     frame_0000.png -> frame_0000.json), or in --truth DIR; only `visible` lines count. If
+//     the first image has none and --truth is not given, the run has no truth (timing only).
+//   - CSV (--truth FILE.csv): one row per line and frame, `frame,line,rho,theta`:
+//       frame  the number in the image's file name: its last run of digits (image.0001.pgm
+//              -> 1, frame_0007.png -> 7, a video's frame "x.avi#12" -> 12); the 0-based
+//              position in INPUT for a name without digits (app/edge_reference.h's format)
+//       line   an identifier of the line (integer >= 0), the same line across frames
+//       rho    pixels, theta radians: u·cosθ + v·sinθ = ρ, u = column, v = row, pixel centres
+//              at integers (detector/line.h); image (distorted) coordinates; theta any value
+//              (normalised to [0, pi))
+//     An optional header row starting with "frame", blank lines and lines starting with '#'
+//     are skipped. A frame without rows has no truth line. The visible chord of a CSV line is
+//     its clip to the image rectangle. CSV lines are edges or centre lines as the target is.
+//
+// Metrics per method (scored on the first K lines of the method, K = --lines if given, else
+// the frame's truth line count + 2):
+//   match     truth and detected line one to one, greedily by angle/1° + offset/2 px, among
+//             pairs within max_angle_deg (1°) and max_offset_px (2 px). The angle error is the
+//             angle between the lines; the offset error is the larger distance of the truth's
+//             visible chord ends from the detected line.
+//   all found frames where every truth line was matched
+//   errors    mean and 95th percentile (nearest rank) of the angle and offset errors of the
+//             matched lines
+//   spurious  per frame, the scored lines (first K) that matched no truth line, averaged
+//   time      median over frames of the time per frame, and of the time per frame divided by
+//             the frame's truth line count (per target line; without truth, by the target count)
+//   re-inits  vpMeLine only: failures counted (a tracker threw, or with truth its line is
+//             further than 5° or 10 px from its truth line) and the re-initialisations done.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpImage.h>
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/json_io.h"
+#include "detector/line.h"
+#include "detector/options.h"
+
+namespace oal {
+
+/// What the target lines are: stripes (centre lines, two edges each) or single edges.
+enum class TargetKind { kAuto, kStripes, kEdges };
+/// "auto", "stripes", "edges".
+std::string ToString(TargetKind kind);
+/// The inverse; throws std::invalid_argument naming the accepted values.
+TargetKind TargetKindFromString(const std::string& text);
+
+/// One target line in one frame: what scoring and a user re-initialising a tracker see.
+struct TargetLineTruth {
+  int id = 0;             ///< the line's identity across frames (target index, CSV `line`)
+  LineParams image_line;  ///< image (distorted) coordinates: distorted_fit or the CSV line
+  LineParams ideal_line;  ///< undistorted pixels (JSON `ideal`); = image_line for CSV
+  Point2d end_a, end_b;   ///< ends of the visible chord, image pixels
+  double width_px = 0.0;  ///< stripe width, pixels (0: an edge or unknown)
+};
+
+/// Reads a truth CSV (format in the file comment): frame index -> its lines. Throws
+/// std::runtime_error "FILE:LINE: ..." for a missing file or a malformed row. Chord ends are
+/// left at zero (set per frame from the image size).
+std::map<int, std::vector<TargetLineTruth>> LoadTruthCsv(const std::string& path);
+
+/// The visible target lines of a frame_NNNN.json truth file (oalservo render). Throws
+/// std::runtime_error naming the file if it is missing or malformed.
+std::vector<TargetLineTruth> LoadTruthJson(const std::string& path);
+
+/// A line detector or tracker under comparison. The runner calls, per frame:
+///   Start(first frame, targets)   once, untimed (a tracker's initialisation)
+///   Process(image, lines)         timed: the method's lines, best first, detector/line.h
+///                                 convention, in image or (Undistorted()) undistorted pixels
+///   AfterFrame(image, targets)    untimed: what a user does after seeing the result (a
+///                                 tracker re-initialised after a failure)
+/// `targets` are the frame's truth lines, or without truth our detector's first lines
+/// (`from_truth` false). An oal-tracker method plugs in here.
+class LineMethod {
+ public:
+  virtual ~LineMethod() = default;
+  virtual std::string Name() const = 0;
+  /// True when the lines are in undistorted pixels (scored against `ideal_line`).
+  virtual bool Undistorted() const { return false; }
+  virtual void Start(const vpImage<unsigned char>& /*image*/,
+                     const std::vector<TargetLineTruth>& /*targets*/, bool /*from_truth*/) {}
+  virtual void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) = 0;
+  virtual void AfterFrame(const vpImage<unsigned char>& /*image*/,
+                          const std::vector<TargetLineTruth>& /*targets*/, bool /*from_truth*/) {}
+  /// Failures and re-initialisations so far; -1 for a method that is not a tracker.
+  virtual int failures() const { return -1; }
+  virtual int reinitialisations() const { return -1; }
+};
+
+/// vpMe settings of the vpMeLine method and its failure rule.
+struct VpMeLineOptions {
+  /// Search half-length along the normal of each moving edge, pixels, [1, 100]. Lines that
+  /// move further between frames are lost (ViSP's default is 4; 15 follows slow and
+  /// moderate motion).
+  int range_px = 15;
+  /// Likelihood threshold of a moving edge (vpMe::setThreshold; ViSP 3.5 default 10000 for
+  /// its 5x5 masks), > 0. 10000 keeps edges of 40+ grey levels of contrast.
+  double threshold = 10000.0;
+  /// Distance between moving edges along the line, pixels, [1, 100].
+  double sample_step_px = 5.0;
+  /// With truth, a tracker further than either bound from its truth line has failed.
+  double drift_angle_deg = 5.0;
+  double drift_offset_px = 10.0;
+
+  void Check() const;
+};
+
+struct CompareOptions {
+  std::string input;        ///< what OpenImageSource opens; required
+  std::string truth;        ///< "" (JSON next to the images), a directory, or a .csv
+  std::string config_path;  ///< YAML for our detector; "" = defaults
+  std::string camera_path;  ///< ViSP camera XML; "" = none
+  std::string out_dir;      ///< "" = no files; else compare.md, .json and figures
+  int lines = 0;            ///< K, lines scored per frame; 0 = truth count + 2, [0, 100]
+  int max_frames = 0;       ///< 0 = all, >= 0
+  TargetKind target_kind = TargetKind::kAuto;  ///< auto: from the truth widths, else config
+  double max_angle_deg = 1.0;                  ///< match tolerance, degrees, > 0
+  double max_offset_px = 2.0;                  ///< match tolerance, pixels, > 0
+  double max_stripe_width_px = 0;  ///< edge pairing bound, pixels; 0: 1.5 x widest truth + 2
+                                   ///< (30 without widths), >= 0
+  int figures = 3;                 ///< compare_frame_NNNN.png written with --out, [0, 10]
+  VpMeLineOptions me;
+
+  void Check() const;
+};
+
+/// What one method did over all frames.
+struct MethodResult {
+  std::string name;
+  std::string reference;  ///< "ideal", "distorted_fit", "csv" or "none"
+  int frames = 0;
+  int frames_all_found = 0;
+  int truth_lines = 0;  ///< summed over frames
+  int found_lines = 0;
+  int spurious_lines = 0;               ///< summed over frames (without truth: the lines output)
+  std::vector<double> angle_error_deg;  ///< matched lines
+  std::vector<double> offset_error_px;
+  std::vector<double> time_us;           ///< per frame
+  std::vector<double> time_us_per_line;  ///< per frame, divided by the target count
+  int failures = -1;                     ///< trackers only
+  int reinitialisations = -1;
+  std::vector<int> missed_frames;              ///< frames where some truth line was not found
+  std::vector<int> missed_per_frame;           ///< truth lines not found, per frame
+  std::vector<std::vector<LineParams>> lines;  ///< scored lines per frame (for figures)
+};
+
+struct CompareReport {
+  CompareOptions options;
+  std::string truth_source;  ///< "json", "csv" or "none"
+  TargetKind target_kind = TargetKind::kStripes;
+  double max_stripe_width_px = 0.0;  ///< as used
+  int frames = 0;
+  int width = 0, height = 0;
+  std::vector<MethodResult> methods;
+  std::vector<std::string> figures;  ///< written figure paths
+  std::vector<std::string> warnings;
+};
+
+/// Runs every method on every frame of options.input and scores it. With options.out_dir
+/// writes compare.md, compare.json and the figures there (each atomically, all or none).
+/// Throws std::invalid_argument for bad options and std::runtime_error naming the file for
+/// a missing or malformed input, truth, configuration or camera file.
+/// `extra_methods` are run after the built-in ones (e.g. an oal-tracker).
+CompareReport RunComparison(const CompareOptions& options,
+                            std::vector<std::unique_ptr<LineMethod>> extra_methods = {});
+
+/// The markdown table: one row per method.
+std::string CompareMarkdown(const CompareReport& report);
+/// The report as JSON (summary figures per method, not the per-frame lines).
+Json CompareJson(const CompareReport& report);
+
+}  // namespace oal

@@ -1,0 +1,11 @@
+// `oalservo compare INPUT [--truth FILE|DIR] [--config FILE] [--camera FILE] [--out DIR]
+// [--lines N]`: line detectors and trackers head to head (app/compare.h has the methods, the
+// truth formats and the metric definitions).
+#pragma once
+
+namespace oal {
+
+/// `oalservo compare ...`; argv[0] is "compare". Prints the markdown table to stdout.
+int RunCompare(int argc, char** argv);
+
+}  // namespace oal

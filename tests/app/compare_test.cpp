@@ -1,0 +1,198 @@
+#include "app/compare.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "app/render_command.h"
+#include "tests/app/test_util.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+constexpr int kFrames = 6;
+const char* const kMethods[] = {
+    "oal", "vpMeLine",        "HoughLines (Canny)", "HoughLines (Otsu)", "HoughLinesP (Canny)",
+    "LSD", "FastLineDetector"};
+
+// Six rendered frames of 320x240 (fx scaled from 600 at 640x480), lines long enough to find.
+std::string RenderShort(const test::TestDir& dir) {
+  RenderCommandOptions render;
+  render.out_dir = dir / "data";
+  render.count = kFrames;
+  render.seed = 3;
+  render.width = 320;
+  render.height = 240;
+  render.fx_px = 300.0;
+  render.noise_sigma = 2.0;
+  render.blur_sigma_px = 0.7;
+  render.max_tilt_deg = 20.0;
+  render.min_visible_px = 100.0;
+  EXPECT_EQ(RenderDataset(render), kFrames);
+  return render.out_dir;
+}
+
+std::string CompareError(const CompareOptions& options) {
+  try {
+    RunComparison(options);
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(Compare, RenderedSequenceGivesOneRowPerMethod) {
+  test::TestDir dir;
+  CompareOptions options;
+  options.input = RenderShort(dir);
+  options.out_dir = dir / "out";
+  const CompareReport report = RunComparison(options);
+  EXPECT_EQ(report.truth_source, "json");
+  EXPECT_EQ(report.frames, kFrames);
+  ASSERT_EQ(report.methods.size(), std::size(kMethods));
+  for (std::size_t m = 0; m < report.methods.size(); ++m) {
+    EXPECT_EQ(report.methods[m].name, kMethods[m]);
+    EXPECT_EQ(report.methods[m].frames, kFrames);
+    EXPECT_EQ(report.methods[m].time_us.size(), static_cast<std::size_t>(kFrames));
+    EXPECT_EQ(report.methods[m].truth_lines, kFrames * 4);
+  }
+  // Our detector finds every line of every frame.
+  EXPECT_EQ(report.methods[0].frames_all_found, kFrames);
+  EXPECT_EQ(report.methods[0].found_lines, kFrames * 4);
+  // vpMeLine, initialised from the truth, finds lines (the poses are independent draws, so
+  // it may well have to be re-initialised after the first frame).
+  EXPECT_GE(report.methods[1].found_lines, 4);
+  EXPECT_GE(report.methods[1].reinitialisations, 0);
+  EXPECT_EQ(report.methods[2].reinitialisations, -1);
+
+  // The table: a header, a rule and one row per method, each with the same columns.
+  const std::string markdown = test::ReadText(fs::path(options.out_dir) / "compare.md");
+  EXPECT_EQ(markdown, CompareMarkdown(report));
+  std::istringstream in(markdown);
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] == '|') rows.push_back(line);
+  }
+  ASSERT_EQ(rows.size(), 2 + std::size(kMethods));
+  const auto columns = [](const std::string& row) {
+    return std::count(row.begin(), row.end(), '|');
+  };
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(columns(rows[i]), columns(rows[0])) << rows[i];
+    if (i >= 2) {
+      EXPECT_THAT(rows[i], HasSubstr(std::string("| ") + kMethods[i - 2] + " |"));
+    }
+  }
+
+  const json parsed = json::parse(test::ReadText(fs::path(options.out_dir) / "compare.json"));
+  EXPECT_EQ(parsed.at("frames"), kFrames);
+  ASSERT_EQ(parsed.at("methods").size(), std::size(kMethods));
+  for (const json& method : parsed.at("methods")) {
+    EXPECT_TRUE(method.at("frames_all_found").is_number());
+    EXPECT_TRUE(method.at("angle_error_deg").at("p95").is_number());
+    EXPECT_TRUE(method.at("offset_error_px").at("mean").is_number());
+    EXPECT_TRUE(method.at("spurious_per_frame").is_number());
+    EXPECT_GE(method.at("time_us_per_frame_median").get<double>(), 0.0);
+  }
+  EXPECT_TRUE(parsed.at("methods")[1].contains("reinitialisations"));
+  ASSERT_FALSE(report.figures.empty());
+  for (const std::string& figure : report.figures) EXPECT_TRUE(fs::is_regular_file(figure));
+  EXPECT_TRUE(test::TempFilesIn(options.out_dir).empty());
+}
+
+TEST(Compare, CsvTruthIsReadAndScored) {
+  test::TestDir dir;
+  const std::string data = RenderShort(dir);
+  // The CSV form of the JSON truth's distorted_fit lines (no distortion here).
+  std::ostringstream csv;
+  csv << "frame,line,rho,theta\n# from the rendered truth\n";
+  for (int f = 0; f < kFrames; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%04d.json", f);
+    for (const TargetLineTruth& line : LoadTruthJson((fs::path(data) / name).string())) {
+      csv << f << "," << line.id << "," << line.image_line.rho_px << ","
+          << line.image_line.theta_rad << "\n";
+    }
+  }
+  test::WriteText(dir / "truth.csv", csv.str());
+  CompareOptions options;
+  options.input = data;
+  options.truth = dir / "truth.csv";
+  const CompareReport report = RunComparison(options);
+  EXPECT_EQ(report.truth_source, "csv");
+  EXPECT_EQ(report.methods[0].truth_lines, kFrames * 4);
+  EXPECT_EQ(report.methods[0].frames_all_found, kFrames);
+}
+
+TEST(Compare, MissingTruthFileNamesIt) {
+  test::TestDir dir;
+  CompareOptions options;
+  options.input = RenderShort(dir);
+  fs::remove(fs::path(options.input) / "frame_0003.json");
+  options.out_dir = dir / "out";
+  const std::string error = CompareError(options);
+  EXPECT_THAT(error, HasSubstr("frame_0003.json"));
+  EXPECT_FALSE(fs::exists(fs::path(options.out_dir) / "compare.md"));
+  EXPECT_FALSE(fs::exists(fs::path(options.out_dir) / "compare.json"));
+
+  options.truth = dir / "nowhere.csv";
+  EXPECT_THAT(CompareError(options), HasSubstr("nowhere.csv"));
+}
+
+TEST(Compare, MalformedCsvNamesFileAndLine) {
+  test::TestDir dir;
+  test::WriteText(dir / "bad.csv", "frame,line,rho,theta\n0,0,10.5,0.3\n1,0,abc,0.3\n");
+  EXPECT_THROW(LoadTruthCsv(dir / "bad.csv"), std::runtime_error);
+  try {
+    LoadTruthCsv(dir / "bad.csv");
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("bad.csv:3"));
+    EXPECT_THAT(error.what(), HasSubstr("rho"));
+  }
+  test::WriteText(dir / "short.csv", "0,0,10.5\n");
+  try {
+    LoadTruthCsv(dir / "short.csv");
+    ADD_FAILURE() << "no error for a short row";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("short.csv:1"));
+    EXPECT_THAT(error.what(), HasSubstr("4 comma-separated fields"));
+  }
+
+  // Through the comparison: the error names the file and no output is left behind.
+  CompareOptions options;
+  options.input = RenderShort(dir);
+  options.truth = dir / "bad.csv";
+  options.out_dir = dir / "out";
+  EXPECT_THAT(CompareError(options), HasSubstr("bad.csv:3"));
+  EXPECT_FALSE(fs::exists(fs::path(options.out_dir) / "compare.md"));
+}
+
+TEST(Compare, WithoutTruthOnlyTimes) {
+  test::TestDir dir;
+  const std::string data = RenderShort(dir);
+  fs::create_directories(dir / "images");
+  for (int f = 0; f < 3; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%04d.png", f);
+    fs::copy_file(fs::path(data) / name, fs::path(dir / "images") / name);
+  }
+  CompareOptions options;
+  options.input = dir / "images";
+  const CompareReport report = RunComparison(options);
+  EXPECT_EQ(report.truth_source, "none");
+  EXPECT_EQ(report.frames, 3);
+  EXPECT_THAT(CompareMarkdown(report), HasSubstr("| vpMeLine |"));
+  EXPECT_GE(report.methods[1].lines[0].size(), 1u);  // trackers started on our detections
+}
+
+}  // namespace
+}  // namespace oal
