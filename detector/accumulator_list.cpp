@@ -31,10 +31,12 @@ void RotateSmall(double a, double* c, double* s) {
 
 // FirstMatch tests kMatchLanes entries per vector, two vectors per loop iteration; the
 // match arrays are padded to whole iterations.
-constexpr int kMatchLanes = 4;  // one 16-byte SIMD register of floats
+constexpr int kMatchLanes = 4;                // one 16-byte SIMD register of floats
 constexpr int kMatchBlock = 2 * kMatchLanes;  // entries tested per loop iteration
 
-int RoundUpToBlocks(int n) { return (n + kMatchBlock - 1) / kMatchBlock * kMatchBlock; }
+int RoundUpToBlocks(int n) {
+  return (n + kMatchBlock - 1) / kMatchBlock * kMatchBlock;
+}
 
 }  // namespace
 
@@ -172,6 +174,20 @@ int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_
     return i;
   }
   if (size >= capacity_) return -1;
+  Append(cos_theta, sin_theta, rho_px).last_border = border;
+  return size;
+}
+
+int OrderedAccumulatorList::Seed(double cos_theta, double sin_theta, double rho_px, int seed_id) {
+  const int size = static_cast<int>(entries_.size());
+  if (size >= capacity_) return -1;
+  OalEntry& entry = Append(cos_theta, sin_theta, rho_px);
+  entry.borders = 0;
+  entry.seed_id = seed_id;
+  return size;
+}
+
+OalEntry& OrderedAccumulatorList::Append(double cos_theta, double sin_theta, double rho_px) {
   if (sin_theta < 0.0 || (sin_theta == 0.0 && cos_theta < 0.0)) {
     cos_theta = -cos_theta;
     sin_theta = -sin_theta;
@@ -186,9 +202,8 @@ int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_
   entry.theta_rad = std::atan2(sin_theta, cos_theta);
   if (entry.theta_rad >= kPi) entry.theta_rad = 0.0;
   entry.rho_px = rho_px;
-  entry.last_border = border;
   Mirror(entries_.size() - 1);
-  return size;
+  return entry;
 }
 
 bool OrderedAccumulatorList::InsertionSort(std::vector<SortKey>::iterator first,
@@ -221,8 +236,8 @@ bool OrderedAccumulatorList::SortOrder() {
   if (old_end != order_.begin() && old_end != order_.end() && Higher(*old_end, *(old_end - 1))) {
     merged_order_.clear();
     // std::merge is stable: of equal keys, the older entry stays first.
-    std::merge(order_.begin(), old_end, old_end, order_.end(),
-               std::back_inserter(merged_order_), Higher);
+    std::merge(order_.begin(), old_end, old_end, order_.end(), std::back_inserter(merged_order_),
+               Higher);
     order_.swap(merged_order_);
     moved = true;
   }

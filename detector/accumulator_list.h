@@ -18,10 +18,11 @@ struct OalEntry {
   double theta_rad = 0.0;
   double cos_theta = 1.0;
   double sin_theta = 0.0;
-  int weight = 1;  ///< votes (paper: "weighting")
-  int count = 0;   ///< borders since the entry was created (paper: "count")
-  int borders = 1; ///< borders that voted for the entry at least once
+  int weight = 1;   ///< votes (paper: "weighting")
+  int count = 0;    ///< borders since the entry was created (paper: "count")
+  int borders = 1;  ///< borders that voted for the entry at least once
   int last_border = -1;
+  int seed_id = -1;  ///< id of the tracked line that seeded the entry, or -1 (Seed())
 
   LineParams Line() const { return LineParams{rho_px, theta_rad}; }
   /// Ordering measure of Eq. 3.
@@ -35,8 +36,7 @@ class OrderedAccumulatorList {
   /// `angle_change_rad`, `r_change_px`: Eq. 1 and 2. `max_lines`: the culling limit of
   /// step 5. `capacity`: a hard bound on entries (>= max_lines); a vote that matches nothing
   /// while the list is full is dropped, so memory never grows past it.
-  OrderedAccumulatorList(double angle_change_rad, double r_change_px, int max_lines,
-                         int capacity);
+  OrderedAccumulatorList(double angle_change_rad, double r_change_px, int max_lines, int capacity);
 
   void Clear() {
     entries_.clear();
@@ -50,6 +50,12 @@ class OrderedAccumulatorList {
   /// entry with weight 1 and count 0 is appended. Returns the index voted for, or -1 if the
   /// vote was dropped.
   int Vote(double cos_theta, double sin_theta, double rho_px, int border);
+
+  /// Appends an entry for a line expected in this frame (a tracker's previous line): weight
+  /// 1 (the seed counts as one prior vote in the averaging), count 0, no border yet, and
+  /// `seed_id`, which the entry keeps whatever votes it collects. Call after Clear() and
+  /// before the first border. Returns its index, or -1 if the list is full.
+  int Seed(double cos_theta, double sin_theta, double rho_px, int seed_id);
 
   /// Steps 4 and 5 at the end of a border: increment `count` of every entry for which
   /// `counts(entry)` is true, sort by Eq. 3 (stable), then cull from the bottom entries with
@@ -68,6 +74,8 @@ class OrderedAccumulatorList {
 
  private:
   void SortAndCull();
+  /// Appends a new entry (weight 1, count 0) for the line; the list must not be full.
+  OalEntry& Append(double cos_theta, double sin_theta, double rho_px);
   /// Index of the first entry within anglechange and rchange of the line, or -1.
   int FirstMatch(double cos_theta, double sin_theta, double rho_px) const;
   void Mirror(std::size_t i);
@@ -77,9 +85,7 @@ class OrderedAccumulatorList {
     int double_score;
     int index;
   };
-  static bool Higher(const SortKey& a, const SortKey& b) {
-    return a.double_score > b.double_score;
-  }
+  static bool Higher(const SortKey& a, const SortKey& b) { return a.double_score > b.double_score; }
 
   /// Sorts order_ by Eq. 3; false if the entries are already in that order.
   bool SortOrder();

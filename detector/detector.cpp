@@ -15,7 +15,9 @@ namespace {
 
 constexpr double kDegToRad = kPi / 180.0;
 
-int MaxPairs(int points) { return points * (points - 1) / 2; }
+int MaxPairs(int points) {
+  return points * (points - 1) / 2;
+}
 
 // Where `line` enters and leaves the closed polygon `outline` (first and last crossing
 // along the line); false if it misses it.
@@ -137,7 +139,8 @@ void OalDetector::PrepareFor(int width, int height) {
   lines_.reserve(static_cast<std::size_t>(options_.max_output_lines));
 }
 
-const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image) {
+const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
+                                                     const std::vector<LineSeed>& seeds) {
   if (image.empty() || image.stride < image.width) {
     throw std::invalid_argument("OalDetector::Detect: empty image or stride < width");
   }
@@ -145,6 +148,11 @@ const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image)
   oal_.Clear();
   frame_points_.clear();
   lines_.clear();
+  for (const LineSeed& seed : seeds) {
+    // To the list's origin at the image centre.
+    const double c = std::cos(seed.line.theta_rad), s = std::sin(seed.line.theta_rad);
+    oal_.Seed(c, s, seed.line.rho_px - centre_u_ * c - centre_v_ * s, seed.id);
+  }
   columns_.Read(image);
   for (int border = 0; border < columns_.count(); ++border) ScanBorder(image, border);
   ReadOff(image.width, image.height);
@@ -243,6 +251,7 @@ void OalDetector::ReadOff(int width, int height) {
     const SupportStats stats = MeasureSupport(line.line, frame_points_, tolerance);
     if (options_.rank_by_support && stats.points < options_.min_support) continue;
     line.votes = entry.weight;
+    line.seed_id = entry.seed_id;
     line.count = entry.count;
     line.borders = stats.borders;
     line.support = stats.points;
@@ -266,12 +275,11 @@ void OalDetector::ReadOff(int width, int height) {
   const double duplicate_angle = options_.duplicate_angle_deg * kDegToRad;
   for (const DetectedLine& candidate : candidates_) {
     if (static_cast<int>(lines_.size()) >= options_.max_output_lines) break;
-    const bool duplicate =
-        std::any_of(lines_.begin(), lines_.end(), [&](const DetectedLine& kept) {
-          return AngleBetween(kept.line, candidate.line) <= duplicate_angle &&
-                 std::fabs(RhoAlignedTo(kept.line, candidate.line) - kept.line.rho_px) <=
-                     options_.duplicate_r_px;
-        });
+    const bool duplicate = std::any_of(lines_.begin(), lines_.end(), [&](const DetectedLine& kept) {
+      return AngleBetween(kept.line, candidate.line) <= duplicate_angle &&
+             std::fabs(RhoAlignedTo(kept.line, candidate.line) - kept.line.rho_px) <=
+                 options_.duplicate_r_px;
+    });
     if (!duplicate) lines_.push_back(candidate);
   }
 

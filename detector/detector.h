@@ -15,10 +15,10 @@
 // coordinates (the pixels an ideal pinhole camera with the same intrinsics would see).
 #pragma once
 
+#include <visp3/core/vpCameraParameters.h>
+
 #include <optional>
 #include <vector>
-
-#include <visp3/core/vpCameraParameters.h>
 
 #include "detector/accumulator_list.h"
 #include "detector/border_scan.h"
@@ -38,6 +38,14 @@ struct DetectedLine {
   int support = 0;        ///< feature points of all borders within support_tolerance_px
   double width_px = 0.0;  ///< mean line thickness across the line (0 for edges)
   Point2d end_a, end_b;   ///< where the line meets the image border
+  int seed_id = -1;       ///< the LineSeed whose entry collected this line's votes, or -1
+};
+
+/// A line expected in the next frame, e.g. a tracked line, in the coordinates of the
+/// detector's output (line.h; undistorted if Undistorts()).
+struct LineSeed {
+  int id = 0;
+  LineParams line;
 };
 
 class OalDetector {
@@ -51,10 +59,15 @@ class OalDetector {
   /// Detects the lines of `image`, best first. The returned reference stays valid until the
   /// next call. An image smaller than the first border gives no line; an empty view throws
   /// std::invalid_argument. After the first frame of a given size nothing is allocated.
-  const std::vector<DetectedLine>& Detect(const GrayImageView& image);
+  const std::vector<DetectedLine>& Detect(const GrayImageView& image) { return Detect(image, {}); }
   const std::vector<DetectedLine>& Detect(const vpImage<unsigned char>& image) {
-    return Detect(ViewOf(image));
+    return Detect(ViewOf(image), {});
   }
+  /// As above, with the accumulator list seeded by `seeds` before the first border
+  /// (OrderedAccumulatorList::Seed): a line that moved less than anglechange and rchange
+  /// from its seed collects its votes in the seed's entry and comes out with its seed_id.
+  const std::vector<DetectedLine>& Detect(const GrayImageView& image,
+                                          const std::vector<LineSeed>& seeds);
 
   bool Undistorts() const { return undistorter_.has_value(); }
   const DetectorOptions& options() const { return options_; }

@@ -14,12 +14,6 @@ namespace {
 
 constexpr double kDegToRad = kPi / 180.0;
 
-// Our (u = column, v = row) line as vpMeLine's (i = row, j = column): swapping the axes
-// turns u·cosθ + v·sinθ = ρ into i·sinθ + j·cosθ = ρ, i.e. θ' = π/2 − θ.
-LineParams ToMeLine(const LineParams& line) {
-  return LineParams{line.rho_px, kPi / 2.0 - line.theta_rad};
-}
-
 // The detector's line for a track that has none this frame: the prediction, with its ends.
 DetectedLine PredictedLine(const LineParams& line, int width, int height) {
   DetectedLine predicted;
@@ -61,14 +55,14 @@ void TrackerOptions::Check() const {
 }
 
 double TrackedLine::getRho() const {
-  return ToMeLine(line.line).rho_px;
+  return ToMeLineConvention(line.line).rho_px;
 }
 double TrackedLine::getTheta() const {
-  return ToMeLine(line.line).theta_rad;
+  return ToMeLineConvention(line.line).theta_rad;
 }
 
 void TrackedLine::getEquationParam(double& A, double& B, double& C) const {
-  const LineParams me = ToMeLine(line.line);
+  const LineParams me = ToMeLineConvention(line.line);
   A = std::cos(me.theta_rad);
   B = std::sin(me.theta_rad);
   C = -me.rho_px;
@@ -94,8 +88,12 @@ void OalLineTracker::initTracking(const vpImage<unsigned char>& I) {
 void OalLineTracker::track(const vpImage<unsigned char>& I) {
   width_ = static_cast<int>(I.getWidth());
   height_ = static_cast<int>(I.getHeight());
+  seeds_.clear();
+  if (options_.seed_from_previous) {
+    for (std::size_t k = 0; k < tracks_.size(); ++k) seeds_.push_back({tracks_[k].id, Predict(k)});
+  }
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<DetectedLine>& detected = detector_.Detect(I);
+  const std::vector<DetectedLine>& detected = detector_.Detect(ViewOf(I), seeds_);
   last_time_us_ =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   Update(detected);
@@ -146,6 +144,13 @@ void OalLineTracker::Update(const std::vector<DetectedLine>& detected) {
       const double angle = std::fabs(motion.theta_rad), offset = std::fabs(motion.rho_px);
       if (angle > gate_angle || offset > options_.gate_offset_px) continue;
       pairs.push_back({angle / gate_angle + offset / options_.gate_offset_px, k, d});
+    }
+  }
+  // A line that grew from a track's seed is that track's, whatever the gate says; the
+  // rest are taken closest first.
+  for (std::size_t d = 0; d < detected.size(); ++d) {
+    for (std::size_t k = 0; k < tracks_.size(); ++k) {
+      if (detected[d].seed_id == tracks_[k].id) pairs.push_back({-1.0, k, d});
     }
   }
   std::stable_sort(pairs.begin(), pairs.end(),

@@ -108,6 +108,7 @@ class OalLineTracker : public vpTracker {
   TrackerOptions options_;
   OalDetector detector_;
   std::vector<TrackedLine> tracks_;
+  std::vector<LineSeed> seeds_;
   /// Per track (same index): change of rho about the image centre and of theta per frame.
   std::vector<LineParams> velocities_;
   int next_id_ = 0;

@@ -178,3 +178,39 @@ TEST(TrackerOptions, CheckNamesTheField) {
 
 }  // namespace
 }  // namespace oal
+
+namespace oal {
+namespace {
+
+// Step 1 of the tracker's identity: a seed collects the votes of a line that barely moved.
+TEST(OalDetector, SeededEntryCarriesItsIdToTheLineThatGrewFromIt) {
+  testing::TestImage image(320, 240, 210);
+  const LineParams truth{140.0, 0.4};
+  testing::PaintStripe(&image, truth, 6.0, 30);
+  OalDetector detector;
+  const std::vector<LineSeed> seeds = {{7, LineParams{141.5, 0.41}},  // the line, moved a bit
+                                       {9, LineParams{10.0, 2.0}}};   // a line that is gone
+  const auto& lines = detector.Detect(image.View(), seeds);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].seed_id, 7);
+  EXPECT_NEAR(lines[0].line.rho_px, truth.rho_px, 0.3);  // the refit forgets the seed's offset
+  EXPECT_EQ(detector.Detect(image.View()).front().seed_id, -1);
+}
+
+TEST(OalLineTracker, SeededLinesKeepTheirIdsWithoutTheGate) {
+  const TrackerScene scene("two-line");
+  TrackerOptions options;
+  options.gate_offset_px = 0.5;  // association by gate alone would lose them
+  options.gate_angle_deg = 0.05;
+  OalLineTracker tracker(options);
+  tracker.initTracking(scene.Frame(0.0, 1).image);
+  ASSERT_EQ(tracker.getLines().size(), 2u);
+  for (int frame = 1; frame < 6; ++frame) {
+    tracker.track(scene.Frame(0.002 * frame, frame).image);  // 1 px per frame
+    EXPECT_EQ(tracker.count(TrackStatus::kTracked), 2) << "frame " << frame;
+    EXPECT_EQ(tracker.count(TrackStatus::kNew), 0) << "frame " << frame;
+  }
+}
+
+}  // namespace
+}  // namespace oal
