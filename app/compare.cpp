@@ -26,6 +26,7 @@
 #include "app/image_source.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
+#include "detector/tracker.h"
 #include "scene/scene.h"
 
 namespace oal {
@@ -200,6 +201,48 @@ class OalMethod : public LineMethod {
  private:
   OalDetector detector_;
   const std::vector<DetectedLine>* last_ = nullptr;
+};
+
+// Our temporal tracker: the lines it holds in each frame (lost ones excluded), best
+// supported first, as the detector ranks them. A user never re-initialises it; its
+// failures are the tracks it lost.
+class OalTrackerMethod : public LineMethod {
+ public:
+  OalTrackerMethod(const DetectorOptions& options, const std::optional<CameraFile>& camera)
+      : tracker_(Options(options), camera ? camera->camera : vpCameraParameters()) {}
+  std::string Name() const override { return "oal-tracker"; }
+  bool Undistorted() const override { return tracker_.detector().Undistorts(); }
+  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
+    tracker_.track(image);
+    held_.clear();
+    for (const TrackedLine& track : tracker_.getLines()) {
+      if (track.status != TrackStatus::kLost) held_.push_back(&track.line);
+    }
+    std::stable_sort(held_.begin(), held_.end(), [](const DetectedLine* a, const DetectedLine* b) {
+      return a->support > b->support;
+    });
+    lines->clear();
+    for (const DetectedLine* line : held_) lines->push_back(line->line);
+  }
+  void AfterFrame(const vpImage<unsigned char>& /*image*/,
+                  const std::vector<TargetLineTruth>& /*targets*/, bool /*from_truth*/) override {
+    for (const TrackedLine& track : tracker_.getLines()) {
+      failures_ += track.status == TrackStatus::kLost && track.frames_lost == 1;
+    }
+  }
+  int failures() const override { return failures_; }
+  int reinitialisations() const override { return 0; }
+
+ private:
+  static TrackerOptions Options(const DetectorOptions& detector) {
+    TrackerOptions options;
+    options.detector = detector;
+    return options;
+  }
+
+  OalLineTracker tracker_;
+  std::vector<const DetectedLine*> held_;
+  int failures_ = 0;
 };
 
 // The OpenCV methods, one class: they share the Canny edges, the segment merging and the
@@ -889,6 +932,7 @@ CompareReport RunComparison(const CompareOptions& options,
   auto oal = std::make_unique<OalMethod>(config.detector, camera);
   OalMethod* ours = oal.get();
   methods.push_back(std::move(oal));
+  methods.push_back(std::make_unique<OalTrackerMethod>(config.detector, camera));
   methods.push_back(std::make_unique<VpMeLineMethod>(options.me, stripes));
   using Kind = OpenCvMethod::Kind;
   for (Kind kind : {Kind::kHoughCanny, Kind::kHoughOtsu, Kind::kHoughP, Kind::kLsd, Kind::kFld}) {

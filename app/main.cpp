@@ -14,6 +14,7 @@
 #include "app/demo_command.h"
 #include "app/detect_command.h"
 #include "app/detector_accuracy_command.h"
+#include "app/edge_reference_command.h"
 #include "app/render_command.h"
 
 #ifndef OAL_VERSION
@@ -26,6 +27,8 @@ constexpr oal::Command kCommands[] = {
     {"detect", &oal::RunDetect, "detect lines in images, a directory, a video or a V4L2 camera"},
     {"detect-accuracy", &oal::RunDetectAccuracy,
      "accuracy of the detector on rendered frames, against the paper and OpenCV"},
+    {"edge-reference", &oal::RunEdgeReference,
+     "independent reference lines for a sequence with one straight edge (truth CSV)"},
     {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
     {"compare", &oal::RunCompare,
      "our detector, vpMeLine and OpenCV line detectors against ground truth"},

@@ -50,6 +50,8 @@ void TrackerOptions::Check() const {
           "0 < gate_angle_deg <= 90");
   require(gate_offset_px > 0 && gate_offset_px <= 10000, "gate_offset_px", gate_offset_px,
           "0 < gate_offset_px <= 10000");
+  require(min_new_support >= 0 && min_new_support <= 100000, "min_new_support", min_new_support,
+          "0 <= min_new_support <= 100000");
   require(max_lost_frames >= 0 && max_lost_frames <= 100000, "max_lost_frames", max_lost_frames,
           "0 <= max_lost_frames <= 100000");
 }
@@ -90,7 +92,11 @@ void OalLineTracker::track(const vpImage<unsigned char>& I) {
   height_ = static_cast<int>(I.getHeight());
   seeds_.clear();
   if (options_.seed_from_previous) {
-    for (std::size_t k = 0; k < tracks_.size(); ++k) seeds_.push_back({tracks_[k].id, Predict(k)});
+    // Only lines seen in the last frame: a lost track's prediction drifts, and a seed there
+    // would gather stray votes. Lost tracks come back through the gate instead.
+    for (std::size_t k = 0; k < tracks_.size(); ++k) {
+      if (tracks_[k].status != TrackStatus::kLost) seeds_.push_back({tracks_[k].id, Predict(k)});
+    }
   }
   const auto start = std::chrono::steady_clock::now();
   const std::vector<DetectedLine>& detected = detector_.Detect(ViewOf(I), seeds_);
@@ -146,8 +152,8 @@ void OalLineTracker::Update(const std::vector<DetectedLine>& detected) {
       pairs.push_back({angle / gate_angle + offset / options_.gate_offset_px, k, d});
     }
   }
-  // A line that grew from a track's seed is that track's, whatever the gate says; the
-  // rest are taken closest first.
+  // A line that grew from a track's seed is that track's, whatever the gate says (the seed
+  // matched it within anglechange and rchange); the rest are taken closest first.
   for (std::size_t d = 0; d < detected.size(); ++d) {
     for (std::size_t k = 0; k < tracks_.size(); ++k) {
       if (detected[d].seed_id == tracks_[k].id) pairs.push_back({-1.0, k, d});
@@ -189,16 +195,26 @@ void OalLineTracker::Update(const std::vector<DetectedLine>& detected) {
   tracks_.resize(kept);
   velocities_.resize(kept);
 
-  // Lines nobody claimed start new tracks, strongest first.
+  // Lines nobody claimed start new tracks, strongest first; when every slot is taken, a
+  // new line replaces the track lost the longest (a line in view beats a memory).
   for (std::size_t d = 0; d < detected.size(); ++d) {
-    if (line_taken[d] || static_cast<int>(tracks_.size()) >= options_.max_tracks) continue;
+    if (line_taken[d] || detected[d].support < options_.min_new_support) continue;
     TrackedLine track;
     track.id = next_id_++;
     track.status = TrackStatus::kNew;
     track.line = detected[d];
     track.frames_seen = 1;
-    tracks_.push_back(track);
-    velocities_.push_back(LineParams{0.0, 0.0});
+    if (static_cast<int>(tracks_.size()) < options_.max_tracks) {
+      tracks_.push_back(track);
+      velocities_.push_back(LineParams{0.0, 0.0});
+      continue;
+    }
+    const auto oldest = std::max_element(
+        tracks_.begin(), tracks_.end(),
+        [](const TrackedLine& a, const TrackedLine& b) { return a.frames_lost < b.frames_lost; });
+    if (oldest == tracks_.end() || oldest->status != TrackStatus::kLost) break;
+    velocities_[static_cast<std::size_t>(oldest - tracks_.begin())] = LineParams{0.0, 0.0};
+    *oldest = track;
   }
 }
 

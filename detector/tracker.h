@@ -2,13 +2,16 @@
 // track() follows the lines from frame to frame, display() draws them. It needs no clicks.
 //
 // Identity. Every line has an id that it keeps while it is tracked. In each frame:
-//   1. the previous frame's lines seed the detector's accumulator list, so a line that moved
-//      less than the matching thresholds (anglechange, rchange) collects its votes in the
-//      entry of its seed and comes out labelled with the seed's id (OAL-native identity);
-//   2. lines that moved further (fast motion) are associated with the remaining tracks by a
-//      gate around each track's prediction (constant velocity in rho and theta), the closest
+//   1. the lines seen in the previous frame, at their predicted place (constant velocity in
+//      rho and theta), seed the detector's accumulator list, so a line that moved less than
+//      the matching thresholds (anglechange, rchange) from its prediction collects its votes
+//      in the entry of its seed and comes out labelled with the seed's id (OAL-native
+//      identity) and goes to its seed's track;
+//   2. the other lines (fast motion, reappearing lines) are associated with the remaining
+//      tracks, lost ones included, by the gate around each track's prediction, the closest
 //      pairs first;
-//   3. a detected line left over starts a new track; a track that got no line is `lost`
+//   3. a detected line left over, with enough support, starts a new track (replacing the
+//      track lost the longest when all max_tracks are taken); a track that got no line is `lost`
 //      (kept, at its prediction, for `max_lost_frames`, so a line that reappears gets its id
 //      back), then dropped.
 // When every track is lost the tracker re-detects by itself: each frame runs the detector on
@@ -49,6 +52,10 @@ struct TrackerOptions {
   int max_lost_frames = 30;
   /// Seed the accumulator list with the previous frame's lines (step 1 above).
   bool seed_from_previous = true;
+  /// A line starts a new track only with at least this many supporting feature points
+  /// (DetectedLine::support), so short-lived spurious lines do not become tracks.
+  /// Range [0, 100000].
+  int min_new_support = 12;
 
   void Check() const;
 };

@@ -20,9 +20,14 @@ using nlohmann::json;
 using ::testing::HasSubstr;
 
 constexpr int kFrames = 6;
-const char* const kMethods[] = {
-    "oal", "vpMeLine",        "HoughLines (Canny)", "HoughLines (Otsu)", "HoughLinesP (Canny)",
-    "LSD", "FastLineDetector"};
+const char* const kMethods[] = {"oal",
+                                "oal-tracker",
+                                "vpMeLine",
+                                "HoughLines (Canny)",
+                                "HoughLines (Otsu)",
+                                "HoughLinesP (Canny)",
+                                "LSD",
+                                "FastLineDetector"};
 
 // Six rendered frames of 320x240 (fx scaled from 600 at 640x480), lines long enough to find.
 std::string RenderShort(const test::TestDir& dir) {
@@ -68,11 +73,14 @@ TEST(Compare, RenderedSequenceGivesOneRowPerMethod) {
   // Our detector finds every line of every frame.
   EXPECT_EQ(report.methods[0].frames_all_found, kFrames);
   EXPECT_EQ(report.methods[0].found_lines, kFrames * 4);
+  // Our tracker follows them too, re-detecting by itself (never re-initialised).
+  EXPECT_EQ(report.methods[1].frames_all_found, kFrames);
+  EXPECT_EQ(report.methods[1].reinitialisations, 0);
   // vpMeLine, initialised from the truth, finds lines (the poses are independent draws, so
   // it may well have to be re-initialised after the first frame).
-  EXPECT_GE(report.methods[1].found_lines, 4);
-  EXPECT_GE(report.methods[1].reinitialisations, 0);
-  EXPECT_EQ(report.methods[2].reinitialisations, -1);
+  EXPECT_GE(report.methods[2].found_lines, 4);
+  EXPECT_GE(report.methods[2].reinitialisations, 0);
+  EXPECT_EQ(report.methods[3].reinitialisations, -1);
 
   // The table: a header, a rule and one row per method, each with the same columns.
   const std::string markdown = test::ReadText(fs::path(options.out_dir) / "compare.md");

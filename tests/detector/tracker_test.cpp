@@ -28,9 +28,9 @@ class TrackerScene {
     return options;
   }
 
-  // Camera 0.6 m in front of the board, rolled by 20 deg, moved by x_m along its x axis.
-  RenderedFrame Frame(double x_m, std::uint64_t seed) const {
-    const vpHomogeneousMatrix cMo(x_m, 0.01, 0.6, 0.0, 0.0, 20.0 * kDeg);
+  // Camera 0.6 m in front of the board, rolled by `roll_deg`, moved by x_m along its x axis.
+  RenderedFrame Frame(double x_m, std::uint64_t seed, double roll_deg = 20.0) const {
+    const vpHomogeneousMatrix cMo(x_m, 0.01, 0.6, 0.0, 0.0, roll_deg * kDeg);
     return renderer_.Render(cMo, seed);
   }
 
@@ -210,6 +210,26 @@ TEST(OalLineTracker, SeededLinesKeepTheirIdsWithoutTheGate) {
     EXPECT_EQ(tracker.count(TrackStatus::kTracked), 2) << "frame " << frame;
     EXPECT_EQ(tracker.count(TrackStatus::kNew), 0) << "frame " << frame;
   }
+}
+
+}  // namespace
+}  // namespace oal
+
+namespace oal {
+namespace {
+
+TEST(OalLineTracker, NewLinesReplaceTheLongestLostTracksWhenFull) {
+  const TrackerScene scene("two-line");
+  TrackerOptions options;
+  options.max_tracks = 2;
+  OalLineTracker tracker(options);
+  tracker.initTracking(scene.Frame(0.0, 1).image);
+  ASSERT_EQ(tracker.getLines().size(), 2u);
+  // The board rolled by 90 deg: two lines far outside every gate.
+  tracker.track(scene.Frame(0.0, 2, 110.0).image);
+  ASSERT_EQ(tracker.getLines().size(), 2u);
+  EXPECT_EQ(tracker.count(TrackStatus::kNew), 2);
+  for (const TrackedLine& track : tracker.getLines()) EXPECT_GE(track.id, 2);
 }
 
 }  // namespace

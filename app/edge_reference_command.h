@@ -1,0 +1,9 @@
+#pragma once
+
+namespace oal {
+
+/// `oalservo edge-reference PATTERN --out FILE.csv`: the independent sub-pixel edge fit of
+/// app/edge_reference.h over an image sequence, written as compare's truth CSV.
+int RunEdgeReference(int argc, char** argv);
+
+}  // namespace oal
