@@ -1,11 +1,10 @@
 #include "app/edge_reference_command.h"
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "app/command_line.h"
 #include "app/edge_reference.h"
@@ -42,15 +41,14 @@ int RunEdgeReference(int argc, char** argv) {
   int found = 0;
   for (const FrameReference& frame : references) {
     if (frame.reference.status != EdgeReferenceStatus::kFound) {
-      Warn("edge-reference", "frame " + std::to_string(frame.frame) + ": " +
-                                 frame.reference.message);
+      Warn("edge-reference",
+           "frame " + std::to_string(frame.frame) + ": " + frame.reference.message);
       continue;
     }
     ++found;
-    std::cout << "frame " << frame.frame << ": rho " << frame.reference.line.rho_px
-              << " px, theta " << frame.reference.line.theta_rad << " rad, rms "
-              << frame.reference.rms_residual_px << " px over " << frame.reference.points
-              << " edge points\n";
+    std::cout << "frame " << frame.frame << ": rho " << frame.reference.line.rho_px << " px, theta "
+              << frame.reference.line.theta_rad << " rad, rms " << frame.reference.rms_residual_px
+              << " px over " << frame.reference.points << " edge points\n";
   }
   WriteTruthCsv(references, out_path);
   std::cout << found << " of " << references.size() << " frames have a reference; wrote "

@@ -4,12 +4,11 @@
 #include <benchmark/benchmark.h>
 
 #include <map>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "detector/detector.h"
 #include "scene/scene.h"
@@ -23,8 +22,7 @@ RenderOptions CheapCamera(int width, int height) {
   options.width = width;
   options.height = height;
   const double f = 600.0 * width / 640.0;
-  options.camera.initPersProjWithDistortion(f, f, 0.5 * (width - 1), 0.5 * (height - 1), 0.0,
-                                            0.33);
+  options.camera.initPersProjWithDistortion(f, f, 0.5 * (width - 1), 0.5 * (height - 1), 0.0, 0.33);
   options.noise_sigma = 8.0;
   options.blur_sigma_px = 1.0;
   return options;
@@ -45,8 +43,9 @@ const RenderedFrame& Frame(const std::string& target, int width, int height) {
 }
 
 cv::Mat MatOf(const RenderedFrame& frame) {
-  return cv::Mat(static_cast<int>(frame.image.getHeight()), static_cast<int>(frame.image.getWidth()),
-                 CV_8UC1, const_cast<unsigned char*>(frame.image.bitmap));
+  return cv::Mat(static_cast<int>(frame.image.getHeight()),
+                 static_cast<int>(frame.image.getWidth()), CV_8UC1,
+                 const_cast<unsigned char*>(frame.image.bitmap));
 }
 
 // A synthetic frame with `count` straight stripes in varied directions.
@@ -74,8 +73,9 @@ vpImage<unsigned char> StripesFrame(int count) {
 void Oal(benchmark::State& state, const std::string& target, bool undistort) {
   const int width = static_cast<int>(state.range(0)), height = static_cast<int>(state.range(1));
   const RenderedFrame& frame = Frame(target, width, height);
-  OalDetector detector = undistort ? OalDetector(DetectorOptions(), CheapCamera(width, height).camera)
-                                   : OalDetector(DetectorOptions());
+  OalDetector detector = undistort
+                             ? OalDetector(DetectorOptions(), CheapCamera(width, height).camera)
+                             : OalDetector(DetectorOptions());
   std::size_t found = 0;
   for (auto _ : state) {
     const auto& lines = detector.Detect(frame.image);
@@ -153,14 +153,18 @@ void CvLsd(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(lines.size());
 }
 
-BENCHMARK_CAPTURE(Oal, two_line, std::string("two-line"), true)->Args({640, 480})->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(Oal, two_line, std::string("two-line"), true)
+    ->Args({640, 480})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(Oal, four_line, std::string("four-line"), true)
     ->Args({320, 240})
     ->Args({640, 480})
     ->Args({1280, 720})
-    ->Args({1920, 1080})->Unit(benchmark::kMicrosecond);
+    ->Args({1920, 1080})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(Oal, four_line_no_undistortion, std::string("four-line"), false)
-    ->Args({640, 480})->Unit(benchmark::kMicrosecond);
+    ->Args({640, 480})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalPaper)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalLineCount)->Arg(1)->Arg(2)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK(CvThresholdCannyHough)->Unit(benchmark::kMicrosecond);

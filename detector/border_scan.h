@@ -41,10 +41,10 @@ BorderRect BorderAt(int width, int height, int d);
 
 /// A feature point found on a border.
 struct BorderPoint {
-  Point2d pixel;             ///< sub-pixel image position
-  double run_px = 0.0;       ///< length of the run along the loop (0 for edges)
-  std::uint8_t sides = 0;    ///< BorderSide bits
-  bool straight = true;      ///< the run lies on one side (its width can be measured)
+  Point2d pixel;           ///< sub-pixel image position
+  double run_px = 0.0;     ///< length of the run along the loop (0 for edges)
+  std::uint8_t sides = 0;  ///< BorderSide bits
+  bool straight = true;    ///< the run lies on one side (its width can be measured)
 };
 
 /// Copies the loop's pixels, in loop order, into `samples` (resized; no allocation once it

@@ -2,10 +2,10 @@
 // buffers reach the detector without a copy.
 #pragma once
 
+#include <visp3/core/vpImage.h>
+
 #include <cstddef>
 #include <cstdint>
-
-#include <visp3/core/vpImage.h>
 
 namespace oal {
 

@@ -12,17 +12,17 @@ namespace oal {
 
 /// A feature point of the whole frame, in the detector's working coordinates.
 struct FramePoint {
-  Point2d p;                 ///< undistorted when the detector corrects distortion
-  float run_px = 0.0f;       ///< run length along the border (0: unknown, e.g. edges)
-  std::uint8_t sides = 0;    ///< BorderSide bits of the border the point is on
-  bool straight = true;      ///< the run lay on one side of the border
-  std::int16_t border = 0;   ///< index of the border, 0 = outermost
+  Point2d p;                ///< undistorted when the detector corrects distortion
+  float run_px = 0.0f;      ///< run length along the border (0: unknown, e.g. edges)
+  std::uint8_t sides = 0;   ///< BorderSide bits of the border the point is on
+  bool straight = true;     ///< the run lay on one side of the border
+  std::int16_t border = 0;  ///< index of the border, 0 = outermost
 };
 
 struct SupportStats {
-  int points = 0;            ///< feature points within the tolerance
-  int borders = 0;           ///< distinct borders among them
-  double width_px = 0.0;     ///< mean line width across the line (0 if unknown)
+  int points = 0;         ///< feature points within the tolerance
+  int borders = 0;        ///< distinct borders among them
+  double width_px = 0.0;  ///< mean line width across the line (0 if unknown)
 };
 
 /// Width across a line of normal (cos_theta, sin_theta) of the stripe whose run gave

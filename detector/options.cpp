@@ -10,8 +10,8 @@ template <typename T>
 void Require(bool ok, const char* field, T value, const char* constraint) {
   if (ok) return;
   std::ostringstream message;
-  message << "DetectorOptions::" << field << " = " << value << ". Violated constraint: "
-          << constraint;
+  message << "DetectorOptions::" << field << " = " << value
+          << ". Violated constraint: " << constraint;
   throw std::invalid_argument(message.str());
 }
 
@@ -19,9 +19,12 @@ void Require(bool ok, const char* field, T value, const char* constraint) {
 
 std::string ToString(Polarity polarity) {
   switch (polarity) {
-    case Polarity::kDarkLines: return "dark";
-    case Polarity::kLightLines: return "light";
-    case Polarity::kEdges: return "edges";
+    case Polarity::kDarkLines:
+      return "dark";
+    case Polarity::kLightLines:
+      return "light";
+    case Polarity::kEdges:
+      return "edges";
   }
   return "?";
 }
@@ -58,9 +61,10 @@ void DetectorOptions::Check() const {
           min_crossing_angle_deg, "1 <= min_crossing_angle_deg <= 90");
   Require(max_points_per_border >= 2 && max_points_per_border <= 64, "max_points_per_border",
           max_points_per_border, "2 <= max_points_per_border <= 64");
-  Require(max_pair_width_ratio == 0.0 || (max_pair_width_ratio >= 1.0 && max_pair_width_ratio <= 100.0),
-          "max_pair_width_ratio", max_pair_width_ratio,
-          "max_pair_width_ratio == 0 or 1 <= max_pair_width_ratio <= 100");
+  Require(
+      max_pair_width_ratio == 0.0 || (max_pair_width_ratio >= 1.0 && max_pair_width_ratio <= 100.0),
+      "max_pair_width_ratio", max_pair_width_ratio,
+      "max_pair_width_ratio == 0 or 1 <= max_pair_width_ratio <= 100");
   Require(angle_change_deg > 0 && angle_change_deg <= 45, "angle_change_deg", angle_change_deg,
           "0 < angle_change_deg <= 45");
   Require(r_change_px > 0 && r_change_px <= 1000, "r_change_px", r_change_px,

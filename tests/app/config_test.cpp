@@ -64,7 +64,8 @@ TEST(Config, ReadsEveryKey) {
       "  start_px: 4\n  step_px: 3\n  polarity: edges\n  threshold_mode: fixed\n"
       "  fixed_threshold: 100\n  min_contrast: 20\n  min_width_px: 1.5\n  max_width_px: 30\n"
       "  min_crossing_angle_deg: 20\n  max_points_per_border: 16\n"
-      "  skip_same_side_pairs: false\n  max_pair_width_ratio: 2.5\n  angle_change_deg: 1.5\n  r_change_px: 3.5\n"
+      "  skip_same_side_pairs: false\n  max_pair_width_ratio: 2.5\n  angle_change_deg: 1.5\n  "
+      "r_change_px: 3.5\n"
       "  max_lines: 30\n  count_visible_borders_only: false\n  refit_lines: false\n"
       "  rank_by_support: false\n  support_tolerance_px: 2.5\n  max_output_lines: 5\n"
       "  min_votes: 4\n  min_support: 8\n  duplicate_angle_deg: 4\n  duplicate_r_px: 9\n",

@@ -1,8 +1,8 @@
 #include "detector/accumulator_list.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace oal {
 namespace {
@@ -94,7 +94,7 @@ TEST(OrderedAccumulatorList, MostLikelyEntryGetsTheVote) {
 TEST(OrderedAccumulatorList, CullsNegativeScoresOnlyBeyondMaxLines) {
   OrderedAccumulatorList list(1 * kDeg, 2.0, /*max_lines=*/2, 40);
   for (int i = 0; i < 3; ++i) VoteFor(&list, 0.0, 0.3);  // A: 3 votes
-  VoteFor(&list, 40.0, 0.3);                            // B, C, D: 1 vote each
+  VoteFor(&list, 40.0, 0.3);                             // B, C, D: 1 vote each
   VoteFor(&list, 80.0, 0.3);
   VoteFor(&list, 120.0, 0.3);
   auto all = [](const OalEntry&) { return true; };

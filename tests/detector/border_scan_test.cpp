@@ -24,7 +24,7 @@ TEST(BorderScan, RectangleGeometryAndCorners) {
   EXPECT_EQ(rect.Height(), 4);
   EXPECT_EQ(rect.Perimeter(), 16);
   const std::pair<double, Point2d> expected[] = {
-      {0, {2, 2}}, {5, {7, 2}}, {6, {7, 3}}, {8, {7, 5}}, {9, {6, 5}},
+      {0, {2, 2}},  {5, {7, 2}},  {6, {7, 3}},  {8, {7, 5}},  {9, {6, 5}},
       {13, {2, 5}}, {14, {2, 4}}, {15, {2, 3}}, {16, {2, 2}}, {5.5, {7, 2.5}}};
   for (const auto& [s, pixel] : expected) {
     EXPECT_NEAR(rect.ToPixel(s).u, pixel.u, kSubPixelTol) << "s = " << s;
@@ -37,10 +37,10 @@ TEST(BorderScan, RectangleGeometryAndCorners) {
 }
 
 TEST(BorderScan, BordersShrinkUntilTheCentre) {
-  EXPECT_TRUE(BorderAt(640, 480, 238).Valid());   // 4 x 4 pixels left
-  EXPECT_TRUE(BorderAt(640, 480, 239).Valid());   // the innermost 2-pixel-high ring
+  EXPECT_TRUE(BorderAt(640, 480, 238).Valid());  // 4 x 4 pixels left
+  EXPECT_TRUE(BorderAt(640, 480, 239).Valid());  // the innermost 2-pixel-high ring
   EXPECT_FALSE(BorderAt(640, 480, 240).Valid());
-  EXPECT_FALSE(BorderAt(15, 15, 10).Valid());     // smaller than the first border
+  EXPECT_FALSE(BorderAt(15, 15, 10).Valid());  // smaller than the first border
 }
 
 TEST(BorderScan, GatherWalksTheLoopClockwise) {
@@ -95,8 +95,8 @@ TEST(BorderScan, RunMidpointIsIntensityWeighted) {
 TEST(BorderScan, DeadPixelsAndTooWideRunsGiveNoPoint) {
   const BorderRect rect = BorderAt(100, 100, 0);
   std::vector<std::uint8_t> samples(rect.Perimeter(), 200);
-  samples[30] = 0;                                        // a dead pixel
-  for (int i = 150; i < 180; ++i) samples[i] = 0;         // 30 px: wider than max_width_px
+  samples[30] = 0;                                 // a dead pixel
+  for (int i = 150; i < 180; ++i) samples[i] = 0;  // 30 px: wider than max_width_px
   std::vector<BorderPoint> points;
   EXPECT_EQ(FindBorderPoints(samples, rect, 128, LineOptions(), &points), 0);
 }

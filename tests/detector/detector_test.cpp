@@ -1,12 +1,12 @@
 #include "detector/detector.h"
 
+#include <gtest/gtest.h>
+
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <new>
 #include <stdexcept>
-
-#include <gtest/gtest.h>
 
 #include "scene/scene.h"
 #include "test_images.h"
@@ -20,8 +20,12 @@ void* operator new(std::size_t size) {
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace oal {
 namespace {
@@ -161,9 +165,8 @@ TEST_P(RenderedFrames, EveryTargetLineWithinHalfDegreeAndOnePixel) {
   sampling.min_visible_length_px = 250.0;
   std::uint64_t state = 20261123;
 
-  OalDetector detector = param.correct_distortion
-                             ? OalDetector(DetectorOptions(), render.camera)
-                             : OalDetector(DetectorOptions());
+  OalDetector detector = param.correct_distortion ? OalDetector(DetectorOptions(), render.camera)
+                                                  : OalDetector(DetectorOptions());
   const int frames = 12;
   for (int frame = 0; frame < frames; ++frame) {
     const RenderedFrame rendered = renderer.Render(SamplePose(renderer, sampling, &state), frame);
