@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "scene/geometry.h"
+
 namespace oal {
 namespace {
 
@@ -50,13 +52,8 @@ double Kdu(const vpCameraParameters& camera) {
 // ---------------------------------------------------------------------------------------------
 // Small 3D helpers.
 
-struct Vec3 {
-  double x = 0.0, y = 0.0, z = 0.0;
-};
-
-Vec3 Cross(const Vec3& a, const Vec3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+using scene_geometry::Cross;
+using scene_geometry::Vec3;
 
 // cMo applied to the object point (X, Y, 0).
 Vec3 ToCamera(const vpHomogeneousMatrix& cMo, double X, double Y) {
@@ -586,15 +583,7 @@ vpHomogeneousMatrix DrawPose(const PoseSampling& sampling, std::mt19937_64& gen)
   const Vec3 centre{offset * std::cos(offset_angle) - distance * z.x,
                     offset * std::sin(offset_angle) - distance * z.y, -distance * z.z};
 
-  vpHomogeneousMatrix cMo;  // rows of cRo are the camera axes; cto = -cRo * centre
-  const Vec3 axes[3] = {x, y, z};
-  for (int r = 0; r < 3; ++r) {
-    cMo[r][0] = axes[r].x;
-    cMo[r][1] = axes[r].y;
-    cMo[r][2] = axes[r].z;
-    cMo[r][3] = -(axes[r].x * centre.x + axes[r].y * centre.y + axes[r].z * centre.z);
-  }
-  return cMo;
+  return scene_geometry::PoseFromCameraAxes(x, y, z, centre);
 }
 
 bool LongEnough(const std::vector<TruthLine>& truth, double min_length_px) {

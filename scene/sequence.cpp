@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "scene/geometry.h"
+
 namespace oal {
 namespace {
 
@@ -48,22 +50,11 @@ std::uint64_t FrameNoiseSeed(std::uint64_t seed, int frame) {
   return x ^ (x >> 31);
 }
 
-struct Vec3 {
-  double x = 0.0, y = 0.0, z = 0.0;
-};
+using scene_geometry::Cross;
+using scene_geometry::Vec3;
 
-Vec3 Cross(const Vec3& a, const Vec3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-Vec3 Unit(const Vec3& a) {
-  const double n = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
-  return {a.x / n, a.y / n, a.z / n};
-}
-
-Vec3 Combine(double a, const Vec3& u, double b, const Vec3& v) {
-  return {a * u.x + b * v.x, a * u.y + b * v.y, a * u.z + b * v.z};
-}
+using scene_geometry::Combine;
+using scene_geometry::Unit;
 
 // Camera with its centre at `centre` (object frame, in front of the board: z < 0) looking at
 // the board point (look_x, look_y, 0), rolled by `roll_rad` about its optical axis (roll 0:
@@ -81,15 +72,7 @@ vpHomogeneousMatrix LookAt(const Vec3& centre, double look_x, double look_y, dou
   const Vec3 z = Combine(cp, z0, sp, x1);
   const Vec3 x = Combine(cp, x1, -sp, z0);
 
-  vpHomogeneousMatrix cMo;  // rows of cRo are the camera axes; cto = -cRo * centre
-  const Vec3 axes[3] = {x, y, z};
-  for (int r = 0; r < 3; ++r) {
-    cMo[r][0] = axes[r].x;
-    cMo[r][1] = axes[r].y;
-    cMo[r][2] = axes[r].z;
-    cMo[r][3] = -(axes[r].x * centre.x + axes[r].y * centre.y + axes[r].z * centre.z);
-  }
-  return cMo;
+  return scene_geometry::PoseFromCameraAxes(x, y, z, centre);
 }
 
 // A smooth camera motion: the camera translates parallel to the board on two sinusoids
