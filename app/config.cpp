@@ -2,12 +2,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace oal {
@@ -42,6 +46,11 @@ struct Value {
   int Int() const { return As<int>("an integer"); }
   double Double() const { return As<double>("a number"); }
   bool Bool() const { return As<bool>("true or false"); }
+  double FiniteDouble() const {
+    const double value = Double();
+    if (!std::isfinite(value)) Fail("'" + key + "' must be a finite number, got '" + Text() + "'");
+    return value;
+  }
 
   // Enum from text through the one place that maps strings to enums (options.h).
   template <typename Enum>
@@ -195,6 +204,180 @@ void ReadDetectorSection(const YAML::Node& section, const std::string& file, App
   CheckAt(config->detector, file, "detector", lines);
 }
 
+// ------------------------------------------------------------------------------------------
+// `target:`: a shipped target by name, or a full description (config/four-line-target.yaml).
+
+constexpr const char* kShippedTargets = "two-line, four-line";
+
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// A point [x, y] in metres.
+struct PointValue {
+  double x = 0.0, y = 0.0;
+};
+
+PointValue ReadPoint(const Value& value) {
+  const YAML::Node& node = value.node;
+  if (!node.IsSequence() || node.size() != 2) {
+    value.Fail("'" + value.key + "' must be a point [x, y] in metres, got '" +
+               (node.IsSequence() ? "a sequence of " + std::to_string(node.size()) : value.Text()) +
+               "'");
+  }
+  PointValue point;
+  point.x = Value{node[0], value.file, value.key + "[0]"}.FiniteDouble();
+  point.y = Value{node[1], value.file, value.key + "[1]"}.FiniteDouble();
+  return point;
+}
+
+// One entry of `lines:`, {from: [x, y], to: [x, y], width: w}, all keys required.
+TargetLine ReadTargetLine(const Value& value) {
+  if (!value.node.IsMap()) {
+    value.Fail("'" + value.key + "' must be a map {from: [x, y], to: [x, y], width: w}, got '" +
+               value.Text() + "'");
+  }
+  std::optional<PointValue> from, to;
+  std::optional<double> width;
+  std::map<std::string, int> seen;
+  for (const auto& entry : value.node) {
+    const std::string key = entry.first.Scalar();
+    const std::string full_key = value.key + "." + key;
+    const auto [first, inserted] = seen.emplace(key, entry.first.Mark().line + 1);
+    if (!inserted) {
+      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
+                               "' is repeated (first at line " + std::to_string(first->second) +
+                               ")");
+    }
+    const Value item{entry.second, value.file, full_key};
+    if (key == "from") {
+      from = ReadPoint(item);
+    } else if (key == "to") {
+      to = ReadPoint(item);
+    } else if (key == "width") {
+      width = item.FiniteDouble();
+      if (*width <= 0.0) {
+        item.Fail("'" + full_key + "' must be > 0 (metres), got '" + item.Text() + "'");
+      }
+    } else {
+      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
+                               "' is unknown (known: from, to, width)");
+    }
+  }
+  for (const auto& [key, present] : {std::pair<const char*, bool>{"from", from.has_value()},
+                                     {"to", to.has_value()},
+                                     {"width", width.has_value()}}) {
+    if (!present)
+      value.Fail("'" + value.key + "' has no '" + key + "' (a line needs from, to, width)");
+  }
+  if (from->x == to->x && from->y == to->y) {
+    value.Fail("'" + value.key + "' has from == to = [" + Number(from->x) + ", " + Number(from->y) +
+               "]: a line needs two different ends");
+  }
+  return TargetLine{from->x, from->y, to->x, to->y, *width};
+}
+
+const std::vector<Field<LineTarget>>& TargetFields() {
+  using T = LineTarget;
+  static const std::vector<Field<T>> fields = {
+      {"name",
+       [](const Value& value, T* target) {
+         target->name = value.As<std::string>("a string");
+         if (target->name.empty()) value.Fail("'" + value.key + "' must not be empty");
+       }},
+      {"board_width_m",
+       [](const Value& value, T* target) { target->board_width_m = value.FiniteDouble(); }},
+      {"board_height_m",
+       [](const Value& value, T* target) { target->board_height_m = value.FiniteDouble(); }},
+      IntField("board_grey", &T::board_grey),
+      IntField("line_grey", &T::line_grey),
+      {"lines",
+       [](const Value& value, T* target) {
+         if (!value.node.IsSequence()) {
+           value.Fail("'" + value.key +
+                      "' must be a sequence of {from: [x, y], to: [x, y], width: w} ([] for none), "
+                      "got '" +
+                      value.Text() + "'");
+         }
+         target->lines.clear();
+         for (std::size_t i = 0; i < value.node.size(); ++i) {
+           target->lines.push_back(ReadTargetLine(
+               Value{value.node[i], value.file, value.key + "[" + std::to_string(i) + "]"}));
+         }
+       }},
+  };
+  return fields;
+}
+
+// Both ends of every line on the board (edges included; the board is centred on the origin).
+void CheckLinesOnBoard(const YAML::Node& section, const std::string& file,
+                       const LineTarget& target) {
+  const double hw = 0.5 * target.board_width_m, hh = 0.5 * target.board_height_m;
+  const double slack = 1e-9;  // metres: ends written on the edge stay on it
+  const YAML::Node lines = section["lines"];
+  for (std::size_t i = 0; i < target.lines.size(); ++i) {
+    const TargetLine& line = target.lines[i];
+    for (const auto& [end, x, y] :
+         {std::tuple<const char*, double, double>{"from", line.x1_m, line.y1_m},
+          {"to", line.x2_m, line.y2_m}}) {
+      if (std::fabs(x) <= hw + slack && std::fabs(y) <= hh + slack) continue;
+      const std::string key = "target.lines[" + std::to_string(i) + "]." + end;
+      throw std::runtime_error(At(file, lines[i][end]) + ": '" + key + "' = [" + Number(x) + ", " +
+                               Number(y) + "] lies outside the board (|x| <= " + Number(hw) +
+                               ", |y| <= " + Number(hh) +
+                               " m: the board is centred on the origin)");
+    }
+  }
+}
+
+// `target:` with `lines` is a full description (name, board_width_m, board_height_m and lines
+// required; the greys default to LineTarget's); without, only `name`, a shipped target.
+void ReadTargetSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  LineTarget target;
+  Lines lines;
+  ReadFields(section, file, "target", TargetFields(), "", &target, &lines);
+  if (lines.count("lines") == 0) {
+    for (const auto& entry : section) {
+      const std::string key = entry.first.Scalar();
+      if (key == "name") continue;
+      throw std::runtime_error(
+          At(file, entry.first) + ": key 'target." + key +
+          "' needs a full target description: give 'lines' too, or only 'name' for a shipped "
+          "target (" +
+          kShippedTargets + ")");
+    }
+    if (lines.count("name") == 0) {
+      throw std::runtime_error(At(file, section) + ": section 'target' needs 'name' (" +
+                               kShippedTargets + ") or a full description with 'lines'");
+    }
+    try {
+      config->target = TargetByName(target.name);
+    } catch (const std::invalid_argument&) {
+      throw std::runtime_error(file + ":" + std::to_string(lines.at("name")) +
+                               ": 'target.name' = '" + target.name + "' is not a shipped target (" +
+                               kShippedTargets +
+                               "); describe it in full with board_width_m, board_height_m and "
+                               "lines");
+    }
+    return;
+  }
+  for (const char* required : {"name", "board_width_m", "board_height_m"}) {
+    if (lines.count(required) == 0) {
+      throw std::runtime_error(At(file, section) + ": 'target." + required +
+                               "' is missing (a full target description needs name, "
+                               "board_width_m, board_height_m and lines)");
+    }
+  }
+  LineTarget board = target;  // the board first, so that the lines are checked against it
+  board.lines.clear();
+  CheckAt(board, file, "target", lines);
+  CheckLinesOnBoard(section, file, target);
+  CheckAt(target, file, "target", lines);
+  config->target = std::move(target);
+}
+
 struct Section {
   const char* name;
   void (*read)(const YAML::Node& section, const std::string& file, AppConfig* config);
@@ -202,6 +385,7 @@ struct Section {
 
 constexpr Section kSections[] = {
     {"detector", &ReadDetectorSection},
+    {"target", &ReadTargetSection},
 };
 
 // Sections later versions will read: rejected with a message that says so.

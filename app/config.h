@@ -6,6 +6,18 @@
 //     paper: true        # start from DetectorOptions::Paper() instead of the defaults
 //     step_px: 5
 //
+//   target: {name: four-line}   # a shipped target (scene/scene.h TargetByName), or in full:
+//   target:              # oal::LineTarget (config/four-line-target.yaml documents the keys)
+//     name: my-board     # required
+//     board_width_m: 0.4 # required, > 0; the board is centred on the object origin
+//     board_height_m: 0.3
+//     board_grey: 215    # optional, [0, 255]
+//     line_grey: 35      # optional, [0, 255]
+//     lines:             # required, may be empty; metres on the board plane (x right, y down)
+//       - {from: [-0.08, -0.15], to: [-0.08, 0.15], width: 0.03}
+//
+// A target section replaces the whole target (it never modifies the base's target).
+//
 // Sections reserved for later versions (camera, servo, robot, pose, render) are rejected
 // with a message saying so, rather than silently ignored.
 #pragma once
@@ -13,6 +25,7 @@
 #include <string>
 
 #include "detector/options.h"
+#include "scene/scene.h"
 
 namespace oal {
 
@@ -20,6 +33,7 @@ namespace oal {
 /// config.cpp's section table.
 struct AppConfig {
   DetectorOptions detector;
+  LineTarget target = FourLineTarget();  ///< the planar target (pose, render, `oalservo target`)
 };
 
 /// Applies the YAML file at `path` to `base` and checks the result. Throws

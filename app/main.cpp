@@ -16,6 +16,7 @@
 #include "app/detector_accuracy_command.h"
 #include "app/edge_reference_command.h"
 #include "app/render_command.h"
+#include "app/target_command.h"
 
 #ifndef OAL_VERSION
 #define OAL_VERSION "unknown"
@@ -33,6 +34,7 @@ constexpr oal::Command kCommands[] = {
     {"compare", &oal::RunCompare,
      "our detector, vpMeLine and OpenCV line detectors against ground truth"},
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
+    {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
 };
 
 void PrintUsage(std::ostream& out) {

@@ -11,6 +11,7 @@
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
 #include "app/command_line.h"
+#include "app/config.h"
 #include "app/json_io.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
@@ -104,9 +105,14 @@ void WriteFrame(const fs::path& dir, int index, const RenderedFrame& frame, cons
   WriteFileAtomically(dir / FrameName(index, ".json"), truth.dump(2) + "\n");
 }
 
-int RenderSequenceDataset(const RenderCommandOptions& options) {
-  const Sequence sequence = MakeSequence(SequenceKindFromString(options.sequence), options.count,
-                                         options.seed, TargetByName(options.target));
+// The target to render: the config's `target:` section if a config is given, else by name.
+LineTarget TargetOf(const RenderCommandOptions& options) {
+  return options.config.empty() ? TargetByName(options.target) : LoadConfig(options.config).target;
+}
+
+int RenderSequenceDataset(const RenderCommandOptions& options, const LineTarget& target) {
+  const Sequence sequence =
+      MakeSequence(SequenceKindFromString(options.sequence), options.count, options.seed, target);
   const SceneRenderer renderer(sequence.target, sequence.options);
   const RenderOptions& render = renderer.options();
   const fs::path dir(options.out_dir);
@@ -116,7 +122,7 @@ int RenderSequenceDataset(const RenderCommandOptions& options) {
   for (int i = 0; i < options.count; ++i) {
     const SequenceFrame& step = sequence.frames[static_cast<std::size_t>(i)];
     const RenderedFrame frame = renderer.Render(step.cMo, step.noise_seed, step.effects);
-    Json truth = TruthJson(options.target, options.seed, frame, i, step.noise_seed, render.camera,
+    Json truth = TruthJson(target.name, options.seed, frame, i, step.noise_seed, render.camera,
                            render.width, render.height);
     for (std::size_t l = 0; l < frame.truth.size(); ++l) {
       truth["lines"][l]["occluded_fraction"] = frame.truth[l].occluded_fraction;
@@ -129,7 +135,7 @@ int RenderSequenceDataset(const RenderCommandOptions& options) {
       {"kind", options.sequence},
       {"seed", options.seed},
       {"count", options.count},
-      {"target", options.target},
+      {"target", target.name},
       {"description", sequence.description},
       {"camera", CameraJson(render.camera, render.width, render.height)},
       {"noise_sigma", render.noise_sigma},
@@ -151,7 +157,7 @@ void RenderCommandOptions::Check() const {
       Require(false, "sequence", sequence, ("sequence is one of: " + SequenceKindNames()).c_str());
     }
   }
-  Require(target == "two-line" || target == "four-line", "target", target,
+  Require(!config.empty() || target == "two-line" || target == "four-line", "target", target,
           "target is two-line or four-line");
   Require(count >= 1 && count <= 100000, "count", count, "1 <= count <= 100000");
   Require(!out_dir.empty(), "out_dir", "''", "an output directory is given");
@@ -186,8 +192,9 @@ vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu)
 
 int RenderDataset(const RenderCommandOptions& options) {
   options.Check();
-  if (!options.sequence.empty()) return RenderSequenceDataset(options);
-  const SceneRenderer renderer(TargetByName(options.target), ToRenderOptions(options));
+  const LineTarget target = TargetOf(options);
+  if (!options.sequence.empty()) return RenderSequenceDataset(options, target);
+  const SceneRenderer renderer(target, ToRenderOptions(options));
   const PoseSampling sampling = ToPoseSampling(options);
   const vpCameraParameters& camera = renderer.options().camera;
   const fs::path dir(options.out_dir);
@@ -201,7 +208,7 @@ int RenderDataset(const RenderCommandOptions& options) {
     const std::uint64_t noise_seed = NoiseSeed(options.seed, i);
     const RenderedFrame frame = renderer.Render(cMo, noise_seed);
     WriteFrame(dir, i, frame,
-               TruthJson(options.target, options.seed, frame, i, noise_seed, camera, options.width,
+               TruthJson(target.name, options.seed, frame, i, noise_seed, camera, options.width,
                          options.height));
   }
   return options.count;
@@ -217,7 +224,11 @@ int RunRender(int argc, char** argv) {
       "--sequence", options.sequence,
       "render a reproducible sequence instead of random poses: " + SequenceKindNames() +
           " (sets size, camera, noise, blur and poses)");
-  cli.add_option("--target", options.target, "two-line or four-line")->capture_default_str();
+  CLI::Option* target =
+      cli.add_option("--target", options.target, "two-line or four-line")->capture_default_str();
+  cli.add_option("--config", options.config,
+                 "YAML file whose 'target:' section gives the target (instead of --target)")
+      ->excludes(target);
   CLI::Option* count = cli.add_option("--count", options.count,
                                       "number of frames (default with --sequence: " +
                                           std::to_string(kDefaultSequenceFrames) + ")")

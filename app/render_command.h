@@ -25,21 +25,24 @@ struct RenderCommandOptions {
   /// illumination and poses, and only target, count, seed and out_dir are used.
   std::string sequence;
   std::string target = "four-line";  ///< "two-line" or "four-line"
-  int count = 10;                    ///< frames, [1, 100000]
-  std::uint64_t seed = 1;            ///< poses and noise are a function of it
-  std::string out_dir;               ///< created if missing; required
-  int width = 640;                   ///< pixels, [16, 8192]
-  int height = 480;                  ///< pixels, [16, 8192]
-  double fx_px = 600.0;              ///< focal length, pixels (fy = fx), > 0
-  double kdu = 0.0;                  ///< ViSP distortion, distorted -> undistorted; 0: none
-  double noise_sigma = 0.0;          ///< Gaussian noise, grey levels, [0, 100]
-  double blur_sigma_px = 0.0;        ///< Gaussian blur, pixels, [0, 20]
-  double gradient = 0.0;             ///< illumination fall-off across the image, [0, 0.9]
-  std::string background_image;      ///< grey image around the board; empty: uniform
-  double min_distance_m = 0.4;       ///< camera to board, metres, > 0
-  double max_distance_m = 0.9;       ///< metres, >= min_distance_m
-  double max_tilt_deg = 30.0;        ///< optical axis to board normal, degrees, [0, 80]
-  double min_visible_px = 0.0;       ///< each line's visible length at least this, pixels
+  /// YAML file whose `target:` section gives the target instead of `target` (app/config.h);
+  /// empty: use `target`. The data set's JSON then names the config's target.
+  std::string config;
+  int count = 10;                ///< frames, [1, 100000]
+  std::uint64_t seed = 1;        ///< poses and noise are a function of it
+  std::string out_dir;           ///< created if missing; required
+  int width = 640;               ///< pixels, [16, 8192]
+  int height = 480;              ///< pixels, [16, 8192]
+  double fx_px = 600.0;          ///< focal length, pixels (fy = fx), > 0
+  double kdu = 0.0;              ///< ViSP distortion, distorted -> undistorted; 0: none
+  double noise_sigma = 0.0;      ///< Gaussian noise, grey levels, [0, 100]
+  double blur_sigma_px = 0.0;    ///< Gaussian blur, pixels, [0, 20]
+  double gradient = 0.0;         ///< illumination fall-off across the image, [0, 0.9]
+  std::string background_image;  ///< grey image around the board; empty: uniform
+  double min_distance_m = 0.4;   ///< camera to board, metres, > 0
+  double max_distance_m = 0.9;   ///< metres, >= min_distance_m
+  double max_tilt_deg = 30.0;    ///< optical axis to board normal, degrees, [0, 80]
+  double min_visible_px = 0.0;   ///< each line's visible length at least this, pixels
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;

@@ -155,10 +155,10 @@ TEST(Config, OutOfRangeValueNamesFileLineAndField) {
 
 TEST(Config, SectionsOtherThanTheKnownOnesAreRejected) {
   EXPECT_EQ(ErrorOf("detector: {}\ndetectr:\n  step_px: 5\n"),
-            "cfg.yaml:2: section 'detectr' is unknown (known: detector)");
+            "cfg.yaml:2: section 'detectr' is unknown (known: detector, target)");
   EXPECT_EQ(ErrorOf("servo:\n  gain: 0.5\n"),
             "cfg.yaml:1: section 'servo' is not supported by this version of oalservo "
-            "(supported: detector)");
+            "(supported: detector, target)");
   EXPECT_THAT(ErrorOf("- detector\n"), HasSubstr("cfg.yaml:1: the top level must be a map"));
   EXPECT_THAT(ErrorOf("detector: 5\n"), HasSubstr("cfg.yaml:1: section 'detector' must be a map"));
 }
@@ -193,6 +193,154 @@ TEST(Config, LoadConfigNamesTheFile) {
   } catch (const std::runtime_error& error) {
     EXPECT_THAT(error.what(), HasSubstr(dir / "bad.yaml:2: key 'detector.bogus' is unknown"));
   }
+}
+
+// ------------------------------------------------------------------------------------------
+// target:
+
+void ExpectSameTarget(const LineTarget& a, const LineTarget& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.board_width_m, b.board_width_m);
+  EXPECT_EQ(a.board_height_m, b.board_height_m);
+  EXPECT_EQ(a.board_grey, b.board_grey);
+  EXPECT_EQ(a.line_grey, b.line_grey);
+  ASSERT_EQ(a.lines.size(), b.lines.size());
+  for (std::size_t i = 0; i < a.lines.size(); ++i) {
+    SCOPED_TRACE("line " + std::to_string(i + 1));
+    EXPECT_EQ(a.lines[i].x1_m, b.lines[i].x1_m);
+    EXPECT_EQ(a.lines[i].y1_m, b.lines[i].y1_m);
+    EXPECT_EQ(a.lines[i].x2_m, b.lines[i].x2_m);
+    EXPECT_EQ(a.lines[i].y2_m, b.lines[i].y2_m);
+    EXPECT_EQ(a.lines[i].width_m, b.lines[i].width_m);
+  }
+}
+
+TEST(ConfigTarget, DefaultIsTheFourLineTargetAndSectionsReplaceIt) {
+  ExpectSameTarget(ParseConfig("", "cfg.yaml").target, FourLineTarget());
+  ExpectSameTarget(ParseConfig("target:\n", "cfg.yaml").target, FourLineTarget());
+  ExpectSameTarget(ParseConfig("target: {name: two-line}\n", "cfg.yaml").target, TwoLineTarget());
+  ExpectSameTarget(ParseConfig("target:\n  name: four-line\n", "cfg.yaml").target,
+                   FourLineTarget());
+}
+
+TEST(ConfigTarget, ShippedFilesAreExactlyTheBuiltInTargets) {
+  const std::string dir = std::string(OAL_SOURCE_DIR) + "/config/";
+  ExpectSameTarget(LoadConfig(dir + "four-line-target.yaml").target, FourLineTarget());
+  ExpectSameTarget(LoadConfig(dir + "two-line-target.yaml").target, TwoLineTarget());
+  // They leave the detector alone.
+  ExpectSameOptions(LoadConfig(dir + "four-line-target.yaml").detector, DetectorOptions());
+}
+
+TEST(ConfigTarget, ReadsAFullDescription) {
+  const LineTarget target = ParseConfig(
+                                "detector: {step_px: 4}\n"
+                                "target:\n"
+                                "  name: desk\n"
+                                "  board_width_m: 0.4\n"
+                                "  board_height_m: 0.3\n"
+                                "  line_grey: 0\n"
+                                "  lines:\n"
+                                "    - {from: [-0.1, -0.15], to: [-0.1, 0.15], width: 0.02}\n"
+                                "    - from: [-0.2, 0.05]\n"
+                                "      to: [0.2, 0]\n"
+                                "      width: 1e-2\n",
+                                "cfg.yaml")
+                                .target;
+  EXPECT_EQ(target.name, "desk");
+  EXPECT_EQ(target.board_width_m, 0.4);
+  EXPECT_EQ(target.board_height_m, 0.3);
+  EXPECT_EQ(target.board_grey, LineTarget().board_grey);  // optional
+  EXPECT_EQ(target.line_grey, 0);
+  ASSERT_EQ(target.lines.size(), 2u);
+  EXPECT_EQ(target.lines[1].x1_m, -0.2);
+  EXPECT_EQ(target.lines[1].y1_m, 0.05);
+  EXPECT_EQ(target.lines[1].x2_m, 0.2);
+  EXPECT_EQ(target.lines[1].y2_m, 0.0);
+  EXPECT_EQ(target.lines[1].width_m, 0.01);
+  // A blank board.
+  EXPECT_TRUE(
+      ParseConfig("target: {name: b, board_width_m: 1, board_height_m: 1, lines: []}\n", "cfg.yaml")
+          .target.lines.empty());
+}
+
+// A full description with `line` as the only entry of `lines:` (at file line 6).
+std::string TargetWithLine(const std::string& line) {
+  return "target:\n  name: t\n  board_width_m: 0.4\n  board_height_m: 0.3\n  lines:\n    - " +
+         line + "\n";
+}
+
+TEST(ConfigTarget, MalformedLinesNameFileLineAndKey) {
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0, 0], width: 0.01}")),
+            "cfg.yaml:6: 'target.lines[0]' has from == to = [0, 0]: a line needs two different "
+            "ends");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0}")),
+            "cfg.yaml:6: 'target.lines[0].width' must be > 0 (metres), got '0'");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: -0.01}")),
+            "cfg.yaml:6: 'target.lines[0].width' must be > 0 (metres), got '-0.01'");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.25, 0], width: 0.01}")),
+            "cfg.yaml:6: 'target.lines[0].to' = [0.25, 0] lies outside the board (|x| <= 0.2, "
+            "|y| <= 0.15 m: the board is centred on the origin)");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1], width: 0.01}")),
+            "cfg.yaml:6: 'target.lines[0].to' must be a point [x, y] in metres, got 'a "
+            "sequence of 1'");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, a], to: [0.1, 0], width: 0.01}")),
+            "cfg.yaml:6: 'target.lines[0].from[1]' must be a number, got 'a'");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, .inf], to: [0.1, 0], width: 0.01}")),
+            "cfg.yaml:6: 'target.lines[0].from[1]' must be a finite number, got '.inf'");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0]}")),
+            "cfg.yaml:6: 'target.lines[0]' has no 'width' (a line needs from, to, width)");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0.01, colour: 3}")),
+            "cfg.yaml:6: key 'target.lines[0].colour' is unknown (known: from, to, width)");
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], from: [0, 0.1], width: 1}")),
+            "cfg.yaml:6: key 'target.lines[0].from' is repeated (first at line 6)");
+  EXPECT_EQ(ErrorOf(TargetWithLine("[0, 0, 0.1, 0]")),
+            "cfg.yaml:6: 'target.lines[0]' must be a map {from: [x, y], to: [x, y], width: w}, got "
+            "'a sequence'");
+  // The second entry, on its own line.
+  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0.01}\n"
+                                   "    - {from: [0, 0], to: [0.1, -0.2], width: 0.01}")),
+            "cfg.yaml:7: 'target.lines[1].to' = [0.1, -0.2] lies outside the board (|x| <= 0.2, "
+            "|y| <= 0.15 m: the board is centred on the origin)");
+}
+
+TEST(ConfigTarget, MalformedBoardNamesFileLineAndKey) {
+  EXPECT_EQ(ErrorOf("target: {name: five-line}\n"),
+            "cfg.yaml:1: 'target.name' = 'five-line' is not a shipped target (two-line, "
+            "four-line); describe it in full with board_width_m, board_height_m and lines");
+  EXPECT_THAT(ErrorOf("target:\n  name: four-line\n  board_grey: 200\n"),
+              HasSubstr("cfg.yaml:3: key 'target.board_grey' needs a full target description"));
+  EXPECT_THAT(ErrorOf("target:\n  board_width_m: 1\n"),
+              HasSubstr("cfg.yaml:2: key 'target.board_width_m' needs a full target description"));
+  EXPECT_THAT(ErrorOf("target:\n  name: x\n  board_height_m: 1\n  lines: []\n"),
+              HasSubstr("cfg.yaml:2: 'target.board_width_m' is missing"));
+  EXPECT_THAT(ErrorOf("target:\n  board_width_m: 1\n  board_height_m: 1\n  lines: []\n"),
+              HasSubstr("'target.name' is missing"));
+  EXPECT_THAT(ErrorOf("target:\n  name: x\n  board_with_m: 1\n"),
+              HasSubstr("cfg.yaml:3: key 'target.board_with_m' is unknown (known: name, "
+                        "board_width_m, board_height_m, board_grey, line_grey, lines)"));
+  EXPECT_EQ(ErrorOf("target:\n  name: x\n  board_width_m: wide\n"),
+            "cfg.yaml:3: 'target.board_width_m' must be a number, got 'wide'");
+  EXPECT_EQ(ErrorOf("target:\n  name: x\n  lines: 4\n"),
+            "cfg.yaml:3: 'target.lines' must be a sequence of {from: [x, y], to: [x, y], width: "
+            "w} ([] for none), got '4'");
+  EXPECT_EQ(ErrorOf("target:\n  name: ''\n"), "cfg.yaml:2: 'target.name' must not be empty");
+  EXPECT_EQ(ErrorOf("target: [four-line]\n"), "cfg.yaml:1: section 'target' must be a map of keys");
+  // Out of range: LineTarget::Check(), at the line that set the field.
+  const std::string board =
+      ErrorOf("target:\n  name: x\n  board_width_m: -1\n  board_height_m: 1\n  lines: []\n");
+  EXPECT_THAT(board, HasSubstr("cfg.yaml:3: 'target.board_width_m' is invalid: "
+                               "LineTarget::board_width_m = -1"));
+  EXPECT_THAT(board, HasSubstr("board_width_m > 0"));
+  EXPECT_THAT(ErrorOf("target:\n  name: x\n  board_width_m: 1\n  board_height_m: 1\n"
+                      "  lines: []\n  line_grey: 300\n"),
+              HasSubstr("cfg.yaml:6: 'target.line_grey' is invalid: LineTarget::line_grey = 300. "
+                        "Violated constraint: 0 <= line_grey <= 255"));
+  // The board is checked before the lines against it.
+  EXPECT_THAT(
+      ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0.01}") + "  board_grey: -5\n"),
+      HasSubstr("'target.board_grey' is invalid"));
+  EXPECT_EQ(ErrorOf("target:\n  name: x\n  name: y\n"),
+            "cfg.yaml:3: key 'target.name' is repeated (first at line 2)");
 }
 
 }  // namespace
