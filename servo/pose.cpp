@@ -1,0 +1,282 @@
+// Steps 2-4 of the pose (pose.h): corners -> vpPose (Dementhon, Lagrange, virtual visual
+// servoing), roll, pitch, yaw and the paper's plane angles.
+#include "servo/pose.h"
+
+#include <visp3/core/vpException.h>
+#include <visp3/core/vpPoint.h>
+#include <visp3/core/vpRzyxVector.h>
+#include <visp3/vision/vpPose.h>
+
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include "servo/pose_internal.h"
+
+namespace oal {
+namespace {
+
+using pose_internal::HashTarget;
+
+constexpr double kDegPerRad = 180.0 / kPi;
+
+double Wrap360(double deg) {
+  double wrapped = std::fmod(deg, 360.0);
+  if (wrapped < 0.0) wrapped += 360.0;
+  return wrapped >= 360.0 ? 0.0 : wrapped;
+}
+
+double Wrap180(double deg) {
+  const double wrapped = Wrap360(deg + 180.0) - 180.0;
+  return wrapped <= -180.0 ? wrapped + 360.0 : wrapped;
+}
+
+// Reprojection RMS of the corners in undistorted pixels, +inf if a corner is not in front.
+double ResidualPx(const vpHomogeneousMatrix& cMo, const HashTarget& target,
+                  const std::array<vpColVector, 4>& corners_m, const vpCameraParameters& camera) {
+  double sum = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const double ox = target.corner[k].x, oy = target.corner[k].y;
+    const double xc = cMo[0][0] * ox + cMo[0][1] * oy + cMo[0][3];
+    const double yc = cMo[1][0] * ox + cMo[1][1] * oy + cMo[1][3];
+    const double zc = cMo[2][0] * ox + cMo[2][1] * oy + cMo[2][3];
+    if (!(zc > 0.0)) return std::numeric_limits<double>::infinity();
+    const double du = camera.get_px() * (xc / zc - corners_m[k][0]);
+    const double dv = camera.get_py() * (yc / zc - corners_m[k][1]);
+    sum += du * du + dv * dv;
+  }
+  const double rms = std::sqrt(sum / 4.0);
+  return std::isfinite(rms) ? rms : std::numeric_limits<double>::infinity();
+}
+
+bool IsFinite(const vpHomogeneousMatrix& m) {
+  for (unsigned r = 0; r < 3; ++r)
+    for (unsigned c = 0; c < 4; ++c)
+      if (!std::isfinite(m[r][c])) return false;
+  return true;
+}
+
+// Runs one vpPose method from `*cMo` (the seed for VIRTUAL_VS); false on any failure.
+bool Compute(vpPose* pose, vpPose::vpPoseMethodType method, vpHomogeneousMatrix* cMo) {
+  try {
+    return pose->computePose(method, *cMo) && IsFinite(*cMo);
+  } catch (const vpException&) {
+    return false;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// Undistorted pixel of a board point seen from cMo (false when not in front of the camera).
+bool Project(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera, double x, double y,
+             Point2d* out) {
+  const double xc = cMo[0][0] * x + cMo[0][1] * y + cMo[0][3];
+  const double yc = cMo[1][0] * x + cMo[1][1] * y + cMo[1][3];
+  const double zc = cMo[2][0] * x + cMo[2][1] * y + cMo[2][3];
+  if (!(zc > 0.0)) return false;
+  out->u = camera.get_u0() + camera.get_px() * xc / zc;
+  out->v = camera.get_v0() + camera.get_py() * yc / zc;
+  return true;
+}
+
+// The bisector of two nearly parallel lines: the middle of a stripe between its edges.
+LineParams Middle(const LineParams& a, const LineParams& b) {
+  double ca = std::cos(a.theta_rad), sa = std::sin(a.theta_rad), ra = a.rho_px;
+  double cb = std::cos(b.theta_rad), sb = std::sin(b.theta_rad), rb = b.rho_px;
+  if (ca * cb + sa * sb < 0.0) {
+    cb = -cb;
+    sb = -sb;
+    rb = -rb;
+  }
+  const double nu = ca + cb, nv = sa + sb, norm = std::hypot(nu, nv);
+  return Normalized((ra + rb) / norm, std::atan2(nv / norm, nu / norm));
+}
+
+// How far each corner's image lies from where the detector's stripe middles put it, seen from
+// cMo: corner image (centre lines) minus intersection of the stripe middles (pose.h,
+// correct_stripe_centres). False if some image cannot be formed.
+bool StripeCentreShifts(const vpHomogeneousMatrix& cMo, const HashTarget& target,
+                        const vpCameraParameters& camera, const std::array<bool, 4>& is_stripe,
+                        std::array<Point2d, 4>* shift) {
+  std::array<LineParams, 4> centre, seen;
+  for (int k = 0; k < 4; ++k) {
+    const auto& a = target.corner[(k + 3) % 4];  // the two corners on line k
+    const auto& b = target.corner[k];
+    Point2d pa, pb;
+    if (!Project(cMo, camera, a.x, a.y, &pa) || !Project(cMo, camera, b.x, b.y, &pb)) return false;
+    centre[k] = LineThrough(pa, pb);
+    seen[k] = centre[k];
+    if (!is_stripe[k]) continue;
+    const double hx = 0.5 * target.width_m[k] * target.normal[k].x;
+    const double hy = 0.5 * target.width_m[k] * target.normal[k].y;
+    Point2d ea, eb, fa, fb;
+    if (!Project(cMo, camera, a.x + hx, a.y + hy, &ea) ||
+        !Project(cMo, camera, b.x + hx, b.y + hy, &eb) ||
+        !Project(cMo, camera, a.x - hx, a.y - hy, &fa) ||
+        !Project(cMo, camera, b.x - hx, b.y - hy, &fb)) {
+      return false;
+    }
+    seen[k] = Middle(LineThrough(ea, eb), LineThrough(fa, fb));
+  }
+  for (int k = 0; k < 4; ++k) {
+    Point2d c, m;
+    if (!Intersect(centre[k], centre[(k + 1) % 4], &c, 1e-6) ||
+        !Intersect(seen[k], seen[(k + 1) % 4], &m, 1e-6)) {
+      return false;
+    }
+    (*shift)[k] = Point2d{c.u - m.u, c.v - m.v};
+  }
+  return true;
+}
+
+PoseResult Fail(PoseResult result, const std::string& message) {
+  result.status = PoseStatus::kDegenerate;
+  result.message = message;
+  result.cMo.eye();
+  return result;
+}
+
+}  // namespace
+
+PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget& target,
+                        const PoseOptions& options,
+                        const std::optional<vpHomogeneousMatrix>& previous_cMo) {
+  options.Check();
+  const HashTarget hash = pose_internal::HashTargetFrom(target);
+  // Step 1.
+  PoseResult result = pose_internal::Identify(lines, hash, options);
+  if (result.status != PoseStatus::kOk) return result;
+
+  const vpCameraParameters& camera = options.camera;
+  vpPose pose;
+  for (int k = 0; k < 4; ++k) {
+    double x = 0.0, y = 0.0;
+    pose_internal::PixelToMetre(camera, options.lines_undistorted, result.corners_px[k], &x, &y);
+    result.corners_m[k].resize(2, false);
+    result.corners_m[k][0] = x;
+    result.corners_m[k][1] = y;
+    vpPoint point(hash.corner[k].x, hash.corner[k].y, 0.0);
+    point.set_x(x);
+    point.set_y(y);
+    pose.addPoint(point);
+  }
+
+  // Steps 3-4: Dementhon and Lagrange, the lower residual refined by virtual visual servoing.
+  pose.setVvsIterMax(options.vvs_max_iterations);
+  vpHomogeneousMatrix by_dementhon, by_lagrange;
+  const bool dementhon_ok = Compute(&pose, vpPose::DEMENTHON, &by_dementhon);
+  const bool lagrange_ok = Compute(&pose, vpPose::LAGRANGE, &by_lagrange);
+  const double dementhon_px =
+      dementhon_ok ? ResidualPx(by_dementhon, hash, result.corners_m, camera) : HUGE_VAL;
+  const double lagrange_px =
+      lagrange_ok ? ResidualPx(by_lagrange, hash, result.corners_m, camera) : HUGE_VAL;
+  if (!std::isfinite(dementhon_px) && !std::isfinite(lagrange_px)) {
+    return Fail(std::move(result),
+                "vpPose found no pose in front of the camera (Dementhon and Lagrange failed)");
+  }
+  result.method = dementhon_px <= lagrange_px ? PoseMethod::kDementhon : PoseMethod::kLagrange;
+  vpHomogeneousMatrix cMo = result.method == PoseMethod::kDementhon ? by_dementhon : by_lagrange;
+  std::array<bool, 4> is_stripe{};
+  bool any_stripe = false;  // the detector measured stripe middles, not edges
+  for (int k = 0; k < 4; ++k) {
+    is_stripe[k] = lines[result.line_index[k]].width_px > 0.0;
+    any_stripe = any_stripe || is_stripe[k];
+  }
+  // The stripe-centre correction from the linear pose: the shifts are a small fraction of a
+  // pixel and change little with the pose, so one refinement after it suffices.
+  std::array<Point2d, 4> shift{};
+  if (options.correct_stripe_centres && any_stripe &&
+      StripeCentreShifts(cMo, hash, camera, is_stripe, &shift)) {
+    pose.clearPoint();
+    for (int k = 0; k < 4; ++k) {
+      result.corners_px[k].u += shift[k].u;
+      result.corners_px[k].v += shift[k].v;
+      double x = 0.0, y = 0.0;
+      pose_internal::PixelToMetre(camera, options.lines_undistorted, result.corners_px[k], &x, &y);
+      result.corners_m[k][0] = x;
+      result.corners_m[k][1] = y;
+      vpPoint point(hash.corner[k].x, hash.corner[k].y, 0.0);
+      point.set_x(x);
+      point.set_y(y);
+      pose.addPoint(point);
+    }
+  }
+  // Step 2: the roll of line 1, from its corner with line 2 (corner 0) to its corner with
+  // line 4 (corner 3), in (undistorted) pixels, after the stripe-centre correction.
+  {
+    const double du = camera.get_px() * (result.corners_m[3][0] - result.corners_m[0][0]);
+    const double dv = camera.get_py() * (result.corners_m[3][1] - result.corners_m[0][1]);
+    result.line1_roll_deg = Wrap360(std::atan2(-du, dv) * kDegPerRad);
+  }
+
+  pose.setCovarianceComputation(true);
+  double residual_px = HUGE_VAL;
+  vpMatrix covariance;
+  if (Compute(&pose, vpPose::VIRTUAL_VS, &cMo)) {
+    residual_px = ResidualPx(cMo, hash, result.corners_m, camera);
+    covariance = pose.getCovarianceMatrix();
+  }
+  if (previous_cMo && IsFinite(*previous_cMo)) {
+    vpHomogeneousMatrix seeded = *previous_cMo;
+    if (Compute(&pose, vpPose::VIRTUAL_VS, &seeded)) {
+      const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
+      if (std::isfinite(seeded_px) && seeded_px <= residual_px + options.previous_tolerance_px) {
+        cMo = seeded;
+        residual_px = seeded_px;
+        covariance = pose.getCovarianceMatrix();
+        result.from_previous = true;
+      }
+    }
+  }
+  if (!std::isfinite(residual_px)) {
+    return Fail(std::move(result), "vpPose's virtual visual servoing did not converge");
+  }
+  result.residual_px = residual_px;
+
+  // Checks: in front of the camera, facing the board's front, small residual.
+  for (int k = 0; k < 4; ++k) {
+    const double zc = cMo[2][0] * hash.corner[k].x + cMo[2][1] * hash.corner[k].y + cMo[2][3];
+    if (!(zc >= options.min_depth_m)) {
+      std::ostringstream message;
+      message << "pose behind the camera: corner " << k + 1 << " at depth " << zc
+              << " m (min_depth_m = " << options.min_depth_m << ")";
+      return Fail(std::move(result), message.str());
+    }
+  }
+  const vpHomogeneousMatrix oMc = cMo.inverse();
+  if (!(oMc[2][3] < 0.0)) {
+    return Fail(std::move(result), "pose sees the back of the board (camera at object z >= 0)");
+  }
+  if (residual_px > options.max_residual_px) {
+    std::ostringstream message;
+    message << "reprojection residual " << residual_px
+            << " px > max_residual_px = " << options.max_residual_px;
+    return Fail(std::move(result), message.str());
+  }
+  result.cMo = cMo;
+  result.covariance = covariance;
+
+  const vpRotationMatrix cRo = cMo.getRotationMatrix();
+  const vpRzyxVector rzyx(cRo);
+  result.roll_deg = Wrap360(rzyx[0] * kDegPerRad);
+  result.yaw_deg = Wrap180(rzyx[1] * kDegPerRad);
+  result.pitch_deg = Wrap180(rzyx[2] * kDegPerRad);
+
+  // Eq. 5: the board normal (object z in the camera frame) against lines 1 and 2.
+  const double n[3] = {cRo[0][2], cRo[1][2], cRo[2][2]};
+  for (int k = 0; k < 2; ++k) {
+    const double dx = cRo[0][0] * hash.direction[k].x + cRo[0][1] * hash.direction[k].y;
+    const double dy = cRo[1][0] * hash.direction[k].x + cRo[1][1] * hash.direction[k].y;
+    const double norm = std::hypot(dx, dy);
+    // m = z × d, the in-image direction across the line.
+    const double across = norm > 0.0 ? (n[0] * -dy + n[1] * dx) / norm : 0.0;
+    result.plane_angle_deg[k] = std::atan2(-across, n[2]) * kDegPerRad;
+  }
+  result.status = PoseStatus::kOk;
+  result.message.clear();
+  return result;
+}
+
+}  // namespace oal
