@@ -378,6 +378,38 @@ void ReadTargetSection(const YAML::Node& section, const std::string& file, AppCo
   config->target = std::move(target);
 }
 
+// ------------------------------------------------------------------------------------------
+// `pose:`: PoseOptions' tunables. camera, lines_undistorted, image_width and image_height are
+// not keys: the command sets them from --camera, the detector and the frame.
+
+const std::vector<Field<PoseOptions>>& PoseFields() {
+  using O = PoseOptions;
+  static const std::vector<Field<O>> fields = {
+      IntField("max_candidate_lines", &O::max_candidate_lines),
+      DoubleField("min_group_angle_deg", &O::min_group_angle_deg),
+      DoubleField("max_outside_px", &O::max_outside_px),
+      DoubleField("max_intersection_radius", &O::max_intersection_radius),
+      DoubleField("min_side_px", &O::min_side_px),
+      DoubleField("ortho_sigma", &O::ortho_sigma),
+      DoubleField("width_sigma", &O::width_sigma),
+      DoubleField("max_identification_cost", &O::max_identification_cost),
+      DoubleField("min_identification_margin", &O::min_identification_margin),
+      DoubleField("max_residual_px", &O::max_residual_px),
+      DoubleField("previous_tolerance_px", &O::previous_tolerance_px),
+      DoubleField("min_depth_m", &O::min_depth_m),
+      BoolField("correct_stripe_centres", &O::correct_stripe_centres),
+      DoubleField("dementhon_above_px", &O::dementhon_above_px),
+      IntField("vvs_max_iterations", &O::vvs_max_iterations),
+  };
+  return fields;
+}
+
+void ReadPoseSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  Lines lines;
+  ReadFields(section, file, "pose", PoseFields(), "", &config->pose, &lines);
+  CheckAt(config->pose, file, "pose", lines);
+}
+
 struct Section {
   const char* name;
   void (*read)(const YAML::Node& section, const std::string& file, AppConfig* config);
@@ -386,10 +418,11 @@ struct Section {
 constexpr Section kSections[] = {
     {"detector", &ReadDetectorSection},
     {"target", &ReadTargetSection},
+    {"pose", &ReadPoseSection},
 };
 
 // Sections later versions will read: rejected with a message that says so.
-constexpr const char* kReservedSections[] = {"camera", "servo", "robot", "pose", "render"};
+constexpr const char* kReservedSections[] = {"camera", "servo", "robot", "render"};
 
 std::string SectionNames() {
   std::string names;

@@ -18,7 +18,11 @@
 //
 // A target section replaces the whole target (it never modifies the base's target).
 //
-// Sections reserved for later versions (camera, servo, robot, pose, render) are rejected
+//   pose:                # oal::PoseOptions' tunables (config/pose.yaml documents the keys);
+//     max_residual_px: 2.0   # the camera, lines_undistorted and the image size come from the
+//                            # command (--camera, the detector, the frame), not from here
+//
+// Sections reserved for later versions (camera, servo, robot, render) are rejected
 // with a message saying so, rather than silently ignored.
 #pragma once
 
@@ -26,6 +30,7 @@
 
 #include "detector/options.h"
 #include "scene/scene.h"
+#include "servo/pose.h"
 
 namespace oal {
 
@@ -34,6 +39,7 @@ namespace oal {
 struct AppConfig {
   DetectorOptions detector;
   LineTarget target = FourLineTarget();  ///< the planar target (pose, render, `oalservo target`)
+  PoseOptions pose;  ///< `pose:`; its camera, lines_undistorted and image size stay as given
 };
 
 /// Applies the YAML file at `path` to `base` and checks the result. Throws

@@ -15,6 +15,8 @@
 #include "app/detect_command.h"
 #include "app/detector_accuracy_command.h"
 #include "app/edge_reference_command.h"
+#include "app/pose_accuracy_command.h"
+#include "app/pose_command.h"
 #include "app/render_command.h"
 #include "app/target_command.h"
 
@@ -30,6 +32,9 @@ constexpr oal::Command kCommands[] = {
      "accuracy of the detector on rendered frames, against the paper and OpenCV"},
     {"edge-reference", &oal::RunEdgeReference,
      "independent reference lines for a sequence with one straight edge (truth CSV)"},
+    {"pose-accuracy", &oal::RunPoseAccuracy,
+     "accuracy of the camera pose from the four-line target on rendered frames"},
+    {"pose", &oal::RunPose, "camera pose from the four-line target in every frame"},
     {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
     {"compare", &oal::RunCompare,
      "our detector, vpMeLine and OpenCV line detectors against ground truth"},

@@ -495,6 +495,8 @@ void PoseOptions::Check() const {
           previous_tolerance_px, "0 <= previous_tolerance_px <= 1000");
   Require(min_depth_m > 0.0 && min_depth_m <= 1e3, "PoseOptions::min_depth_m", min_depth_m,
           "0 < min_depth_m <= 1e3");
+  Require(InRange(dementhon_above_px, 0.0, 1000.0), "PoseOptions::dementhon_above_px",
+          dementhon_above_px, "0 <= dementhon_above_px <= 1000");
   Require(vvs_max_iterations >= 1 && vvs_max_iterations <= 1000, "PoseOptions::vvs_max_iterations",
           vvs_max_iterations, "1 <= vvs_max_iterations <= 1000");
 }

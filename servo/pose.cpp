@@ -165,13 +165,16 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
 
   // Steps 3-4: Dementhon and Lagrange, the lower residual refined by virtual visual servoing.
   pose.setVvsIterMax(options.vvs_max_iterations);
+  // Lagrange first; Dementhon too unless Lagrange's residual is already below
+  // dementhon_above_px, where the refinement would end in the same minimum anyway.
   vpHomogeneousMatrix by_dementhon, by_lagrange;
-  const bool dementhon_ok = Compute(&pose, vpPose::DEMENTHON, &by_dementhon);
   const bool lagrange_ok = Compute(&pose, vpPose::LAGRANGE, &by_lagrange);
-  const double dementhon_px =
-      dementhon_ok ? ResidualPx(by_dementhon, hash, result.corners_m, camera) : HUGE_VAL;
   const double lagrange_px =
       lagrange_ok ? ResidualPx(by_lagrange, hash, result.corners_m, camera) : HUGE_VAL;
+  const bool run_dementhon = !(lagrange_px < options.dementhon_above_px);
+  const bool dementhon_ok = run_dementhon && Compute(&pose, vpPose::DEMENTHON, &by_dementhon);
+  const double dementhon_px =
+      dementhon_ok ? ResidualPx(by_dementhon, hash, result.corners_m, camera) : HUGE_VAL;
   if (!std::isfinite(dementhon_px) && !std::isfinite(lagrange_px)) {
     return Fail(std::move(result),
                 "vpPose found no pose in front of the camera (Dementhon and Lagrange failed)");

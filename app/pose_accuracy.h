@@ -1,0 +1,59 @@
+// The pose's accuracy evaluation (issue 4): rendered four-line frames with distortion and
+// noise at random poses, our detector with point undistortion, then EstimatePose; errors
+// against the rendered cMo. Deterministic for a given seed.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "detector/options.h"
+#include "scene/scene.h"
+
+namespace oal {
+
+struct PoseAccuracyOptions {
+  int frames = 1000;       ///< [1, 1000000]
+  std::uint64_t seed = 1;  ///< poses and noise
+  int width = 640, height = 480;
+  double focal_px = 600.0;
+  double kdu = 0.33;  ///< the detector evaluation's cheap wide lens
+  double noise_sigma = 8.0;
+  double blur_sigma_px = 1.0;
+  double illumination_gradient = 0.2;
+  PoseSampling sampling = DefaultSampling();
+  DetectorOptions detector;
+
+  /// Distance 0.3-1.0 m, tilt up to 40 deg, any roll, every line crossing 150 px of image.
+  static PoseSampling DefaultSampling() {
+    PoseSampling sampling;
+    sampling.min_distance_m = 0.3;
+    sampling.max_distance_m = 1.0;
+    sampling.max_tilt_deg = 40.0;
+    sampling.min_visible_length_px = 150.0;
+    return sampling;
+  }
+  void Check() const;
+};
+
+struct PoseAccuracyReport {
+  PoseAccuracyOptions options;
+  int frames = 0;
+  std::array<int, 4> status_counts{};         ///< by PoseStatus
+  std::vector<double> translation_error_pct;  ///< |t - t_true| / |t_true|, frames with a pose
+  std::vector<double> rotation_error_deg;     ///< angle of R R_true^T
+  std::vector<double> roll_error_deg;         ///< |roll - roll_true| wrapped to [0, 180]
+  int roll_flips = 0;                         ///< frames with a roll error above 45 deg
+  std::vector<double> pose_time_us;           ///< EstimatePose alone
+  std::vector<double> detect_time_us;
+  std::vector<int> failed_frames;  ///< frames without a pose
+
+  int posed() const { return status_counts[0]; }
+};
+
+PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
+                                        const std::function<void(int, int)>& progress = {});
+
+}  // namespace oal

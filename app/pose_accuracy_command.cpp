@@ -1,0 +1,124 @@
+#include "app/pose_accuracy_command.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/atomic_file.h"
+#include "app/command_line.h"
+#include "app/config.h"
+#include "app/detector_accuracy.h"  // Quantile
+#include "app/pose_accuracy.h"
+#include "servo/pose.h"
+
+namespace oal {
+namespace {
+
+std::string Table(const PoseAccuracyReport& r) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(3);
+  const double no_pose = 100.0 * (r.frames - r.posed()) / std::max(1, r.frames);
+  out << "| measure | value |\n|---|---:|\n"
+      << "| frames | " << r.frames << " |\n"
+      << "| frames without a pose | " << r.frames - r.posed() << " (" << std::setprecision(2)
+      << no_pose << " %) |\n";
+  for (PoseStatus status :
+       {PoseStatus::kNotEnoughLines, PoseStatus::kNotIdentifiable, PoseStatus::kDegenerate}) {
+    out << "| — " << ToString(status) << " | " << r.status_counts[static_cast<std::size_t>(status)]
+        << " |\n";
+  }
+  out << std::setprecision(3) << "| translation error median / p95 (% of distance) | "
+      << Quantile(r.translation_error_pct, 0.5) << " / " << Quantile(r.translation_error_pct, 0.95)
+      << " |\n"
+      << "| rotation error median / p95 (deg) | " << Quantile(r.rotation_error_deg, 0.5) << " / "
+      << Quantile(r.rotation_error_deg, 0.95) << " |\n"
+      << "| roll error median / max (deg) | " << Quantile(r.roll_error_deg, 0.5) << " / "
+      << Quantile(r.roll_error_deg, 1.0) << " |\n"
+      << "| frames with roll off by > 45 deg | " << r.roll_flips << " |\n"
+      << std::setprecision(1) << "| pose step median / p95 (us) | " << Quantile(r.pose_time_us, 0.5)
+      << " / " << Quantile(r.pose_time_us, 0.95) << " |\n"
+      << "| detector median (us) | " << Quantile(r.detect_time_us, 0.5) << " |\n";
+  return out.str();
+}
+
+nlohmann::json ToJson(const PoseAccuracyReport& r) {
+  const PoseAccuracyOptions& o = r.options;
+  return {{"options",
+           {{"frames", o.frames},
+            {"seed", o.seed},
+            {"width", o.width},
+            {"height", o.height},
+            {"focal_px", o.focal_px},
+            {"kdu", o.kdu},
+            {"noise_sigma", o.noise_sigma},
+            {"blur_sigma_px", o.blur_sigma_px},
+            {"illumination_gradient", o.illumination_gradient},
+            {"min_distance_m", o.sampling.min_distance_m},
+            {"max_distance_m", o.sampling.max_distance_m},
+            {"max_tilt_deg", o.sampling.max_tilt_deg},
+            {"min_visible_length_px", o.sampling.min_visible_length_px}}},
+          {"frames", r.frames},
+          {"posed", r.posed()},
+          {"status_counts", r.status_counts},
+          {"translation_error_pct_median", Quantile(r.translation_error_pct, 0.5)},
+          {"translation_error_pct_p95", Quantile(r.translation_error_pct, 0.95)},
+          {"rotation_error_deg_median", Quantile(r.rotation_error_deg, 0.5)},
+          {"rotation_error_deg_p95", Quantile(r.rotation_error_deg, 0.95)},
+          {"roll_error_deg_max", Quantile(r.roll_error_deg, 1.0)},
+          {"roll_flips", r.roll_flips},
+          {"pose_time_us_median", Quantile(r.pose_time_us, 0.5)},
+          {"detect_time_us_median", Quantile(r.detect_time_us, 0.5)},
+          {"frames_without_pose", r.failed_frames}};
+}
+
+}  // namespace
+
+int RunPoseAccuracy(int argc, char** argv) {
+  CLI::App cli{
+      "Accuracy of the camera pose from the four-line target on rendered frames (fixed "
+      "seeds): the detector with point undistortion, then line identification, "
+      "intersections and vpPose; errors against the rendered pose.",
+      "oalservo pose-accuracy"};
+  PoseAccuracyOptions options;
+  std::string config_path, out_path;
+  cli.add_option("--frames", options.frames, "number of rendered frames")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  cli.add_option("--seed", options.seed, "seed of poses and noise")->capture_default_str();
+  cli.add_option("--kdu", options.kdu, "lens distortion (ViSP kdu)")->capture_default_str();
+  cli.add_option("--noise", options.noise_sigma, "noise sigma, grey levels")->capture_default_str();
+  cli.add_option("--blur", options.blur_sigma_px, "blur sigma, pixels")->capture_default_str();
+  cli.add_option("--min-distance", options.sampling.min_distance_m, "metres")
+      ->capture_default_str();
+  cli.add_option("--max-distance", options.sampling.max_distance_m, "metres")
+      ->capture_default_str();
+  cli.add_option("--max-tilt-deg", options.sampling.max_tilt_deg, "camera tilt bound")
+      ->capture_default_str();
+  cli.add_option("--config", config_path, "YAML config (detector section)")
+      ->check(CLI::ExistingFile);
+  cli.add_option("--out", out_path, "write the report as JSON to this file");
+  if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+
+  if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
+  const bool tty = isatty(fileno(stderr));
+  const PoseAccuracyReport report = EvaluatePoseAccuracy(options, [&](int done, int total) {
+    if (tty && (done % 20 == 0 || done == total)) {
+      std::cerr << "\rframe " << done << " / " << total << std::flush;
+      if (done == total) std::cerr << '\n';
+    }
+  });
+  std::cout << Table(report);
+  if (!out_path.empty()) {
+    AtomicFile file(out_path);
+    file.stream() << ToJson(report).dump(2) << '\n';
+    file.Commit();
+  }
+  return kExitOk;
+}
+
+}  // namespace oal

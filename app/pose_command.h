@@ -1,0 +1,71 @@
+// `oalservo pose`: the camera pose from the four-line target (servo/pose.h) in every frame of
+// the same inputs as `oalservo detect`, one JSON object per frame (JSON Lines):
+//
+//   {"frame":0,"source":"x.png","width":640,"height":480,"status":"ok","message":"",
+//    "cMo":{"t_m":[x,y,z],"thetau_rad":[tux,tuy,tuz]},
+//    "roll_deg":..,"pitch_deg":..,"yaw_deg":..,"line1_roll_deg":..,
+//    "plane_angles_deg":[a1,a2],"residual_px":..,"method":"lagrange","from_previous":false,
+//    "lines":[i1,i2,i3,i4],"coordinates":"image","corners_px":[[u,v],[u,v],[u,v],[u,v]],
+//    "time_us":{"detect":..,"pose":..}}
+//
+// status is PoseStatus's ToString() ("ok", "not-enough-lines", "not-identifiable",
+// "degenerate") and message its reason ("" when ok). Every object has every key: cMo,
+// roll_deg ... from_previous are null unless the status is ok; lines[k] is the index, in the
+// detector's lines of that frame, of target line k + 1 (-1 when not identified); corners_px
+// (corner k = line k+1 ∩ line k+2, in `coordinates`: "undistorted" when the detector corrects
+// distortion, else "image") is null until the lines are identified. Angles are PoseResult's.
+//
+// The pose needs the camera's intrinsics: --camera FILE, or, without it, the camera.xml that
+// `oalservo render` writes next to the frames (the directory of the first input), which is
+// then used with a warning saying so. Without either the command fails before any output.
+// Within one input the previous frame's pose, when its status was ok, seeds the next frame's
+// (so a sequence does not flip between the two poses of a planar target).
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace oal {
+
+struct PoseCommandOptions {
+  /// Image, directory, printf pattern, video or /dev/videoN (app/image_source.h).
+  std::vector<std::string> inputs;
+  /// YAML configuration: `detector:`, `target:` (default four-line) and `pose:` sections
+  /// (config/detector.yaml, config/four-line-target.yaml, config/pose.yaml); empty: none.
+  std::string config_path;
+  /// ViSP camera XML; empty: camera.xml in the first input's directory, else an error.
+  std::string camera_path;
+  /// Camera to read from the camera file; empty: the first camera of the file.
+  std::string camera_name;
+  /// JSON Lines output, written atomically; empty: the stream passed to EstimatePoses().
+  std::string out_path;
+  /// Directory for one annotated PNG per frame (pose_0000.png...); empty: none.
+  std::string annotate_dir;
+  /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
+  int max_frames = 0;
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+struct PoseSummary {
+  int frames = 0;
+  int ok = 0;  ///< frames with status ok
+  /// The camera file used (--camera, or the camera.xml found next to the inputs).
+  std::string camera_path;
+  /// For the user (camera found automatically, skipped files, camera size mismatch).
+  std::vector<std::string> warnings;
+};
+
+/// Estimates the pose in every frame of every input. Output goes to options.out_path
+/// (atomically: nothing is left there on error) or, without one, to `out`, flushed after each
+/// frame. A frame without a pose is a row with its status, not an error. Throws
+/// std::runtime_error / std::invalid_argument on bad input or configuration, or when no
+/// camera is given or found ("pose needs the camera intrinsics: give --camera FILE").
+PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out);
+
+/// `oalservo pose ...`; argv[0] is "pose".
+int RunPose(int argc, char** argv);
+
+}  // namespace oal
