@@ -98,6 +98,16 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult
     cMo = Json{{"t_m", Vector3(t[0], t[1], t[2])}, {"thetau_rad", Vector3(tu[0], tu[1], tu[2])}};
   }
   auto if_ok = [ok](const Json& value) { return ok ? value : Json(); };
+  // The pose covariance (vpPose, 6 x 6, translation then theta-u), row by row.
+  Json covariance;
+  if (ok && pose.covariance.getRows() == 6 && pose.covariance.getCols() == 6) {
+    covariance = Json::array();
+    for (unsigned int r = 0; r < 6; ++r) {
+      Json row = Json::array();
+      for (unsigned int c = 0; c < 6; ++c) row.push_back(pose.covariance[r][c]);
+      covariance.push_back(std::move(row));
+    }
+  }
   Json corners;  // null until identified
   if (identified) {
     corners = Json::array();
@@ -117,6 +127,7 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult
       {"line1_roll_deg", if_ok(pose.line1_roll_deg)},
       {"plane_angles_deg", if_ok(Json::array({pose.plane_angle_deg[0], pose.plane_angle_deg[1]}))},
       {"residual_px", if_ok(pose.residual_px)},
+      {"covariance", std::move(covariance)},
       {"method", if_ok(ToString(pose.method))},
       {"from_previous", if_ok(pose.from_previous)},
       {"lines", Json::array({pose.line_index[0], pose.line_index[1], pose.line_index[2],

@@ -72,6 +72,15 @@ void ExpectPoseNearTruth(const json& frame, const std::string& truth_path) {
     EXPECT_TRUE(frame.at(key).is_number()) << key;
   }
   EXPECT_EQ(frame.at("plane_angles_deg").size(), 2u);
+  const json& covariance = frame.at("covariance");
+  ASSERT_EQ(covariance.size(), 6u);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_GE(covariance[i][i].get<double>(), 0.0);  // variances
+    for (int j = 0; j < 6; ++j) {
+      const double a = covariance[i][j], b = covariance[j][i];
+      EXPECT_NEAR(a, b, 1e-9 * (std::fabs(a) + std::fabs(b)) + 1e-30);  // symmetric
+    }
+  }
   EXPECT_TRUE(frame.at("method") == "dementhon" || frame.at("method") == "lagrange");
   EXPECT_TRUE(frame.at("from_previous").is_boolean());
   EXPECT_EQ(frame.at("lines").size(), 4u);
