@@ -69,4 +69,14 @@ void WritePng(const fs::path& path, const cv::Mat& image) {
   WriteFileAtomically(path, bytes);
 }
 
+void CheckOutputFile(const std::filesystem::path& target) {
+  const std::filesystem::path parent = target.parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw std::invalid_argument("output directory '" + parent.string() + "' does not exist");
+  }
+  if (std::filesystem::is_directory(target)) {
+    throw std::invalid_argument("output '" + target.string() + "' is a directory, not a file");
+  }
+}
+
 }  // namespace oal

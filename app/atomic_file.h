@@ -40,6 +40,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// Throws std::invalid_argument when `target` cannot be an output file: its directory does
+/// not exist, or it is itself a directory. Call before any work, so nothing is half done.
+void CheckOutputFile(const std::filesystem::path& target);
+
 /// Writes `bytes` to `target` atomically.
 void WriteFileAtomically(const std::filesystem::path& target, const std::string& bytes);
 void WriteFileAtomically(const std::filesystem::path& target,

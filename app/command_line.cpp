@@ -1,6 +1,9 @@
 #include "app/command_line.h"
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <iostream>
 
 namespace oal {
@@ -18,6 +21,15 @@ std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv) {
     throw UsageError(std::string(error.what()) + " (run with --help for usage)");
   }
   return std::nullopt;
+}
+
+std::function<void(int, int)> TerminalFrameProgress() {
+  if (!isatty(fileno(stderr))) return {};
+  return [](int done, int total) {
+    if (done % 20 != 0 && done != total) return;
+    std::cerr << "\rframe " << done << " / " << total << std::flush;
+    if (done == total) std::cerr << '\n';
+  };
 }
 
 void Warn(const std::string& command, const std::string& message) {

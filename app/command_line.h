@@ -2,6 +2,7 @@
 // main() tells apart, and CLI11 parsing that turns --help into a normal exit.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -36,6 +37,10 @@ class UsageError : public std::runtime_error {
 /// Parses argv into `cli`. Returns an exit code when the command should stop here (--help
 /// was printed: kExitOk), std::nullopt to go on. Throws UsageError on a bad command line.
 std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv);
+
+/// "frame N / total" on stderr, redrawn in place every 20 frames, when stderr is a
+/// terminal; nothing otherwise (logs stay clean).
+std::function<void(int done, int total)> TerminalFrameProgress();
 
 /// A warning for the user on stderr: "oalservo <command>: warning: <message>". Libraries
 /// never print; commands report through this.

@@ -115,15 +115,7 @@ void DetectCommandOptions::Check() const {
     throw std::invalid_argument("DetectCommandOptions::max_frames = " + std::to_string(max_frames) +
                                 ". Violated constraint: max_frames >= 0");
   }
-  if (!out_path.empty()) {
-    const fs::path parent = fs::path(out_path).parent_path();
-    if (!parent.empty() && !fs::is_directory(parent)) {
-      throw std::invalid_argument("output directory '" + parent.string() + "' does not exist");
-    }
-    if (fs::is_directory(out_path)) {
-      throw std::invalid_argument("output '" + out_path + "' is a directory, not a file");
-    }
-  }
+  if (!out_path.empty()) CheckOutputFile(out_path);
 }
 
 DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& out) {

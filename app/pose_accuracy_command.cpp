@@ -1,7 +1,5 @@
 #include "app/pose_accuracy_command.h"
 
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iomanip>
@@ -105,19 +103,9 @@ int RunPoseAccuracy(int argc, char** argv) {
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
   if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
-  const bool tty = isatty(fileno(stderr));
-  const PoseAccuracyReport report = EvaluatePoseAccuracy(options, [&](int done, int total) {
-    if (tty && (done % 20 == 0 || done == total)) {
-      std::cerr << "\rframe " << done << " / " << total << std::flush;
-      if (done == total) std::cerr << '\n';
-    }
-  });
+  const PoseAccuracyReport report = EvaluatePoseAccuracy(options, TerminalFrameProgress());
   std::cout << Table(report);
-  if (!out_path.empty()) {
-    AtomicFile file(out_path);
-    file.stream() << ToJson(report).dump(2) << '\n';
-    file.Commit();
-  }
+  if (!out_path.empty()) WriteFileAtomically(out_path, ToJson(report).dump(2) + '\n');
   return kExitOk;
 }
 
