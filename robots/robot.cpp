@@ -1,0 +1,49 @@
+#include "robots/robot.h"
+
+#include <visp3/core/vpThetaUVector.h>
+
+namespace oal {
+
+std::string ToString(RobotStatus status) {
+  switch (status) {
+    case RobotStatus::kOk:
+      return "ok";
+    case RobotStatus::kError:
+      return "error";
+    case RobotStatus::kStopped:
+      return "stopped";
+    case RobotStatus::kNotReady:
+      return "not-ready";
+    case RobotStatus::kLimit:
+      return "limit";
+    case RobotStatus::kWorkspace:
+      return "workspace";
+    case RobotStatus::kUnreachable:
+      return "unreachable";
+    case RobotStatus::kUnsupported:
+      return "unsupported";
+    case RobotStatus::kTimeout:
+      return "timeout";
+  }
+  return "unknown";
+}
+
+std::string ToString(RobotFrame frame) {
+  switch (frame) {
+    case RobotFrame::kCamera:
+      return "camera";
+    case RobotFrame::kEndEffector:
+      return "end-effector";
+  }
+  return "unknown";
+}
+
+PoseDistance Distance(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
+  const vpHomogeneousMatrix aMb = a.inverse() * b;
+  PoseDistance d;
+  d.translation_m = aMb.getTranslationVector().frobeniusNorm();
+  d.rotation_rad = vpThetaUVector(aMb.getRotationMatrix()).getTheta();
+  return d;
+}
+
+}  // namespace oal

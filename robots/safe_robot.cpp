@@ -1,0 +1,315 @@
+#include "robots/safe_robot.h"
+
+#include <visp3/core/vpExponentialMap.h>
+#include <visp3/core/vpMath.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace oal {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point from) {
+  return std::chrono::duration<double>(Clock::now() - from).count();
+}
+
+[[noreturn]] void Reject(const std::string& field, const std::string& value,
+                         const std::string& constraint) {
+  throw std::invalid_argument("SafetyOptions::" + field + " = " + value +
+                              ". Violated constraint: " + constraint);
+}
+
+std::string Str(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+constexpr const char* kAxisName[6] = {"vx", "vy", "vz", "wx", "wy", "wz"};
+constexpr const char* kBoxAxis[3] = {"x", "y", "z"};
+
+}  // namespace
+
+void SafetyOptions::Check() const {
+  if (!(max_translation_mps > 0 && std::isfinite(max_translation_mps))) {
+    Reject("max_translation_mps", Str(max_translation_mps), "finite and > 0");
+  }
+  if (!(max_rotation_radps > 0 && std::isfinite(max_rotation_radps))) {
+    Reject("max_rotation_radps", Str(max_rotation_radps), "finite and > 0");
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::isfinite(workspace_min_m[i]) && std::isfinite(workspace_max_m[i]) &&
+          workspace_min_m[i] < workspace_max_m[i])) {
+      Reject(std::string("workspace_min_m/workspace_max_m [") + kBoxAxis[i] + "]",
+             Str(workspace_min_m[i]) + " / " + Str(workspace_max_m[i]), "finite and min < max");
+    }
+  }
+  if (!(move_timeout_s > 0 && std::isfinite(move_timeout_s))) {
+    Reject("move_timeout_s", Str(move_timeout_s), "finite and > 0");
+  }
+  if (!(reach_tolerance_m > 0)) Reject("reach_tolerance_m", Str(reach_tolerance_m), "> 0");
+  if (!(reach_tolerance_rad > 0)) Reject("reach_tolerance_rad", Str(reach_tolerance_rad), "> 0");
+  if (!(max_cycle_s >= 0 && std::isfinite(max_cycle_s))) {
+    Reject("max_cycle_s", Str(max_cycle_s), "finite and >= 0");
+  }
+}
+
+std::string ToString(SafeRobotState state) {
+  switch (state) {
+    case SafeRobotState::kDisconnected:
+      return "disconnected";
+    case SafeRobotState::kDisabled:
+      return "disabled";
+    case SafeRobotState::kEnabled:
+      return "enabled";
+    case SafeRobotState::kStopped:
+      return "stopped";
+  }
+  return "unknown";
+}
+
+SafeRobot::SafeRobot(Robot& robot, const SafetyOptions& options)
+    : robot_(robot), options_(options) {
+  options_.Check();
+  sampling_time_s_ = robot_.Capabilities().sampling_time_s;
+  if (!(sampling_time_s_ > 0)) {
+    throw std::invalid_argument("SafeRobot: robot '" + robot_.Name() +
+                                "' reports a sampling time <= 0");
+  }
+}
+
+SafeRobot::~SafeRobot() {
+  robot_.Stop();
+}
+
+RobotResult SafeRobot::Connect() {
+  RobotResult r = robot_.Connect();
+  if (r.ok() && state_ == SafeRobotState::kDisconnected) state_ = SafeRobotState::kDisabled;
+  return r;
+}
+
+RobotResult SafeRobot::Enable() {
+  if (state_ == SafeRobotState::kDisconnected) {
+    return RobotResult::Fail(RobotStatus::kNotReady, "not connected: call Connect() first");
+  }
+  RobotResult r = robot_.Enable();
+  if (!r.ok()) return r;
+  emergency_.store(false, std::memory_order_relaxed);
+  stop_reason_ = RobotResult::Ok();
+  state_ = SafeRobotState::kEnabled;
+  return r;
+}
+
+RobotResult SafeRobot::Disable() noexcept {
+  RobotResult r = robot_.Disable();
+  if (state_ != SafeRobotState::kDisconnected) state_ = SafeRobotState::kDisabled;
+  return r;
+}
+
+RobotResult SafeRobot::Stop() noexcept {
+  return Latch(RobotResult::Fail(RobotStatus::kStopped, "Stop() called"));
+}
+
+RobotResult SafeRobot::Latch(RobotResult why) noexcept {
+  RobotResult stop = robot_.Stop();
+  if (state_ == SafeRobotState::kEnabled) {
+    state_ = SafeRobotState::kStopped;
+    stop_reason_ = std::move(why);
+  }
+  return stop;
+}
+
+RobotResult SafeRobot::CheckMayMove() {
+  if (emergency_.load(std::memory_order_relaxed)) {
+    Latch(RobotResult::Fail(RobotStatus::kStopped, "emergency stop requested"));
+  }
+  switch (state_) {
+    case SafeRobotState::kEnabled:
+      return RobotResult::Ok();
+    case SafeRobotState::kDisconnected:
+      return RobotResult::Fail(RobotStatus::kNotReady, "not connected: call Connect() first");
+    case SafeRobotState::kDisabled:
+      return RobotResult::Fail(RobotStatus::kNotReady, "not enabled: call Enable() first");
+    case SafeRobotState::kStopped:
+      break;
+  }
+  return RobotResult::Fail(RobotStatus::kStopped,
+                           "robot stopped (" + stop_reason_.message + "); Enable() to resume");
+}
+
+vpHomogeneousMatrix SafeRobot::BoxFramePose(RobotFrame frame,
+                                            const vpHomogeneousMatrix& wMx) const {
+  if (frame == options_.workspace_frame) return wMx;
+  if (frame == RobotFrame::kCamera) return wMx * robot_.eMc().inverse();  // wMe = wMc * cMe
+  return wMx * robot_.eMc();                                              // wMc = wMe * eMc
+}
+
+RobotResult SafeRobot::CheckInBox(const vpHomogeneousMatrix& wMb, const std::string& what) const {
+  if (!options_.workspace_enabled) return RobotResult::Ok();
+  for (unsigned i = 0; i < 3; ++i) {
+    const double p = wMb[i][3];
+    const double lo = options_.workspace_min_m[i];
+    const double hi = options_.workspace_max_m[i];
+    if (!(p >= lo && p <= hi)) {
+      std::ostringstream s;
+      s << what << " would take the " << ToString(options_.workspace_frame) << " to " << kBoxAxis[i]
+        << " = " << p << " m, outside the workspace box [" << lo << ", " << hi << "] m";
+      return RobotResult::Fail(RobotStatus::kWorkspace, s.str());
+    }
+  }
+  return RobotResult::Ok();
+}
+
+void SafeRobot::RecordCycle(double seconds) {
+  ++timing_.cycles;
+  timing_.last_s = seconds;
+  timing_.total_s += seconds;
+  if (seconds > timing_.max_s) timing_.max_s = seconds;
+}
+
+RobotPose SafeRobot::GetPosition(RobotFrame frame) {
+  if (state_ == SafeRobotState::kDisconnected) {
+    RobotPose p;
+    p.result = RobotResult::Fail(RobotStatus::kNotReady, "not connected: call Connect() first");
+    return p;
+  }
+  return robot_.GetPosition(frame);
+}
+
+vpColVector SafeRobot::Saturate(const vpColVector& v, double max_translation_mps,
+                                double max_rotation_radps, double* scale, int* limiting_axis) {
+  if (v.size() != 6) {
+    throw std::invalid_argument("SafeRobot: twist has " + std::to_string(v.size()) +
+                                " entries, expected 6");
+  }
+  double s = 1;
+  int axis = -1;
+  for (unsigned i = 0; i < 6; ++i) {
+    const double limit = i < 3 ? max_translation_mps : max_rotation_radps;
+    const double a = std::abs(v[i]);
+    if (a > limit && limit / a < s) {
+      s = limit / a;
+      axis = static_cast<int>(i);
+    }
+  }
+  if (scale) *scale = s;
+  if (limiting_axis) *limiting_axis = axis;
+  return s < 1 ? v * s : v;
+}
+
+CycleReport SafeRobot::SetVelocity(RobotFrame frame, const vpColVector& v) {
+  const Clock::time_point start = Clock::now();
+  CycleReport report;
+  auto finish = [&](RobotResult r) {
+    report.result = std::move(r);
+    report.duration_s = Seconds(start);
+    RecordCycle(report.duration_s);
+    if (report.result.ok() && options_.max_cycle_s > 0 &&
+        report.duration_s > options_.max_cycle_s) {
+      RobotResult why = RobotResult::Fail(
+          RobotStatus::kTimeout,
+          "cycle took " + Str(report.duration_s) + " s > max_cycle_s " + Str(options_.max_cycle_s));
+      Latch(why);
+      report.result = std::move(why);
+    }
+    return report;
+  };
+  if (v.size() != 6) {
+    throw std::invalid_argument("SafeRobot::SetVelocity: twist has " + std::to_string(v.size()) +
+                                " entries, expected 6");
+  }
+  for (unsigned i = 0; i < 6; ++i) {
+    if (!std::isfinite(v[i])) {
+      RobotResult why = RobotResult::Fail(
+          RobotStatus::kLimit, std::string("twist component ") + kAxisName[i] + " is not finite");
+      Latch(why);
+      return finish(why);
+    }
+  }
+  if (RobotResult r = CheckMayMove(); !r.ok()) return finish(r);
+  report.twist = Saturate(v, options_.max_translation_mps, options_.max_rotation_radps,
+                          &report.scale, &report.limiting_axis);
+  report.saturated = report.scale < 1;
+  if (options_.workspace_enabled) {
+    const RobotPose now = robot_.GetPosition(frame);
+    if (!now.result.ok()) {
+      Latch(now.result);
+      return finish(now.result);
+    }
+    const vpHomogeneousMatrix next =
+        now.pose * vpExponentialMap::direct(report.twist, sampling_time_s_);
+    if (RobotResult r = CheckInBox(BoxFramePose(frame, next), "the velocity command"); !r.ok()) {
+      Latch(r);
+      return finish(r);
+    }
+  }
+  RobotResult r = robot_.SetVelocity(frame, report.twist);
+  if (!r.ok()) Latch(r);
+  return finish(r);
+}
+
+MoveReport SafeRobot::MovePosition(RobotFrame frame, const vpHomogeneousMatrix& target) {
+  const Clock::time_point move_start = Clock::now();
+  MoveReport report;
+  auto fail = [&](RobotResult r) {
+    Latch(r);
+    report.result = std::move(r);
+    report.duration_s = Seconds(move_start);
+    return report;
+  };
+  if (RobotResult r = CheckMayMove(); !r.ok()) {
+    report.result = r;
+    return report;
+  }
+  const RobotPose reach = robot_.NearestReachable(frame, target);
+  if (!reach.result.ok()) return fail(reach.result);
+  report.target = reach.pose;
+  if (RobotResult r = CheckInBox(BoxFramePose(frame, report.target), "the move target"); !r.ok()) {
+    return fail(r);
+  }
+  if (RobotResult r = robot_.StartMove(frame, report.target); !r.ok()) return fail(r);
+  const int max_polls = static_cast<int>(std::ceil(options_.move_timeout_s / sampling_time_s_));
+  for (;;) {
+    const Clock::time_point cycle_start = Clock::now();
+    if (RobotResult r = CheckMayMove(); !r.ok()) return fail(r);
+    if (report.polls >= max_polls) {
+      return fail(RobotResult::Fail(
+          RobotStatus::kTimeout,
+          "move not finished after " + Str(options_.move_timeout_s) + " s (move_timeout_s)"));
+    }
+    const MoveProgress progress = robot_.PollMove();
+    ++report.polls;
+    if (!progress.result.ok()) return fail(progress.result);
+    const RobotPose now = robot_.GetPosition(frame);
+    if (!now.result.ok()) return fail(now.result);
+    report.reached = now.pose;
+    if (RobotResult r = CheckInBox(BoxFramePose(frame, now.pose), "the move"); !r.ok()) {
+      return fail(r);
+    }
+    const double cycle_s = Seconds(cycle_start);
+    RecordCycle(cycle_s);
+    if (options_.max_cycle_s > 0 && cycle_s > options_.max_cycle_s) {
+      return fail(RobotResult::Fail(
+          RobotStatus::kTimeout,
+          "cycle took " + Str(cycle_s) + " s > max_cycle_s " + Str(options_.max_cycle_s)));
+    }
+    if (progress.done) break;
+  }
+  const PoseDistance d = Distance(report.target, report.reached);
+  if (d.translation_m > options_.reach_tolerance_m ||
+      d.rotation_rad > options_.reach_tolerance_rad) {
+    return fail(RobotResult::Fail(RobotStatus::kError,
+                                  "move ended " + Str(d.translation_m * 1e3) + " mm and " +
+                                      Str(vpMath::deg(d.rotation_rad)) + " deg from its target"));
+  }
+  report.result = RobotResult::Ok();
+  report.duration_s = Seconds(move_start);
+  return report;
+}
+
+}  // namespace oal
