@@ -1,7 +1,10 @@
 #include "app/config.h"
 
+#include <visp3/core/vpMath.h>
+#include <visp3/core/vpRxyzVector.h>
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -141,10 +145,16 @@ void CheckAt(const Options& options, const std::string& file, const std::string&
     options.Check();
   } catch (const std::invalid_argument& error) {
     const std::string message = error.what();
-    const std::size_t begin = message.find("::");
+    // "Options::field = ..." (most Check()s) or "Options.field = ..." (ServoOptions).
     const std::size_t end = message.find(" = ");
+    std::size_t begin = message.find("::");
+    std::size_t skip = 2;
+    if (begin == std::string::npos || begin > end) {
+      begin = message.rfind('.', end);
+      skip = 1;
+    }
     if (begin != std::string::npos && end != std::string::npos && begin < end) {
-      const std::string field = message.substr(begin + 2, end - begin - 2);
+      const std::string field = message.substr(begin + skip, end - begin - skip);
       const auto line = lines.find(field);
       if (line != lines.end()) {
         throw std::runtime_error(file + ":" + std::to_string(line->second) + ": '" + name + "." +
@@ -410,19 +420,196 @@ void ReadPoseSection(const YAML::Node& section, const std::string& file, AppConf
   CheckAt(config->pose, file, "pose", lines);
 }
 
+// ------------------------------------------------------------------------------------------
+// The servo app's sections: camera, robot, servo, goal, target_pose.
+
+// [x, y, z], finite.
+std::array<double, 3> ReadVector3(const Value& value, const char* unit) {
+  const YAML::Node& node = value.node;
+  if (!node.IsSequence() || node.size() != 3) {
+    value.Fail("'" + value.key + "' must be [x, y, z] in " + unit + ", got '" +
+               (node.IsSequence() ? "a sequence of " + std::to_string(node.size()) : value.Text()) +
+               "'");
+  }
+  std::array<double, 3> v{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    v[i] = Value{node[i], value.file, value.key + "[" + std::to_string(i) + "]"}.FiniteDouble();
+  }
+  return v;
+}
+
+// {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]}, R = Rx·Ry·Rz; both keys optional (0).
+vpHomogeneousMatrix ReadPose(const Value& value) {
+  if (!value.node.IsMap()) {
+    value.Fail("'" + value.key +
+               "' must be a pose {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]}, got '" +
+               value.Text() + "'");
+  }
+  std::array<double, 3> t{}, r{};
+  std::map<std::string, int> seen;
+  for (const auto& entry : value.node) {
+    const std::string key = entry.first.Scalar();
+    const std::string full_key = value.key + "." + key;
+    const auto [first, inserted] = seen.emplace(key, entry.first.Mark().line + 1);
+    if (!inserted) {
+      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
+                               "' is repeated (first at line " + std::to_string(first->second) +
+                               ")");
+    }
+    const Value item{entry.second, value.file, full_key};
+    if (key == "translation_m") {
+      t = ReadVector3(item, "metres");
+    } else if (key == "rxyz_deg") {
+      r = ReadVector3(item, "degrees");
+    } else {
+      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
+                               "' is unknown (known: translation_m, rxyz_deg)");
+    }
+  }
+  const vpRxyzVector rxyz(vpMath::rad(r[0]), vpMath::rad(r[1]), vpMath::rad(r[2]));
+  return vpHomogeneousMatrix(vpTranslationVector(t[0], t[1], t[2]), vpRotationMatrix(rxyz));
+}
+
+template <typename Options>
+Field<Options> PoseField(const char* key, vpHomogeneousMatrix Options::*member) {
+  return {key,
+          [member](const Value& value, Options* options) { options->*member = ReadPose(value); }};
+}
+
+const std::vector<Field<CameraConfig>>& CameraFields() {
+  using O = CameraConfig;
+  static const std::vector<Field<O>> fields = {
+      DoubleField("px", &O::px),      DoubleField("py", &O::py),
+      DoubleField("u0", &O::u0),      DoubleField("v0", &O::v0),
+      DoubleField("kdu", &O::kdu),    IntField("width", &O::width),
+      IntField("height", &O::height), DoubleField("noise", &O::noise),
+      DoubleField("blur", &O::blur),  PoseField("eMc", &O::eMc),
+  };
+  return fields;
+}
+
+void ReadCameraSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  Lines lines;
+  ReadFields(section, file, "camera", CameraFields(), "", &config->camera, &lines);
+  CheckAt(config->camera, file, "camera", lines);
+}
+
+template <typename T>
+Field<RobotConfig> SafetyField(const char* key, T SafetyOptions::*member) {
+  return {key, [member](const Value& value, RobotConfig* robot) {
+            if constexpr (std::is_same_v<T, bool>) {
+              robot->safety.*member = value.Bool();
+            } else if constexpr (std::is_same_v<T, double>) {
+              robot->safety.*member = value.Double();
+            } else {
+              robot->safety.*member = ReadVector3(value, "metres");
+            }
+          }};
+}
+
+const std::vector<Field<RobotConfig>>& RobotFields() {
+  using O = RobotConfig;
+  static const std::vector<Field<O>> fields = {
+      {"type",
+       [](const Value& value, O* robot) {
+         robot->type = value.As<std::string>("a string");
+         if (robot->type != "simulated") {
+           value.Fail("'" + value.key + "' must be one of simulated, got '" + robot->type + "'");
+         }
+       }},
+      PoseField("start", &O::start_wMc),
+      DoubleField("sampling_time_s", &O::sampling_time_s),
+      SafetyField("max_translation_mps", &SafetyOptions::max_translation_mps),
+      SafetyField("max_rotation_radps", &SafetyOptions::max_rotation_radps),
+      SafetyField("workspace_enabled", &SafetyOptions::workspace_enabled),
+      SafetyField("workspace_min_m", &SafetyOptions::workspace_min_m),
+      SafetyField("workspace_max_m", &SafetyOptions::workspace_max_m),
+  };
+  return fields;
+}
+
+void ReadRobotSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  Lines lines;
+  ReadFields(section, file, "robot", RobotFields(), "", &config->robot, &lines);
+  CheckAt(config->robot, file, "robot", lines);
+}
+
+Field<ServoLoopOptions> LawDouble(const char* key, double ServoOptions::*member) {
+  return {key, [member](const Value& value, ServoLoopOptions* options) {
+            options->law.*member = value.Double();
+          }};
+}
+
+const std::vector<Field<ServoLoopOptions>>& ServoFields() {
+  using O = ServoLoopOptions;
+  static const std::vector<Field<O>> fields = {
+      {"mode",
+       [](const Value& value, O* options) {
+         options->law.mode =
+             value.Choice(&ServoModeFromString, "point-and-go, exponential, velocity");
+       }},
+      LawDouble("delta", &ServoOptions::delta),
+      LawDouble("gain", &ServoOptions::gain),
+      {"adaptive_gain",
+       [](const Value& value, O* options) { options->law.adaptive_gain = value.Bool(); }},
+      LawDouble("gain_at_zero", &ServoOptions::gain_at_zero),
+      LawDouble("gain_at_infinity", &ServoOptions::gain_at_infinity),
+      LawDouble("gain_slope_at_zero", &ServoOptions::gain_slope_at_zero),
+      LawDouble("translation_tolerance_m", &ServoOptions::translation_tolerance_m),
+      LawDouble("rotation_tolerance_deg", &ServoOptions::rotation_tolerance_deg),
+      IntField("max_iterations", &O::max_iterations),
+      DoubleField("max_time_s", &O::max_time_s),
+      DoubleField("max_pose_jump_m", &O::max_pose_jump_m),
+      DoubleField("max_pose_jump_deg", &O::max_pose_jump_deg),
+  };
+  return fields;
+}
+
+void ReadServoSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  Lines lines;
+  ReadFields(section, file, "servo", ServoFields(), "", &config->servo, &lines);
+  CheckAt(config->servo, file, "servo", lines);
+}
+
+void ReadGoalSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  using O = vpHomogeneousMatrix;
+  static const std::vector<Field<O>> fields = {
+      {"cdMo", [](const Value& value, O* cdMo) { *cdMo = ReadPose(value); }},
+      {"taught_from_pose",
+       [](const Value& value, O*) {
+         value.Fail("'" + value.key +
+                    "' is not supported by this version of oalservo: give 'goal.cdMo'");
+       }},
+  };
+  Lines lines;
+  vpHomogeneousMatrix cdMo = config->goal_cdMo;
+  ReadFields(section, file, "goal", fields, "", &cdMo, &lines);
+  if (cdMo[2][3] <= 0.0) {
+    throw std::runtime_error(file + ":" + std::to_string(lines.count("cdMo") ? lines["cdMo"] : 0) +
+                             ": 'goal.cdMo' puts the target at z = " + Number(cdMo[2][3]) +
+                             " m: it must lie in front of the goal camera (z > 0)");
+  }
+  config->goal_cdMo = cdMo;
+}
+
+void ReadTargetPoseSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  config->target_wMo = ReadPose(Value{section, file, "target_pose"});
+}
+
 struct Section {
   const char* name;
   void (*read)(const YAML::Node& section, const std::string& file, AppConfig* config);
 };
 
 constexpr Section kSections[] = {
-    {"detector", &ReadDetectorSection},
-    {"target", &ReadTargetSection},
-    {"pose", &ReadPoseSection},
+    {"detector", &ReadDetectorSection}, {"target", &ReadTargetSection},
+    {"pose", &ReadPoseSection},         {"camera", &ReadCameraSection},
+    {"robot", &ReadRobotSection},       {"servo", &ReadServoSection},
+    {"goal", &ReadGoalSection},         {"target_pose", &ReadTargetPoseSection},
 };
 
 // Sections later versions will read: rejected with a message that says so.
-constexpr const char* kReservedSections[] = {"camera", "servo", "robot", "render"};
+constexpr const char* kReservedSections[] = {"render"};
 
 std::string SectionNames() {
   std::string names;
@@ -483,6 +670,77 @@ YAML::Node LoadYaml(const std::string& text, const std::string& file) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string Num(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+[[noreturn]] void Violated(const std::string& field, const std::string& value,
+                           const std::string& constraint) {
+  throw std::invalid_argument(field + " = " + value + ". Violated constraint: " + constraint);
+}
+
+}  // namespace
+
+vpCameraParameters CameraConfig::Camera() const {
+  vpCameraParameters camera;
+  if (kdu != 0.0) {
+    camera.initPersProjWithDistortion(px, py, u0, v0, -kdu, kdu);  // kud refined by FitKud
+    camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
+  } else {
+    camera.initPersProjWithoutDistortion(px, py, u0, v0);
+  }
+  return camera;
+}
+
+void CameraConfig::Check() const {
+  if (!(px > 0.0) || !std::isfinite(px)) Violated("CameraConfig::px", Num(px), "px > 0");
+  if (!(py > 0.0) || !std::isfinite(py)) Violated("CameraConfig::py", Num(py), "py > 0");
+  if (!std::isfinite(u0)) Violated("CameraConfig::u0", Num(u0), "finite");
+  if (!std::isfinite(v0)) Violated("CameraConfig::v0", Num(v0), "finite");
+  if (!std::isfinite(kdu) || std::fabs(kdu) > 10.0) {
+    Violated("CameraConfig::kdu", Num(kdu), "|kdu| <= 10");
+  }
+  if (width < 16 || width > 8192)
+    Violated("CameraConfig::width", Num(width), "16 <= width <= 8192");
+  if (height < 16 || height > 8192) {
+    Violated("CameraConfig::height", Num(height), "16 <= height <= 8192");
+  }
+  if (!(noise >= 0.0 && noise <= 100.0)) {
+    Violated("CameraConfig::noise", Num(noise), "0 <= noise <= 100");
+  }
+  if (!(blur >= 0.0 && blur <= 20.0)) Violated("CameraConfig::blur", Num(blur), "0 <= blur <= 20");
+}
+
+void RobotConfig::Check() const {
+  if (type != "simulated") Violated("RobotConfig::type", type, "type is simulated");
+  if (!(sampling_time_s > 0.0 && sampling_time_s <= 1.0)) {
+    Violated("RobotConfig::sampling_time_s", Num(sampling_time_s), "0 < sampling_time_s <= 1");
+  }
+  safety.Check();
+}
+
+void ServoLoopOptions::Check() const {
+  law.Check();
+  if (max_iterations < 1 || max_iterations > 1000000) {
+    Violated("ServoLoopOptions::max_iterations", Num(max_iterations),
+             "1 <= max_iterations <= 1000000");
+  }
+  if (!(max_time_s > 0.0) || !std::isfinite(max_time_s)) {
+    Violated("ServoLoopOptions::max_time_s", Num(max_time_s), "max_time_s > 0");
+  }
+  if (!(max_pose_jump_m > 0.0) || !std::isfinite(max_pose_jump_m)) {
+    Violated("ServoLoopOptions::max_pose_jump_m", Num(max_pose_jump_m), "max_pose_jump_m > 0");
+  }
+  if (!(max_pose_jump_deg > 0.0 && max_pose_jump_deg <= 180.0)) {
+    Violated("ServoLoopOptions::max_pose_jump_deg", Num(max_pose_jump_deg),
+             "0 < max_pose_jump_deg <= 180");
+  }
+}
 
 AppConfig ParseConfig(const std::string& yaml_text, const std::string& file_name,
                       const AppConfig& base) {

@@ -22,25 +22,91 @@
 //     max_residual_px: 2.0   # the camera, lines_undistorted and the image size come from the
 //                            # command (--camera, the detector, the frame), not from here
 //
-// Sections reserved for later versions (camera, servo, robot, render) are rejected
-// with a message saying so, rather than silently ignored.
+// The servo app's sections (config/servo-sim.yaml documents every key):
+//
+//   camera:   px, py, u0, v0, kdu, width, height, noise, blur, eMc    (CameraConfig)
+//   robot:    type: simulated, start (wMc), velocity limits, workspace box (RobotConfig)
+//   servo:    the law (ServoOptions) and the loop's limits             (ServoLoopOptions)
+//   goal:     cdMo, the target as the camera should see it at the goal
+//   target_pose: wMo, the target's pose in the world (robot base) frame
+//
+// A pose is a map {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]} with the rotation
+// R = Rx(rx)·Ry(ry)·Rz(rz) (vpRxyzVector).
+//
+// The section reserved for later versions (render) is rejected with a message saying so,
+// rather than silently ignored.
 #pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <string>
 
 #include "detector/options.h"
+#include "robots/safe_robot.h"
 #include "scene/scene.h"
+#include "servo/pbvs.h"
 #include "servo/pose.h"
 
 namespace oal {
+
+/// `camera:` the simulated (or real) camera: intrinsics, kdu distortion, image size, and the
+/// rendering's noise and blur.
+struct CameraConfig {
+  double px = 600.0, py = 600.0;  ///< focal lengths, pixels, > 0
+  double u0 = 319.5, v0 = 239.5;  ///< principal point, pixels, finite
+  double kdu = 0.0;               ///< ViSP's distorted -> undistorted coefficient; 0: none
+  int width = 640, height = 480;  ///< image size, pixels, [16, 8192]
+  double noise = 0.0;             ///< Gaussian noise of the rendering, grey levels, [0, 100]
+  double blur = 0.0;              ///< Gaussian blur of the rendering, pixels, [0, 20]
+  vpHomogeneousMatrix eMc;        ///< hand-eye: the camera in the end-effector frame
+
+  /// The vpCameraParameters (with distortion when kdu != 0).
+  vpCameraParameters Camera() const;
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// `robot:` which robot, where it starts, and the runner's safety limits.
+struct RobotConfig {
+  std::string type = "simulated";  ///< only "simulated" (a free-flying camera) for now
+  vpHomogeneousMatrix start_wMc;   ///< start pose of the camera in the world (simulated)
+  double sampling_time_s = 0.04;   ///< one velocity command / move poll, s, (0, 1]
+  SafetyOptions safety;            ///< velocity limits and workspace box
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// `servo:` the law and the loop's stop conditions.
+struct ServoLoopOptions {
+  ServoOptions law;
+  int max_iterations = 50;         ///< frames processed before iteration-limit, [1, 1e6]
+  double max_time_s = 60.0;        ///< wall time before time-limit, s, > 0
+  double max_pose_jump_m = 0.05;   ///< estimate vs odometry prediction, m, > 0
+  double max_pose_jump_deg = 5.0;  ///< ... and degrees, (0, 180]
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
 
 /// Everything a configuration file can set. A new section is a member here plus one row in
 /// config.cpp's section table.
 struct AppConfig {
   DetectorOptions detector;
   LineTarget target = FourLineTarget();  ///< the planar target (pose, render, `oalservo target`)
-  PoseOptions pose;  ///< `pose:`; its camera, lines_undistorted and image size stay as given
+  PoseOptions pose;        ///< `pose:`; its camera, lines_undistorted and image size stay as given
+  CameraConfig camera;     ///< `camera:`
+  RobotConfig robot;       ///< `robot:`
+  ServoLoopOptions servo;  ///< `servo:`
+  /// `goal: {cdMo: POSE}`: the target in the goal camera frame (default 0.5 m ahead).
+  vpHomogeneousMatrix goal_cdMo = vpHomogeneousMatrix(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);
+  /// `target_pose: POSE`: wMo, the target in the world frame.
+  vpHomogeneousMatrix target_wMo;
 };
+
+/// The servo command reads the same file: all sections live in AppConfig.
+using ServoAppConfig = AppConfig;
 
 /// Applies the YAML file at `path` to `base` and checks the result. Throws
 /// std::runtime_error "FILE:LINE: ..." for a missing or malformed file, an unknown section

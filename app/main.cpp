@@ -18,6 +18,7 @@
 #include "app/pose_accuracy_command.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"
+#include "app/servo_command.h"
 #include "app/target_command.h"
 
 #ifndef OAL_VERSION
@@ -35,6 +36,8 @@ constexpr oal::Command kCommands[] = {
     {"pose-accuracy", &oal::RunPoseAccuracy,
      "accuracy of the camera pose from the four-line target on rendered frames"},
     {"pose", &oal::RunPose, "camera pose from the four-line target in every frame"},
+    {"servo", &oal::RunServoMain,
+     "visual servoing to a goal pose, camera in the loop (default: simulated robot)"},
     {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
     {"compare", &oal::RunCompare,
      "our detector, vpMeLine and OpenCV line detectors against ground truth"},
