@@ -165,6 +165,16 @@ void CheckAt(const Options& options, const std::string& file, const std::string&
   }
 }
 
+// A section that is exactly one Options struct: its fields, then its Check() reported at
+// the line of the field it names.
+template <typename Options>
+void ReadCheckedSection(const YAML::Node& section, const std::string& file, const char* name,
+                        const std::vector<Field<Options>>& fields, Options* options) {
+  Lines lines;
+  ReadFields(section, file, name, fields, "", options, &lines);
+  CheckAt(*options, file, name, lines);
+}
+
 const std::vector<Field<DetectorOptions>>& DetectorFields() {
   using O = DetectorOptions;
   static const std::vector<Field<O>> fields = {
@@ -415,9 +425,7 @@ const std::vector<Field<PoseOptions>>& PoseFields() {
 }
 
 void ReadPoseSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
-  Lines lines;
-  ReadFields(section, file, "pose", PoseFields(), "", &config->pose, &lines);
-  CheckAt(config->pose, file, "pose", lines);
+  ReadCheckedSection(section, file, "pose", PoseFields(), &config->pose);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -489,9 +497,7 @@ const std::vector<Field<CameraConfig>>& CameraFields() {
 }
 
 void ReadCameraSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
-  Lines lines;
-  ReadFields(section, file, "camera", CameraFields(), "", &config->camera, &lines);
-  CheckAt(config->camera, file, "camera", lines);
+  ReadCheckedSection(section, file, "camera", CameraFields(), &config->camera);
 }
 
 template <typename T>
@@ -529,9 +535,7 @@ const std::vector<Field<RobotConfig>>& RobotFields() {
 }
 
 void ReadRobotSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
-  Lines lines;
-  ReadFields(section, file, "robot", RobotFields(), "", &config->robot, &lines);
-  CheckAt(config->robot, file, "robot", lines);
+  ReadCheckedSection(section, file, "robot", RobotFields(), &config->robot);
 }
 
 Field<ServoLoopOptions> LawDouble(const char* key, double ServoOptions::*member) {
@@ -566,9 +570,7 @@ const std::vector<Field<ServoLoopOptions>>& ServoFields() {
 }
 
 void ReadServoSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
-  Lines lines;
-  ReadFields(section, file, "servo", ServoFields(), "", &config->servo, &lines);
-  CheckAt(config->servo, file, "servo", lines);
+  ReadCheckedSection(section, file, "servo", ServoFields(), &config->servo);
 }
 
 void ReadGoalSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
