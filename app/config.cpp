@@ -487,11 +487,12 @@ Field<Options> PoseField(const char* key, vpHomogeneousMatrix Options::*member) 
 const std::vector<Field<CameraConfig>>& CameraFields() {
   using O = CameraConfig;
   static const std::vector<Field<O>> fields = {
-      DoubleField("px", &O::px),      DoubleField("py", &O::py),
-      DoubleField("u0", &O::u0),      DoubleField("v0", &O::v0),
-      DoubleField("kdu", &O::kdu),    IntField("width", &O::width),
-      IntField("height", &O::height), DoubleField("noise", &O::noise),
-      DoubleField("blur", &O::blur),  PoseField("eMc", &O::eMc),
+      DoubleField("px", &O::px),       DoubleField("py", &O::py),
+      DoubleField("u0", &O::u0),       DoubleField("v0", &O::v0),
+      DoubleField("kdu", &O::kdu),     BoolField("correct_distortion", &O::correct_distortion),
+      IntField("width", &O::width),    IntField("height", &O::height),
+      DoubleField("noise", &O::noise), DoubleField("blur", &O::blur),
+      PoseField("eMc", &O::eMc),
   };
   return fields;
 }

@@ -56,6 +56,9 @@ struct CameraConfig {
   double px = 600.0, py = 600.0;  ///< focal lengths, pixels, > 0
   double u0 = 319.5, v0 = 239.5;  ///< principal point, pixels, finite
   double kdu = 0.0;               ///< ViSP's distorted -> undistorted coefficient; 0: none
+  /// Undistort the feature points with kdu (detector) and use it in the pose; false ignores
+  /// the lens in both (the paper's condition: its lines stay curved).
+  bool correct_distortion = true;
   int width = 640, height = 480;  ///< image size, pixels, [16, 8192]
   double noise = 0.0;             ///< Gaussian noise of the rendering, grey levels, [0, 100]
   double blur = 0.0;              ///< Gaussian blur of the rendering, pixels, [0, 20]

@@ -134,9 +134,15 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   render.noise_sigma = config.camera.noise;
   render.blur_sigma_px = config.camera.blur;
   const SceneRenderer renderer(config.target, render);
-  OalDetector detector(config.detector, camera);
+  // What the detector and the pose believe about the lens: the true one, or (the paper's
+  // condition) a pinhole camera with the same intrinsics.
+  const vpCameraParameters model = config.camera.correct_distortion
+                                       ? camera
+                                       : vpCameraParameters(config.camera.px, config.camera.py,
+                                                            config.camera.u0, config.camera.v0);
+  OalDetector detector(config.detector, model);
   PoseOptions pose_options = config.pose;
-  pose_options.camera = camera;
+  pose_options.camera = model;
   pose_options.lines_undistorted = detector.Undistorts();
   pose_options.image_width = config.camera.width;
   pose_options.image_height = config.camera.height;

@@ -149,6 +149,30 @@ TEST(ServoLoop, Table3ConvergesWithin10IterationsWithDelta08) {
   EXPECT_TRUE(report.robot_stopped);
 }
 
+// Through a cheap wide lens with noise: corrected on the feature points the loop converges
+// as on a perfect camera; uncorrected (the paper's condition) it never reaches the goal and
+// the loop stops itself, with the robot stopped, rather than servo on a flipping pose.
+TEST(ServoLoop, Table3WithDistortionCorrectedConverges) {
+  const ServoAppConfig config = LoadConfig(SourcePath("config/table3-sim-distorted.yaml"));
+  ASSERT_TRUE(config.camera.correct_distortion);
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  EXPECT_LE(report.moves, 10);
+  EXPECT_LE(report.iterations.back().true_translation_error_mm, kTolTranslationMm);
+  EXPECT_LE(report.iterations.back().true_rotation_error_deg, kTolRotationDeg);
+}
+
+TEST(ServoLoop, Table3WithDistortionUncorrectedDoesNotConvergeAndStops) {
+  const ServoAppConfig config = LoadConfig(SourcePath("config/table3-sim-paper.yaml"));
+  ASSERT_FALSE(config.camera.correct_distortion);
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_NE(report.status, ServoRunStatus::kConverged);
+  EXPECT_TRUE(report.robot_stopped);
+  EXPECT_FALSE(report.message.empty());
+}
+
 TEST(ServoLoop, TargetOutOfViewStopsWithTargetLost) {
   ServoAppConfig config = Small(DefaultServoConfig());
   // Looking up, away from the table.
