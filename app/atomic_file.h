@@ -40,6 +40,20 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// Runs `write(stream, interactive)` on `target` written atomically (the file appears only
+/// if `write` returns), or on `console` with interactive = true when `target` is empty, so
+/// that a caller can flush each record for a live reader.
+template <typename Write>
+void WriteToFileOrConsole(const std::string& target, std::ostream& console, Write write) {
+  if (target.empty()) {
+    write(console, true);
+    return;
+  }
+  AtomicFile file(target);  // removed on any exception in `write`
+  write(file.stream(), false);
+  file.Commit();
+}
+
 /// Throws std::invalid_argument when `target` cannot be an output file: its directory does
 /// not exist, or it is itself a directory. Call before any work, so nothing is half done.
 void CheckOutputFile(const std::filesystem::path& target);

@@ -183,4 +183,15 @@ void SaveCameraFile(const std::string& path, const vpCameraParameters& camera,
                            (error ? ": " + error.message() : std::string()));
 }
 
+std::optional<std::string> CameraSizeMismatch(const CameraFile& camera, int width, int height,
+                                              const std::string& source) {
+  if (camera.width == 0 || camera.height == 0) return std::nullopt;
+  if (static_cast<int>(camera.width) == width && static_cast<int>(camera.height) == height) {
+    return std::nullopt;
+  }
+  return "camera '" + camera.name + "' is calibrated for " + std::to_string(camera.width) + "x" +
+         std::to_string(camera.height) + " but '" + source + "' is " + std::to_string(width) + "x" +
+         std::to_string(height);
+}
+
 }  // namespace oal

@@ -10,6 +10,7 @@
 
 #include <visp3/core/vpCameraParameters.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,11 @@ struct CameraFile {
   unsigned int width = 0;   ///< <image_width>, 0 if absent
   unsigned int height = 0;  ///< <image_height>, 0 if absent
 };
+
+/// A warning when `camera` was calibrated for another image size than width x height of the
+/// frame `source`; nothing when the sizes agree or the file gives none.
+std::optional<std::string> CameraSizeMismatch(const CameraFile& camera, int width, int height,
+                                              const std::string& source);
 
 /// Reads camera `camera_name` from `path`, or the first camera of the file when the name is
 /// empty. The model perspectiveProjWithDistortion is used when the camera has one, else

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include "app/atomic_file.h"
+
 namespace oal {
 
 std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv) {
@@ -30,6 +32,17 @@ std::function<void(int, int)> TerminalFrameProgress() {
     std::cerr << "\rframe " << done << " / " << total << std::flush;
     if (done == total) std::cerr << '\n';
   };
+}
+
+void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
+                       int max_frames, const std::string& out_path) {
+  const std::string name = options_name;
+  if (inputs.empty()) throw std::invalid_argument(name + "::inputs is empty");
+  if (max_frames < 0) {
+    throw std::invalid_argument(name + "::max_frames = " + std::to_string(max_frames) +
+                                ". Violated constraint: max_frames >= 0");
+  }
+  if (!out_path.empty()) CheckOutputFile(out_path);
 }
 
 void Warn(const std::string& command, const std::string& message) {

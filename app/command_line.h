@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -41,6 +42,11 @@ std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv);
 /// "frame N / total" on stderr, redrawn in place every 20 frames, when stderr is a
 /// terminal; nothing otherwise (logs stay clean).
 std::function<void(int done, int total)> TerminalFrameProgress();
+
+/// The checks every command over image sources shares: at least one input, max_frames >= 0
+/// and a writable --out. Throws std::invalid_argument naming `options_name`'s field.
+void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
+                       int max_frames, const std::string& out_path);
 
 /// A warning for the user on stderr: "oalservo <command>: warning: <message>". Libraries
 /// never print; commands report through this.

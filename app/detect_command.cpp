@@ -54,19 +54,6 @@ std::optional<CameraFile> LoadCamera(const DetectCommandOptions& options) {
   return LoadCameraFile(options.camera_path, options.camera_name);
 }
 
-void CheckCameraSize(const DetectRun& run, const Frame& frame, DetectSummary* summary) {
-  const CameraFile& camera = *run.camera;
-  if (camera.width == 0 || camera.height == 0) return;
-  if (static_cast<int>(camera.width) == frame.gray.cols &&
-      static_cast<int>(camera.height) == frame.gray.rows) {
-    return;
-  }
-  summary->warnings.push_back("camera '" + camera.name + "' is calibrated for " +
-                              std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                              " but '" + frame.source + "' is " + std::to_string(frame.gray.cols) +
-                              "x" + std::to_string(frame.gray.rows));
-}
-
 Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,
                const std::vector<DetectedLine>& lines) {
   Json json_lines = Json::array();
@@ -89,14 +76,18 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
   for (auto& source : run->sources) {
     while (options.max_frames == 0 || summary->frames < options.max_frames) {
       if (!source->Next(&frame)) break;
-      if (summary->frames == 0 && run->camera) CheckCameraSize(*run, frame, summary);
+      if (summary->frames == 0 && run->camera) {
+        if (auto warning =
+                CameraSizeMismatch(*run->camera, frame.gray.cols, frame.gray.rows, frame.source)) {
+          summary->warnings.push_back(*warning);
+        }
+      }
       const auto start = std::chrono::steady_clock::now();
       const std::vector<DetectedLine>& lines = run->detector.Detect(frame.view());
       const auto stop = std::chrono::steady_clock::now();
       const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
-      sink << FrameJson(summary->frames, frame, time_us, undistorted, lines).dump() << '\n';
-      if (flush_each) sink.flush();
-      if (!sink) throw std::runtime_error("cannot write the output");
+      WriteJsonLine(sink, FrameJson(summary->frames, frame, time_us, undistorted, lines),
+                    flush_each);
       if (!options.annotate_dir.empty()) {
         WritePng(fs::path(options.annotate_dir) / AnnotationName(summary->frames),
                  AnnotateLines(frame.gray, lines, run->undistorted_by));
@@ -110,12 +101,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
 }  // namespace
 
 void DetectCommandOptions::Check() const {
-  if (inputs.empty()) throw std::invalid_argument("DetectCommandOptions::inputs is empty");
-  if (max_frames < 0) {
-    throw std::invalid_argument("DetectCommandOptions::max_frames = " + std::to_string(max_frames) +
-                                ". Violated constraint: max_frames >= 0");
-  }
-  if (!out_path.empty()) CheckOutputFile(out_path);
+  CheckFrameCommand("DetectCommandOptions", inputs, max_frames, out_path);
 }
 
 DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& out) {
@@ -128,13 +114,9 @@ DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& ou
     run.sources.push_back(OpenImageSource(input, &summary.warnings));
   }
   if (!options.annotate_dir.empty()) fs::create_directories(options.annotate_dir);
-  if (options.out_path.empty()) {
-    ProcessFrames(options, &run, out, true, &summary);
-    return summary;
-  }
-  AtomicFile file(options.out_path);  // removed on any exception below
-  ProcessFrames(options, &run, file.stream(), false, &summary);
-  file.Commit();
+  WriteToFileOrConsole(options.out_path, out, [&](std::ostream& sink, bool flush_each) {
+    ProcessFrames(options, &run, sink, flush_each, &summary);
+  });
   return summary;
 }
 

@@ -3,6 +3,8 @@
 #include <visp3/core/vpThetaUVector.h>
 #include <visp3/core/vpTranslationVector.h>
 
+#include <stdexcept>
+
 namespace oal {
 
 Json PointJson(const Point2d& point) {
@@ -57,6 +59,12 @@ Json CameraJson(const vpCameraParameters& camera, int width, int height) {
       {"kdu", distortion ? camera.get_kdu() : 0.0},
       {"width", width},
       {"height", height}};
+}
+
+void WriteJsonLine(std::ostream& sink, const Json& record, bool flush) {
+  sink << record.dump() << '\n';
+  if (flush) sink.flush();
+  if (!sink) throw std::runtime_error("cannot write the output");
 }
 
 }  // namespace oal

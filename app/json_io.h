@@ -6,6 +6,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <nlohmann/json.hpp>
+#include <ostream>
 
 #include "detector/detector.h"
 #include "scene/scene.h"
@@ -27,5 +28,9 @@ Json TruthLineJson(const TruthLine& line);
 Json PoseJson(const vpHomogeneousMatrix& cMo);
 /// {model, px, py, u0, v0, kud, kdu, width, height}
 Json CameraJson(const vpCameraParameters& camera, int width, int height);
+
+/// Writes `record` as one line of JSON Lines; flushes when asked; throws
+/// std::runtime_error if the stream failed (disk full, closed pipe).
+void WriteJsonLine(std::ostream& sink, const Json& record, bool flush);
 
 }  // namespace oal

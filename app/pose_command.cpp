@@ -70,18 +70,6 @@ AppConfig LoadPoseConfig(const PoseCommandOptions& options) {
   return config;
 }
 
-void CheckCameraSize(const CameraFile& camera, const Frame& frame, PoseSummary* summary) {
-  if (camera.width == 0 || camera.height == 0) return;
-  if (static_cast<int>(camera.width) == frame.gray.cols &&
-      static_cast<int>(camera.height) == frame.gray.rows) {
-    return;
-  }
-  summary->warnings.push_back("camera '" + camera.name + "' is calibrated for " +
-                              std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                              " but '" + frame.source + "' is " + std::to_string(frame.gray.cols) +
-                              "x" + std::to_string(frame.gray.rows) + ": the poses will be wrong");
-}
-
 Json Vector3(double x, double y, double z) {
   return Json::array({x, y, z});
 }
@@ -227,7 +215,12 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
     std::optional<vpHomogeneousMatrix> previous_cMo;  // a sequence is one source
     while (options.max_frames == 0 || summary->frames < options.max_frames) {
       if (!source->Next(&frame)) break;
-      if (summary->frames == 0) CheckCameraSize(run->camera, frame, summary);
+      if (summary->frames == 0) {
+        if (auto warning =
+                CameraSizeMismatch(run->camera, frame.gray.cols, frame.gray.rows, frame.source)) {
+          summary->warnings.push_back(*warning + ": the poses will be wrong");
+        }
+      }
       pose_options.image_width = frame.gray.cols;
       pose_options.image_height = frame.gray.rows;
       const auto start = std::chrono::steady_clock::now();
@@ -237,10 +230,8 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
       const auto stop = std::chrono::steady_clock::now();
       const double detect_us = std::chrono::duration<double, std::micro>(detected - start).count();
       const double pose_us = std::chrono::duration<double, std::micro>(stop - detected).count();
-      sink << FrameJson(summary->frames, frame, undistorted, pose, detect_us, pose_us).dump()
-           << '\n';
-      if (flush_each) sink.flush();
-      if (!sink) throw std::runtime_error("cannot write the output");
+      WriteJsonLine(sink, FrameJson(summary->frames, frame, undistorted, pose, detect_us, pose_us),
+                    flush_each);
       if (!options.annotate_dir.empty()) {
         WritePng(fs::path(options.annotate_dir) / AnnotationName(summary->frames),
                  AnnotatePose(frame, lines, pose, run->camera.camera, run->undistorted_by));
@@ -259,12 +250,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
 }  // namespace
 
 void PoseCommandOptions::Check() const {
-  if (inputs.empty()) throw std::invalid_argument("PoseCommandOptions::inputs is empty");
-  if (max_frames < 0) {
-    throw std::invalid_argument("PoseCommandOptions::max_frames = " + std::to_string(max_frames) +
-                                ". Violated constraint: max_frames >= 0");
-  }
-  if (!out_path.empty()) CheckOutputFile(out_path);
+  CheckFrameCommand("PoseCommandOptions", inputs, max_frames, out_path);
 }
 
 PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) {
@@ -287,13 +273,9 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
     run.sources.push_back(OpenImageSource(input, &summary.warnings));
   }
   if (!options.annotate_dir.empty()) fs::create_directories(options.annotate_dir);
-  if (options.out_path.empty()) {
-    ProcessFrames(options, &run, out, true, &summary);
-    return summary;
-  }
-  AtomicFile file(options.out_path);  // removed on any exception below
-  ProcessFrames(options, &run, file.stream(), false, &summary);
-  file.Commit();
+  WriteToFileOrConsole(options.out_path, out, [&](std::ostream& sink, bool flush_each) {
+    ProcessFrames(options, &run, sink, flush_each, &summary);
+  });
   return summary;
 }
 
