@@ -692,8 +692,7 @@ std::string Num(double value) {
 vpCameraParameters CameraConfig::Camera() const {
   vpCameraParameters camera;
   if (kdu != 0.0) {
-    camera.initPersProjWithDistortion(px, py, u0, v0, -kdu, kdu);  // kud refined by FitKud
-    camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
+    camera = CameraWithKdu(px, py, u0, v0, kdu, width, height);
   } else {
     camera.initPersProjWithoutDistortion(px, py, u0, v0);
   }

@@ -122,12 +122,9 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
   RenderOptions render;
   render.width = options.width;
   render.height = options.height;
-  render.camera.initPersProjWithDistortion(options.focal_px, options.focal_px,
-                                           0.5 * (options.width - 1), 0.5 * (options.height - 1),
-                                           0.0, options.kdu);
-  render.camera.initPersProjWithDistortion(
-      options.focal_px, options.focal_px, 0.5 * (options.width - 1), 0.5 * (options.height - 1),
-      FitKud(render.camera, options.width, options.height), options.kdu);
+  render.camera =
+      CameraWithKdu(options.focal_px, options.focal_px, 0.5 * (options.width - 1),
+                    0.5 * (options.height - 1), options.kdu, options.width, options.height);
   render.noise_sigma = options.noise_sigma;
   render.blur_sigma_px = options.blur_sigma_px;
   render.illumination_gradient = options.illumination_gradient;

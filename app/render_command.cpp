@@ -182,12 +182,7 @@ void RenderCommandOptions::Check() const {
 }
 
 vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu) {
-  const double u0 = 0.5 * (width - 1), v0 = 0.5 * (height - 1);
-  vpCameraParameters camera;
-  camera.initPersProjWithDistortion(fx_px, fx_px, u0, v0, 0.0, kdu);
-  const double kud = kdu == 0.0 ? 0.0 : FitKud(camera, width, height);
-  camera.initPersProjWithDistortion(fx_px, fx_px, u0, v0, kud, kdu);
-  return camera;
+  return CameraWithKdu(fx_px, fx_px, 0.5 * (width - 1), 0.5 * (height - 1), kdu, width, height);
 }
 
 int RenderDataset(const RenderCommandOptions& options) {

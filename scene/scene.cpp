@@ -861,6 +861,14 @@ double FitKud(const vpCameraParameters& camera, int width, int height) {
   return saa > 0.0 ? sab / saa : 0.0;
 }
 
+vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
+                                 int height) {
+  vpCameraParameters camera;
+  camera.initPersProjWithDistortion(px, py, u0, v0, 0.0, kdu);
+  camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
+  return camera;
+}
+
 vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling& sampling,
                                std::uint64_t* state) {
   sampling.Check();

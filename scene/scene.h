@@ -167,6 +167,11 @@ Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y);
 /// camera file written with both is consistent in ViSP's two directions.
 double FitKud(const vpCameraParameters& camera, int width, int height);
 
+/// A camera with ViSP's distortion model: `kdu` and the kud that best inverts it over a
+/// width x height image (FitKud), as a calibration gives both (kud = 0 when kdu = 0).
+vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
+                                 int height);
+
 /// Random camera poses looking at the target for data sets and tests.
 /// The optical axis meets the board at a point drawn uniformly in a disc of radius
 /// max_offset_m; the camera centre lies on the front side (object z < 0) at a distance drawn

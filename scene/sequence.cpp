@@ -163,12 +163,8 @@ RenderOptions BaseOptions(double kdu) {
   RenderOptions options;
   options.width = kWidth;
   options.height = kHeight;
-  const double u0 = 0.5 * (kWidth - 1), v0 = 0.5 * (kHeight - 1);
-  options.camera.initPersProjWithDistortion(kFocalPx, kFocalPx, u0, v0, 0.0, kdu);
-  if (kdu != 0.0) {
-    options.camera.initPersProjWithDistortion(kFocalPx, kFocalPx, u0, v0,
-                                              FitKud(options.camera, kWidth, kHeight), kdu);
-  }
+  options.camera = CameraWithKdu(kFocalPx, kFocalPx, 0.5 * (kWidth - 1), 0.5 * (kHeight - 1), kdu,
+                                 kWidth, kHeight);
   options.noise_sigma = kNoiseSigma;
   options.blur_sigma_px = kBlurSigmaPx;
   return options;
