@@ -36,12 +36,7 @@ std::string RenderSmall(const test::TestDir& dir, int count, double kdu) {
   return render.out_dir;
 }
 
-std::vector<json> ParseJsonLines(const std::string& text) {
-  std::vector<json> frames;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) frames.push_back(json::parse(line));
-  return frames;
-}
+using test::ParseJsonLines;
 
 void ExpectWellFormedFrame(const json& frame, int index, int width, int height,
                            const std::string& coordinates) {

@@ -43,12 +43,7 @@ std::string RenderSmall(const test::TestDir& dir, const std::string& name, int c
   return render.out_dir;
 }
 
-std::vector<json> ParseJsonLines(const std::string& text) {
-  std::vector<json> frames;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) frames.push_back(json::parse(line));
-  return frames;
-}
+using test::ParseJsonLines;
 
 std::string FrameFile(const std::string& dir, int index, const char* extension) {
   std::string number = std::to_string(index);

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -73,6 +75,14 @@ inline std::vector<std::string> TempFilesIn(const fs::path& dir) {
     if (name.find(".tmp-") != std::string::npos) found.push_back(name);
   }
   return found;
+}
+
+/// One JSON value per line of `text` (JSON Lines).
+inline std::vector<nlohmann::json> ParseJsonLines(const std::string& text) {
+  std::vector<nlohmann::json> records;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) records.push_back(nlohmann::json::parse(line));
+  return records;
 }
 
 }  // namespace oal::test
