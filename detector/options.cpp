@@ -8,11 +8,7 @@ namespace {
 
 template <typename T>
 void Require(bool ok, const char* field, T value, const char* constraint) {
-  if (ok) return;
-  std::ostringstream message;
-  message << "DetectorOptions::" << field << " = " << value
-          << ". Violated constraint: " << constraint;
-  throw std::invalid_argument(message.str());
+  RequireOption(ok, std::string("DetectorOptions::") + field, value, constraint);
 }
 
 }  // namespace

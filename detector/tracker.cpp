@@ -39,11 +39,7 @@ const char* ToString(TrackStatus status) {
 void TrackerOptions::Check() const {
   detector.Check();
   auto require = [](bool ok, const std::string& field, double value, const char* constraint) {
-    if (ok) return;
-    std::ostringstream message;
-    message << "TrackerOptions::" << field << " = " << value
-            << ". Violated constraint: " << constraint;
-    throw std::invalid_argument(message.str());
+    RequireOption(ok, "TrackerOptions::" + field, value, constraint);
   };
   require(max_tracks >= 1 && max_tracks <= 64, "max_tracks", max_tracks, "1 <= max_tracks <= 64");
   require(gate_angle_deg > 0 && gate_angle_deg <= 90, "gate_angle_deg", gate_angle_deg,

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "detector/options.h"
 #include "scene/geometry.h"
 
 namespace oal {
@@ -30,14 +31,6 @@ constexpr double kBackgroundTexelM = 0.002;
 // Samples of a target line used to find its visible part, and to fit its distorted image.
 constexpr int kVisibilitySamples = 1000;
 constexpr int kFitSamples = 400;
-
-template <typename T>
-void Require(bool ok, const std::string& field, T value, const std::string& constraint) {
-  if (ok) return;
-  std::ostringstream message;
-  message << field << " = " << value << ". Violated constraint: " << constraint;
-  throw std::invalid_argument(message.str());
-}
 
 bool InRange(double value, double lo, double hi) {
   return value >= lo && value <= hi;
@@ -598,12 +591,14 @@ bool LongEnough(const std::vector<TruthLine>& truth, double min_length_px) {
 // Targets.
 
 void LineTarget::Check() const {
-  Require(board_width_m > 0.0, "LineTarget::board_width_m", board_width_m, "board_width_m > 0");
-  Require(board_height_m > 0.0, "LineTarget::board_height_m", board_height_m, "board_height_m > 0");
-  Require(board_grey >= 0 && board_grey <= 255, "LineTarget::board_grey", board_grey,
-          "0 <= board_grey <= 255");
-  Require(line_grey >= 0 && line_grey <= 255, "LineTarget::line_grey", line_grey,
-          "0 <= line_grey <= 255");
+  RequireOption(board_width_m > 0.0, "LineTarget::board_width_m", board_width_m,
+                "board_width_m > 0");
+  RequireOption(board_height_m > 0.0, "LineTarget::board_height_m", board_height_m,
+                "board_height_m > 0");
+  RequireOption(board_grey >= 0 && board_grey <= 255, "LineTarget::board_grey", board_grey,
+                "0 <= board_grey <= 255");
+  RequireOption(line_grey >= 0 && line_grey <= 255, "LineTarget::line_grey", line_grey,
+                "0 <= line_grey <= 255");
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const TargetLine& line = lines[i];
     const std::string prefix = "LineTarget::lines[" + std::to_string(i) + "].";
@@ -611,11 +606,11 @@ void LineTarget::Check() const {
                                        {"y1_m", line.y1_m},
                                        {"x2_m", line.x2_m},
                                        {"y2_m", line.y2_m}}) {
-      Require(std::isfinite(value), prefix + field, value, std::string(field) + " is finite");
+      RequireOption(std::isfinite(value), prefix + field, value, std::string(field) + " is finite");
     }
-    Require(line.width_m > 0.0, prefix + "width_m", line.width_m, "width_m > 0");
+    RequireOption(line.width_m > 0.0, prefix + "width_m", line.width_m, "width_m > 0");
     const double length = std::hypot(line.x2_m - line.x1_m, line.y2_m - line.y1_m);
-    Require(length > 0.0, prefix + "length", length, "the two ends differ");
+    RequireOption(length > 0.0, prefix + "length", length, "the two ends differ");
   }
 }
 
@@ -648,42 +643,42 @@ LineTarget TargetByName(const std::string& name) {
 // Options.
 
 void RenderOptions::Check() const {
-  Require(InRange(width, 16, 8192), "RenderOptions::width", width, "16 <= width <= 8192");
-  Require(InRange(height, 16, 8192), "RenderOptions::height", height, "16 <= height <= 8192");
+  RequireOption(InRange(width, 16, 8192), "RenderOptions::width", width, "16 <= width <= 8192");
+  RequireOption(InRange(height, 16, 8192), "RenderOptions::height", height, "16 <= height <= 8192");
   const auto model = camera.get_projModel();
-  Require(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
-              model == vpCameraParameters::perspectiveProjWithDistortion,
-          "RenderOptions::camera.projModel", static_cast<int>(model),
-          "perspective projection with or without (kdu) distortion");
-  Require(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), "RenderOptions::camera.px",
-          camera.get_px(), "px > 0");
-  Require(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), "RenderOptions::camera.py",
-          camera.get_py(), "py > 0");
-  Require(std::isfinite(camera.get_u0()), "RenderOptions::camera.u0", camera.get_u0(),
-          "u0 is finite");
-  Require(std::isfinite(camera.get_v0()), "RenderOptions::camera.v0", camera.get_v0(),
-          "v0 is finite");
+  RequireOption(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
+                    model == vpCameraParameters::perspectiveProjWithDistortion,
+                "RenderOptions::camera.projModel", static_cast<int>(model),
+                "perspective projection with or without (kdu) distortion");
+  RequireOption(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), "RenderOptions::camera.px",
+                camera.get_px(), "px > 0");
+  RequireOption(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), "RenderOptions::camera.py",
+                camera.get_py(), "py > 0");
+  RequireOption(std::isfinite(camera.get_u0()), "RenderOptions::camera.u0", camera.get_u0(),
+                "u0 is finite");
+  RequireOption(std::isfinite(camera.get_v0()), "RenderOptions::camera.v0", camera.get_v0(),
+                "v0 is finite");
   // The pixel -> ray map must not fold over inside the image: 1 + 3 kdu r^2 > 0 at the
   // farthest corner (the radial derivative of r (1 + kdu r^2)).
   const double du = std::max(std::fabs(camera.get_u0()), std::fabs(width - 1 - camera.get_u0()));
   const double dv = std::max(std::fabs(camera.get_v0()), std::fabs(height - 1 - camera.get_v0()));
   const double r2 =
       du * du / (camera.get_px() * camera.get_px()) + dv * dv / (camera.get_py() * camera.get_py());
-  Require(std::isfinite(Kdu(camera)) && 1.0 + 3.0 * Kdu(camera) * r2 > 0.0,
-          "RenderOptions::camera.kdu", Kdu(camera),
-          "1 + 3 kdu r^2 > 0 at the image corners (the lens model is invertible)");
-  Require(InRange(noise_sigma, 0.0, 100.0), "RenderOptions::noise_sigma", noise_sigma,
-          "0 <= noise_sigma <= 100");
-  Require(InRange(blur_sigma_px, 0.0, 20.0), "RenderOptions::blur_sigma_px", blur_sigma_px,
-          "0 <= blur_sigma_px <= 20");
-  Require(InRange(illumination_gradient, 0.0, 0.9), "RenderOptions::illumination_gradient",
-          illumination_gradient, "0 <= illumination_gradient <= 0.9");
-  Require(std::isfinite(gradient_angle_rad), "RenderOptions::gradient_angle_rad",
-          gradient_angle_rad, "gradient_angle_rad is finite");
-  Require(InRange(background_grey, 0, 255), "RenderOptions::background_grey", background_grey,
-          "0 <= background_grey <= 255");
-  Require(InRange(supersample, 1, 8), "RenderOptions::supersample", supersample,
-          "1 <= supersample <= 8");
+  RequireOption(std::isfinite(Kdu(camera)) && 1.0 + 3.0 * Kdu(camera) * r2 > 0.0,
+                "RenderOptions::camera.kdu", Kdu(camera),
+                "1 + 3 kdu r^2 > 0 at the image corners (the lens model is invertible)");
+  RequireOption(InRange(noise_sigma, 0.0, 100.0), "RenderOptions::noise_sigma", noise_sigma,
+                "0 <= noise_sigma <= 100");
+  RequireOption(InRange(blur_sigma_px, 0.0, 20.0), "RenderOptions::blur_sigma_px", blur_sigma_px,
+                "0 <= blur_sigma_px <= 20");
+  RequireOption(InRange(illumination_gradient, 0.0, 0.9), "RenderOptions::illumination_gradient",
+                illumination_gradient, "0 <= illumination_gradient <= 0.9");
+  RequireOption(std::isfinite(gradient_angle_rad), "RenderOptions::gradient_angle_rad",
+                gradient_angle_rad, "gradient_angle_rad is finite");
+  RequireOption(InRange(background_grey, 0, 255), "RenderOptions::background_grey", background_grey,
+                "0 <= background_grey <= 255");
+  RequireOption(InRange(supersample, 1, 8), "RenderOptions::supersample", supersample,
+                "1 <= supersample <= 8");
 }
 
 bool Occluder::Contains(double u, double v) const {
@@ -695,37 +690,38 @@ bool Occluder::Contains(double u, double v) const {
 }
 
 void Occluder::Check() const {
-  Require(std::isfinite(centre_u_px), "Occluder::centre_u_px", centre_u_px,
-          "centre_u_px is finite");
-  Require(std::isfinite(centre_v_px), "Occluder::centre_v_px", centre_v_px,
-          "centre_v_px is finite");
-  Require(half_width_px > 0.0 && half_width_px < 1e6, "Occluder::half_width_px", half_width_px,
-          "0 < half_width_px < 1e6");
+  RequireOption(std::isfinite(centre_u_px), "Occluder::centre_u_px", centre_u_px,
+                "centre_u_px is finite");
+  RequireOption(std::isfinite(centre_v_px), "Occluder::centre_v_px", centre_v_px,
+                "centre_v_px is finite");
+  RequireOption(half_width_px > 0.0 && half_width_px < 1e6, "Occluder::half_width_px",
+                half_width_px, "0 < half_width_px < 1e6");
   if (shape == Shape::kRectangle) {
-    Require(half_height_px > 0.0 && half_height_px < 1e6, "Occluder::half_height_px",
-            half_height_px, "0 < half_height_px < 1e6");
+    RequireOption(half_height_px > 0.0 && half_height_px < 1e6, "Occluder::half_height_px",
+                  half_height_px, "0 < half_height_px < 1e6");
   }
-  Require(InRange(grey, 0, 255), "Occluder::grey", grey, "0 <= grey <= 255");
+  RequireOption(InRange(grey, 0, 255), "Occluder::grey", grey, "0 <= grey <= 255");
 }
 
 void FrameEffects::Check() const {
-  Require(InRange(gain, 0.0, 10.0), "FrameEffects::gain", gain, "0 <= gain <= 10");
-  Require(InRange(offset, -255.0, 255.0), "FrameEffects::offset", offset, "-255 <= offset <= 255");
+  RequireOption(InRange(gain, 0.0, 10.0), "FrameEffects::gain", gain, "0 <= gain <= 10");
+  RequireOption(InRange(offset, -255.0, 255.0), "FrameEffects::offset", offset,
+                "-255 <= offset <= 255");
   for (const Occluder& occluder : occluders) occluder.Check();
 }
 
 void PoseSampling::Check() const {
-  Require(min_distance_m > 0.0, "PoseSampling::min_distance_m", min_distance_m,
-          "min_distance_m > 0");
-  Require(max_distance_m >= min_distance_m && std::isfinite(max_distance_m),
-          "PoseSampling::max_distance_m", max_distance_m, "min_distance_m <= max_distance_m");
-  Require(InRange(max_tilt_deg, 0.0, 80.0), "PoseSampling::max_tilt_deg", max_tilt_deg,
-          "0 <= max_tilt_deg <= 80");
-  Require(max_offset_m >= 0.0 && std::isfinite(max_offset_m), "PoseSampling::max_offset_m",
-          max_offset_m, "max_offset_m >= 0");
-  Require(min_visible_length_px >= 0.0 && std::isfinite(min_visible_length_px),
-          "PoseSampling::min_visible_length_px", min_visible_length_px,
-          "min_visible_length_px >= 0");
+  RequireOption(min_distance_m > 0.0, "PoseSampling::min_distance_m", min_distance_m,
+                "min_distance_m > 0");
+  RequireOption(max_distance_m >= min_distance_m && std::isfinite(max_distance_m),
+                "PoseSampling::max_distance_m", max_distance_m, "min_distance_m <= max_distance_m");
+  RequireOption(InRange(max_tilt_deg, 0.0, 80.0), "PoseSampling::max_tilt_deg", max_tilt_deg,
+                "0 <= max_tilt_deg <= 80");
+  RequireOption(max_offset_m >= 0.0 && std::isfinite(max_offset_m), "PoseSampling::max_offset_m",
+                max_offset_m, "max_offset_m >= 0");
+  RequireOption(min_visible_length_px >= 0.0 && std::isfinite(min_visible_length_px),
+                "PoseSampling::min_visible_length_px", min_visible_length_px,
+                "min_visible_length_px >= 0");
 }
 
 // -------------------------------------------------------------------------------------------
@@ -740,8 +736,8 @@ SceneRenderer::SceneRenderer(LineTarget target, RenderOptions options)
     const bool exists = std::ifstream(options_.background_image).good();
     const cv::Mat grey =
         exists ? cv::imread(options_.background_image, cv::IMREAD_GRAYSCALE) : cv::Mat();
-    Require(!grey.empty(), "RenderOptions::background_image", "'" + options_.background_image + "'",
-            "a readable image file");
+    RequireOption(!grey.empty(), "RenderOptions::background_image",
+                  "'" + options_.background_image + "'", "a readable image file");
     background_.resize(static_cast<unsigned>(grey.rows), static_cast<unsigned>(grey.cols));
     for (int r = 0; r < grey.rows; ++r) {
       std::copy_n(grey.ptr<unsigned char>(r), grey.cols, background_[r]);

@@ -21,14 +21,6 @@ using pose_internal::Vec2;
 constexpr double kDegPerRad = 180.0 / kPi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-template <typename T>
-void Require(bool ok, const std::string& field, T value, const std::string& constraint) {
-  if (ok) return;
-  std::ostringstream message;
-  message << field << " = " << value << ". Violated constraint: " << constraint;
-  throw std::invalid_argument(message.str());
-}
-
 bool InRange(double value, double lo, double hi) {
   return value >= lo && value <= hi;
 }
@@ -453,52 +445,56 @@ std::string ToString(PoseMethod method) {
 
 void PoseOptions::Check() const {
   const auto model = camera.get_projModel();
-  Require(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
-              model == vpCameraParameters::perspectiveProjWithDistortion,
-          "PoseOptions::camera.projModel", static_cast<int>(model),
-          "perspective projection with or without (kdu) distortion");
-  Require(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), "PoseOptions::camera.px",
-          camera.get_px(), "px > 0");
-  Require(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), "PoseOptions::camera.py",
-          camera.get_py(), "py > 0");
-  Require(std::isfinite(camera.get_u0()) && std::isfinite(camera.get_v0()),
-          "PoseOptions::camera.u0", camera.get_u0(), "u0 and v0 are finite");
-  Require(max_candidate_lines >= 4 && max_candidate_lines <= 12, "PoseOptions::max_candidate_lines",
-          max_candidate_lines, "4 <= max_candidate_lines <= 12");
-  Require(min_group_angle_deg > 0.0 && min_group_angle_deg < 90.0,
-          "PoseOptions::min_group_angle_deg", min_group_angle_deg, "0 < min_group_angle_deg < 90");
-  Require(image_width >= 0 && image_width <= 100000, "PoseOptions::image_width", image_width,
-          "0 <= image_width <= 100000");
-  Require(image_height >= 0 && image_height <= 100000, "PoseOptions::image_height", image_height,
-          "0 <= image_height <= 100000");
-  Require((image_width == 0) == (image_height == 0), "PoseOptions::image_height", image_height,
-          "image_width and image_height both 0 (unknown) or both > 0");
-  Require(InRange(max_outside_px, 0.0, 1e6), "PoseOptions::max_outside_px", max_outside_px,
-          "0 <= max_outside_px <= 1e6");
-  Require(max_intersection_radius > 0.0 && max_intersection_radius <= 100.0,
-          "PoseOptions::max_intersection_radius", max_intersection_radius,
-          "0 < max_intersection_radius <= 100");
-  Require(InRange(min_side_px, 0.0, 1e6), "PoseOptions::min_side_px", min_side_px,
-          "0 <= min_side_px <= 1e6");
-  Require(ortho_sigma > 0.0 && ortho_sigma <= 10.0, "PoseOptions::ortho_sigma", ortho_sigma,
-          "0 < ortho_sigma <= 10");
-  Require(width_sigma > 0.0 && width_sigma <= 10.0, "PoseOptions::width_sigma", width_sigma,
-          "0 < width_sigma <= 10");
-  Require(max_identification_cost > 0.0 && max_identification_cost <= 1e9,
-          "PoseOptions::max_identification_cost", max_identification_cost,
-          "0 < max_identification_cost <= 1e9");
-  Require(InRange(min_identification_margin, 0.0, 1e9), "PoseOptions::min_identification_margin",
-          min_identification_margin, "0 <= min_identification_margin <= 1e9");
-  Require(max_residual_px > 0.0 && max_residual_px <= 1000.0, "PoseOptions::max_residual_px",
-          max_residual_px, "0 < max_residual_px <= 1000");
-  Require(InRange(previous_tolerance_px, 0.0, 1000.0), "PoseOptions::previous_tolerance_px",
-          previous_tolerance_px, "0 <= previous_tolerance_px <= 1000");
-  Require(min_depth_m > 0.0 && min_depth_m <= 1e3, "PoseOptions::min_depth_m", min_depth_m,
-          "0 < min_depth_m <= 1e3");
-  Require(InRange(dementhon_above_px, 0.0, 1000.0), "PoseOptions::dementhon_above_px",
-          dementhon_above_px, "0 <= dementhon_above_px <= 1000");
-  Require(vvs_max_iterations >= 1 && vvs_max_iterations <= 1000, "PoseOptions::vvs_max_iterations",
-          vvs_max_iterations, "1 <= vvs_max_iterations <= 1000");
+  RequireOption(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
+                    model == vpCameraParameters::perspectiveProjWithDistortion,
+                "PoseOptions::camera.projModel", static_cast<int>(model),
+                "perspective projection with or without (kdu) distortion");
+  RequireOption(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), "PoseOptions::camera.px",
+                camera.get_px(), "px > 0");
+  RequireOption(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), "PoseOptions::camera.py",
+                camera.get_py(), "py > 0");
+  RequireOption(std::isfinite(camera.get_u0()) && std::isfinite(camera.get_v0()),
+                "PoseOptions::camera.u0", camera.get_u0(), "u0 and v0 are finite");
+  RequireOption(max_candidate_lines >= 4 && max_candidate_lines <= 12,
+                "PoseOptions::max_candidate_lines", max_candidate_lines,
+                "4 <= max_candidate_lines <= 12");
+  RequireOption(min_group_angle_deg > 0.0 && min_group_angle_deg < 90.0,
+                "PoseOptions::min_group_angle_deg", min_group_angle_deg,
+                "0 < min_group_angle_deg < 90");
+  RequireOption(image_width >= 0 && image_width <= 100000, "PoseOptions::image_width", image_width,
+                "0 <= image_width <= 100000");
+  RequireOption(image_height >= 0 && image_height <= 100000, "PoseOptions::image_height",
+                image_height, "0 <= image_height <= 100000");
+  RequireOption((image_width == 0) == (image_height == 0), "PoseOptions::image_height",
+                image_height, "image_width and image_height both 0 (unknown) or both > 0");
+  RequireOption(InRange(max_outside_px, 0.0, 1e6), "PoseOptions::max_outside_px", max_outside_px,
+                "0 <= max_outside_px <= 1e6");
+  RequireOption(max_intersection_radius > 0.0 && max_intersection_radius <= 100.0,
+                "PoseOptions::max_intersection_radius", max_intersection_radius,
+                "0 < max_intersection_radius <= 100");
+  RequireOption(InRange(min_side_px, 0.0, 1e6), "PoseOptions::min_side_px", min_side_px,
+                "0 <= min_side_px <= 1e6");
+  RequireOption(ortho_sigma > 0.0 && ortho_sigma <= 10.0, "PoseOptions::ortho_sigma", ortho_sigma,
+                "0 < ortho_sigma <= 10");
+  RequireOption(width_sigma > 0.0 && width_sigma <= 10.0, "PoseOptions::width_sigma", width_sigma,
+                "0 < width_sigma <= 10");
+  RequireOption(max_identification_cost > 0.0 && max_identification_cost <= 1e9,
+                "PoseOptions::max_identification_cost", max_identification_cost,
+                "0 < max_identification_cost <= 1e9");
+  RequireOption(InRange(min_identification_margin, 0.0, 1e9),
+                "PoseOptions::min_identification_margin", min_identification_margin,
+                "0 <= min_identification_margin <= 1e9");
+  RequireOption(max_residual_px > 0.0 && max_residual_px <= 1000.0, "PoseOptions::max_residual_px",
+                max_residual_px, "0 < max_residual_px <= 1000");
+  RequireOption(InRange(previous_tolerance_px, 0.0, 1000.0), "PoseOptions::previous_tolerance_px",
+                previous_tolerance_px, "0 <= previous_tolerance_px <= 1000");
+  RequireOption(min_depth_m > 0.0 && min_depth_m <= 1e3, "PoseOptions::min_depth_m", min_depth_m,
+                "0 < min_depth_m <= 1e3");
+  RequireOption(InRange(dementhon_above_px, 0.0, 1000.0), "PoseOptions::dementhon_above_px",
+                dementhon_above_px, "0 <= dementhon_above_px <= 1000");
+  RequireOption(vvs_max_iterations >= 1 && vvs_max_iterations <= 1000,
+                "PoseOptions::vvs_max_iterations", vvs_max_iterations,
+                "1 <= vvs_max_iterations <= 1000");
 }
 
 PoseResult IdentifyTargetLines(const std::vector<DetectedLine>& lines, const LineTarget& target,
