@@ -419,6 +419,8 @@ const std::vector<Field<PoseOptions>>& PoseFields() {
       DoubleField("min_depth_m", &O::min_depth_m),
       BoolField("correct_stripe_centres", &O::correct_stripe_centres),
       DoubleField("dementhon_above_px", &O::dementhon_above_px),
+      DoubleField("previous_accept_px", &O::previous_accept_px),
+      BoolField("compute_covariance", &O::compute_covariance),
       IntField("vvs_max_iterations", &O::vvs_max_iterations),
   };
   return fields;

@@ -146,6 +146,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   pose_options.lines_undistorted = detector.Undistorts();
   pose_options.image_width = config.camera.width;
   pose_options.image_height = config.camera.height;
+  pose_options.compute_covariance = false;  // the loop does not use it
   pose_options.Check();
 
   SimulatedCameraOptions sim_options;

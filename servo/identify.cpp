@@ -439,6 +439,8 @@ std::string ToString(PoseMethod method) {
       return "dementhon";
     case PoseMethod::kLagrange:
       return "lagrange";
+    case PoseMethod::kPrevious:
+      return "previous";
   }
   return "unknown";
 }
@@ -492,6 +494,8 @@ void PoseOptions::Check() const {
                 "0 < min_depth_m <= 1e3");
   RequireOption(InRange(dementhon_above_px, 0.0, 1000.0), "PoseOptions::dementhon_above_px",
                 dementhon_above_px, "0 <= dementhon_above_px <= 1000");
+  RequireOption(InRange(previous_accept_px, 0.0, 1000.0), "PoseOptions::previous_accept_px",
+                previous_accept_px, "0 <= previous_accept_px <= 1000");
   RequireOption(vvs_max_iterations >= 1 && vvs_max_iterations <= 1000,
                 "PoseOptions::vvs_max_iterations", vvs_max_iterations,
                 "1 <= vvs_max_iterations <= 1000");

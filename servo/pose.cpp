@@ -131,6 +131,38 @@ bool StripeCentreShifts(const vpHomogeneousMatrix& cMo, const HashTarget& target
   return true;
 }
 
+// The four corners handed to vpPose: the measured intersections, moved by the stripe-centre
+// shifts seen from a pose when there is one (pose.h, correct_stripe_centres).
+struct Corners {
+  const std::array<Point2d, 4>& measured_px;
+  const std::array<bool, 4>& is_stripe;
+  const HashTarget& hash;
+  const PoseOptions& options;
+
+  void Set(const vpHomogeneousMatrix* seen_from, PoseResult* result, vpPose* pose) const {
+    const bool any_stripe = is_stripe[0] || is_stripe[1] || is_stripe[2] || is_stripe[3];
+    std::array<Point2d, 4> shift{};
+    if (seen_from == nullptr || !options.correct_stripe_centres || !any_stripe ||
+        !StripeCentreShifts(*seen_from, hash, options.camera, is_stripe, &shift)) {
+      shift = {};
+    }
+    pose->clearPoint();
+    for (int k = 0; k < 4; ++k) {
+      result->corners_px[k] = Point2d{measured_px[k].u + shift[k].u, measured_px[k].v + shift[k].v};
+      double x = 0.0, y = 0.0;
+      pose_internal::PixelToMetre(options.camera, options.lines_undistorted, result->corners_px[k],
+                                  &x, &y);
+      result->corners_m[k].resize(2, false);
+      result->corners_m[k][0] = x;
+      result->corners_m[k][1] = y;
+      vpPoint point(hash.corner[k].x, hash.corner[k].y, 0.0);
+      point.set_x(x);
+      point.set_y(y);
+      pose->addPoint(point);
+    }
+  }
+};
+
 PoseResult Fail(PoseResult result, const std::string& message) {
   result.status = PoseStatus::kDegenerate;
   result.message = message;
@@ -150,60 +182,68 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
   if (result.status != PoseStatus::kOk) return result;
 
   const vpCameraParameters& camera = options.camera;
+  const std::array<Point2d, 4> measured_px = result.corners_px;
+  std::array<bool, 4> is_stripe{};
+  for (int k = 0; k < 4; ++k) is_stripe[k] = lines[result.line_index[k]].width_px > 0.0;
+  const Corners corners{measured_px, is_stripe, hash, options};
   vpPose pose;
-  for (int k = 0; k < 4; ++k) {
-    double x = 0.0, y = 0.0;
-    pose_internal::PixelToMetre(camera, options.lines_undistorted, result.corners_px[k], &x, &y);
-    result.corners_m[k].resize(2, false);
-    result.corners_m[k][0] = x;
-    result.corners_m[k][1] = y;
-    vpPoint point(hash.corner[k].x, hash.corner[k].y, 0.0);
-    point.set_x(x);
-    point.set_y(y);
-    pose.addPoint(point);
+  pose.setVvsIterMax(options.vvs_max_iterations);
+  vpHomogeneousMatrix cMo;
+  double residual_px = HUGE_VAL;
+
+  // In a loop the previous pose is a good seed: its refinement alone is kept when it fits
+  // well (previous_accept_px), and the linear methods are skipped.
+  const bool have_previous = previous_cMo && IsFinite(*previous_cMo);
+  if (have_previous && options.previous_accept_px > 0.0) {
+    vpHomogeneousMatrix seeded = *previous_cMo;
+    corners.Set(&seeded, &result, &pose);
+    if (Compute(&pose, vpPose::VIRTUAL_VS, &seeded)) {
+      const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
+      if (seeded_px < options.previous_accept_px) {
+        cMo = seeded;
+        residual_px = seeded_px;
+        result.method = PoseMethod::kPrevious;
+        result.from_previous = true;
+      }
+    }
   }
 
-  // Steps 3-4: Dementhon and Lagrange, the lower residual refined by virtual visual servoing.
-  pose.setVvsIterMax(options.vvs_max_iterations);
-  // Lagrange first; Dementhon too unless Lagrange's residual is already below
-  // dementhon_above_px, where the refinement would end in the same minimum anyway.
-  vpHomogeneousMatrix by_dementhon, by_lagrange;
-  const bool lagrange_ok = Compute(&pose, vpPose::LAGRANGE, &by_lagrange);
-  const double lagrange_px =
-      lagrange_ok ? ResidualPx(by_lagrange, hash, result.corners_m, camera) : HUGE_VAL;
-  const bool run_dementhon = !(lagrange_px < options.dementhon_above_px);
-  const bool dementhon_ok = run_dementhon && Compute(&pose, vpPose::DEMENTHON, &by_dementhon);
-  const double dementhon_px =
-      dementhon_ok ? ResidualPx(by_dementhon, hash, result.corners_m, camera) : HUGE_VAL;
-  if (!std::isfinite(dementhon_px) && !std::isfinite(lagrange_px)) {
-    return Fail(std::move(result),
-                "vpPose found no pose in front of the camera (Dementhon and Lagrange failed)");
-  }
-  result.method = dementhon_px <= lagrange_px ? PoseMethod::kDementhon : PoseMethod::kLagrange;
-  vpHomogeneousMatrix cMo = result.method == PoseMethod::kDementhon ? by_dementhon : by_lagrange;
-  std::array<bool, 4> is_stripe{};
-  bool any_stripe = false;  // the detector measured stripe middles, not edges
-  for (int k = 0; k < 4; ++k) {
-    is_stripe[k] = lines[result.line_index[k]].width_px > 0.0;
-    any_stripe = any_stripe || is_stripe[k];
-  }
-  // The stripe-centre correction from the linear pose: the shifts are a small fraction of a
-  // pixel and change little with the pose, so one refinement after it suffices.
-  std::array<Point2d, 4> shift{};
-  if (options.correct_stripe_centres && any_stripe &&
-      StripeCentreShifts(cMo, hash, camera, is_stripe, &shift)) {
-    pose.clearPoint();
-    for (int k = 0; k < 4; ++k) {
-      result.corners_px[k].u += shift[k].u;
-      result.corners_px[k].v += shift[k].v;
-      double x = 0.0, y = 0.0;
-      pose_internal::PixelToMetre(camera, options.lines_undistorted, result.corners_px[k], &x, &y);
-      result.corners_m[k][0] = x;
-      result.corners_m[k][1] = y;
-      vpPoint point(hash.corner[k].x, hash.corner[k].y, 0.0);
-      point.set_x(x);
-      point.set_y(y);
-      pose.addPoint(point);
+  if (result.method != PoseMethod::kPrevious) {
+    // Steps 3-4: Lagrange, and Dementhon unless Lagrange's residual is already below
+    // dementhon_above_px (where the refinement would end in the same minimum anyway); the
+    // lower residual is refined by virtual visual servoing.
+    corners.Set(nullptr, &result, &pose);
+    vpHomogeneousMatrix by_dementhon, by_lagrange;
+    const bool lagrange_ok = Compute(&pose, vpPose::LAGRANGE, &by_lagrange);
+    const double lagrange_px =
+        lagrange_ok ? ResidualPx(by_lagrange, hash, result.corners_m, camera) : HUGE_VAL;
+    const bool run_dementhon = !(lagrange_px < options.dementhon_above_px);
+    const bool dementhon_ok = run_dementhon && Compute(&pose, vpPose::DEMENTHON, &by_dementhon);
+    const double dementhon_px =
+        dementhon_ok ? ResidualPx(by_dementhon, hash, result.corners_m, camera) : HUGE_VAL;
+    if (!std::isfinite(dementhon_px) && !std::isfinite(lagrange_px)) {
+      return Fail(std::move(result),
+                  "vpPose found no pose in front of the camera (Dementhon and Lagrange failed)");
+    }
+    result.method = dementhon_px <= lagrange_px ? PoseMethod::kDementhon : PoseMethod::kLagrange;
+    cMo = result.method == PoseMethod::kDementhon ? by_dementhon : by_lagrange;
+    // The stripe-centre shifts are a small fraction of a pixel and change little with the
+    // pose: seen from the linear pose, one refinement after them suffices.
+    const vpHomogeneousMatrix linear = cMo;
+    corners.Set(&linear, &result, &pose);
+    if (Compute(&pose, vpPose::VIRTUAL_VS, &cMo)) {
+      residual_px = ResidualPx(cMo, hash, result.corners_m, camera);
+    }
+    if (have_previous) {
+      vpHomogeneousMatrix seeded = *previous_cMo;
+      if (Compute(&pose, vpPose::VIRTUAL_VS, &seeded)) {
+        const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
+        if (std::isfinite(seeded_px) && seeded_px <= residual_px + options.previous_tolerance_px) {
+          cMo = seeded;
+          residual_px = seeded_px;
+          result.from_previous = true;
+        }
+      }
     }
   }
   // Step 2: the roll of line 1, from its corner with line 2 (corner 0) to its corner with
@@ -213,25 +253,12 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
     const double dv = camera.get_py() * (result.corners_m[3][1] - result.corners_m[0][1]);
     result.line1_roll_deg = Wrap360(std::atan2(-du, dv) * kDegPerRad);
   }
-
-  pose.setCovarianceComputation(true);
-  double residual_px = HUGE_VAL;
   vpMatrix covariance;
-  if (Compute(&pose, vpPose::VIRTUAL_VS, &cMo)) {
-    residual_px = ResidualPx(cMo, hash, result.corners_m, camera);
-    covariance = pose.getCovarianceMatrix();
-  }
-  if (previous_cMo && IsFinite(*previous_cMo)) {
-    vpHomogeneousMatrix seeded = *previous_cMo;
-    if (Compute(&pose, vpPose::VIRTUAL_VS, &seeded)) {
-      const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
-      if (std::isfinite(seeded_px) && seeded_px <= residual_px + options.previous_tolerance_px) {
-        cMo = seeded;
-        residual_px = seeded_px;
-        covariance = pose.getCovarianceMatrix();
-        result.from_previous = true;
-      }
-    }
+  if (options.compute_covariance && std::isfinite(residual_px)) {
+    // From the converged pose the refinement stops after an iteration or two.
+    pose.setCovarianceComputation(true);
+    vpHomogeneousMatrix refined = cMo;
+    if (Compute(&pose, vpPose::VIRTUAL_VS, &refined)) covariance = pose.getCovarianceMatrix();
   }
   if (!std::isfinite(residual_px)) {
     return Fail(std::move(result), "vpPose's virtual visual servoing did not converge");
