@@ -576,25 +576,79 @@ void ReadServoSection(const YAML::Node& section, const std::string& file, AppCon
   ReadCheckedSection(section, file, "servo", ServoFields(), &config->servo);
 }
 
+// A path in the config file: relative ones are relative to the file's directory.
+std::string PathNextTo(const std::string& file, const Value& value) {
+  const std::string text = value.As<std::string>("a path");
+  if (text.empty()) value.Fail("'" + value.key + "' must not be empty");
+  const std::filesystem::path path(text);
+  if (path.is_absolute() || text.rfind("/dev/", 0) == 0) return text;
+  return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
+}
+
+struct Goal {
+  vpHomogeneousMatrix cdMo;
+  std::string image, origin;
+};
+
 void ReadGoalSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
-  using O = vpHomogeneousMatrix;
-  static const std::vector<Field<O>> fields = {
-      {"cdMo", [](const Value& value, O* cdMo) { *cdMo = ReadPose(value); }},
-      {"taught_from_pose",
-       [](const Value& value, O*) {
-         value.Fail("'" + value.key +
-                    "' is not supported by this version of oalservo: give 'goal.cdMo'");
+  static const std::vector<Field<Goal>> fields = {
+      {"cdMo", [](const Value& value, Goal* goal) { goal->cdMo = ReadPose(value); }},
+      {"image",
+       [](const Value& value, Goal* goal) {
+         goal->image = PathNextTo(value.file, value);
+         goal->origin = value.file + ":" + std::to_string(value.node.Mark().line + 1);
        }},
   };
   Lines lines;
-  vpHomogeneousMatrix cdMo = config->goal_cdMo;
-  ReadFields(section, file, "goal", fields, "", &cdMo, &lines);
-  if (cdMo[2][3] <= 0.0) {
+  Goal goal{config->goal_cdMo, config->goal_image, config->goal_image_origin};
+  ReadFields(section, file, "goal", fields, "", &goal, &lines);
+  if (lines.count("cdMo") && lines.count("image")) {
+    throw std::runtime_error(file + ":" + std::to_string(lines["image"]) +
+                             ": 'goal.image' and 'goal.cdMo' (line " +
+                             std::to_string(lines["cdMo"]) + ") both set the goal: give one");
+  }
+  if (goal.cdMo[2][3] <= 0.0) {
     throw std::runtime_error(file + ":" + std::to_string(lines.count("cdMo") ? lines["cdMo"] : 0) +
-                             ": 'goal.cdMo' puts the target at z = " + Number(cdMo[2][3]) +
+                             ": 'goal.cdMo' puts the target at z = " + Number(goal.cdMo[2][3]) +
                              " m: it must lie in front of the goal camera (z > 0)");
   }
-  config->goal_cdMo = cdMo;
+  if (lines.count("cdMo")) goal.image.clear();  // a later file's cdMo replaces a taught goal
+  config->goal_cdMo = goal.cdMo;
+  config->goal_image = goal.image;
+  config->goal_image_origin = goal.image.empty() ? "" : goal.origin;
+}
+
+const std::vector<Field<SourceConfig>>& SourceFields() {
+  using O = SourceConfig;
+  static const std::vector<Field<O>> fields = {
+      {"type",
+       [](const Value& value, O* source) { source->type = value.As<std::string>("a string"); }},
+      {"device",
+       [](const Value& value, O* source) { source->device = value.As<std::string>("a path"); }},
+      IntField("fps", &O::fps),
+      {"path", [](const Value& value, O* source) { source->path = PathNextTo(value.file, value); }},
+  };
+  return fields;
+}
+
+void ReadSourceSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  ReadCheckedSection(section, file, "source", SourceFields(), &config->source);
+}
+
+const std::vector<Field<OutputConfig>>& OutputFields() {
+  using O = OutputConfig;
+  static const std::vector<Field<O>> fields = {
+      {"directory",
+       [](const Value& value, O* output) { output->directory = value.As<std::string>("a path"); }},
+      {"display",
+       [](const Value& value, O* output) { output->display = value.As<std::string>("a string"); }},
+      BoolField("save_frames", &O::save_frames),
+  };
+  return fields;
+}
+
+void ReadOutputSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  ReadCheckedSection(section, file, "output", OutputFields(), &config->output);
 }
 
 void ReadTargetPoseSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
@@ -611,6 +665,7 @@ constexpr Section kSections[] = {
     {"pose", &ReadPoseSection},         {"camera", &ReadCameraSection},
     {"robot", &ReadRobotSection},       {"servo", &ReadServoSection},
     {"goal", &ReadGoalSection},         {"target_pose", &ReadTargetPoseSection},
+    {"source", &ReadSourceSection},     {"output", &ReadOutputSection},
 };
 
 // Sections later versions will read: rejected with a message that says so.
@@ -726,6 +781,25 @@ void RobotConfig::Check() const {
     Violated("RobotConfig::sampling_time_s", Num(sampling_time_s), "0 < sampling_time_s <= 1");
   }
   safety.Check();
+}
+
+void SourceConfig::Check() const {
+  if (type != "simulated" && type != "v4l2" && type != "replay") {
+    Violated("SourceConfig::type", type, "type is one of simulated, v4l2, replay");
+  }
+  if (type == "v4l2" && device.empty()) Violated("SourceConfig::device", "''", "a device path");
+  if (fps != 0 && fps != 25 && fps != 50) {
+    Violated("SourceConfig::fps", Num(fps), "fps is 0 (the driver's), 25 or 50");
+  }
+  if (type == "replay" && path.empty()) {
+    Violated("SourceConfig::path", "''", "a video, directory or pattern to replay");
+  }
+}
+
+void OutputConfig::Check() const {
+  if (display != "auto" && display != "on" && display != "off") {
+    Violated("OutputConfig::display", display, "display is one of auto, on, off");
+  }
 }
 
 void ServoLoopOptions::Check() const {

@@ -27,8 +27,10 @@
 //   camera:   px, py, u0, v0, kdu, width, height, noise, blur, eMc    (CameraConfig)
 //   robot:    type: simulated, start (wMc), velocity limits, workspace box (RobotConfig)
 //   servo:    the law (ServoOptions) and the loop's limits             (ServoLoopOptions)
-//   goal:     cdMo, the target as the camera should see it at the goal
+//   goal:     cdMo, the target as the camera should see it at the goal, or image: a taught goal
 //   target_pose: wMo, the target's pose in the world (robot base) frame
+//   source:   simulated (rendered), v4l2 (device, fps) or replay (path)  (SourceConfig)
+//   output:   directory, display (auto/on/off), save_frames               (OutputConfig)
 //
 // A pose is a map {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]} with the rotation
 // R = Rx(rx)·Ry(ry)·Rz(rz) (vpRxyzVector).
@@ -93,6 +95,36 @@ struct ServoLoopOptions {
   void Check() const;
 };
 
+/// `source:` where the servo loop's frames come from.
+struct SourceConfig {
+  /// "simulated": the target rendered from the robot's camera pose every iteration (closed
+  /// loop, the default); "v4l2": a real camera on the robot (vpV4l2Grabber), closed loop;
+  /// "replay": a video, image directory, printf pattern or /dev/videoN played open loop: the
+  /// law's commands are computed and logged, the robot is not moved.
+  std::string type = "simulated";
+  std::string device = "/dev/video0";  ///< v4l2: the device; its size is camera.width/height
+  int fps = 0;                         ///< v4l2: 25 or 50 (vpV4l2Grabber's rates); 0: driver's
+  /// replay: what to play (app/image_source.h); relative paths are relative to the config file.
+  std::string path;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// `output:` what the servo command writes and shows.
+struct OutputConfig {
+  /// servo.csv, servo-error.png and frames/ go here (relative to the working directory);
+  /// `oalservo servo --out DIR` overrides it. Empty: write nothing.
+  std::string directory = "out/servo";
+  /// "auto": a vpDisplayX window when $DISPLAY is set; "on": a window or an error; "off".
+  std::string display = "auto";
+  /// Without a window, write each iteration's annotated frame to DIR/frames/iter_NNNN.png.
+  bool save_frames = true;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
 /// Everything a configuration file can set. A new section is a member here plus one row in
 /// config.cpp's section table.
 struct AppConfig {
@@ -104,6 +136,12 @@ struct AppConfig {
   ServoLoopOptions servo;  ///< `servo:`
   /// `goal: {cdMo: POSE}`: the target in the goal camera frame (default 0.5 m ahead).
   vpHomogeneousMatrix goal_cdMo = vpHomogeneousMatrix(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);
+  /// `goal: {image: FILE}`: a taught goal, the pose seen in this image (relative to the config
+  /// file); replaces goal_cdMo when the loop starts (TeachGoal in servo_loop.h). Empty: none.
+  std::string goal_image;
+  std::string goal_image_origin;  ///< "FILE:LINE" of goal.image, for messages
+  SourceConfig source;            ///< `source:`
+  OutputConfig output;            ///< `output:`
   /// `target_pose: POSE`: wMo, the target in the world frame.
   vpHomogeneousMatrix target_wMo;
 };

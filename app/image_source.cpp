@@ -55,13 +55,13 @@ class ImageListSource : public ImageSource {
 
   bool Next(Frame* frame) override {
     if (next_ >= paths_.size()) return false;
-    const fs::path& path = paths_[next_];
-    frame->gray = (next_ == 0 && !first_.empty()) ? first_ : DecodeGray(path);
+    const fs::path& path = paths_[next_++];  // past it even if it does not decode
+    frame->gray = (next_ == 1 && !first_.empty()) ? first_ : DecodeGray(path);
     frame->source = path.string();
-    ++next_;
     return true;
   }
   std::string Name() const override { return name_; }
+  int ExpectedFrames() const override { return static_cast<int>(paths_.size()); }
 
  private:
   std::string name_;
@@ -153,6 +153,10 @@ class VideoSource : public ImageSource {
     return true;
   }
   std::string Name() const override { return "video " + Quoted(path_); }
+  int ExpectedFrames() const override {
+    const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+    return count >= 1.0 && count < 1e9 ? static_cast<int>(count) : -1;
+  }
 
  private:
   std::string path_;
@@ -165,10 +169,14 @@ class VideoSource : public ImageSource {
 #ifdef VISP_HAVE_V4L2
 class V4l2Source : public ImageSource {
  public:
-  explicit V4l2Source(const std::string& device) : device_(device) {
+  V4l2Source(const std::string& device, const V4l2Settings& settings) : device_(device) {
     grabber_.setDevice(device);
     grabber_.setInput(0);  // USB cameras have one input; ViSP's default (2) is for TV boards
     grabber_.setScale(1);  // full resolution; ViSP's default halves it
+    if (settings.width > 0) grabber_.setWidth(static_cast<unsigned>(settings.width));
+    if (settings.height > 0) grabber_.setHeight(static_cast<unsigned>(settings.height));
+    if (settings.fps == 25) grabber_.setFramerate(vpV4l2Grabber::framerate_25fps);
+    if (settings.fps == 50) grabber_.setFramerate(vpV4l2Grabber::framerate_50fps);
     try {
       grabber_.open(image_);
     } catch (const vpException& error) {
@@ -199,15 +207,6 @@ class V4l2Source : public ImageSource {
   int index_ = 0;
 };
 #endif
-
-std::unique_ptr<ImageSource> OpenDevice(const std::string& device) {
-  if (!fs::exists(device)) throw std::runtime_error("no V4L2 device at " + device);
-#ifdef VISP_HAVE_V4L2
-  return std::make_unique<V4l2Source>(device);
-#else
-  throw std::runtime_error("cannot read " + device + ": this ViSP build has no V4L2 support");
-#endif
-}
 
 bool IsDevicePath(const std::string& spec) {
   return spec.rfind("/dev/video", 0) == 0 || spec.rfind("/dev/v4l/", 0) == 0;
@@ -279,10 +278,21 @@ std::string ExpandPattern(const std::string& text, int index) {
   return pattern.prefix + number + pattern.suffix;
 }
 
+std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
+                                            const V4l2Settings& settings) {
+  if (!fs::exists(device)) throw std::runtime_error("no V4L2 device at " + device);
+#ifdef VISP_HAVE_V4L2
+  return std::make_unique<V4l2Source>(device, settings);
+#else
+  (void)settings;
+  throw std::runtime_error("cannot read " + device + ": this ViSP build has no V4L2 support");
+#endif
+}
+
 std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
                                              std::vector<std::string>* warnings) {
   if (spec.empty()) throw std::runtime_error("empty input name");
-  if (IsDevicePath(spec)) return OpenDevice(spec);
+  if (IsDevicePath(spec)) return OpenV4l2Source(spec);
   if (spec.find('%') != std::string::npos && !fs::exists(spec)) return OpenPattern(spec);
   if (!fs::exists(spec)) throw std::runtime_error("no such file or directory '" + spec + "'");
   if (fs::is_directory(spec)) return OpenDirectory(spec, warnings);

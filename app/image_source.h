@@ -20,21 +20,28 @@
 
 namespace oal {
 
+/// The detector's view of an 8-bit grey cv::Mat (CV_8UC1), without a copy.
+inline GrayImageView ViewOf(const cv::Mat& gray) {
+  return GrayImageView{gray.data, gray.cols, gray.rows, static_cast<std::ptrdiff_t>(gray.step)};
+}
+
 struct Frame {
   cv::Mat gray;        ///< CV_8UC1; may share memory with the source until its next Next()
   std::string source;  ///< image path, or "<video or device>#<index in that source>"
 
-  GrayImageView view() const {
-    return GrayImageView{gray.data, gray.cols, gray.rows, static_cast<std::ptrdiff_t>(gray.step)};
-  }
+  GrayImageView view() const { return ViewOf(gray); }
 };
 
 class ImageSource {
  public:
   virtual ~ImageSource() = default;
   /// Reads the next frame into `frame`; false at the end of the source. Throws
-  /// std::runtime_error naming the file when a frame cannot be read or decoded.
+  /// std::runtime_error naming the file when a frame cannot be read or decoded; a list of
+  /// images has then moved past that file, so a caller may skip it and call Next() again.
   virtual bool Next(Frame* frame) = 0;
+  /// Frames the source announces (files listed, the container's frame count); -1: unknown
+  /// (a camera, a video without a count).
+  virtual int ExpectedFrames() const { return -1; }
   /// What is being read, for messages, e.g. "directory 'frames'".
   virtual std::string Name() const = 0;
 };
@@ -45,6 +52,18 @@ class ImageSource {
 /// directory are reported in `warnings` (if given).
 std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
                                              std::vector<std::string>* warnings = nullptr);
+
+/// What to ask of a V4L2 camera; 0 leaves the driver's choice.
+struct V4l2Settings {
+  int width = 0, height = 0;  ///< frame size, pixels
+  int fps = 0;                ///< 25 or 50 (vpV4l2Grabber's rates)
+};
+
+/// Opens the V4L2 camera `device` (e.g. /dev/video0) with `settings`. Throws
+/// std::runtime_error saying so when the device does not exist, cannot be opened, or this ViSP
+/// has no V4L2 support.
+std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
+                                            const V4l2Settings& settings = V4l2Settings());
 
 /// True if `path` has the extension of an image format OpenCV reads (case-insensitive).
 bool HasImageExtension(const std::string& path);

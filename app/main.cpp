@@ -18,6 +18,7 @@
 #include "app/pose_accuracy_command.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"
+#include "app/servo_accuracy_command.h"
 #include "app/servo_command.h"
 #include "app/target_command.h"
 
@@ -38,6 +39,8 @@ constexpr oal::Command kCommands[] = {
     {"pose", &oal::RunPose, "camera pose from the four-line target in every frame"},
     {"servo", &oal::RunServoMain,
      "visual servoing to a goal pose, camera in the loop (default: simulated robot)"},
+    {"servo-accuracy", &oal::RunServoAccuracy,
+     "servo convergence from many random start poses, for each law"},
     {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
     {"compare", &oal::RunCompare,
      "our detector, vpMeLine and OpenCV line detectors against ground truth"},

@@ -3,12 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/servo_default_config.h"
+#include "app/servo_output.h"
 
 namespace oal {
 namespace {
@@ -44,28 +47,100 @@ ServoAppConfig DefaultServoConfig() {
 }
 
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options) {
-  if (options.config_path.empty()) return DefaultServoConfig();
-  return LoadConfig(options.config_path);
+  // A file only says what differs from the built-in default.
+  ServoAppConfig config = options.config_path.empty()
+                              ? DefaultServoConfig()
+                              : LoadConfig(options.config_path, DefaultServoConfig());
+  if (!options.out_dir.empty()) config.output.directory = options.out_dir;
+  if (!options.mode.empty()) config.servo.law.mode = ServoModeFromString(options.mode);
+  if (!options.display.empty()) config.output.display = options.display;
+  config.output.Check();
+  return config;
 }
+
+namespace {
+
+// The window or the annotated frames, fed by the loop's on_frame hook.
+class FrameOutput {
+ public:
+  FrameOutput(const OutputConfig& output, const fs::path& frames_dir) : frames_dir_(frames_dir) {
+    const bool window =
+        output.display == "on" || (output.display == "auto" && CanOpenServoWindow());
+    if (window) {
+      window_ = std::make_unique<ServoWindow>();
+    } else if (output.save_frames && !frames_dir.empty()) {
+      fs::create_directories(frames_dir);
+      save_ = true;
+    }
+  }
+
+  bool Active() const { return window_ != nullptr || save_; }
+  bool HasWindow() const { return window_ != nullptr; }
+
+  // Shows or writes the frame; true when the user asked to stop (a click in the window).
+  bool Handle(const ServoFrame& frame) {
+    const cv::Mat annotated = AnnotateServoFrame(frame);
+    if (window_) {
+      window_->Show(annotated);
+      return window_->StopClicked();
+    }
+    char name[32];
+    std::snprintf(name, sizeof(name), "iter_%04d.png", frame.row.iteration);
+    WritePng(frames_dir_ / name, annotated);
+    return false;
+  }
+
+ private:
+  fs::path frames_dir_;
+  std::unique_ptr<ServoWindow> window_;
+  bool save_ = false;
+};
+
+}  // namespace
 
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks) {
   const ServoAppConfig config = LoadServoConfig(options);
-  const fs::path csv = fs::path(options.out_dir) / "servo.csv";
-  if (!options.out_dir.empty()) {
-    fs::create_directories(options.out_dir);
+  const fs::path dir = config.output.directory;
+  const fs::path csv = dir / "servo.csv", plot = dir / "servo-error.png";
+  if (!dir.empty()) {
+    fs::create_directories(dir);
     CheckOutputFile(csv);
+    CheckOutputFile(plot);
   }
+  FrameOutput frames(config.output, dir.empty() ? fs::path() : dir / "frames");
   out << "oalservo servo: "
       << (options.config_path.empty() ? kDefaultServoConfigName : options.config_path) << ", "
-      << ToString(config.servo.law.mode) << " law\n";
-  const ServoRunReport report = RunServo(config, out, hooks);
+      << ToString(config.servo.law.mode) << " law"
+      << (frames.HasWindow() ? ", live window (click to stop)" : "") << '\n';
+
+  ServoRunHooks run_hooks = hooks;
+  SafeRobot* robot = nullptr;
+  run_hooks.on_robot = [&](SafeRobot* running) {
+    robot = running;
+    if (hooks.on_robot) hooks.on_robot(running);
+  };
+  if (frames.Active()) {
+    run_hooks.on_frame = [&](const ServoFrame& frame) {
+      if (hooks.on_frame) hooks.on_frame(frame);
+      if (frames.Handle(frame) && robot != nullptr) robot->RequestEmergencyStop();
+    };
+  }
+  const ServoRunReport report = RunServo(config, out, run_hooks);
   out << "oalservo servo: " << ToString(report.status) << ": " << report.message << '\n';
-  if (!options.out_dir.empty()) {
+  if (!dir.empty()) {
     AtomicFile file(csv);
     WriteServoCsv(report, file.stream());
     file.Commit();
-    out << "oalservo servo: wrote " << csv.string() << '\n';
+    try {
+      WriteServoPlot(report, config.servo.law, plot);
+    } catch (const std::runtime_error& error) {
+      Warn("servo", error.what());  // the run and its CSV stand without the picture
+    }
+    out << "oalservo servo: wrote " << csv.string() << ", " << plot.string()
+        << (frames.Active() && !frames.HasWindow() ? " and " + (dir / "frames").string() + "/"
+                                                   : std::string())
+        << '\n';
   }
   return report;
 }
@@ -80,12 +155,19 @@ int RunServoMain(int argc, char** argv) {
   cli.add_option("--config", options.config_path,
                  "YAML configuration: camera, robot, servo, goal, target_pose (and detector, "
                  "target, pose) sections; default: the built-in config/servo-sim.yaml");
-  cli.add_option("--out", options.out_dir, "output directory for servo.csv (created if missing)")
-      ->capture_default_str();
+  cli.add_option("--out", options.out_dir,
+                 "output directory (overrides output.directory; default out/servo): servo.csv, "
+                 "servo-error.png, frames/");
+  cli.add_option("--mode", options.mode, "the law (overrides servo.mode)")
+      ->check(CLI::IsMember({"point-and-go", "exponential", "velocity"}));
+  cli.add_option("--display", options.display,
+                 "live window (overrides output.display): auto = when $DISPLAY is set")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   cli.footer(
       "Examples:\n"
       "  oalservo servo\n"
-      "  oalservo servo --config config/table3-sim.yaml --out out/table3");
+      "  oalservo servo --config config/table3-sim.yaml --out out/table3\n"
+      "  oalservo servo --config config/table3-sim.yaml --mode point-and-go --display off");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   g_interrupt.store(false);
   SigintScope sigint;
@@ -93,7 +175,9 @@ int RunServoMain(int argc, char** argv) {
   hooks.interrupt = &g_interrupt;
   hooks.on_robot = [](SafeRobot* robot) { g_robot.store(robot); };
   const ServoRunReport report = RunServoCommand(options, std::cout, hooks);
-  return report.status == ServoRunStatus::kConverged ? kExitOk : kExitError;
+  const bool ok =
+      report.status == ServoRunStatus::kConverged || report.status == ServoRunStatus::kEndOfInput;
+  return ok ? kExitOk : kExitError;
 }
 
 }  // namespace oal

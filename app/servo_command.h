@@ -1,11 +1,15 @@
-// `oalservo servo [--config FILE] [--out DIR]`: visual servoing to a goal pose with the
-// camera in the loop (app/servo_loop.h). With no --config it runs the built-in default, equal
-// to config/servo-sim.yaml: a simulated free-flying camera, the exponential law, delta 0.8.
-// Prints one row per iteration in the form of the paper's Table 3 (iteration, X, Y, Z mm,
-// pitch, roll deg of the camera in the base frame, translation error mm, rotation error deg,
-// status), then the outcome, and writes DIR/servo.csv (atomically). Ctrl-C stops the robot
-// (SafeRobot::RequestEmergencyStop) and ends the run with status interrupted.
-// Exit status: 0 converged, 1 any other outcome or an error, 2 a bad command line.
+// `oalservo servo [--config FILE] [--out DIR] [--mode LAW] [--display auto|on|off]`: visual
+// servoing to a goal pose with the camera in the loop (app/servo_loop.h). With no --config it
+// runs the built-in default, equal to config/servo-sim.yaml: a simulated free-flying camera,
+// the exponential law, delta 0.8. Prints one row per iteration in the form of the paper's
+// Table 3 (iteration, X, Y, Z mm, pitch, roll deg of the camera in the base frame, translation
+// error mm, rotation error deg, status), then the outcome, and writes into the output
+// directory (config output.directory, or --out) servo.csv, servo-error.png and, without a
+// window, the annotated frames (app/servo_output.h), each atomically. A vpDisplayX window
+// shows the frames when a display exists (output.display). Ctrl-C, or a click in the window,
+// stops the robot (SafeRobot::RequestEmergencyStop) and ends the run with status interrupted.
+// Exit status: 0 converged (or a replay played to its end), 1 any other outcome or an error,
+// 2 a bad command line.
 #pragma once
 
 #include <iosfwd>
@@ -17,16 +21,22 @@
 namespace oal {
 
 struct ServoCommandOptions {
-  std::string config_path;            ///< YAML configuration; empty: the built-in default
-  std::string out_dir = "out/servo";  ///< directory for servo.csv (created if missing)
+  std::string config_path;  ///< YAML configuration; empty: the built-in default
+  /// Overrides of the configuration; empty: as configured.
+  std::string out_dir;  ///< output.directory (created if missing)
+  std::string mode;     ///< servo.mode: point-and-go, exponential, velocity
+  std::string display;  ///< output.display: auto, on, off
 };
 
 /// The built-in default configuration (config/servo-sim.yaml, embedded at build time).
 ServoAppConfig DefaultServoConfig();
-/// The configuration `options` selects: --config applied over the defaults, or the built-in.
+/// The configuration `options` selects: --config applied over the built-in default (keys and
+/// sections a file leaves out keep the default's values), or the built-in itself,
+/// then the command line's overrides. Throws std::runtime_error / std::invalid_argument for a
+/// bad file or override.
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options);
 
-/// Loads the configuration, runs the loop (rows to `out`) and writes out_dir/servo.csv.
+/// Loads the configuration, runs the loop (rows to `out`) and writes the outputs.
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks = ServoRunHooks());
 

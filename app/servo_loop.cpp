@@ -9,10 +9,14 @@
 #include <cstdint>
 #include <iomanip>
 #include <limits>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
+#include "app/image_source.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
 #include "robots/simulated_camera.h"
@@ -72,6 +76,101 @@ ServoRunStatus StatusOfRefusal(const RobotResult& result, const SafeRobot& robot
   return ServoRunStatus::kError;
 }
 
+// What the detector and the pose believe about the lens: the true one, or (the paper's
+// condition, camera.correct_distortion false) a pinhole camera with the same intrinsics.
+struct LoopModel {
+  const ServoAppConfig& config;
+  vpCameraParameters camera;
+
+  explicit LoopModel(const ServoAppConfig& c)
+      : config(c),
+        camera(c.camera.correct_distortion
+                   ? c.camera.Camera()
+                   : vpCameraParameters(c.camera.px, c.camera.py, c.camera.u0, c.camera.v0)) {}
+
+  PoseOptions PoseOptionsFor(const OalDetector& detector) const {
+    PoseOptions options = config.pose;
+    options.camera = camera;
+    options.lines_undistorted = detector.Undistorts();
+    options.image_width = config.camera.width;
+    options.image_height = config.camera.height;
+    options.compute_covariance = false;  // the loop does not use it
+    options.Check();
+    return options;
+  }
+};
+
+// Where the loop's frames come from (config `source:`).
+class LoopCamera {
+ public:
+  virtual ~LoopCamera() = default;
+  /// The frame of iteration `iteration`: seen from `true_cMo` (simulation) or the next one of
+  /// the source; false at the end of a recording. Throws std::runtime_error when a frame cannot
+  /// be read.
+  virtual bool Grab(const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) = 0;
+  virtual std::string Name() const = 0;
+};
+
+// The simulated camera: the target rendered from the true pose with the configured lens,
+// noise and blur.
+class RenderedCamera : public LoopCamera {
+ public:
+  explicit RenderedCamera(const ServoAppConfig& config)
+      : renderer_(config.target, RenderOptionsOf(config.camera)) {}
+
+  bool Grab(const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) override {
+    frame_ = renderer_.Render(true_cMo, kNoiseSeed + static_cast<std::uint64_t>(iteration));
+    *gray = cv::Mat(static_cast<int>(frame_.image.getHeight()),
+                    static_cast<int>(frame_.image.getWidth()), CV_8UC1, frame_.image.bitmap);
+    return true;
+  }
+  std::string Name() const override { return "the simulated camera"; }
+
+ private:
+  static RenderOptions RenderOptionsOf(const CameraConfig& camera) {
+    RenderOptions render;
+    render.width = camera.width;
+    render.height = camera.height;
+    render.camera = camera.Camera();
+    render.noise_sigma = camera.noise;
+    render.blur_sigma_px = camera.blur;
+    return render;
+  }
+
+  SceneRenderer renderer_;
+  RenderedFrame frame_;
+};
+
+// A V4L2 camera or a recording (app/image_source.h).
+class SourceCamera : public LoopCamera {
+ public:
+  explicit SourceCamera(std::unique_ptr<ImageSource> source) : source_(std::move(source)) {}
+
+  bool Grab(const vpHomogeneousMatrix& /*true_cMo*/, int /*iteration*/, cv::Mat* gray) override {
+    if (!source_->Next(&frame_)) return false;
+    *gray = frame_.gray;
+    return true;
+  }
+  std::string Name() const override { return source_->Name(); }
+
+ private:
+  std::unique_ptr<ImageSource> source_;
+  Frame frame_;
+};
+
+std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
+  const SourceConfig& source = config.source;
+  if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
+  if (source.type == "v4l2") {
+    V4l2Settings settings;
+    settings.width = config.camera.width;
+    settings.height = config.camera.height;
+    settings.fps = source.fps;
+    return std::make_unique<SourceCamera>(OpenV4l2Source(source.device, settings));
+  }
+  return std::make_unique<SourceCamera>(OpenImageSource(source.path));
+}
+
 }  // namespace
 
 std::string ToString(ServoRunStatus status) {
@@ -90,6 +189,8 @@ std::string ToString(ServoRunStatus status) {
       return "time-limit";
     case ServoRunStatus::kInterrupted:
       return "interrupted";
+    case ServoRunStatus::kEndOfInput:
+      return "end-of-input";
     case ServoRunStatus::kError:
       return "error";
   }
@@ -120,50 +221,72 @@ void WriteServoCsv(const ServoRunReport& report, std::ostream& out) {
   }
 }
 
+vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
+  const std::string where = config.goal_image_origin + ": goal.image '" + config.goal_image + "'";
+  const cv::Mat gray = cv::imread(config.goal_image, cv::IMREAD_GRAYSCALE);
+  if (gray.empty()) throw std::runtime_error(where + ": cannot read or decode the image");
+  if (gray.cols != config.camera.width || gray.rows != config.camera.height) {
+    throw std::runtime_error(where + " is " + std::to_string(gray.cols) + "x" +
+                             std::to_string(gray.rows) + " but camera.width x camera.height is " +
+                             std::to_string(config.camera.width) + "x" +
+                             std::to_string(config.camera.height));
+  }
+  const LoopModel model(config);
+  OalDetector detector(config.detector, model.camera);
+  const PoseResult pose =
+      EstimatePose(detector.Detect(ViewOf(gray)), config.target, model.PoseOptionsFor(detector));
+  if (pose.status != PoseStatus::kOk) {
+    throw std::runtime_error(where + ": no pose of target '" + config.target.name +
+                             "' in it: " + ToString(pose.status) +
+                             (pose.message.empty() ? "" : " (" + pose.message + ")"));
+  }
+  return pose.cMo;
+}
+
 ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
                         const ServoRunHooks& hooks) {
-  // Everything checked before the robot moves.
+  // Everything checked, and the goal taught, before the robot moves.
   config.camera.Check();
   config.robot.Check();
   config.servo.Check();
-  const vpCameraParameters camera = config.camera.Camera();
-  RenderOptions render;
-  render.width = config.camera.width;
-  render.height = config.camera.height;
-  render.camera = camera;
-  render.noise_sigma = config.camera.noise;
-  render.blur_sigma_px = config.camera.blur;
-  const SceneRenderer renderer(config.target, render);
-  // What the detector and the pose believe about the lens: the true one, or (the paper's
-  // condition) a pinhole camera with the same intrinsics.
-  const vpCameraParameters model = config.camera.correct_distortion
-                                       ? camera
-                                       : vpCameraParameters(config.camera.px, config.camera.py,
-                                                            config.camera.u0, config.camera.v0);
-  OalDetector detector(config.detector, model);
-  PoseOptions pose_options = config.pose;
-  pose_options.camera = model;
-  pose_options.lines_undistorted = detector.Undistorts();
-  pose_options.image_width = config.camera.width;
-  pose_options.image_height = config.camera.height;
-  pose_options.compute_covariance = false;  // the loop does not use it
-  pose_options.Check();
+  config.source.Check();
+  if (config.source.type == "v4l2" && config.robot.type == "simulated") {
+    throw std::invalid_argument(
+        "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
+        "whose motion the camera would not see); to watch a camera without moving anything use "
+        "source: {type: replay, path: " +
+        config.source.device + "}");
+  }
+  const LoopModel model(config);
+  OalDetector detector(config.detector, model.camera);
+  const PoseOptions pose_options = model.PoseOptionsFor(detector);
+  const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config);
+  const bool moves_robot = config.source.type != "replay";
+  const bool simulated = config.source.type == "simulated";
 
   SimulatedCameraOptions sim_options;
   sim_options.sampling_time_s = config.robot.sampling_time_s;
   sim_options.move_mode = SimulatedCameraOptions::MoveMode::kJump;
   sim_options.wMc = config.robot.start_wMc;
   sim_options.eMc = config.camera.eMc;
-  SimulatedCamera simulated(sim_options);
-  SafeRobot robot(simulated, config.robot.safety);
+  SimulatedCamera simulated_robot(sim_options);
+  SafeRobot robot(simulated_robot, config.robot.safety);
 
   ServoRunReport report;
+  report.cdMo = config.goal_image.empty() ? config.goal_cdMo : TeachGoal(config);
+  if (!config.goal_image.empty()) {
+    const vpTranslationVector t = report.cdMo.getTranslationVector();
+    log << "goal taught from " << config.goal_image << ": target at (" << Fixed(t[0], 4) << ", "
+        << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
+  }
+  if (!moves_robot)
+    log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
   auto finish = [&](ServoRunStatus status, std::string message) {
     report.status = status;
     report.message = std::move(message);
     robot.Stop();
     report.robot_stopped = robot.state() == SafeRobotState::kStopped;
-    report.final_wMc = simulated.wMc();
+    report.final_wMc = simulated_robot.wMc();
     if (!report.iterations.empty()) report.iterations.back().status = ToString(status);
     return report;
   };
@@ -181,13 +304,15 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   const auto start = std::chrono::steady_clock::now();
   std::optional<vpHomogeneousMatrix> previous_cMo;
   vpHomogeneousMatrix previous_wMc;
+  cv::Mat gray;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   log << "iter     X mm     Y mm     Z mm    pitch     roll   err mm   err deg  status\n";
   for (int iteration = 0;; ++iteration) {
     if ((hooks.interrupt != nullptr && hooks.interrupt->load()) || robot.EmergencyStopRequested()) {
       robot.RequestEmergencyStop();
-      return finish(
-          ServoRunStatus::kInterrupted,
-          "interrupted (Ctrl-C) after " + std::to_string(iteration) + " iterations; robot stopped");
+      return finish(ServoRunStatus::kInterrupted,
+                    "interrupted (Ctrl-C or a stop from the window) after " +
+                        std::to_string(iteration) + " iterations; robot stopped");
     }
     const double elapsed_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -212,20 +337,56 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     ServoIteration row;
     row.iteration = iteration;
     Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg);
-    const PoseDistance truth =
-        Distance(config.goal_cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
-    row.true_translation_error_mm = truth.translation_m * 1e3;
-    row.true_rotation_error_deg = vpMath::deg(truth.rotation_rad);
-    row.translation_error_mm = std::numeric_limits<double>::quiet_NaN();
-    row.rotation_error_deg = std::numeric_limits<double>::quiet_NaN();
+    row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
+    if (simulated) {
+      const PoseDistance truth = Distance(report.cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
+      row.true_translation_error_mm = truth.translation_m * 1e3;
+      row.true_rotation_error_deg = vpMath::deg(truth.rotation_rad);
+    }
+    row.translation_error_mm = row.rotation_error_deg = kNaN;
     row.status = "running";
-    report.iterations.push_back(row);
 
-    const RenderedFrame frame = renderer.Render(true_cMo, kNoiseSeed + iteration);
-    const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(frame.image));
+    std::string source_error;
+    bool have_frame = false;
+    try {
+      have_frame = frames->Grab(true_cMo, iteration, &gray);
+    } catch (const std::exception& error) {
+      source_error = error.what();
+    }
+    if (!source_error.empty()) {
+      return finish(ServoRunStatus::kError, "cannot read the next frame at iteration " +
+                                                std::to_string(iteration) + ": " + source_error +
+                                                "; robot stopped");
+    }
+    if (!have_frame) {
+      return finish(ServoRunStatus::kEndOfInput,
+                    "end of " + frames->Name() + " after " + std::to_string(iteration) + " frames");
+    }
+    if (gray.cols != config.camera.width || gray.rows != config.camera.height) {
+      return finish(ServoRunStatus::kError,
+                    frames->Name() + " gives " + std::to_string(gray.cols) + "x" +
+                        std::to_string(gray.rows) + " frames but camera.width x camera.height is " +
+                        std::to_string(config.camera.width) + "x" +
+                        std::to_string(config.camera.height) + "; robot stopped");
+    }
+    report.iterations.push_back(row);
+    ServoIteration& current = report.iterations.back();
+
+    const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray));
     const PoseResult pose = EstimatePose(lines, config.target, pose_options, previous_cMo);
+    std::optional<ServoStep> step;
+    if (pose.status == PoseStatus::kOk) {
+      step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);
+      current.translation_error_mm = step->translation_error_m * 1e3;
+      current.rotation_error_deg = vpMath::deg(step->rotation_error_rad);
+      if (step->status == ServoStatus::kConverged) current.status = "converged";
+    }
+    if (hooks.on_frame) {
+      hooks.on_frame(ServoFrame{gray, lines, pose, current, model.camera, detector.Undistorts()});
+    }
     if (pose.status != PoseStatus::kOk) {
-      LogRow(report.iterations.back(), log);
+      current.status = ToString(ServoRunStatus::kTargetLost);
+      LogRow(current, log);
       return finish(
           ServoRunStatus::kTargetLost,
           "target lost at iteration " + std::to_string(iteration) + ": " + ToString(pose.status) +
@@ -236,7 +397,8 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
       const PoseDistance jump = Distance(predicted, pose.cMo);
       if (jump.translation_m > loop.max_pose_jump_m ||
           vpMath::deg(jump.rotation_rad) > loop.max_pose_jump_deg) {
-        LogRow(report.iterations.back(), log);
+        current.status = ToString(ServoRunStatus::kPoseJump);
+        LogRow(current, log);
         return finish(ServoRunStatus::kPoseJump,
                       "pose jump at iteration " + std::to_string(iteration) + ": the estimate is " +
                           Fixed(jump.translation_m * 1e3, 1) + " mm and " +
@@ -248,32 +410,28 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     previous_cMo = pose.cMo;
     previous_wMc = wMc;
-
-    const ServoStep step = ComputeServoStep(pose.cMo, config.goal_cdMo, loop.law);
-    report.iterations.back().translation_error_mm = step.translation_error_m * 1e3;
-    report.iterations.back().rotation_error_deg = vpMath::deg(step.rotation_error_rad);
-    if (step.status == ServoStatus::kConverged) {
-      report.iterations.back().status = "converged";
-      LogRow(report.iterations.back(), log);
+    LogRow(current, log);
+    if (step->status == ServoStatus::kConverged) {
       return finish(ServoRunStatus::kConverged,
                     "converged in " + std::to_string(iteration) + " moves: estimated error " +
-                        Fixed(step.translation_error_m * 1e3, 3) + " mm, " +
-                        Fixed(vpMath::deg(step.rotation_error_rad), 4) + " deg");
+                        Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
+                        Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg");
     }
-    LogRow(report.iterations.back(), log);
+    if (!moves_robot) continue;
 
     RobotResult moved;
     if (velocity) {
-      moved = robot.SetVelocity(RobotFrame::kCamera, step.twist).result;
+      moved = robot.SetVelocity(RobotFrame::kCamera, step->twist).result;
     } else {
-      moved = robot.MovePosition(RobotFrame::kCamera, wMc * step.c_T_cnew).result;
+      moved = robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew).result;
     }
     ++report.moves;
     if (!moved.ok()) {
       const ServoRunStatus status = StatusOfRefusal(moved, robot);
       if (status == ServoRunStatus::kInterrupted) {
-        return finish(status, "interrupted (Ctrl-C) during the move of iteration " +
-                                  std::to_string(iteration) + "; robot stopped");
+        return finish(
+            status, "interrupted (Ctrl-C or a stop from the window) during the move of iteration " +
+                        std::to_string(iteration) + "; robot stopped");
       }
       return finish(status, ToString(status) + " at iteration " + std::to_string(iteration) + ": " +
                                 moved.message + "; robot stopped");

@@ -23,18 +23,32 @@
 //      a workspace, velocity or reach limit (limit), the emergency stop (interrupted), any
 //      other failure (error);
 //   7. after servo.max_iterations frames without convergence: iteration-limit.
+//
+// Frame sources (config `source:`): "simulated" renders the frame from the true cMo (above);
+// "v4l2" grabs from a camera carried by the robot (closed loop; not with the simulated robot,
+// whose motion a real camera would not see); "replay" plays a recorded video or image
+// sequence open loop: every step is computed and logged but the robot is not moved, so the
+// odometry prediction of step 4 is the previous estimate itself; the end of the recording
+// ends the run (end-of-input). Without simulation there is no true pose: the true-error
+// columns are NaN.
+//
+// A taught goal (config `goal.image`) is read before the robot moves: the pose estimated in
+// that image becomes cdMo (TeachGoal).
 // Whatever the outcome, the robot is stopped when RunServo returns (a guard stops it also on
 // an exception).
 #pragma once
 
 #include <atomic>
 #include <functional>
+#include <opencv2/core/mat.hpp>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "app/config.h"
+#include "detector/detector.h"
 #include "robots/safe_robot.h"
+#include "servo/pose.h"
 
 namespace oal {
 
@@ -46,11 +60,12 @@ enum class ServoRunStatus {
   kIterationLimit,
   kTimeLimit,
   kInterrupted,
+  kEndOfInput,
   kError,
 };
 
 /// "converged", "target-lost", "pose-jump", "limit", "iteration-limit", "time-limit",
-/// "interrupted", "error".
+/// "interrupted", "end-of-input", "error".
 std::string ToString(ServoRunStatus status);
 
 /// One iteration (one frame): where the camera was when the frame was taken and what the law
@@ -69,7 +84,8 @@ struct ServoIteration {
 
 struct ServoRunReport {
   ServoRunStatus status = ServoRunStatus::kError;
-  std::string message;  ///< why the run ended, one line for the user
+  vpHomogeneousMatrix cdMo;  ///< the goal used (configured or taught)
+  std::string message;       ///< why the run ended, one line for the user
   std::vector<ServoIteration> iterations;
   vpHomogeneousMatrix final_wMc;  ///< the camera where the run left it
   bool robot_stopped = false;     ///< the robot was stopped at the end (always true)
@@ -80,10 +96,29 @@ struct ServoRunReport {
 /// emergency stop is requested); `on_robot` is called with the SafeRobot once it is running
 /// and with nullptr before it is destroyed, so a signal handler can reach
 /// SafeRobot::RequestEmergencyStop().
+/// What the loop saw in one iteration, for displays and annotated frames (valid during the
+/// on_frame call only).
+struct ServoFrame {
+  const cv::Mat& gray;  ///< the frame, CV_8UC1
+  const std::vector<DetectedLine>& lines;
+  const PoseResult& pose;
+  const ServoIteration& row;
+  const vpCameraParameters& camera;  ///< the camera model the detector and pose used
+  bool lines_undistorted = false;    ///< the lines are in undistorted pixels
+};
+
 struct ServoRunHooks {
   const std::atomic<bool>* interrupt = nullptr;
   std::function<void(SafeRobot*)> on_robot;
+  /// Called once per frame, after the pose and the law, before the robot moves.
+  std::function<void(const ServoFrame&)> on_frame;
 };
+
+/// The goal of a taught configuration: the pose of config.target estimated in the image
+/// config.goal_image with the configured camera and detector. Throws std::runtime_error naming
+/// config.goal_image_origin and the image when it cannot be read, has another size than the
+/// camera, or shows no pose.
+vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config);
 
 /// Runs the loop (see the file comment). Writes one line per iteration to `log`. Throws
 /// std::invalid_argument / std::runtime_error for a bad configuration, before the robot moves.

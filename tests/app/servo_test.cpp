@@ -113,8 +113,9 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
               HasSubstr("servo.yaml:2: 'robot.start.translation_m' must be [x, y, z]"));
   EXPECT_THAT(ErrorOf("goal:\n  cdMo:\n    translation: [0, 0, 1]\n"),
               HasSubstr("servo.yaml:3: key 'goal.cdMo.translation' is unknown"));
-  EXPECT_THAT(ErrorOf("goal:\n  taught_from_pose: x.png\n"),
-              HasSubstr("servo.yaml:2: 'goal.taught_from_pose' is not supported"));
+  EXPECT_THAT(
+      ErrorOf("goal:\n  taught_from_pose: x.png\n"),
+      HasSubstr("servo.yaml:2: key 'goal.taught_from_pose' is unknown (known: cdMo, image)"));
   EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5]}\n"),
               HasSubstr("servo.yaml:2: 'goal.cdMo' puts the target at z = -0.5"));
   EXPECT_THAT(ErrorOf("target_pose: {translation_m: [0, 0, 0], rxyz: [0, 0, 0]}\n"),

@@ -1,0 +1,100 @@
+#include "app/servo_accuracy.h"
+
+#include <visp3/core/vpMath.h>
+
+#include <sstream>
+#include <stdexcept>
+
+#include "scene/scene.h"
+
+namespace oal {
+
+int ServoAccuracyLaw::converged() const {
+  int count = 0;
+  for (const ServoAccuracyRun& run : runs) count += run.status == ServoRunStatus::kConverged;
+  return count;
+}
+
+void ServoAccuracyOptions::Check() const {
+  const auto fail = [](const std::string& field, double value, const std::string& constraint) {
+    std::ostringstream message;
+    message << "ServoAccuracyOptions::" << field << " = " << value
+            << ". Violated constraint: " << constraint;
+    throw std::invalid_argument(message.str());
+  };
+  if (starts < 1) fail("starts", starts, "starts >= 1");
+  if (!(min_distance_m > 0.0)) fail("min_distance_m", min_distance_m, "min_distance_m > 0");
+  if (!(max_distance_m >= min_distance_m)) {
+    fail("max_distance_m", max_distance_m, "max_distance_m >= min_distance_m");
+  }
+  if (!(max_off_deg >= 0.0 && max_off_deg <= 80.0)) {
+    fail("max_off_deg", max_off_deg, "0 <= max_off_deg <= 80");
+  }
+  if (max_iterations < 0) fail("max_iterations", max_iterations, "max_iterations >= 0");
+  if (modes.empty()) throw std::invalid_argument("ServoAccuracyOptions::modes is empty");
+}
+
+std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoAppConfig& config,
+                                                   const ServoAccuracyOptions& options) {
+  options.Check();
+  RenderOptions render;
+  render.width = config.camera.width;
+  render.height = config.camera.height;
+  render.camera = config.camera.Camera();
+  const SceneRenderer renderer(config.target, render);
+  PoseSampling sampling;
+  sampling.min_distance_m = options.min_distance_m;
+  sampling.max_distance_m = options.max_distance_m;
+  sampling.max_tilt_deg = options.max_off_deg;
+  sampling.max_offset_m = 0.05;
+  sampling.any_roll = false;  // roll within ±max_off_deg of the goal's
+  sampling.min_visible_length_px = 0.15 * config.camera.width;
+  std::uint64_t state = options.seed;
+  std::vector<vpHomogeneousMatrix> starts;
+  for (int i = 0; i < options.starts; ++i) {
+    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
+    starts.push_back(config.target_wMo * cMo.inverse());  // wMc = wMo · oMc
+  }
+  return starts;
+}
+
+ServoAccuracyReport EvaluateServoAccuracy(const ServoAppConfig& config,
+                                          const ServoAccuracyOptions& options,
+                                          const std::function<void(int, int)>& progress) {
+  const std::vector<vpHomogeneousMatrix> starts = SampleServoStarts(config, options);
+  ServoAccuracyReport report;
+  report.options = options;
+  const int total = static_cast<int>(starts.size() * options.modes.size());
+  int done = 0;
+  for (const ServoMode mode : options.modes) {
+    ServoAccuracyLaw law;
+    law.mode = mode;
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+      ServoAppConfig run_config = config;
+      run_config.servo.law.mode = mode;
+      if (options.max_iterations > 0) run_config.servo.max_iterations = options.max_iterations;
+      run_config.robot.start_wMc = starts[i];
+      std::ostringstream log;  // the per-iteration rows are not kept
+      const ServoRunReport result = RunServo(run_config, log);
+      ServoAccuracyRun run;
+      run.start = static_cast<int>(i);
+      run.status = result.status;
+      run.message = result.message;
+      run.moves = result.moves;
+      if (!result.iterations.empty()) {
+        const ServoIteration& first = result.iterations.front();
+        const ServoIteration& last = result.iterations.back();
+        run.start_distance_m = first.true_translation_error_mm * 1e-3;
+        run.start_off_deg = first.true_rotation_error_deg;
+        run.final_translation_error_mm = last.true_translation_error_mm;
+        run.final_rotation_error_deg = last.true_rotation_error_deg;
+      }
+      law.runs.push_back(run);
+      if (progress) progress(++done, total);
+    }
+    report.laws.push_back(std::move(law));
+  }
+  return report;
+}
+
+}  // namespace oal

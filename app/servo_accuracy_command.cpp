@@ -1,0 +1,126 @@
+#include "app/servo_accuracy_command.h"
+
+#include <CLI/CLI.hpp>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/atomic_file.h"
+#include "app/command_line.h"
+#include "app/detector_accuracy.h"  // Quantile
+#include "app/servo_accuracy.h"
+#include "app/servo_command.h"
+
+namespace oal {
+namespace {
+
+std::string Table(const ServoAccuracyReport& report) {
+  std::ostringstream out;
+  out << "| law | converged | moves median / p95 / max | true final error median / max |\n"
+      << "|---|---:|---:|---|\n";
+  for (const ServoAccuracyLaw& law : report.laws) {
+    std::vector<double> moves, mm, deg;
+    for (const ServoAccuracyRun& run : law.runs) {
+      if (run.status != ServoRunStatus::kConverged) continue;
+      moves.push_back(run.moves);
+      mm.push_back(run.final_translation_error_mm);
+      deg.push_back(run.final_rotation_error_deg);
+    }
+    const int n = static_cast<int>(law.runs.size());
+    out << std::fixed << "| " << ToString(law.mode) << " | " << law.converged() << " / " << n
+        << " (" << std::setprecision(1) << 100.0 * law.converged() / n << " %) | "
+        << std::setprecision(0) << Quantile(moves, 0.5) << " / " << Quantile(moves, 0.95) << " / "
+        << Quantile(moves, 1.0) << " | " << std::setprecision(2) << Quantile(mm, 0.5) << " mm "
+        << std::setprecision(3) << Quantile(deg, 0.5) << "° / " << std::setprecision(2)
+        << Quantile(mm, 1.0) << " mm " << std::setprecision(3) << Quantile(deg, 1.0) << "° |\n";
+  }
+  for (const ServoAccuracyLaw& law : report.laws) {
+    for (const ServoAccuracyRun& run : law.runs) {
+      if (run.status == ServoRunStatus::kConverged) continue;
+      out << "- " << ToString(law.mode) << ", start " << run.start << " (" << std::setprecision(0)
+          << run.start_distance_m * 1e3 << " mm, " << std::setprecision(1) << run.start_off_deg
+          << "° from the goal): " << ToString(run.status) << ": " << run.message << '\n';
+    }
+  }
+  return out.str();
+}
+
+nlohmann::json ToJson(const ServoAccuracyReport& report) {
+  const ServoAccuracyOptions& o = report.options;
+  nlohmann::json laws = nlohmann::json::array();
+  for (const ServoAccuracyLaw& law : report.laws) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const ServoAccuracyRun& run : law.runs) {
+      runs.push_back({{"start", run.start},
+                      {"status", ToString(run.status)},
+                      {"message", run.message},
+                      {"moves", run.moves},
+                      {"start_distance_to_goal_m", run.start_distance_m},
+                      {"start_rotation_to_goal_deg", run.start_off_deg},
+                      {"final_true_translation_error_mm", run.final_translation_error_mm},
+                      {"final_true_rotation_error_deg", run.final_rotation_error_deg}});
+    }
+    laws.push_back({{"law", ToString(law.mode)},
+                    {"starts", law.runs.size()},
+                    {"converged", law.converged()},
+                    {"runs", runs}});
+  }
+  return {{"options",
+           {{"starts", o.starts},
+            {"seed", o.seed},
+            {"min_distance_m", o.min_distance_m},
+            {"max_distance_m", o.max_distance_m},
+            {"max_off_deg", o.max_off_deg},
+            {"max_iterations", o.max_iterations}}},
+          {"laws", laws}};
+}
+
+}  // namespace
+
+int RunServoAccuracy(int argc, char** argv) {
+  CLI::App cli{
+      "Closed-loop convergence of the servo loop from random start poses (fixed seed), image "
+      "in the loop, for each law: starts 0.3-0.8 m from the target, up to 30 deg off; the goal "
+      "and the camera from the configuration (default: the built-in config/servo-sim.yaml).",
+      "oalservo servo-accuracy"};
+  ServoAccuracyOptions options;
+  std::string config_path, out_path;
+  std::vector<std::string> laws;
+  cli.add_option("--config", config_path, "YAML configuration (as for oalservo servo)")
+      ->check(CLI::ExistingFile);
+  cli.add_option("--starts", options.starts, "random start poses per law")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  cli.add_option("--seed", options.seed, "seed of the start poses")->capture_default_str();
+  cli.add_option("--min-distance", options.min_distance_m, "metres")->capture_default_str();
+  cli.add_option("--max-distance", options.max_distance_m, "metres")->capture_default_str();
+  cli.add_option("--max-off-deg", options.max_off_deg, "tilt and roll bound")
+      ->capture_default_str();
+  cli.add_option("--max-iterations", options.max_iterations,
+                 "overrides servo.max_iterations (0: as configured)")
+      ->capture_default_str();
+  cli.add_option("--laws", laws, "laws to run (default: all three)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"point-and-go", "exponential", "velocity"}));
+  cli.add_option("--out", out_path, "write the runs as JSON to this file");
+  cli.footer(
+      "Example:\n"
+      "  oalservo servo-accuracy --starts 100 --out out/servo-accuracy.json");
+  if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  if (!out_path.empty()) CheckOutputFile(out_path);
+  if (!laws.empty()) {
+    options.modes.clear();
+    for (const std::string& law : laws) options.modes.push_back(ServoModeFromString(law));
+  }
+  ServoCommandOptions servo;
+  servo.config_path = config_path;
+  const ServoAppConfig config = LoadServoConfig(servo);
+  const ServoAccuracyReport report =
+      EvaluateServoAccuracy(config, options, FrameProgress("servo run", 30.0));
+  std::cout << Table(report);
+  if (!out_path.empty()) WriteFileAtomically(out_path, ToJson(report).dump(2) + '\n');
+  return kExitOk;
+}
+
+}  // namespace oal

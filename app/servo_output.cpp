@@ -1,0 +1,194 @@
+#include "app/servo_output.h"
+
+#include <visp3/core/vpConfig.h>
+#include <visp3/core/vpDisplay.h>
+#include <visp3/core/vpImage.h>
+#include <visp3/core/vpImageConvert.h>
+#include <visp3/core/vpRGBa.h>
+#ifdef VISP_HAVE_X11
+#include <visp3/gui/vpDisplayX.h>
+#endif
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iomanip>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "app/annotate.h"
+#include "app/atomic_file.h"
+
+namespace oal {
+namespace {
+
+const cv::Scalar kWhite(255, 255, 255), kBlack(0, 0, 0);
+
+// A string for a gnuplot single-quoted literal ('' is a quote).
+std::string GnuplotQuoted(const std::string& text) {
+  std::string quoted = "'";
+  for (char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+  return quoted + "'";
+}
+
+// A word for /bin/sh, single-quoted.
+std::string ShellQuoted(const std::string& text) {
+  std::string quoted = "'";
+  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+// Errors as "nan": gnuplot leaves such points out.
+std::string Value(double value) {
+  if (!std::isfinite(value)) return "nan";
+  std::ostringstream text;
+  text << std::setprecision(9) << value;
+  return text.str();
+}
+
+std::string Fixed(double value, int digits) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(digits) << value;
+  return text.str();
+}
+
+}  // namespace
+
+std::string ServoPlotScript(const ServoRunReport& report, const ServoOptions& law,
+                            const std::filesystem::path& png) {
+  bool truth = false;
+  for (const ServoIteration& row : report.iterations) {
+    truth = truth || std::isfinite(row.true_translation_error_mm);
+  }
+  std::ostringstream gp;
+  gp << "$errors << EOD\n";
+  for (const ServoIteration& row : report.iterations) {
+    gp << row.iteration << ' ' << Value(row.translation_error_mm) << ' '
+       << Value(row.rotation_error_deg) << ' ' << Value(row.true_translation_error_mm) << ' '
+       << Value(row.true_rotation_error_deg) << '\n';
+  }
+  gp << "EOD\n"
+     << "set terminal pngcairo size 800,640 font 'sans,10'\n"
+     << "set output " << GnuplotQuoted(png.string()) << "\n"
+     << "set multiplot layout 2,1 title "
+     << GnuplotQuoted("oalservo servo: " + ToString(law.mode) + " law, " + ToString(report.status) +
+                      " after " + std::to_string(report.iterations.size()) + " frames")
+     << "\n"
+     << "set logscale y\nset grid\nset key top right\nset xlabel 'iteration'\n"
+     << "set xtics 1\nset xrange [-0.3:" << std::max<std::size_t>(report.iterations.size(), 2) - 0.7
+     << "]\n";
+  const auto panel = [&](const char* label, int estimated, int true_column, double tolerance) {
+    gp << "set ylabel " << GnuplotQuoted(label) << "\n"
+       << "plot $errors using 1:" << estimated
+       << " with linespoints lw 2 pt 7 title 'estimated (what the law sees)'";
+    if (truth) {
+      gp << ", $errors using 1:" << true_column
+         << " with linespoints lw 2 pt 5 title 'true (simulation)'";
+    }
+    gp << ", " << Value(tolerance) << " with lines dt 2 lc rgb 'black' title 'tolerance'\n";
+  };
+  panel("translation error to the goal (mm)", 2, 4, law.translation_tolerance_m * 1e3);
+  panel("rotation error to the goal (deg)", 3, 5, law.rotation_tolerance_deg);
+  gp << "unset multiplot\n";
+  return gp.str();
+}
+
+void WriteServoPlot(const ServoRunReport& report, const ServoOptions& law,
+                    const std::filesystem::path& path) {
+  // gnuplot draws into a temporary file that replaces `path` only when it succeeded.
+  const std::filesystem::path temp = TempPathFor(path);
+  const std::filesystem::path script = TempPathFor(path.string() + ".gp");
+  WriteFileAtomically(script, ServoPlotScript(report, law, temp));
+  const std::string command = "gnuplot " + ShellQuoted(script.string()) + " 2>&1";
+  std::string output;
+  int status = -1;
+  if (FILE* pipe = popen(command.c_str(), "r")) {
+    char buffer[256];
+    while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
+    status = pclose(pipe);
+  }
+  RemoveQuietly(script);
+  std::error_code error;
+  if (status != 0 || !std::filesystem::is_regular_file(temp, error)) {
+    RemoveQuietly(temp);
+    throw std::runtime_error("cannot plot " + path.string() + " with gnuplot (" +
+                             (status == -1 || (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+                                  ? std::string("gnuplot not found: install gnuplot-nox")
+                                  : "exit status " + std::to_string(status)) +
+                             (output.empty() ? "" : "): " + output.substr(0, 300)) + ")");
+  }
+  std::filesystem::rename(temp, path);
+}
+
+cv::Mat AnnotateServoFrame(const ServoFrame& frame) {
+  const std::optional<vpCameraParameters> undistorted_by =
+      frame.lines_undistorted ? std::optional<vpCameraParameters>(frame.camera) : std::nullopt;
+  cv::Mat image = AnnotatePose(frame.gray, frame.lines, frame.pose, frame.camera, undistorted_by);
+  const ServoIteration& row = frame.row;
+  std::string caption = "iteration " + std::to_string(row.iteration) + "  " + row.status;
+  if (std::isfinite(row.translation_error_mm)) {
+    caption += "  error " + Fixed(row.translation_error_mm, 2) + " mm " +
+               Fixed(row.rotation_error_deg, 3) + " deg";
+  }
+  const int y = image.rows - 10;
+  cv::putText(image, caption, cv::Point(8, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, kBlack, 3,
+              cv::LINE_AA);
+  cv::putText(image, caption, cv::Point(8, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, kWhite, 1,
+              cv::LINE_AA);
+  return image;
+}
+
+bool CanOpenServoWindow() {
+#ifdef VISP_HAVE_X11
+  const char* display = std::getenv("DISPLAY");
+  return display != nullptr && *display != '\0';
+#else
+  return false;
+#endif
+}
+
+struct ServoWindow::Impl {
+  vpImage<vpRGBa> image;
+#ifdef VISP_HAVE_X11
+  vpDisplayX display;
+#endif
+  bool open = false;
+  bool clicked = false;
+};
+
+ServoWindow::ServoWindow() {
+  if (!CanOpenServoWindow()) {
+    throw std::runtime_error(
+        "output.display is on but no window can be opened (no X11 display: $DISPLAY is unset "
+        "or this ViSP has no X11); use output.display: auto or off");
+  }
+  impl_ = std::make_unique<Impl>();
+}
+
+ServoWindow::~ServoWindow() = default;
+
+void ServoWindow::Show(const cv::Mat& bgr) {
+#ifdef VISP_HAVE_X11
+  vpImageConvert::convert(bgr, impl_->image);
+  if (!impl_->open) {
+    impl_->display.init(impl_->image, 0, 0, "oalservo servo (click to stop)");
+    impl_->open = true;
+  }
+  vpDisplay::display(impl_->image);
+  vpDisplay::flush(impl_->image);
+#else
+  (void)bgr;
+#endif
+}
+
+bool ServoWindow::StopClicked() {
+  if (impl_->open && !impl_->clicked) impl_->clicked = vpDisplay::getClick(impl_->image, false);
+  return impl_->clicked;
+}
+
+}  // namespace oal

@@ -1,0 +1,56 @@
+// What `oalservo servo` shows and writes besides the table (issue 5): the pose-error plot, the
+// annotated frames of a headless run and the live vpDisplayX window.
+//
+//   DIR/servo.csv          one row per iteration (WriteServoCsv, servo_loop.h)
+//   DIR/servo-error.png    translation (mm) and rotation (deg) error per iteration, estimated
+//                          and (simulation) true, against the tolerances, drawn by gnuplot
+//   DIR/frames/iter_NNNN.png  each iteration's frame with the identified lines 1-4, the
+//                          target frame and the errors (no window, output.save_frames)
+// Every file is written atomically.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <opencv2/core/mat.hpp>
+#include <string>
+
+#include "app/servo_loop.h"
+
+namespace oal {
+
+/// The gnuplot script that draws `report`'s errors per iteration (estimated, and true in
+/// simulation, with the law's tolerances; log scale) into the PNG `png`.
+std::string ServoPlotScript(const ServoRunReport& report, const ServoOptions& law,
+                            const std::filesystem::path& png);
+/// Runs gnuplot (Debian's gnuplot-nox) on ServoPlotScript; `path` appears only once complete.
+/// Throws std::runtime_error with gnuplot's message when it is missing or fails.
+void WriteServoPlot(const ServoRunReport& report, const ServoOptions& law,
+                    const std::filesystem::path& path);
+
+/// The frame of one iteration annotated: the pose's lines, corners and target frame
+/// (AnnotatePose) and a caption with the iteration, the errors and the status.
+cv::Mat AnnotateServoFrame(const ServoFrame& frame);
+
+/// True when a window can be opened: this ViSP has X11 and $DISPLAY is set.
+bool CanOpenServoWindow();
+
+/// A vpDisplayX window that shows annotated frames; a click in it asks the loop to stop.
+class ServoWindow {
+ public:
+  /// Throws std::runtime_error when no window can be opened (CanOpenServoWindow()).
+  ServoWindow();
+  ~ServoWindow();
+  ServoWindow(const ServoWindow&) = delete;
+  ServoWindow& operator=(const ServoWindow&) = delete;
+
+  /// Shows a BGR frame (the window opens on the first one, at its size).
+  void Show(const cv::Mat& bgr);
+  /// True once the user has clicked in the window.
+  bool StopClicked();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace oal
