@@ -78,6 +78,7 @@ ServoAccuracyReport EvaluateServoAccuracy(const ServoAppConfig& config,
       const ServoRunReport result = RunServo(run_config, log);
       ServoAccuracyRun run;
       run.start = static_cast<int>(i);
+      run.start_wMc = starts[i];
       run.status = result.status;
       run.message = result.message;
       run.moves = result.moves;

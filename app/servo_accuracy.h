@@ -37,7 +37,8 @@ struct ServoAccuracyOptions {
 
 /// One run from one start.
 struct ServoAccuracyRun {
-  int start = 0;  ///< index of the start pose
+  int start = 0;                  ///< index of the start pose
+  vpHomogeneousMatrix start_wMc;  ///< the start pose (robot.start), to re-run it alone
   ServoRunStatus status = ServoRunStatus::kError;
   std::string message;
   int moves = 0;

@@ -1,5 +1,8 @@
 #include "app/servo_accuracy_command.h"
 
+#include <visp3/core/vpMath.h>
+#include <visp3/core/vpRxyzVector.h>
+
 #include <CLI/CLI.hpp>
 #include <iomanip>
 #include <iostream>
@@ -52,7 +55,14 @@ nlohmann::json ToJson(const ServoAccuracyReport& report) {
   for (const ServoAccuracyLaw& law : report.laws) {
     nlohmann::json runs = nlohmann::json::array();
     for (const ServoAccuracyRun& run : law.runs) {
+      const vpRxyzVector rxyz(run.start_wMc.getRotationMatrix());
+      const vpTranslationVector t = run.start_wMc.getTranslationVector();
+      // The config's pose form: `robot: {start: ...}` re-runs this start alone.
+      const nlohmann::json start_pose = {
+          {"translation_m", {t[0], t[1], t[2]}},
+          {"rxyz_deg", {vpMath::deg(rxyz[0]), vpMath::deg(rxyz[1]), vpMath::deg(rxyz[2])}}};
       runs.push_back({{"start", run.start},
+                      {"robot_start", start_pose},
                       {"status", ToString(run.status)},
                       {"message", run.message},
                       {"moves", run.moves},

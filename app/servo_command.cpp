@@ -75,6 +75,7 @@ class FrameOutput {
   }
 
   bool Active() const { return window_ != nullptr || save_; }
+  ServoWindow* window() { return window_.get(); }
   bool HasWindow() const { return window_ != nullptr; }
 
   // Shows or writes the frame; true when the user asked to stop (a click in the window).
@@ -141,6 +142,10 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
         << (frames.Active() && !frames.HasWindow() ? " and " + (dir / "frames").string() + "/"
                                                    : std::string())
         << '\n';
+  }
+  if (ServoWindow* window = frames.window(); window != nullptr && !window->StopClicked()) {
+    out << "oalservo servo: click in the window to close it" << std::endl;
+    window->WaitForClick(hooks.interrupt);
   }
   return report;
 }

@@ -369,6 +369,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
                         std::to_string(config.camera.width) + "x" +
                         std::to_string(config.camera.height) + "; robot stopped");
     }
+    if (hooks.on_grab) hooks.on_grab(iteration, &gray);
     report.iterations.push_back(row);
     ServoIteration& current = report.iterations.back();
 

@@ -112,6 +112,9 @@ struct ServoRunHooks {
   std::function<void(SafeRobot*)> on_robot;
   /// Called once per frame, after the pose and the law, before the robot moves.
   std::function<void(const ServoFrame&)> on_frame;
+  /// Called with each frame before detection; may change it (tests inject occlusions and a
+  /// target leaving the view through it). The frame may be a view of the source's buffer.
+  std::function<void(int iteration, cv::Mat* gray)> on_grab;
 };
 
 /// The goal of a taught configuration: the pose of config.target estimated in the image

@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "app/annotate.h"
@@ -189,6 +191,13 @@ void ServoWindow::Show(const cv::Mat& bgr) {
 bool ServoWindow::StopClicked() {
   if (impl_->open && !impl_->clicked) impl_->clicked = vpDisplay::getClick(impl_->image, false);
   return impl_->clicked;
+}
+
+void ServoWindow::WaitForClick(const std::atomic<bool>* interrupt) {
+  while (impl_->open && !vpDisplay::getClick(impl_->image, false)) {
+    if (interrupt != nullptr && interrupt->load()) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
 }
 
 }  // namespace oal

@@ -9,6 +9,7 @@
 // Every file is written atomically.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <opencv2/core/mat.hpp>
@@ -47,6 +48,9 @@ class ServoWindow {
   void Show(const cv::Mat& bgr);
   /// True once the user has clicked in the window.
   bool StopClicked();
+  /// Waits for a click in the window (for the user to look at the last frame), or until
+  /// `*interrupt` is set (Ctrl-C).
+  void WaitForClick(const std::atomic<bool>* interrupt);
 
  private:
   struct Impl;

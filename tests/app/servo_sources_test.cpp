@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
@@ -314,6 +315,45 @@ TEST(ServoLoopTable3, PointAndGoReachesTheGoalWithinThreeMoves) {
   EXPECT_LE(report.moves, 3) << log.str();
   EXPECT_LE(report.iterations.back().true_translation_error_mm, 1.0);
   EXPECT_LE(report.iterations.back().true_rotation_error_deg, 0.1);
+}
+
+}  // namespace
+}  // namespace oal
+
+namespace oal {
+namespace {
+
+// Failure injection during the run: the frame is changed before detection.
+ServoRunReport RunWithFrameChange(int from_iteration, const std::function<void(cv::Mat*)>& change) {
+  const ServoAppConfig config = Small(DefaultServoConfig());
+  ServoRunHooks hooks;
+  hooks.on_grab = [&](int iteration, cv::Mat* gray) {
+    if (iteration >= from_iteration) change(gray);
+  };
+  std::ostringstream log;
+  return RunServo(config, log, hooks);
+}
+
+TEST(ServoFailureInjection, TargetLeavingTheViewStopsTheRobot) {
+  const ServoRunReport report =
+      RunWithFrameChange(2, [](cv::Mat* gray) { gray->setTo(cv::Scalar(200)); });
+  EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 2: not-enough-lines"));
+  EXPECT_THAT(report.message, HasSubstr("robot stopped"));
+  EXPECT_EQ(report.moves, 2);  // no move after the frame without the target
+  EXPECT_TRUE(report.robot_stopped);
+  EXPECT_EQ(report.iterations.back().status, "target-lost");
+}
+
+TEST(ServoFailureInjection, OccludedLinesStopTheRobot) {
+  // A sheet of paper over the right half of the view hides two of the four lines.
+  const ServoRunReport report = RunWithFrameChange(1, [](cv::Mat* gray) {
+    (*gray)(cv::Rect(gray->cols / 2, 0, gray->cols / 2, gray->rows)).setTo(cv::Scalar(215));
+  });
+  EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 1"));
+  EXPECT_EQ(report.moves, 1);
+  EXPECT_TRUE(report.robot_stopped);
 }
 
 }  // namespace
