@@ -17,6 +17,7 @@
 #include "app/servo_loop.h"
 #include "app/servo_output.h"
 #include "scene/scene.h"
+#include "servo_test_util.h"
 #include "test_util.h"
 
 namespace oal {
@@ -24,16 +25,6 @@ namespace {
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
-
-// 320x240 with the default's field of view keeps the suite fast.
-ServoAppConfig Small(ServoAppConfig config) {
-  config.camera.width = 320;
-  config.camera.height = 240;
-  config.camera.px = config.camera.py = 300.0;
-  config.camera.u0 = 159.5;
-  config.camera.v0 = 119.5;
-  return config;
-}
 
 // What the configured camera sees from cMo, as the renderer draws it, written as PNG.
 void WriteView(const ServoAppConfig& config, const vpHomogeneousMatrix& cMo, std::uint64_t seed,
@@ -58,18 +49,11 @@ void WriteView(const ServoAppConfig& config, const vpHomogeneousMatrix& cMo, std
 }
 
 std::string ErrorOf(const std::string& yaml) {
-  try {
-    ParseConfig(yaml, "dir/servo.yaml");
-  } catch (const std::runtime_error& error) {
-    return error.what();
-  }
-  return "";
+  return test::ConfigErrorOf(yaml, "dir/servo.yaml");
 }
 
-bool SamePose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
-  const PoseDistance d = Distance(a, b);
-  return d.translation_m < 1e-12 && d.rotation_rad < 1e-12;
-}
+using test::SamePose;
+using test::Small;
 
 TEST(ServoConfigSections, SourceOutputAndGoalImageAreReadAndChecked) {
   const AppConfig config = ParseConfig(
@@ -307,7 +291,7 @@ TEST(ServoAccuracy, EveryLawConvergesFromRandomStarts) {
 }
 
 TEST(ServoLoopTable3, PointAndGoReachesTheGoalWithinThreeMoves) {
-  ServoAppConfig config = LoadConfig(std::string(OAL_SOURCE_DIR) + "/config/table3-sim.yaml");
+  ServoAppConfig config = test::ShippedServoConfig("table3-sim.yaml");
   config.servo.law.mode = ServoMode::kPointAndGo;
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);

@@ -13,6 +13,7 @@
 #include "app/servo_command.h"
 #include "app/servo_default_config.h"
 #include "app/servo_loop.h"
+#include "servo_test_util.h"
 
 namespace oal {
 namespace {
@@ -33,29 +34,13 @@ std::string ReadText(const std::string& path) {
   return text.str();
 }
 
-// Small images keep the suite fast: 320x240 with the same field of view.
-ServoAppConfig Small(ServoAppConfig config) {
-  config.camera.width = 320;
-  config.camera.height = 240;
-  config.camera.px = config.camera.py = 300.0;
-  config.camera.u0 = 159.5;
-  config.camera.v0 = 119.5;
-  return config;
-}
-
 std::string ErrorOf(const std::string& yaml) {
-  try {
-    ParseConfig(yaml, "servo.yaml");
-  } catch (const std::runtime_error& error) {
-    return error.what();
-  }
-  return "";
+  return test::ConfigErrorOf(yaml, "servo.yaml");
 }
 
-bool SamePose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
-  const PoseDistance d = Distance(a, b);
-  return d.translation_m < 1e-12 && d.rotation_rad < 1e-12;
-}
+using test::SamePose;
+using test::ShippedServoConfig;
+using test::Small;
 
 TEST(ServoConfig, BuiltInDefaultIsConfigServoSimYaml) {
   EXPECT_EQ(std::string(kDefaultServoConfigYaml), ReadText(SourcePath("config/servo-sim.yaml")));
@@ -75,7 +60,7 @@ TEST(ServoConfig, BuiltInDefaultIsConfigServoSimYaml) {
 }
 
 TEST(ServoConfig, ShippedTable3UsesThePaperConvention) {
-  const ServoAppConfig config = LoadConfig(SourcePath("config/table3-sim.yaml"));
+  const ServoAppConfig config = ShippedServoConfig("table3-sim.yaml");
   double x, y, z, pitch, roll;
   Table3Columns(config.robot.start_wMc, &x, &y, &z, &pitch, &roll);
   EXPECT_NEAR(x, 490, 1e-9);
@@ -137,7 +122,7 @@ TEST(ServoLoop, DefaultConfigConvergesWithTheImageInTheLoop) {
 }
 
 TEST(ServoLoop, Table3ConvergesWithin10IterationsWithDelta08) {
-  const ServoAppConfig config = LoadConfig(SourcePath("config/table3-sim.yaml"));
+  const ServoAppConfig config = ShippedServoConfig("table3-sim.yaml");
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   std::cout << "Table 3, image in the loop, exponential, delta 0.8:\n"
@@ -154,7 +139,7 @@ TEST(ServoLoop, Table3ConvergesWithin10IterationsWithDelta08) {
 // as on a perfect camera; uncorrected (the paper's condition) it never reaches the goal and
 // the loop stops itself, with the robot stopped, rather than servo on a flipping pose.
 TEST(ServoLoop, Table3WithDistortionCorrectedConverges) {
-  const ServoAppConfig config = LoadConfig(SourcePath("config/table3-sim-distorted.yaml"));
+  const ServoAppConfig config = ShippedServoConfig("table3-sim-distorted.yaml");
   ASSERT_TRUE(config.camera.correct_distortion);
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
@@ -164,14 +149,17 @@ TEST(ServoLoop, Table3WithDistortionCorrectedConverges) {
   EXPECT_LE(report.iterations.back().true_rotation_error_deg, kTolRotationDeg);
 }
 
-TEST(ServoLoop, Table3WithDistortionUncorrectedDoesNotConvergeAndStops) {
-  const ServoAppConfig config = LoadConfig(SourcePath("config/table3-sim-paper.yaml"));
+// Uncorrected, the curved lines bias the pose: the loop ends (it stops itself, or believes it
+// has arrived) far from the true goal, with the robot stopped.
+TEST(ServoLoop, Table3WithDistortionUncorrectedMissesTheTrueGoal) {
+  const ServoAppConfig config = ShippedServoConfig("table3-sim-paper.yaml");
   ASSERT_FALSE(config.camera.correct_distortion);
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
-  EXPECT_NE(report.status, ServoRunStatus::kConverged);
   EXPECT_TRUE(report.robot_stopped);
   EXPECT_FALSE(report.message.empty());
+  ASSERT_FALSE(report.iterations.empty());
+  EXPECT_GT(report.iterations.back().true_translation_error_mm, 5.0) << report.message;
 }
 
 TEST(ServoLoop, TargetOutOfViewStopsWithTargetLost) {

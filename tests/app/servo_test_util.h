@@ -1,0 +1,45 @@
+// Helpers shared by the servo app's tests.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "app/config.h"
+#include "app/servo_command.h"
+#include "robots/robot.h"
+
+namespace oal::test {
+
+/// Small images keep the suite fast: 320x240 with the same field of view.
+inline ServoAppConfig Small(ServoAppConfig config) {
+  config.camera.width = 320;
+  config.camera.height = 240;
+  config.camera.px = config.camera.py = 300.0;
+  config.camera.u0 = 159.5;
+  config.camera.v0 = 119.5;
+  return config;
+}
+
+/// The message ParseConfig throws for `yaml` read as `file_name`; empty if it is accepted.
+inline std::string ConfigErrorOf(const std::string& yaml, const std::string& file_name) {
+  try {
+    ParseConfig(yaml, file_name);
+  } catch (const std::runtime_error& error) {
+    return error.what();
+  }
+  return "";
+}
+
+/// A shipped config/ file as `oalservo servo --config` reads it: over the built-in default.
+inline ServoAppConfig ShippedServoConfig(const std::string& name) {
+  ServoCommandOptions options;
+  options.config_path = std::string(OAL_SOURCE_DIR) + "/config/" + name;
+  return LoadServoConfig(options);
+}
+
+inline bool SamePose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
+  const PoseDistance d = Distance(a, b);
+  return d.translation_m < 1e-12 && d.rotation_rad < 1e-12;
+}
+
+}  // namespace oal::test
