@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "servo/pose.h"
 
 namespace oal {
 
@@ -23,5 +24,13 @@ std::vector<std::vector<cv::Point2d>> LineInFrame(
 /// labelled with their index in `lines`).
 cv::Mat AnnotateLines(const cv::Mat& frame, const std::vector<DetectedLine>& lines,
                       const std::optional<vpCameraParameters>& undistorted_by);
+
+/// A colour copy of the grey `gray` with the lines the pose identified labelled 1-4, the
+/// corners and, when the pose is ok, the target frame's axes (x red, y green, z blue, 5 cm
+/// long) projected with `camera`; the pose status top left. `lines` are the lines the pose
+/// was estimated from (pose.line_index indexes them).
+cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines,
+                     const PoseResult& pose, const vpCameraParameters& camera,
+                     const std::optional<vpCameraParameters>& undistorted_by);
 
 }  // namespace oal

@@ -3,8 +3,12 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "app/atomic_file.h"
 
@@ -25,13 +29,47 @@ std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv) {
   return std::nullopt;
 }
 
+namespace {
+
+// The progress printer: `terminal` redraws one line, else one line per `every_s` seconds.
+std::function<void(int, int)> ProgressPrinter(const std::string& label, bool terminal,
+                                              double every_s) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  auto last = std::make_shared<Clock::time_point>(start);
+  return [=](int done, int total) {
+    const Clock::time_point now = Clock::now();
+    const bool end = total > 0 && done >= total;
+    if (!end && std::chrono::duration<double>(now - *last).count() < every_s) return;
+    *last = now;
+    const double elapsed_s = std::chrono::duration<double>(now - start).count();
+    const double rate = elapsed_s > 0.0 ? done / elapsed_s : 0.0;
+    char text[160];
+    int length = std::snprintf(text, sizeof text, "%s %d / %d, %.1f frames/s", label.c_str(), done,
+                               total, rate);
+    if (total > 0 && rate > 0.0 && length > 0 && length < static_cast<int>(sizeof text)) {
+      const long left_s = std::lround(std::max(0, total - done) / rate);
+      std::snprintf(text + length, sizeof text - static_cast<std::size_t>(length),
+                    ", ETA %ld:%02ld", left_s / 60, left_s % 60);
+    }
+    if (terminal) {
+      std::cerr << "\r" << text << "\x1b[K" << (end ? "\n" : "") << std::flush;
+    } else {
+      std::cerr << text << '\n';
+    }
+  };
+}
+
+}  // namespace
+
 std::function<void(int, int)> TerminalFrameProgress() {
   if (!isatty(fileno(stderr))) return {};
-  return [](int done, int total) {
-    if (done % 20 != 0 && done != total) return;
-    std::cerr << "\rframe " << done << " / " << total << std::flush;
-    if (done == total) std::cerr << '\n';
-  };
+  return ProgressPrinter("frame", true, 0.2);
+}
+
+std::function<void(int, int)> FrameProgress(const std::string& label, double plain_every_s) {
+  const bool terminal = isatty(fileno(stderr));
+  return ProgressPrinter(label, terminal, terminal ? 0.2 : plain_every_s);
 }
 
 void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,

@@ -39,9 +39,15 @@ class UsageError : public std::runtime_error {
 /// was printed: kExitOk), std::nullopt to go on. Throws UsageError on a bad command line.
 std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv);
 
-/// "frame N / total" on stderr, redrawn in place every 20 frames, when stderr is a
-/// terminal; nothing otherwise (logs stay clean).
+/// "frame N / total, R frames/s, ETA m:ss" on stderr, redrawn in place (at most 5 times a
+/// second, and at the end), when stderr is a terminal; nothing otherwise (logs stay clean).
 std::function<void(int done, int total)> TerminalFrameProgress();
+
+/// As TerminalFrameProgress, with `label` instead of "frame"; when stderr is not a terminal,
+/// a plain line "label N / total, R frames/s, ETA m:ss" every `plain_every_s` seconds and at
+/// the end. total <= 0: unknown (no ETA). Not thread-safe: callers serialise the calls.
+std::function<void(int done, int total)> FrameProgress(const std::string& label,
+                                                       double plain_every_s = 10.0);
 
 /// The checks every command over image sources shares: at least one input, max_frames >= 0
 /// and a writable --out. Throws std::invalid_argument naming `options_name`'s field.

@@ -24,6 +24,7 @@
 #include "app/config.h"
 #include "app/detector_accuracy.h"
 #include "app/image_source.h"
+#include "app/truth_file.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "detector/tracker.h"
@@ -516,15 +517,8 @@ class VpMeLineMethod : public LineMethod {
   throw std::runtime_error(path + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
 }
 
-std::string Trimmed(const std::string& text) {
-  const auto begin = text.find_first_not_of(" \t\r");
-  if (begin == std::string::npos) return "";
-  const auto end = text.find_last_not_of(" \t\r");
-  return text.substr(begin, end - begin + 1);
-}
+}  // namespace
 
-// The frame number a CSV row names: the last run of digits in the image's file name
-// (image.0001.pgm -> 1, frame_0007.png -> 7, video.avi#12 -> 12), else the position.
 int FrameNumber(const std::string& source, int position) {
   const std::string name = fs::path(source).filename().string();
   const auto last = name.find_last_of("0123456789");
@@ -534,6 +528,39 @@ int FrameNumber(const std::string& source, int position) {
   if (last - first >= 9) return position;
   return std::stoi(name.substr(first, last - first + 1));
 }
+
+std::vector<LineMatch> MatchLines(const std::vector<ReferenceLine>& references,
+                                  const std::vector<LineParams>& lines, double max_angle_deg,
+                                  double max_offset_px) {
+  struct Candidate {
+    double cost;
+    LineMatch match;
+  };
+  std::vector<Candidate> candidates;
+  for (std::size_t r = 0; r < references.size(); ++r) {
+    const ReferenceLine& reference = references[r];
+    for (std::size_t l = 0; l < lines.size(); ++l) {
+      const auto [angle, offset] =
+          ErrorOf(lines[l], reference.line, reference.end_a, reference.end_b);
+      if (angle <= max_angle_deg && offset <= max_offset_px) {
+        candidates.push_back(
+            {angle / max_angle_deg + offset / max_offset_px, {r, l, angle, offset}});
+      }
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+  std::vector<bool> reference_used(references.size(), false), line_used(lines.size(), false);
+  std::vector<LineMatch> matches;
+  for (const Candidate& c : candidates) {
+    if (reference_used[c.match.reference] || line_used[c.match.line]) continue;
+    reference_used[c.match.reference] = line_used[c.match.line] = true;
+    matches.push_back(c.match);
+  }
+  return matches;
+}
+
+namespace {
 
 // The visible chord of a line without one: its clip to the image.
 bool ClipChord(TargetLineTruth* truth, int width, int height) {
@@ -576,37 +603,22 @@ struct Scorer {
 
   void Score(const std::vector<LineParams>& lines, const std::vector<TargetLineTruth>& truth,
              bool ideal, MethodResult* result) const {
-    struct Candidate {
-      double cost, angle, offset;
-      std::size_t truth, line;
-    };
-    std::vector<Candidate> candidates;
-    for (std::size_t t = 0; t < truth.size(); ++t) {
-      const TargetLineTruth& target = truth[t];
+    std::vector<ReferenceLine> references;
+    for (const TargetLineTruth& target : truth) {
       const LineParams& reference = ideal ? target.ideal_line : target.image_line;
       const Point2d a = ideal && undistorter ? undistorter->Undistort(target.end_a)
                                              : Foot(reference, target.end_a);
       const Point2d b = ideal && undistorter ? undistorter->Undistort(target.end_b)
                                              : Foot(reference, target.end_b);
-      for (std::size_t l = 0; l < lines.size(); ++l) {
-        const auto [angle, offset] = ErrorOf(lines[l], reference, a, b);
-        if (angle <= max_angle_deg && offset <= max_offset_px) {
-          candidates.push_back(
-              {angle / max_angle_deg + offset / max_offset_px, angle, offset, t, l});
-        }
-      }
+      references.push_back({reference, a, b});
     }
-    std::sort(candidates.begin(), candidates.end(),
-              [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
-    std::vector<bool> truth_used(truth.size(), false), line_used(lines.size(), false);
-    int found = 0;
-    for (const Candidate& c : candidates) {
-      if (truth_used[c.truth] || line_used[c.line]) continue;
-      truth_used[c.truth] = line_used[c.line] = true;
-      result->angle_error_deg.push_back(c.angle);
-      result->offset_error_px.push_back(c.offset);
-      ++found;
+    const std::vector<LineMatch> matches =
+        MatchLines(references, lines, max_angle_deg, max_offset_px);
+    for (const LineMatch& match : matches) {
+      result->angle_error_deg.push_back(match.angle_deg);
+      result->offset_error_px.push_back(match.offset_px);
     }
+    const int found = static_cast<int>(matches.size());
     const int missed = static_cast<int>(truth.size()) - found;
     result->truth_lines += static_cast<int>(truth.size());
     result->found_lines += found;
@@ -763,59 +775,7 @@ void CompareOptions::Check() const {
 }
 
 std::map<int, std::vector<TargetLineTruth>> LoadTruthCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) FileError(path, 0, "cannot open the truth file");
-  std::map<int, std::vector<TargetLineTruth>> truth;
-  int number = 0;
-  for (std::string text; std::getline(in, text);) {
-    ++number;
-    const std::string line = Trimmed(text);
-    if (line.empty() || line[0] == '#') continue;
-    if (line.rfind("frame", 0) == 0) continue;  // header
-    std::vector<std::string> fields;
-    std::stringstream row(line);
-    for (std::string field; std::getline(row, field, ',');) fields.push_back(Trimmed(field));
-    if (fields.size() != 4) {
-      FileError(path, number,
-                "expected 4 comma-separated fields frame,line,rho,theta, got " +
-                    std::to_string(fields.size()));
-    }
-    const char* names[] = {"frame", "line", "rho", "theta"};
-    double values[4];
-    for (int i = 0; i < 4; ++i) {
-      std::size_t used = 0;
-      try {
-        values[i] = std::stod(fields[static_cast<std::size_t>(i)], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != fields[static_cast<std::size_t>(i)].size() ||
-          !std::isfinite(values[i])) {
-        FileError(path, number,
-                  std::string("field ") + names[i] + " is not a number: '" +
-                      fields[static_cast<std::size_t>(i)] + "'");
-      }
-    }
-    for (int i = 0; i < 2; ++i) {
-      if (values[i] < 0 || values[i] != std::floor(values[i]) || values[i] > 1e9) {
-        FileError(path, number, std::string("field ") + names[i] + " must be an integer >= 0");
-      }
-    }
-    TargetLineTruth target;
-    const int frame = static_cast<int>(values[0]);
-    target.id = static_cast<int>(values[1]);
-    target.image_line = target.ideal_line = Normalized(values[2], values[3]);
-    std::vector<TargetLineTruth>& lines = truth[frame];
-    for (const TargetLineTruth& other : lines) {
-      if (other.id == target.id) {
-        FileError(path, number,
-                  "line " + std::to_string(target.id) + " of frame " + std::to_string(frame) +
-                      " appears twice");
-      }
-    }
-    lines.push_back(target);
-  }
-  return truth;
+  return LoadTruthCsvWithPoses(path).lines;
 }
 
 std::vector<TargetLineTruth> LoadTruthJson(const std::string& path) {

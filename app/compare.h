@@ -43,8 +43,9 @@
 //              at integers (detector/line.h); image (distorted) coordinates; theta any value
 //              (normalised to [0, pi))
 //     An optional header row starting with "frame", blank lines and lines starting with '#'
-//     are skipped. A frame without rows has no truth line. The visible chord of a CSV line is
-//     its clip to the image rectangle. CSV lines are edges or centre lines as the target is.
+//     are skipped, and so are pose rows (app/truth_file.h, `oalservo evaluate`'s format). A frame
+//     without rows has no truth line. The visible chord of a CSV line is its clip to the image
+//     rectangle. CSV lines are edges or centre lines as the target is.
 //
 // Metrics per method (scored on the first K lines of the method, K = --lines if given, else
 // the frame's truth line count + 2):
@@ -92,6 +93,32 @@ struct TargetLineTruth {
   Point2d end_a, end_b;   ///< ends of the visible chord, image pixels
   double width_px = 0.0;  ///< stripe width, pixels (0: an edge or unknown)
 };
+
+/// The frame number a truth CSV row names for the frame read from `source` at 0-based
+/// `position` in its input: the last run of digits in the file name (image.0001.pgm -> 1,
+/// frame_0007.png -> 7, video.avi#12 -> 12), else `position`.
+int FrameNumber(const std::string& source, int position);
+
+/// A reference (truth) line in the coordinates of the lines it is matched with, and the ends
+/// of its visible chord.
+struct ReferenceLine {
+  LineParams line;
+  Point2d end_a, end_b;
+};
+
+/// A matched pair: indices into the references and the lines, the angle between the two
+/// lines (degrees) and the offset (the larger distance of the chord ends from the line, px).
+struct LineMatch {
+  std::size_t reference = 0, line = 0;
+  double angle_deg = 0.0, offset_px = 0.0;
+};
+
+/// Matches references and lines one to one, greedily by angle / max_angle_deg + offset /
+/// max_offset_px (lowest first, ties in reference then line order), among the pairs within
+/// both bounds (the `match` metric of the file comment). The matches in that order.
+std::vector<LineMatch> MatchLines(const std::vector<ReferenceLine>& references,
+                                  const std::vector<LineParams>& lines, double max_angle_deg,
+                                  double max_offset_px);
 
 /// Reads a truth CSV (format in the file comment): frame index -> its lines. Throws
 /// std::runtime_error "FILE:LINE: ..." for a missing file or a malformed row. Chord ends are

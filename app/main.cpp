@@ -15,6 +15,7 @@
 #include "app/detect_command.h"
 #include "app/detector_accuracy_command.h"
 #include "app/edge_reference_command.h"
+#include "app/evaluate_command.h"
 #include "app/pose_accuracy_command.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"
@@ -44,6 +45,8 @@ constexpr oal::Command kCommands[] = {
     {"render", &oal::RunRender, "render a synthetic data set with ground truth"},
     {"compare", &oal::RunCompare,
      "our detector, vpMeLine and OpenCV line detectors against ground truth"},
+    {"evaluate", &oal::RunEvaluate,
+     "evaluate the tracker and the pose on recorded videos: JSON, annotated video, HTML report"},
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
     {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
 };

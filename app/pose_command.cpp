@@ -1,7 +1,5 @@
 #include "app/pose_command.h"
 
-#include <visp3/core/vpMeterPixelConversion.h>
-
 #include <CLI/CLI.hpp>
 #include <array>
 #include <chrono>
@@ -28,8 +26,6 @@ namespace oal {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr double kAxisLengthM = 0.05;  // drawn target frame axes
 
 std::string AnnotationName(int frame) {
   std::string number = std::to_string(frame);
@@ -126,82 +122,6 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult
   };
 }
 
-// Pixel of the normalised point (x, y) in the frame: through the kdu model (the exact inverse
-// of the detector's undistortion, as annotate.cpp draws lines) when the camera has
-// distortion, else vpMeterPixelConversion.
-cv::Point2d FramePixel(const vpCameraParameters& camera, double x, double y) {
-  if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion &&
-      camera.get_kdu() != 0.0) {
-    const Point2d p = DistortedPixel(camera, x, y);
-    return cv::Point2d(p.u, p.v);
-  }
-  double u = 0.0, v = 0.0;
-  vpMeterPixelConversion::convertPoint(camera, x, y, u, v);
-  return cv::Point2d(u, v);
-}
-
-void DrawText(cv::Mat& image, const std::string& text, const cv::Point& origin,
-              const cv::Scalar& colour, double scale) {
-  cv::putText(image, text, origin, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), 3,
-              cv::LINE_AA);
-  cv::putText(image, text, origin, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
-}
-
-// The frame with the identified lines labelled 1-4, the corners, the target frame's axes
-// (x red, y green, z blue, kAxisLengthM long) when the pose is ok, and the status.
-cv::Mat AnnotatePose(const Frame& frame, const std::vector<DetectedLine>& lines,
-                     const PoseResult& pose, const vpCameraParameters& camera,
-                     const std::optional<vpCameraParameters>& undistorted_by) {
-  static const cv::Scalar kLineColours[4] = {
-      {0, 200, 255}, {255, 0, 200}, {255, 255, 0}, {0, 128, 255}};
-  cv::Mat image;
-  cv::cvtColor(frame.gray, image, cv::COLOR_GRAY2BGR);
-  const int w = frame.gray.cols, h = frame.gray.rows;
-  for (int k = 0; k < 4; ++k) {
-    const int index = pose.line_index[k];
-    if (index < 0 || index >= static_cast<int>(lines.size())) continue;
-    const auto runs = LineInFrame(lines[index].line, w, h, undistorted_by);
-    for (const auto& run : runs) {
-      for (std::size_t i = 1; i < run.size(); ++i) {
-        cv::line(image, run[i - 1], run[i], kLineColours[k], 2, cv::LINE_AA);
-      }
-    }
-    if (runs.empty() || runs.front().empty()) continue;
-    const auto& run = runs.front();
-    const cv::Point2d at = run[run.size() / 3];
-    DrawText(image, std::to_string(k + 1), cv::Point(cvRound(at.x) + 4, cvRound(at.y) - 4),
-             kLineColours[k], 0.5);
-  }
-  const bool ok = pose.status == PoseStatus::kOk;
-  if (ok) {
-    for (const vpColVector& corner : pose.corners_m) {
-      cv::circle(image, FramePixel(camera, corner[0], corner[1]), 3, cv::Scalar(255, 255, 255), 1,
-                 cv::LINE_AA);
-    }
-    // Object origin and axis ends in the camera frame, projected.
-    auto project = [&](double x, double y, double z) {
-      vpColVector o(4);
-      o[0] = x, o[1] = y, o[2] = z, o[3] = 1.0;
-      const vpColVector c = pose.cMo * o;
-      return FramePixel(camera, c[0] / c[2], c[1] / c[2]);
-    };
-    const cv::Point2d origin = project(0.0, 0.0, 0.0);
-    const std::array<cv::Point2d, 3> ends = {project(kAxisLengthM, 0.0, 0.0),
-                                             project(0.0, kAxisLengthM, 0.0),
-                                             project(0.0, 0.0, kAxisLengthM)};
-    const cv::Scalar kAxisColours[3] = {{0, 0, 255}, {0, 200, 0}, {255, 80, 0}};
-    for (int a = 0; a < 3; ++a) {
-      if (std::isfinite(ends[a].x) && std::isfinite(ends[a].y) && std::isfinite(origin.x) &&
-          std::isfinite(origin.y)) {
-        cv::arrowedLine(image, origin, ends[a], kAxisColours[a], 2, cv::LINE_AA, 0, 0.15);
-      }
-    }
-  }
-  DrawText(image, ToString(pose.status), cv::Point(4, 16),
-           ok ? cv::Scalar(0, 220, 0) : cv::Scalar(0, 0, 255), 0.45);
-  return image;
-}
-
 // Runs the detector and the pose over every frame, writing to `sink`; returns when the
 // sources end or max_frames is reached.
 void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream& sink,
@@ -234,7 +154,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
                     flush_each);
       if (!options.annotate_dir.empty()) {
         WritePng(fs::path(options.annotate_dir) / AnnotationName(summary->frames),
-                 AnnotatePose(frame, lines, pose, run->camera.camera, run->undistorted_by));
+                 AnnotatePose(frame.gray, lines, pose, run->camera.camera, run->undistorted_by));
       }
       if (pose.status == PoseStatus::kOk) {
         previous_cMo = pose.cMo;

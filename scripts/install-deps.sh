@@ -9,6 +9,7 @@ packages=(
   libopencv-dev libopencv-contrib-dev libeigen3-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libxml2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libjs-chart.js chromium
   gnuplot-nox
 )
 

@@ -156,10 +156,11 @@ TEST(Config, OutOfRangeValueNamesFileLineAndField) {
 TEST(Config, SectionsOtherThanTheKnownOnesAreRejected) {
   EXPECT_EQ(ErrorOf("detector: {}\ndetectr:\n  step_px: 5\n"),
             "cfg.yaml:2: section 'detectr' is unknown (known: detector, target, pose, camera, "
-            "robot, servo, goal, target_pose)");
+            "robot, servo, goal, target_pose, source, output)");
   EXPECT_EQ(ErrorOf("render:\n  gain: 0.5\n"),
             "cfg.yaml:1: section 'render' is not supported by this version of oalservo "
-            "(supported: detector, target, pose, camera, robot, servo, goal, target_pose)");
+            "(supported: detector, target, pose, camera, robot, servo, goal, target_pose, source, "
+            "output)");
   EXPECT_THAT(ErrorOf("- detector\n"), HasSubstr("cfg.yaml:1: the top level must be a map"));
   EXPECT_THAT(ErrorOf("detector: 5\n"), HasSubstr("cfg.yaml:1: section 'detector' must be a map"));
 }

@@ -1,0 +1,1316 @@
+#include "app/evaluate.h"
+
+#include <unistd.h>
+#include <visp3/core/vpImage.h>
+#include <visp3/core/vpThetaUVector.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "app/annotate.h"
+#include "app/atomic_file.h"
+#include "app/camera_file.h"
+#include "app/compare.h"
+#include "app/config.h"
+#include "app/detector_accuracy.h"
+#include "app/image_source.h"
+#include "app/report.h"
+#include "app/truth_file.h"
+#include "detector/lens.h"
+#include "detector/options.h"
+#include "detector/tracker.h"
+#include "servo/pose.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kRadToDeg = 180.0 / kPi;
+// A truth line is found when a tracked line is within both bounds of it.
+constexpr double kMatchAngleDeg = 5.0;
+constexpr double kMatchOffsetPx = 10.0;
+constexpr std::size_t kQueueFrames = 8;         // decoded frames waiting for the tracker
+constexpr int kMaxConsecutiveUnreadable = 50;   // then the input is given up as ended
+constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
+constexpr int kThumbnailSpacing = 10;           // worst frames at least this many frames apart
+constexpr int kThumbnailWidth = 320;
+constexpr double kVideoFps = 25.0;
+constexpr double kVideoQuality = 75.0;      // JPEG quality of the annotated video, [0, 100]
+constexpr std::size_t kPlottedTracks = 10;  // the tracks seen longest get a series
+
+double Us(Clock::duration d) {
+  return std::chrono::duration<double, std::micro>(d).count();
+}
+
+template <typename T>
+void Require(bool ok, const char* field, const T& value, const char* constraint) {
+  RequireOption(ok, std::string("EvaluateOptions::") + field, value, constraint);
+}
+
+// {count, mean, median, p95, max}; nulls for no values.
+Json Stats(const std::vector<double>& values) {
+  if (values.empty()) {
+    return Json{
+        {"count", 0}, {"mean", nullptr}, {"median", nullptr}, {"p95", nullptr}, {"max", nullptr}};
+  }
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  return Json{{"count", values.size()},
+              {"mean", sum / static_cast<double>(values.size())},
+              {"median", Quantile(values, 0.5)},
+              {"p95", Quantile(values, 0.95)},
+              {"max", *std::max_element(values.begin(), values.end())}};
+}
+
+// ---------------------------------------------------------------------------------------
+// Inputs.
+
+bool HoldsImages(const fs::path& dir) {
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
+    if (entry.is_regular_file() && HasImageExtension(entry.path().string())) return true;
+  }
+  return false;
+}
+
+// A file-system-safe name for the input's output directory.
+std::string BaseName(const std::string& spec) {
+  fs::path path = fs::path(spec).lexically_normal();
+  if (path.filename().empty()) path = path.parent_path();
+  std::string name;
+  if (spec.find('%') != std::string::npos && !fs::exists(spec)) {
+    name = path.parent_path().filename().string();  // frames/img%04d.png -> frames
+    if (name.empty() || name == "." || name == "..") name = path.stem().string();
+  } else if (fs::is_directory(path)) {
+    name = fs::absolute(path).lexically_normal().filename().string();
+    if (name.empty())
+      name = fs::absolute(path).lexically_normal().parent_path().filename().string();
+  } else {
+    name = path.stem().string();
+  }
+  for (char& c : name) {
+    const bool safe =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+    if (!safe) c = '_';
+  }
+  if (name.empty() || name[0] == '.') name = "input" + name;
+  return name;
+}
+
+// ---------------------------------------------------------------------------------------
+// A bounded queue between two threads. Close() ends it: Pop() drains what is left, then
+// returns nothing; Push() returns false (the consumer gave up).
+template <typename T>
+class BoundedQueue {
+ public:
+  explicit BoundedQueue(std::size_t capacity) : capacity_(capacity) {}
+
+  bool Push(T item) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    not_full_.wait(lock, [&] { return closed_ || items_.size() < capacity_; });
+    if (closed_) return false;
+    items_.push_back(std::move(item));
+    not_empty_.notify_one();
+    return true;
+  }
+  std::optional<T> Pop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    not_empty_.wait(lock, [&] { return closed_ || !items_.empty(); });
+    if (items_.empty()) return std::nullopt;
+    T item = std::move(items_.front());
+    items_.pop_front();
+    not_full_.notify_one();
+    return item;
+  }
+  void Close() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_ = true;
+    not_empty_.notify_all();
+    not_full_.notify_all();
+  }
+
+ private:
+  std::size_t capacity_;
+  std::mutex mutex_;
+  std::condition_variable not_full_, not_empty_;
+  std::deque<T> items_;
+  bool closed_ = false;
+};
+
+// Joins a thread when leaving the scope, also on an exception.
+class Joined {
+ public:
+  explicit Joined(std::thread thread) : thread_(std::move(thread)) {}
+  ~Joined() {
+    if (thread_.joinable()) thread_.join();
+  }
+  Joined(const Joined&) = delete;
+  Joined& operator=(const Joined&) = delete;
+  void Join() {
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::thread thread_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Stage 1: decoding.
+
+struct DecodedFrame {
+  int index = 0;
+  cv::Mat gray;  ///< continuous, owned
+  std::string source;
+  std::string error;  ///< non-empty: the frame could not be read
+  double decode_us = 0.0;
+};
+
+struct DecodeStats {
+  double total_us = 0.0;
+  std::string stop_reason;  ///< why reading stopped early ("" at the end of the source)
+};
+
+void DecodeFrames(ImageSource* source, int max_frames, BoundedQueue<DecodedFrame>* queue,
+                  DecodeStats* stats) {
+  Frame frame;
+  int consecutive_errors = 0;
+  for (int index = 0; max_frames == 0 || index < max_frames; ++index) {
+    DecodedFrame item;
+    item.index = index;
+    bool more = true;
+    const Clock::time_point start = Clock::now();
+    try {
+      more = source->Next(&frame);
+    } catch (const std::exception& error) {
+      item.error = error.what();
+    }
+    item.decode_us = Us(Clock::now() - start);
+    stats->total_us += item.decode_us;
+    if (!more) break;
+    if (item.error.empty()) {
+      item.gray = frame.gray.clone();  // the source may reuse its buffer for the next frame
+      item.source = frame.source;
+      consecutive_errors = 0;
+    } else {
+      item.source = source->Name() + " frame " + std::to_string(index);
+      if (++consecutive_errors > kMaxConsecutiveUnreadable) {
+        stats->stop_reason = "gave up after " + std::to_string(kMaxConsecutiveUnreadable) +
+                             " consecutive unreadable frames";
+        break;
+      }
+    }
+    if (!queue->Push(std::move(item))) break;
+  }
+  queue->Close();
+}
+
+// ---------------------------------------------------------------------------------------
+// Truth.
+
+struct FrameTruth {
+  bool known = false;
+  std::vector<TargetLineTruth> lines;  ///< visible lines, image pixels
+  std::optional<vpHomogeneousMatrix> cMo;
+};
+
+// Where an input's truth comes from, and each frame's.
+class TruthReader {
+ public:
+  TruthReader(const EvaluateOptions& options, const PlannedInput& input) {
+    if (!options.truth_path.empty()) {
+      if (fs::path(options.truth_path).extension() == ".csv") {
+        UseCsv(options.truth_path);
+      } else if (fs::is_directory(options.truth_path)) {
+        kind_ = "json";
+        json_dir_ = options.truth_path;
+      } else {
+        throw std::runtime_error("truth '" + options.truth_path +
+                                 "' is neither a .csv file nor a directory of frame JSON files");
+      }
+    } else if (HasVideoExtension(input.spec)) {
+      const fs::path csv = fs::path(input.spec).replace_extension(".truth.csv");
+      if (fs::is_regular_file(csv)) UseCsv(csv.string());
+    } else {
+      kind_ = "auto";  // JSON next to the images, decided at the first frame
+    }
+  }
+
+  const std::string& kind() const { return kind_; }
+  const std::string& path() const { return path_; }
+
+  FrameTruth Get(const std::string& source, int index, int width, int height) {
+    FrameTruth truth;
+    if (kind_ == "auto") {
+      kind_ = fs::is_regular_file(JsonPath(source)) ? "json" : "none";
+      if (kind_ == "json") path_ = fs::path(JsonPath(source)).parent_path().string();
+    }
+    if (kind_ == "json") {
+      const std::string path = JsonPath(source);
+      if (!fs::is_regular_file(path)) return truth;  // this frame has none
+      truth.known = true;
+      truth.lines = LoadTruthJson(path);
+      truth.cMo = LoadTruthPoseJson(path);
+    } else if (kind_ == "csv") {
+      truth.known = true;
+      const int number = FrameNumber(source, index);
+      const auto lines = csv_.lines.find(number);
+      if (lines != csv_.lines.end()) {
+        for (TargetLineTruth line : lines->second) {
+          if (ClipToRect(line.image_line, 0.0, 0.0, width - 1.0, height - 1.0, &line.end_a,
+                         &line.end_b)) {
+            truth.lines.push_back(line);
+          }
+        }
+      }
+      const auto pose = csv_.poses.find(number);
+      if (pose != csv_.poses.end()) truth.cMo = pose->second;
+    }
+    return truth;
+  }
+
+ private:
+  void UseCsv(const std::string& path) {
+    kind_ = "csv";
+    path_ = path;
+    csv_ = LoadTruthCsvWithPoses(path);
+  }
+  std::string JsonPath(const std::string& source) const {
+    const fs::path image(source);
+    return json_dir_.empty() ? fs::path(image).replace_extension(".json").string()
+                             : (fs::path(json_dir_) / (image.stem().string() + ".json")).string();
+  }
+
+  std::string kind_ = "none";  ///< none, json, csv (auto until the first frame)
+  std::string path_;           ///< the CSV, or the JSON files' directory
+  std::string json_dir_;
+  TruthCsv csv_;
+};
+
+// One truth line against the tracked lines: the matched track's errors.
+struct LineError {
+  int line = 0;
+  int track = -1;  ///< -1: not found
+  double angle_deg = 0.0, offset_px = 0.0;
+};
+
+// Matches truth lines to tracked lines one to one, closest pairs first (angle / 5° +
+// offset / 10 px, both within bounds). The truth is compared in the tracker's coordinates:
+// undistorted pixels when it undistorts (the JSON's `ideal` line; a CSV line through its
+// undistorted chord ends), else image pixels.
+std::vector<LineError> MatchTruth(const std::vector<TargetLineTruth>& truth,
+                                  const std::vector<DetectedLine>& held,
+                                  const std::vector<int>& ids,
+                                  const std::optional<PointUndistorter>& undistorter, bool json) {
+  std::vector<ReferenceLine> references;
+  for (const TargetLineTruth& target : truth) {
+    ReferenceLine reference{target.image_line, target.end_a, target.end_b};
+    if (undistorter) {
+      reference.end_a = undistorter->Undistort(target.end_a);
+      reference.end_b = undistorter->Undistort(target.end_b);
+      reference.line = json ? target.ideal_line : LineThrough(reference.end_a, reference.end_b);
+    }
+    references.push_back(reference);
+  }
+  std::vector<LineParams> lines;
+  for (const DetectedLine& line : held) lines.push_back(line.line);
+  std::vector<LineError> errors(truth.size());
+  for (std::size_t t = 0; t < truth.size(); ++t) errors[t].line = truth[t].id;
+  for (const LineMatch& match : MatchLines(references, lines, kMatchAngleDeg, kMatchOffsetPx)) {
+    LineError& error = errors[match.reference];
+    error.track = ids[match.line];
+    error.angle_deg = match.angle_deg;
+    error.offset_px = match.offset_px;
+  }
+  return errors;
+}
+
+// Translation (mm) and rotation (degrees) between an estimated and a true cMo.
+std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
+                                    const vpHomogeneousMatrix& truth) {
+  const vpTranslationVector dt = cMo.getTranslationVector() - truth.getTranslationVector();
+  const vpThetaUVector tu(truth.getRotationMatrix().t() * cMo.getRotationMatrix());
+  return {1000.0 * std::sqrt(dt.sumSquare()),
+          kRadToDeg * std::sqrt(tu[0] * tu[0] + tu[1] * tu[1] + tu[2] * tu[2])};
+}
+
+// ---------------------------------------------------------------------------------------
+// Stage 3: the annotated video and the worst frames.
+
+struct TrackedFrame {
+  int index = 0;
+  cv::Mat gray;
+  std::vector<DetectedLine> held;  ///< the lines held, best supported first
+  std::vector<int> ids;            ///< their track ids
+  std::optional<PoseResult> pose;  ///< none without a camera
+  double badness = 0.0;            ///< worst frames first (EvaluateInput)
+  std::string why;
+};
+
+// The `capacity` worst frames, at least kThumbnailSpacing frames apart, chosen as frames
+// stream by: the same frames in the same order give the same choice.
+class WorstFrames {
+ public:
+  explicit WorstFrames(std::size_t capacity) : capacity_(capacity) {}
+
+  bool Wants(int frame, double badness) const {
+    if (capacity_ == 0 || badness <= 0.0) return false;
+    double near = -1.0;
+    for (const Thumbnail& kept : kept_) {
+      if (std::abs(kept.frame - frame) < kThumbnailSpacing) {
+        near = std::max(near, badness_.at(kept.frame));
+      }
+    }
+    if (near >= 0.0) return badness > near;
+    return kept_.size() < capacity_ || badness > Weakest()->second;
+  }
+  void Add(Thumbnail thumbnail, double badness) {
+    const int frame = thumbnail.frame;
+    kept_.erase(std::remove_if(kept_.begin(), kept_.end(),
+                               [&](const Thumbnail& kept) {
+                                 return std::abs(kept.frame - frame) < kThumbnailSpacing;
+                               }),
+                kept_.end());
+    if (kept_.size() >= capacity_) {
+      const int weakest = Weakest()->first;
+      kept_.erase(std::remove_if(kept_.begin(), kept_.end(),
+                                 [&](const Thumbnail& kept) { return kept.frame == weakest; }),
+                  kept_.end());
+    }
+    badness_[frame] = badness;
+    kept_.push_back(std::move(thumbnail));
+  }
+  /// Worst first (ties: earlier frame first).
+  std::vector<Thumbnail> Sorted() const {
+    std::vector<Thumbnail> sorted = kept_;
+    std::sort(sorted.begin(), sorted.end(), [&](const Thumbnail& a, const Thumbnail& b) {
+      const double ba = badness_.at(a.frame), bb = badness_.at(b.frame);
+      return ba != bb ? ba > bb : a.frame < b.frame;
+    });
+    return sorted;
+  }
+  double BadnessOf(int frame) const { return badness_.at(frame); }
+
+ private:
+  // The kept frame with the least badness (the latest of equals), as (frame, badness).
+  std::optional<std::pair<int, double>> Weakest() const {
+    std::optional<std::pair<int, double>> weakest;
+    for (const Thumbnail& kept : kept_) {
+      const double b = badness_.at(kept.frame);
+      if (!weakest || b < weakest->second ||
+          (b == weakest->second && kept.frame > weakest->first)) {
+        weakest = std::make_pair(kept.frame, b);
+      }
+    }
+    return weakest;
+  }
+
+  std::size_t capacity_;
+  std::vector<Thumbnail> kept_;
+  std::map<int, double> badness_;
+};
+
+const cv::Scalar kTrackColours[] = {{80, 80, 255},  {80, 255, 80},  {255, 160, 80}, {255, 80, 255},
+                                    {80, 255, 255}, {255, 255, 80}, {160, 80, 255}, {80, 160, 255}};
+
+// The frame with every held track (thin, labelled #id), lines 1-4 and the target frame's
+// axes (AnnotatePose), and the frame number.
+cv::Mat Annotate(const TrackedFrame& frame, const std::optional<CameraFile>& camera,
+                 const std::optional<vpCameraParameters>& undistorted_by) {
+  cv::Mat image;
+  if (camera && frame.pose) {
+    image = AnnotatePose(frame.gray, frame.held, *frame.pose, camera->camera, undistorted_by);
+  } else {
+    cv::cvtColor(frame.gray, image, cv::COLOR_GRAY2BGR);
+  }
+  for (std::size_t i = 0; i < frame.held.size(); ++i) {
+    const cv::Scalar& colour = kTrackColours[static_cast<std::size_t>(frame.ids[i]) % 8];
+    const auto runs = LineInFrame(frame.held[i].line, image.cols, image.rows, undistorted_by);
+    for (const auto& run : runs) {
+      for (std::size_t k = 1; k < run.size(); ++k) {
+        cv::line(image, run[k - 1], run[k], colour, 1, cv::LINE_AA);
+      }
+    }
+    if (runs.empty() || runs.front().empty()) continue;
+    const cv::Point2d at = runs.front()[runs.front().size() * 2 / 3];
+    cv::putText(image, "#" + std::to_string(frame.ids[i]),
+                cv::Point(cvRound(at.x) + 3, cvRound(at.y) + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                colour, 1, cv::LINE_AA);
+  }
+  cv::putText(image, "frame " + std::to_string(frame.index), cv::Point(4, image.rows - 6),
+              cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  return image;
+}
+
+std::vector<unsigned char> ThumbnailJpeg(const cv::Mat& annotated) {
+  cv::Mat small;
+  const double scale = std::min(1.0, static_cast<double>(kThumbnailWidth) / annotated.cols);
+  cv::resize(annotated, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  std::vector<unsigned char> jpeg;
+  if (!cv::imencode(".jpg", small, jpeg, {cv::IMWRITE_JPEG_QUALITY, 85})) {
+    throw std::runtime_error("cannot encode a thumbnail");
+  }
+  return jpeg;
+}
+
+// The annotated video, written under a temporary name ending in .avi (the writer picks the
+// container from it) and renamed at Commit().
+class AnnotatedVideo {
+ public:
+  AnnotatedVideo(fs::path target, double scale)
+      : scale_(scale),
+        target_(std::move(target)),
+        temp_(target_.parent_path() /
+              (target_.stem().string() + ".tmp-" + std::to_string(::getpid()) + ".avi")) {}
+  ~AnnotatedVideo() {
+    writer_.release();
+    if (!committed_) RemoveQuietly(temp_);
+  }
+  AnnotatedVideo(const AnnotatedVideo&) = delete;
+  AnnotatedVideo& operator=(const AnnotatedVideo&) = delete;
+
+  void Write(const cv::Mat& image) {
+    if (!writer_.isOpened()) {
+      size_ = cv::Size(std::max(2, 2 * cvRound(0.5 * scale_ * image.cols)),
+                       std::max(2, 2 * cvRound(0.5 * scale_ * image.rows)));
+      if (!writer_.open(temp_.string(), cv::CAP_OPENCV_MJPEG,
+                        cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), kVideoFps, size_, true)) {
+        throw std::runtime_error("cannot write the video " + temp_.string());
+      }
+      writer_.set(cv::VIDEOWRITER_PROP_QUALITY, kVideoQuality);
+    }
+    if (image.size() == size_) {
+      writer_.write(image);
+    } else {
+      cv::Mat resized;
+      cv::resize(image, resized, size_, 0.0, 0.0, cv::INTER_AREA);
+      writer_.write(resized);
+    }
+  }
+  void Commit() {
+    if (!writer_.isOpened()) return;  // no frame
+    writer_.release();
+    fs::rename(temp_, target_);
+    committed_ = true;
+  }
+
+ private:
+  double scale_;
+  fs::path target_, temp_;
+  cv::VideoWriter writer_;
+  cv::Size size_;
+  bool committed_ = false;
+};
+
+struct WriterResult {
+  std::vector<Thumbnail> thumbnails;
+  double busy_us = 0.0;
+  std::string error;
+};
+
+void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::size_t thumbnails,
+                 const std::optional<CameraFile>& camera,
+                 const std::optional<vpCameraParameters>& undistorted_by, WriterResult* result) {
+  WorstFrames worst(thumbnails);
+  try {
+    while (std::optional<TrackedFrame> frame = queue->Pop()) {
+      const Clock::time_point start = Clock::now();
+      const bool wanted = worst.Wants(frame->index, frame->badness);
+      if (video != nullptr || wanted) {
+        const cv::Mat annotated = Annotate(*frame, camera, undistorted_by);
+        if (video != nullptr) video->Write(annotated);
+        if (wanted) worst.Add({frame->index, frame->why, ThumbnailJpeg(annotated)}, frame->badness);
+      }
+      result->busy_us += Us(Clock::now() - start);
+    }
+  } catch (const std::exception& error) {
+    result->error = error.what();
+    queue->Close();
+  }
+  result->thumbnails = worst.Sorted();
+}
+
+// ---------------------------------------------------------------------------------------
+// Stage 2: tracking, pose and truth, per input.
+
+// What every input shares.
+struct RunContext {
+  const EvaluateOptions& options;
+  AppConfig config;
+  std::optional<CameraFile> camera;  ///< --camera
+  std::string chart_js;
+  std::size_t target_lines = 4;  ///< lines held for the target to count as detected
+};
+
+// The camera of an input: --camera, else camera.xml next to it (or in it), else none.
+std::optional<CameraFile> CameraFor(const RunContext& run, const PlannedInput& input,
+                                    std::string* path) {
+  if (run.camera) {
+    *path = run.options.camera_path;
+    return run.camera;
+  }
+  const fs::path spec(input.spec);
+  const fs::path dir = fs::is_directory(spec) ? spec : spec.parent_path();
+  const fs::path candidate = dir / "camera.xml";
+  if (!fs::is_regular_file(candidate)) return std::nullopt;
+  *path = candidate.string();
+  static std::mutex xml_mutex;  // XML parsing (libxml2, ViSP) from several jobs: one at a time
+  std::lock_guard<std::mutex> lock(xml_mutex);
+  return LoadCameraFile(candidate.string());
+}
+
+// Per-frame values for the plots (report.h), nulls where a value does not exist.
+struct Series {
+  Json frame = Json::array(), status = Json::array(), held = Json::array(), pose_ok = Json::array(),
+       pose_t_mm = Json::array(), pose_r_deg = Json::array();
+  std::map<int, Json> rho, theta_deg;        // per track id
+  std::map<int, Json> offset_px, angle_deg;  // per truth line
+  std::map<int, int> seen;                   // frames each track was held
+  Json decode_us = Json::array(), track_us = Json::array(), pose_us = Json::array();
+
+  static void Put(std::map<int, Json>* series, int key, std::size_t frame, const Json& value) {
+    Json& values = (*series)[key];
+    while (values.size() < frame) values.push_back(nullptr);
+    values.push_back(value);
+  }
+  static Json Padded(const std::map<int, Json>& series, std::size_t frames,
+                     const std::vector<int>& keys) {
+    Json out = Json::object();
+    for (int key : keys) {
+      Json values = series.at(key);
+      while (values.size() < frames) values.push_back(nullptr);
+      out[std::to_string(key)] = std::move(values);
+    }
+    return out;
+  }
+  static std::vector<int> Keys(const std::map<int, Json>& series) {
+    std::vector<int> keys;
+    for (const auto& entry : series) keys.push_back(entry.first);
+    return keys;
+  }
+  Json ToJson() const {
+    const std::size_t frames = frame.size();
+    std::vector<std::pair<int, int>> by_seen(seen.begin(), seen.end());  // (id, frames)
+    std::stable_sort(by_seen.begin(), by_seen.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    std::vector<int> tracks;
+    for (std::size_t i = 0; i < by_seen.size() && i < kPlottedTracks; ++i) {
+      tracks.push_back(by_seen[i].first);
+    }
+    std::sort(tracks.begin(), tracks.end());
+    return Json{{"frame", frame},
+                {"status", status},
+                {"held", held},
+                {"pose_ok", pose_ok},
+                {"rho", Padded(rho, frames, tracks)},
+                {"theta_deg", Padded(theta_deg, frames, tracks)},
+                {"offset_px", Padded(offset_px, frames, Keys(offset_px))},
+                {"angle_deg", Padded(angle_deg, frames, Keys(angle_deg))},
+                {"pose_t_mm", pose_t_mm},
+                {"pose_r_deg", pose_r_deg}};
+  }
+};
+
+// Frame status: 3 pose ok, 2 target detected (no pose), 1 some lines, 0 none, -1 unreadable.
+const char* kStatusNames[] = {"unreadable", "lost", "partial", "detected", "pose"};
+
+Json TrackJson(const TrackedLine& track) {
+  return Json{{"id", track.id},
+              {"status", ToString(track.status)},
+              {"rho", track.line.line.rho_px},
+              {"theta", track.line.line.theta_rad},
+              {"support", track.line.support},
+              {"frames_seen", track.frames_seen},
+              {"frames_lost", track.frames_lost}};
+}
+
+Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids) {
+  Json lines = Json::array();
+  for (int k = 0; k < 4; ++k) {
+    const int index = pose.line_index[static_cast<std::size_t>(k)];
+    lines.push_back(index >= 0 && index < static_cast<int>(ids.size()) ? ids[index] : -1);
+  }
+  const bool ok = pose.status == PoseStatus::kOk;
+  Json t, tu;
+  if (ok) {
+    const vpTranslationVector tv = pose.cMo.getTranslationVector();
+    const vpThetaUVector r = pose.cMo.getThetaUVector();
+    t = Json::array({tv[0], tv[1], tv[2]});
+    tu = Json::array({r[0], r[1], r[2]});
+  }
+  return Json{
+      {"status", ToString(pose.status)}, {"message", pose.message},
+      {"tracks", std::move(lines)},      {"t_m", std::move(t)},
+      {"thetau_rad", std::move(tu)},     {"residual_px", ok ? Json(pose.residual_px) : Json()}};
+}
+
+// Counters of one input, turned into its summary.
+struct Tally {
+  int frames = 0, readable = 0, detected = 0, pose_ok = 0;
+  int lost_episodes = 0, longest_lost = 0, current_lost = 0, track_losses = 0;
+  bool ever_detected = false, was_detected = false;
+  int width = 0, height = 0;
+  std::map<std::string, int> pose_status;
+  std::vector<Json> unreadable;
+  int unreadable_count = 0;
+  int truth_frames = 0, truth_lines = 0, found_lines = 0, pose_truth_frames = 0;
+  std::vector<double> angle_deg, offset_px, pose_t_mm, pose_r_deg;
+  std::set<int> track_ids;
+};
+
+// The evaluation of one input: decoder, tracker and writer (file comment of evaluate.h).
+class InputEvaluation {
+ public:
+  InputEvaluation(const RunContext& run, const PlannedInput& input, fs::path dir)
+      : run_(run), input_(input), dir_(std::move(dir)), truth_(run.options, input) {
+    camera_ = CameraFor(run, input, &camera_path_);
+  }
+
+  void AddWarnings(const std::vector<std::string>& warnings) {
+    warnings_.insert(warnings_.end(), warnings.begin(), warnings.end());
+  }
+
+  // Evaluates and writes every file; `on_frame` after each frame.
+  Json Run(ImageSource* source, const std::function<void()>& on_frame, Json* timing) {
+    const Clock::time_point start = Clock::now();
+    fs::create_directories(dir_);
+    TrackerOptions tracker_options;
+    tracker_options.detector = run_.config.detector;
+    OalLineTracker tracker = camera_ ? OalLineTracker(tracker_options, camera_->camera)
+                                     : OalLineTracker(tracker_options);
+    undistorts_ = tracker.detector().Undistorts();
+    if (undistorts_) {
+      undistorted_by_ = camera_->camera;
+      undistorter_.emplace(camera_->camera);
+    }
+    PoseOptions pose_options = run_.config.pose;
+    if (camera_) {
+      pose_options.camera = camera_->camera;
+      pose_options.lines_undistorted = undistorts_;
+    }
+
+    AtomicFile frames_file(dir_ / "frames.jsonl");
+    AtomicFile timing_file(dir_ / "timing.jsonl");
+    std::optional<AnnotatedVideo> video;
+    if (run_.options.write_video) video.emplace(dir_ / "annotated.avi", run_.options.video_scale);
+
+    BoundedQueue<DecodedFrame> decoded(kQueueFrames);
+    BoundedQueue<TrackedFrame> tracked(kQueueFrames);
+    DecodeStats decode_stats;
+    WriterResult writer_result;
+    Joined decoder(
+        std::thread(DecodeFrames, source, run_.options.max_frames, &decoded, &decode_stats));
+    Joined writer(std::thread(WriteFrames, &tracked, video ? &*video : nullptr,
+                              static_cast<std::size_t>(run_.options.thumbnails), std::cref(camera_),
+                              std::cref(undistorted_by_), &writer_result));
+    std::optional<vpHomogeneousMatrix> previous_cMo;
+    std::vector<double> track_us, pose_us;
+    try {
+      while (std::optional<DecodedFrame> frame = decoded.Pop()) {
+        if (!frame->error.empty()) {
+          Unreadable(*frame, frames_file.stream(), timing_file.stream());
+        } else {
+          TrackedFrame out =
+              Process(*frame, &tracker, pose_options, &previous_cMo, frames_file.stream(),
+                      timing_file.stream(), &track_us, &pose_us);
+          if (!tracked.Push(std::move(out))) break;  // the writer failed
+        }
+        if (on_frame) on_frame();
+      }
+    } catch (...) {
+      decoded.Close();
+      tracked.Close();
+      throw;
+    }
+    decoded.Close();
+    tracked.Close();
+    decoder.Join();
+    writer.Join();
+    if (!writer_result.error.empty()) throw std::runtime_error(writer_result.error);
+    if (tally_.frames == 0) throw std::runtime_error(source->Name() + " holds no frame");
+    frames_file.Commit();
+    timing_file.Commit();
+    if (video) video->Commit();
+
+    Json summary = Summary(source, decode_stats);
+    if (run_.options.compare) summary["compare"] = Compare();
+    const double wall_us = Us(Clock::now() - start);
+    *timing = Json{{"input", input_.spec},
+                   {"frames", tally_.frames},
+                   {"video", run_.options.write_video},
+                   {"video_scale", run_.options.video_scale},
+                   {"decode_us", Stats(decode_us_)},
+                   {"track_us", Stats(track_us)},
+                   {"pose_us", Stats(pose_us)},
+                   {"decode_total_s", decode_stats.total_us * 1e-6},
+                   {"writer_busy_s", writer_result.busy_us * 1e-6},
+                   {"wall_s", wall_us * 1e-6},
+                   {"overhead_vs_decode",
+                    decode_stats.total_us > 0 ? wall_us / decode_stats.total_us - 1.0 : 0.0}};
+    Json timing_with_series = *timing;
+    timing_with_series["series"] = Json{{"decode_us", series_.decode_us},
+                                        {"track_us", series_.track_us},
+                                        {"pose_us", series_.pose_us}};
+    WriteFileAtomically(dir_ / "report.html",
+                        InputReportHtml(summary, series_.ToJson(), timing_with_series,
+                                        writer_result.thumbnails, run_.chart_js));
+    WriteFileAtomically(dir_ / "timing.json", timing->dump(2) + "\n");
+    WriteFileAtomically(dir_ / "summary.json", summary.dump(2) + "\n");
+    return summary;
+  }
+
+ private:
+  void Unreadable(const DecodedFrame& frame, std::ostream& frames, std::ostream& timing) {
+    ++tally_.frames;
+    ++tally_.unreadable_count;
+    if (tally_.unreadable.size() < kListedUnreadable) {
+      tally_.unreadable.push_back(
+          Json{{"frame", frame.index}, {"source", frame.source}, {"error", frame.error}});
+    }
+    WriteJsonLine(frames,
+                  Json{{"frame", frame.index},
+                       {"source", frame.source},
+                       {"status", "unreadable"},
+                       {"error", frame.error}},
+                  false);
+    WriteJsonLine(timing, Json{{"frame", frame.index}, {"decode_us", frame.decode_us}}, false);
+    decode_us_.push_back(frame.decode_us);
+    series_.frame.push_back(frame.index);
+    series_.status.push_back(-1);
+    series_.held.push_back(nullptr);
+    series_.pose_ok.push_back(nullptr);
+    series_.pose_t_mm.push_back(nullptr);
+    series_.pose_r_deg.push_back(nullptr);
+    series_.decode_us.push_back(frame.decode_us);
+    series_.track_us.push_back(nullptr);
+    series_.pose_us.push_back(nullptr);
+  }
+
+  TrackedFrame Process(DecodedFrame& frame, OalLineTracker* tracker, PoseOptions pose_options,
+                       std::optional<vpHomogeneousMatrix>* previous_cMo, std::ostream& frames,
+                       std::ostream& timing, std::vector<double>* track_times,
+                       std::vector<double>* pose_times) {
+    const int w = frame.gray.cols, h = frame.gray.rows;
+    if (tally_.readable == 0) tally_.width = w, tally_.height = h;
+    // A view of the frame for ViSP, no copy (the decoder's clone is continuous).
+    const vpImage<unsigned char> image(frame.gray.data, static_cast<unsigned int>(h),
+                                       static_cast<unsigned int>(w), false);
+    const Clock::time_point t0 = Clock::now();
+    tracker->track(image);
+    const Clock::time_point t1 = Clock::now();
+
+    TrackedFrame out;
+    out.index = frame.index;
+    std::vector<const TrackedLine*> held;
+    Json tracks = Json::array();
+    for (const TrackedLine& track : tracker->getLines()) {
+      tracks.push_back(TrackJson(track));
+      tally_.track_ids.insert(track.id);
+      if (track.status == TrackStatus::kLost) {
+        tally_.track_losses += track.frames_lost == 1;
+      } else {
+        held.push_back(&track);
+      }
+    }
+    std::stable_sort(held.begin(), held.end(), [](const TrackedLine* a, const TrackedLine* b) {
+      return a->line.support > b->line.support;
+    });
+    for (const TrackedLine* track : held) {
+      out.held.push_back(track->line);
+      out.ids.push_back(track->id);
+    }
+    Json pose_json;
+    const Clock::time_point t2 = Clock::now();
+    if (camera_) {
+      pose_options.image_width = w;
+      pose_options.image_height = h;
+      out.pose = EstimatePose(out.held, run_.config.target, pose_options, *previous_cMo);
+      if (out.pose->status == PoseStatus::kOk) {
+        *previous_cMo = out.pose->cMo;
+      } else {
+        previous_cMo->reset();
+      }
+      pose_json = PoseFrameJson(*out.pose, out.ids);
+    }
+    const Clock::time_point t3 = Clock::now();
+    const double track_us = Us(t1 - t0), pose_us = Us(t3 - t2);
+    track_times->push_back(track_us);
+    if (camera_) pose_times->push_back(pose_us);
+
+    // Status and counters.
+    const bool pose_ok = out.pose && out.pose->status == PoseStatus::kOk;
+    const bool detected = held.size() >= run_.target_lines;
+    const int status = pose_ok ? 3 : detected ? 2 : held.empty() ? 0 : 1;
+    ++tally_.frames;
+    ++tally_.readable;
+    tally_.detected += detected;
+    tally_.pose_ok += pose_ok;
+    if (out.pose) ++tally_.pose_status[ToString(out.pose->status)];
+    if (detected) {
+      tally_.ever_detected = true;
+      tally_.current_lost = 0;
+    } else if (tally_.ever_detected) {
+      if (tally_.was_detected) ++tally_.lost_episodes;
+      tally_.longest_lost = std::max(tally_.longest_lost, ++tally_.current_lost);
+    }
+    tally_.was_detected = detected;
+
+    // Truth.
+    const FrameTruth truth = truth_.Get(frame.source, frame.index, w, h);
+    Json truth_json;
+    double worst_offset = 0.0;
+    int missed = 0;
+    std::optional<std::pair<double, double>> pose_error;
+    const std::size_t f = series_.frame.size();
+    if (truth.known) {
+      ++tally_.truth_frames;
+      Json lines = Json::array();
+      for (const LineError& e :
+           MatchTruth(truth.lines, out.held, out.ids, undistorter_, truth_.kind() == "json")) {
+        const bool found = e.track >= 0;
+        ++tally_.truth_lines;
+        tally_.found_lines += found;
+        missed += !found;
+        if (found) {
+          tally_.angle_deg.push_back(e.angle_deg);
+          tally_.offset_px.push_back(e.offset_px);
+          worst_offset = std::max(worst_offset, e.offset_px);
+        }
+        lines.push_back(Json{{"line", e.line},
+                             {"track", e.track},
+                             {"angle_deg", found ? Json(e.angle_deg) : Json()},
+                             {"offset_px", found ? Json(e.offset_px) : Json()}});
+        Series::Put(&series_.offset_px, e.line, f, found ? Json(e.offset_px) : Json());
+        Series::Put(&series_.angle_deg, e.line, f, found ? Json(e.angle_deg) : Json());
+      }
+      Json pose_error_json;
+      if (pose_ok && truth.cMo) {
+        pose_error = PoseError(out.pose->cMo, *truth.cMo);
+        ++tally_.pose_truth_frames;
+        tally_.pose_t_mm.push_back(pose_error->first);
+        tally_.pose_r_deg.push_back(pose_error->second);
+        pose_error_json =
+            Json{{"translation_mm", pose_error->first}, {"rotation_deg", pose_error->second}};
+      }
+      truth_json = Json{{"lines", std::move(lines)}, {"pose", std::move(pose_error_json)}};
+    }
+
+    // How bad the frame is, for the thumbnails: lost > partial > no pose > truth errors.
+    std::ostringstream why;
+    out.badness = 0.0;
+    if (status <= 1) {
+      out.badness += status == 0 ? 1000.0 : 500.0;
+      why << (status == 0 ? "no line held" : std::to_string(held.size()) + " lines held") << "; ";
+    }
+    if (camera_ && !pose_ok) {
+      out.badness += 100.0;
+      why << "pose " << ToString(out.pose->status) << "; ";
+    }
+    if (missed > 0) {
+      out.badness += 50.0 * missed;
+      why << missed << " truth line(s) missed; ";
+    }
+    if (worst_offset > 0.0) {
+      out.badness += worst_offset;
+      why << "line offset " << std::round(worst_offset * 100.0) / 100.0 << " px; ";
+    }
+    if (pose_error) {
+      out.badness += pose_error->first / 10.0 + pose_error->second;
+      why << "pose error " << std::round(pose_error->first * 10.0) / 10.0 << " mm, "
+          << std::round(pose_error->second * 100.0) / 100.0 << " deg; ";
+    } else if (pose_ok && !truth.known) {
+      out.badness += out.pose->residual_px;
+      why << "residual " << std::round(out.pose->residual_px * 100.0) / 100.0 << " px; ";
+    }
+    out.why = why.str();
+    if (out.why.size() >= 2) out.why.resize(out.why.size() - 2);
+
+    WriteJsonLine(frames,
+                  Json{{"frame", frame.index},
+                       {"source", frame.source},
+                       {"status", kStatusNames[status + 1]},
+                       {"held", held.size()},
+                       {"tracks", std::move(tracks)},
+                       {"pose", std::move(pose_json)},
+                       {"truth", std::move(truth_json)}},
+                  false);
+    WriteJsonLine(timing,
+                  Json{{"frame", frame.index},
+                       {"decode_us", frame.decode_us},
+                       {"track_us", track_us},
+                       {"pose_us", camera_ ? Json(pose_us) : Json()}},
+                  false);
+    decode_us_.push_back(frame.decode_us);
+
+    series_.frame.push_back(frame.index);
+    series_.status.push_back(status);
+    series_.held.push_back(held.size());
+    series_.pose_ok.push_back(camera_ ? Json(pose_ok ? 1 : 0) : Json());
+    series_.pose_t_mm.push_back(pose_error ? Json(pose_error->first) : Json());
+    series_.pose_r_deg.push_back(pose_error ? Json(pose_error->second) : Json());
+    for (const TrackedLine* track : held) {
+      ++series_.seen[track->id];
+      Series::Put(&series_.rho, track->id, f, track->line.line.rho_px);
+      Series::Put(&series_.theta_deg, track->id, f, track->line.line.theta_rad * kRadToDeg);
+    }
+    series_.decode_us.push_back(frame.decode_us);
+    series_.track_us.push_back(track_us);
+    series_.pose_us.push_back(camera_ ? Json(pose_us) : Json());
+
+    out.gray = std::move(frame.gray);
+    return out;
+  }
+
+  Json Summary(const ImageSource* source, const DecodeStats& decode) const {
+    const Tally& t = tally_;
+    const int expected = source->ExpectedFrames();
+    const double readable = std::max(1, t.readable);
+    // Frames the container announced but that never came are unreadable too (truncation).
+    const int missing =
+        expected > 0 && run_.options.max_frames == 0 ? std::max(0, expected - t.frames) : 0;
+    Json warnings = Json::array();
+    for (const std::string& warning : warnings_) warnings.push_back(warning);
+    if (missing > 0) {
+      warnings.push_back(source->Name() + " announces " + std::to_string(expected) +
+                         " frames but only " + std::to_string(t.frames) +
+                         " could be read (truncated or corrupt)");
+    }
+    if (!decode.stop_reason.empty()) warnings.push_back(decode.stop_reason);
+    Json pose;
+    if (camera_) {
+      Json by_status = Json::object();
+      for (const auto& [status, count] : t.pose_status) by_status[status] = count;
+      pose = Json{{"frames_ok", t.pose_ok},
+                  {"availability", t.pose_ok / readable},
+                  {"by_status", std::move(by_status)}};
+    }
+    Json truth;
+    if (truth_.kind() != "none" && truth_.kind() != "auto") {
+      truth = Json{{"kind", truth_.kind()},
+                   {"path", truth_.path()},
+                   {"frames", t.truth_frames},
+                   {"truth_lines", t.truth_lines},
+                   {"found_lines", t.found_lines},
+                   {"match_bounds", {{"angle_deg", kMatchAngleDeg}, {"offset_px", kMatchOffsetPx}}},
+                   {"angle_deg", Stats(t.angle_deg)},
+                   {"offset_px", Stats(t.offset_px)},
+                   {"pose_frames", t.pose_truth_frames},
+                   {"pose_translation_mm", Stats(t.pose_t_mm)},
+                   {"pose_rotation_deg", Stats(t.pose_r_deg)}};
+    }
+    return Json{{"input", input_.spec},
+                {"name", input_.name},
+                {"status", "complete"},
+                {"source", source->Name()},
+                {"width", t.width},
+                {"height", t.height},
+                {"frames_expected", expected > 0 ? Json(expected) : Json()},
+                {"frames", t.frames},
+                {"frames_readable", t.readable},
+                {"frames_unreadable", t.unreadable_count + missing},
+                {"unreadable", t.unreadable},
+                {"camera", camera_ ? Json(camera_path_) : Json()},
+                {"lines_undistorted", undistorts_},
+                {"detection",
+                 {{"target_lines", run_.target_lines},
+                  {"frames_detected", t.detected},
+                  {"rate", t.detected / readable},
+                  {"lost_episodes", t.lost_episodes},
+                  {"longest_lost_frames", t.longest_lost},
+                  {"tracks_started", t.track_ids.size()},
+                  {"track_losses", t.track_losses}}},
+                {"pose", std::move(pose)},
+                {"truth", std::move(truth)},
+                {"compare", nullptr},
+                {"warnings", std::move(warnings)}};
+  }
+
+  // `oalservo compare` on the input (its own pass over the frames), into NAME/compare.
+  Json Compare() const {
+    CompareOptions compare;
+    compare.input = input_.spec;
+    compare.config_path = run_.options.config_path;
+    compare.max_frames = run_.options.max_frames;
+    compare.out_dir = (dir_ / "compare").string();
+    if (truth_.kind() == "csv") {
+      compare.truth = truth_.path();  // compare reads its line rows (CSV lines: no --camera)
+    } else {
+      compare.camera_path = camera_ ? camera_path_ : "";
+      if (truth_.kind() == "json") compare.truth = truth_.path();
+    }
+    try {
+      return CompareJson(RunComparison(compare));
+    } catch (const std::exception& error) {
+      return Json{{"error", error.what()}};
+    }
+  }
+
+  const RunContext& run_;
+  const PlannedInput& input_;
+  fs::path dir_;
+  TruthReader truth_;
+  std::optional<CameraFile> camera_;
+  std::string camera_path_;
+  bool undistorts_ = false;
+  std::optional<vpCameraParameters> undistorted_by_;
+  std::optional<PointUndistorter> undistorter_;
+  std::vector<std::string> warnings_;
+  Tally tally_;
+  Series series_;
+  std::vector<double> decode_us_;
+};
+
+// Removes temporary files a killed run left in `dir` (any pid: that run is gone).
+void RemoveStaleTemporaries(const fs::path& dir) {
+  std::error_code error;
+  if (!fs::is_directory(dir, error)) return;
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(dir, error)) {
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos) {
+      RemoveQuietly(entry.path());
+    }
+  }
+}
+
+// A complete input's summary.json, or null.
+Json CompletedSummary(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  if (!in) return Json();
+  try {
+    Json summary = Json::parse(in);
+    if (summary.value("status", "") == "complete") return summary;
+  } catch (const Json::exception&) {
+  }
+  return Json();
+}
+
+Json ReadJsonOrNull(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) return Json();
+  try {
+    return Json::parse(in);
+  } catch (const Json::exception&) {
+    return Json();
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+
+void EvaluateOptions::Check() const {
+  if (inputs.empty()) throw std::invalid_argument("EvaluateOptions::inputs is empty");
+  Require(!out_dir.empty(), "out_dir", "''", "an output directory is given");
+  Require(jobs >= 1 && jobs <= 64, "jobs", jobs, "1 <= jobs <= 64");
+  Require(shard_count >= 1, "shard_count", shard_count, "shard_count >= 1");
+  Require(shard_index >= 0 && shard_index < shard_count, "shard_index", shard_index,
+          "0 <= shard_index < shard_count");
+  Require(max_frames >= 0, "max_frames", max_frames, "max_frames >= 0");
+  Require(video_scale >= 0.1 && video_scale <= 1.0, "video_scale", video_scale,
+          "0.1 <= video_scale <= 1");
+  Require(thumbnails >= 0 && thumbnails <= 50, "thumbnails", thumbnails, "0 <= thumbnails <= 50");
+  Require(target_lines >= 0 && target_lines <= 64, "target_lines", target_lines,
+          "0 <= target_lines <= 64");
+  if (fs::exists(out_dir) && !fs::is_directory(out_dir)) {
+    throw std::invalid_argument("output '" + out_dir + "' is not a directory");
+  }
+}
+
+std::pair<int, int> ParseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  int index = -1, count = 0;
+  try {
+    if (slash != std::string::npos) {
+      std::size_t used_index = 0, used_count = 0;
+      index = std::stoi(text.substr(0, slash), &used_index);
+      count = std::stoi(text.substr(slash + 1), &used_count);
+      if (used_index != slash || used_count != text.size() - slash - 1) index = -1;
+    }
+  } catch (const std::exception&) {
+    index = -1;
+  }
+  if (index < 0 || count < 1 || index >= count) {
+    throw std::invalid_argument("--shard '" + text +
+                                "': expected I/N with 0 <= I < N, e.g. 0/4 (I is 0-based)");
+  }
+  return {index, count};
+}
+
+InputPlan PlanInputs(const std::vector<std::string>& inputs) {
+  InputPlan plan;
+  std::vector<std::string> specs;
+  for (const std::string& input : inputs) {
+    std::error_code error;
+    if (!fs::is_directory(input, error) || HoldsImages(input)) {
+      specs.push_back(input);
+      continue;
+    }
+    std::vector<fs::path> entries;
+    for (const fs::directory_entry& entry : fs::directory_iterator(input, error)) {
+      entries.push_back(entry.path());
+    }
+    std::sort(entries.begin(), entries.end());
+    for (const fs::path& entry : entries) {
+      if (fs::is_regular_file(entry) && HasVideoExtension(entry.string())) {
+        specs.push_back(entry.string());
+      } else if (fs::is_directory(entry) && HoldsImages(entry)) {
+        specs.push_back(entry.string());
+      } else {
+        plan.skipped.push_back(entry.string() + ": not a video or a directory of images");
+      }
+    }
+  }
+  std::set<std::string> used;
+  for (const std::string& spec : specs) {
+    const std::string base = BaseName(spec);
+    std::string name = base;
+    for (int k = 2; used.count(name) != 0; ++k) name = base + "-" + std::to_string(k);
+    used.insert(name);
+    plan.inputs.push_back({spec, name});
+  }
+  return plan;
+}
+
+EvaluateResult Evaluate(const EvaluateOptions& options,
+                        const std::function<void(int, int)>& progress) {
+  options.Check();
+  RunContext run{options, AppConfig(), std::nullopt, LoadChartJs(), 4};
+  if (!options.config_path.empty()) run.config = LoadConfig(options.config_path, run.config);
+  run.config.detector.Check();
+  if (!options.camera_path.empty()) run.camera = LoadCameraFile(options.camera_path);
+  run.target_lines = options.target_lines > 0
+                         ? static_cast<std::size_t>(options.target_lines)
+                         : std::max<std::size_t>(1, run.config.target.lines.size());
+  {
+    PoseOptions check = run.config.pose;
+    check.Check();
+  }
+  const InputPlan plan = PlanInputs(options.inputs);
+  if (!options.truth_path.empty() && plan.inputs.size() != 1) {
+    throw std::invalid_argument("--truth applies to one input, but there are " +
+                                std::to_string(plan.inputs.size()) +
+                                " (give each video a <video>.truth.csv instead)");
+  }
+  const fs::path out(options.out_dir);
+  fs::create_directories(out);
+
+  EvaluateResult result;
+  result.skipped = plan.skipped;
+  std::vector<const PlannedInput*> shard;
+  for (std::size_t i = 0; i < plan.inputs.size(); ++i) {
+    if (static_cast<int>(i % static_cast<std::size_t>(options.shard_count)) ==
+        options.shard_index) {
+      shard.push_back(&plan.inputs[i]);
+    }
+  }
+  result.inputs.resize(shard.size());
+  std::vector<Json> timings(shard.size());
+
+  // Resumed inputs; the others' frame counts for the progress.
+  std::vector<std::size_t> todo;
+  int total_frames = 0;
+  for (std::size_t i = 0; i < shard.size(); ++i) {
+    InputOutcome& outcome = result.inputs[i];
+    outcome.input = shard[i]->spec;
+    outcome.name = shard[i]->name;
+    const fs::path dir = out / shard[i]->name;
+    if (options.resume) {
+      Json summary = CompletedSummary(dir);
+      if (!summary.is_null()) {
+        outcome.status = "resumed";
+        outcome.summary = std::move(summary);
+        timings[i] = ReadJsonOrNull(dir / "timing.json");
+        continue;
+      }
+    }
+    RemoveStaleTemporaries(dir);
+    todo.push_back(i);
+    try {
+      const int expected = OpenImageSource(shard[i]->spec)->ExpectedFrames();
+      if (expected > 0) {
+        total_frames += options.max_frames > 0 ? std::min(expected, options.max_frames) : expected;
+      }
+    } catch (const std::exception&) {
+      // reported when the input is evaluated
+    }
+  }
+
+  std::mutex progress_mutex;
+  std::atomic<int> frames_done{0};
+  std::atomic<std::size_t> next{0};
+  auto on_frame = [&] {
+    const int done = ++frames_done;
+    if (!progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    progress(done, total_frames);
+  };
+  auto worker = [&] {
+    for (std::size_t k = next++; k < todo.size(); k = next++) {
+      const std::size_t i = todo[k];
+      InputOutcome& outcome = result.inputs[i];
+      try {
+        std::vector<std::string> warnings;
+        std::unique_ptr<ImageSource> source = OpenImageSource(shard[i]->spec, &warnings);
+        InputEvaluation evaluation(run, *shard[i], out / shard[i]->name);
+        evaluation.AddWarnings(warnings);
+        outcome.summary = evaluation.Run(source.get(), on_frame, &timings[i]);
+        outcome.status = "complete";
+      } catch (const std::exception& error) {
+        outcome.status = "failed";
+        outcome.error = error.what();
+      }
+    }
+  };
+  {
+    std::vector<std::thread> threads;
+    const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(options.jobs),
+                                                    std::max<std::size_t>(1, todo.size()));
+    for (std::size_t t = 1; t < count; ++t) threads.emplace_back(worker);
+    worker();
+    for (std::thread& thread : threads) thread.join();
+  }
+  if (progress && frames_done > 0 && frames_done != total_frames) {
+    progress(frames_done, frames_done);  // ends the progress line
+  }
+  result.frames = frames_done;
+
+  Json inputs = Json::array();
+  for (const InputOutcome& outcome : result.inputs) {
+    inputs.push_back(Json{{"input", outcome.input},
+                          {"name", outcome.name},
+                          {"status", outcome.status == "resumed" ? "complete" : outcome.status},
+                          {"error", outcome.error},
+                          {"summary", outcome.summary}});
+  }
+  const bool sharded = options.shard_count > 1;
+  const std::string suffix = sharded ? "-" + std::to_string(options.shard_index) + "-of-" +
+                                           std::to_string(options.shard_count)
+                                     : "";
+  const Json run_json{{"inputs", std::move(inputs)},
+                      {"skipped", result.skipped},
+                      {"shard", sharded ? Json(std::to_string(options.shard_index) + "/" +
+                                               std::to_string(options.shard_count))
+                                        : Json()}};
+  result.index_path = (out / ("index" + suffix + ".html")).string();
+  WriteFileAtomically(out / ("run" + suffix + ".json"), run_json.dump(2) + "\n");
+  WriteFileAtomically(result.index_path, IndexHtml(run_json, timings, run.chart_js));
+  return result;
+}
+
+}  // namespace oal

@@ -1,0 +1,126 @@
+// `oalservo evaluate`: how well the tracker and the pose hold up on recorded videos, before a
+// robot is servoed with them (docs/EVALUATE.md has the user's guide and the file formats).
+//
+// Inputs. Each INPUT is a video OpenCV reads, an image sequence (a directory of images or a
+// printf pattern, app/image_source.h), a single image, or a directory of these: a directory
+// holding at least one image is one image sequence; any other directory stands for its
+// entries, sorted by name: each video file and each subdirectory holding images is one
+// input, every other entry is skipped and listed in the report. The inputs, in that order,
+// are numbered 0, 1, ...; `--shard I/N` keeps those whose number is I modulo N.
+//
+// Outputs, in --out DIR, one directory per input (named after the input, "-2", "-3" ... for
+// repeated names; the names depend on the whole input list, not on the shard):
+//
+//   NAME/frames.jsonl    one JSON object per frame: tracks, pose, status, truth errors
+//   NAME/timing.jsonl    per frame: decode, track and pose times (microseconds)
+//   NAME/annotated.avi   the frames with the tracks (ids), lines 1-4 and the target frame
+//                        (MJPG; unless --no-video)
+//   NAME/compare/        with --compare: `oalservo compare`'s compare.md, compare.json
+//   NAME/timing.json     timing statistics, decode time against the wall time
+//   NAME/report.html     the input's report: plots (Chart.js, inlined) and worst frames
+//   NAME/summary.json    frames, detection rate, lost-track episodes, pose availability,
+//                        truth errors; written last: its presence means the input is done
+//   index.html, run.json the inputs of the run (index-I-of-N.html, run-I-of-N.json with
+//                        --shard), links to the reports; failed inputs and skipped files
+//
+// Every file is written under a temporary name and renamed (app/atomic_file.h). Timings live
+// only in timing.jsonl, timing.json and the reports' timing block, so every other file is
+// byte-identical between runs with any --jobs (tests compare them).
+//
+// Per input, three threads: the decoder reads frames into a bounded queue, this thread tracks
+// and estimates the pose, the writer draws and encodes the annotated video and the worst
+// frames' thumbnails. The wall time is then close to the decoding time when the decoder is
+// the slowest stage (timing.json: overhead_vs_decode).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "app/json_io.h"
+
+namespace oal {
+
+struct EvaluateOptions {
+  /// Videos, image sequences, or directories of these (file comment).
+  std::vector<std::string> inputs;
+  /// YAML configuration: detector, target and pose sections (app/config.h); "": defaults.
+  std::string config_path;
+  /// ViSP camera XML for every input; "": camera.xml next to each input if there is one,
+  /// else the input gets no pose (tracking only, said in its summary).
+  std::string camera_path;
+  /// Truth for the single input: a .csv (app/truth_file.h) or a directory of frame JSON
+  /// files; "": per input, the renderer's JSON next to each image, or <video>.truth.csv next
+  /// to a video. Given with several inputs it is an error.
+  std::string truth_path;
+  /// Also run `oalservo compare`'s methods on each input (app/compare.h).
+  bool compare = false;
+  /// Inputs processed at once, [1, 64].
+  int jobs = 1;
+  /// Keep the inputs whose number is shard_index modulo shard_count; 0 <= index < count.
+  int shard_index = 0, shard_count = 1;
+  /// Skip the inputs whose summary.json says they are complete; redo the others.
+  bool resume = false;
+  /// Write NAME/annotated.avi.
+  bool write_video = true;
+  /// Size of the annotated video relative to the frames, [0.1, 1]: drawing and encoding it
+  /// is the slowest stage (docs/EVALUATE.md, figures).
+  double video_scale = 1.0;
+  /// Lines held for the target to count as detected in a frame; 0: the configuration's
+  /// target's line count (4 for the four-line target). [0, 64].
+  int target_lines = 0;
+  /// Frames per input at most; 0: all. >= 0.
+  int max_frames = 0;
+  /// Worst frames shown as thumbnails in each report, [0, 50].
+  int thumbnails = 6;
+  /// Output directory, created if missing; required.
+  std::string out_dir;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// "I/N" -> (I, N); throws std::invalid_argument unless 0 <= I < N.
+std::pair<int, int> ParseShard(const std::string& text);
+
+/// One input after the expansion of directories.
+struct PlannedInput {
+  std::string spec;  ///< what OpenImageSource opens
+  std::string name;  ///< its output directory's name, unique in the plan
+};
+
+struct InputPlan {
+  std::vector<PlannedInput> inputs;  ///< every input, before sharding
+  std::vector<std::string> skipped;  ///< entries of input directories that are no input
+};
+
+/// Expands `inputs` (file comment) and names them. Inputs that do not exist stay in the
+/// plan (they fail when evaluated, without stopping the others).
+InputPlan PlanInputs(const std::vector<std::string>& inputs);
+
+/// What happened to one input of the shard.
+struct InputOutcome {
+  std::string input;
+  std::string name;
+  std::string status;  ///< "complete", "resumed" (done by an earlier run) or "failed"
+  std::string error;   ///< why it failed
+  Json summary;        ///< its summary.json (null when failed before any frame)
+};
+
+struct EvaluateResult {
+  std::vector<InputOutcome> inputs;  ///< the shard's inputs, in plan order
+  std::vector<std::string> skipped;  ///< from the plan
+  std::string index_path;            ///< index.html written
+  int frames = 0;                    ///< frames evaluated in this run (resumed inputs: 0)
+};
+
+/// Evaluates every input of the shard into options.out_dir (file comment). An input that
+/// cannot be read fails alone: the others go on. `progress(done, total)` is called with the
+/// frames done over the shard's inputs (total: the frames the inputs announce; 0 unknown),
+/// from one thread at a time. Throws std::invalid_argument for bad options and
+/// std::runtime_error for a bad configuration or camera file, a missing Chart.js (report.h)
+/// or an output that cannot be written.
+EvaluateResult Evaluate(const EvaluateOptions& options,
+                        const std::function<void(int done, int total)>& progress = {});
+
+}  // namespace oal

@@ -1,0 +1,87 @@
+#include "app/evaluate_command.h"
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "app/command_line.h"
+#include "app/evaluate.h"
+
+namespace oal {
+
+int RunEvaluate(int argc, char** argv) {
+  EvaluateOptions options;
+  std::string shard;
+  bool no_video = false;
+  CLI::App cli(
+      "Evaluate the line tracker and the pose on recorded videos or image sequences: per-frame "
+      "JSON Lines, a summary (detection rate, lost-track episodes, pose availability, errors "
+      "against the truth), an annotated video and a self-contained HTML report per input, and "
+      "an index (docs/EVALUATE.md).",
+      "oalservo evaluate");
+  cli.add_option("INPUT", options.inputs,
+                 "video, directory of images, printf pattern (frames/img%04d.png), or a "
+                 "directory of videos and image directories")
+      ->required();
+  cli.add_option("--out", options.out_dir, "output directory (created if missing)")->required();
+  cli.add_option("--config", options.config_path,
+                 "YAML configuration: detector, target and pose sections");
+  cli.add_option("--camera", options.camera_path,
+                 "ViSP camera XML for every input (default: camera.xml next to each input; "
+                 "without a camera there is no pose)");
+  cli.add_option("--truth", options.truth_path,
+                 "truth of the single input: a CSV of lines and poses, or a directory of the "
+                 "renderer's frame JSON (default: JSON next to the images, <video>.truth.csv)");
+  cli.add_flag("--compare", options.compare,
+               "also run oalservo compare's methods (vpMeLine, OpenCV) on each input");
+  cli.add_option("--jobs", options.jobs, "inputs evaluated in parallel")->capture_default_str();
+  cli.add_option("--shard", shard,
+                 "I/N: only the inputs whose number is I modulo N (I from 0), for batch "
+                 "schedulers; gather with a final run with --resume");
+  cli.add_flag("--resume", options.resume,
+               "skip the inputs a previous run completed (their summary.json exists)");
+  cli.add_flag("--no-video", no_video, "do not write the annotated videos");
+  cli.add_option("--video-scale", options.video_scale,
+                 "size of the annotated videos relative to the frames (0.5: a quarter of the "
+                 "pixels, smaller files, faster to encode)")
+      ->capture_default_str();
+  cli.add_option("--lines", options.target_lines,
+                 "lines held for the target to count as detected (0: the target's lines)")
+      ->capture_default_str();
+  cli.add_option("--max-frames", options.max_frames, "frames per input at most (0: all)");
+  cli.add_option("--thumbnails", options.thumbnails, "worst frames shown per report")
+      ->capture_default_str();
+  cli.footer(
+      "Examples:\n"
+      "  oalservo evaluate clip.mp4 --camera camera.xml --out out/eval\n"
+      "  oalservo evaluate recordings/ --camera camera.xml --jobs 2 --out out/eval\n"
+      "  oalservo evaluate recordings/ --shard $SLURM_ARRAY_TASK_ID/8 --out out/eval\n"
+      "  oalservo evaluate '/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm' "
+      "--config config/visp_line_edges.yaml --lines 1 --out out/eval-line");
+  if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  if (!shard.empty()) {
+    try {
+      std::tie(options.shard_index, options.shard_count) = ParseShard(shard);
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());
+    }
+  }
+  options.write_video = !no_video;
+  const EvaluateResult result = Evaluate(options, FrameProgress("evaluate: frame"));
+  int failed = 0, resumed = 0;
+  for (const InputOutcome& input : result.inputs) {
+    if (input.status == "failed") {
+      ++failed;
+      Warn("evaluate", "input '" + input.input + "' failed: " + input.error);
+    }
+    resumed += input.status == "resumed";
+  }
+  for (const std::string& skipped : result.skipped) Warn("evaluate", "skipped " + skipped);
+  std::cerr << "oalservo evaluate: " << result.inputs.size() << " input(s), " << result.frames
+            << " frames evaluated"
+            << (resumed > 0 ? ", " + std::to_string(resumed) + " resumed" : "")
+            << (failed > 0 ? ", " + std::to_string(failed) + " failed" : "") << "; report "
+            << result.index_path << '\n';
+  return failed > 0 ? kExitError : kExitOk;
+}
+
+}  // namespace oal

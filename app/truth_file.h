@@ -1,0 +1,47 @@
+// Ground truth for `oalservo evaluate`: target lines and the camera pose per frame, from the
+// renderer's frame_NNNN.json (oalservo render) or from one CSV file.
+//
+// Truth CSV (docs/EVALUATE.md): one row per line and frame, and at most one pose row per
+// frame, in any order:
+//
+//   frame,line,rho,theta                       a target line (the format of oalservo compare)
+//   frame,pose,tx,ty,tz,tux,tuy,tuz            the pose cMo: translation (metres) and
+//                                              theta-u rotation (radians) of the target frame
+//                                              in the camera frame (ViSP's vpHomogeneousMatrix)
+//
+//   frame  the number in the frame's file name, its last run of digits (image.0001.pgm -> 1,
+//          frame_0007.png -> 7), or for a video its 0-based index (FrameNumber in compare.h)
+//   line   an integer >= 0 identifying the line across frames (the target line's index for
+//          the four-line target: 0-3 are lines 1-4)
+//   rho, theta   pixels and radians, u·cosθ + v·sinθ = ρ (detector/line.h), image
+//          (distorted) coordinates; theta any value (normalised to [0, pi))
+//
+// A header row starting with "frame", blank lines and lines starting with '#' are skipped.
+#pragma once
+
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/compare.h"
+
+namespace oal {
+
+struct TruthCsv {
+  std::map<int, std::vector<TargetLineTruth>> lines;  ///< frame number -> its lines
+  std::map<int, vpHomogeneousMatrix> poses;           ///< frame number -> cMo
+};
+
+/// Reads a truth CSV with line and pose rows (file comment). Throws std::runtime_error
+/// "FILE:LINE: ..." for a missing file or a malformed row (wrong field count, a field that is
+/// not a number, a negative or fractional frame or line, a line or pose given twice).
+TruthCsv LoadTruthCsvWithPoses(const std::string& path);
+
+/// The pose cMo of a frame_NNNN.json truth file (oalservo render); nothing if it has none.
+/// Throws std::runtime_error naming the file if it is missing or malformed.
+std::optional<vpHomogeneousMatrix> LoadTruthPoseJson(const std::string& path);
+
+}  // namespace oal

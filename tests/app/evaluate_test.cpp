@@ -1,0 +1,406 @@
+#include "app/evaluate.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <visp3/core/vpThetaUVector.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/render_command.h"
+#include "app/report.h"
+#include "app/truth_file.h"
+#include "tests/app/test_util.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+constexpr int kFrames = 8;
+constexpr double kRhoShiftPx = 1.5;  // the truth CSV's lines are this far off
+constexpr double kShiftTxM = 0.010;  // and its poses this far along x
+constexpr double kOffsetTolerancePx = 0.35;
+constexpr double kTranslationToleranceMm = 4.0;
+
+std::string FrameName(int index, const char* extension) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%04d%s", index, extension);
+  return name;
+}
+
+// `count` rendered 320x240 frames of the four-line target, with truth JSON and camera.xml.
+std::string RenderFrames(const test::TestDir& dir, const std::string& name, int count,
+                         std::uint64_t seed = 11) {
+  RenderCommandOptions render;
+  render.out_dir = dir / name;
+  render.count = count;
+  render.seed = seed;
+  render.width = 320;
+  render.height = 240;
+  render.fx_px = 300.0;
+  render.noise_sigma = 2.0;
+  render.min_visible_px = 60.0;
+  EXPECT_EQ(RenderDataset(render), count);
+  return render.out_dir;
+}
+
+// The rendered frames of `frames_dir` as an MJPG AVI (OpenCV's own encoder).
+void WriteVideo(const std::string& frames_dir, int count, const std::string& path) {
+  cv::VideoWriter writer(path, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                         25.0, cv::Size(320, 240), true);  // its grey mode fails (OpenCV 4.6)
+  ASSERT_TRUE(writer.isOpened()) << path;
+  for (int i = 0; i < count; ++i) {
+    writer.write(cv::imread(frames_dir + "/" + FrameName(i, ".png"), cv::IMREAD_COLOR));
+  }
+}
+
+// A truth CSV from the renderer's JSON, every line kRhoShiftPx off and every pose kShiftTxM
+// off: the errors the evaluation must report.
+void WriteShiftedTruthCsv(const std::string& frames_dir, int count, const std::string& path) {
+  std::ofstream out(path);
+  out << "frame,line,rho,theta\n# poses: frame,pose,tx,ty,tz,tux,tuy,tuz\n";
+  out.precision(12);
+  for (int i = 0; i < count; ++i) {
+    const json truth = json::parse(test::ReadText(frames_dir + "/" + FrameName(i, ".json")));
+    for (const json& line : truth.at("lines")) {
+      if (!line.at("visible").get<bool>()) continue;
+      out << i << "," << line.at("index") << ","
+          << line.at("distorted_fit").at("rho").get<double>() + kRhoShiftPx << ","
+          << line.at("distorted_fit").at("theta").get<double>() << "\n";
+    }
+    const std::vector<double> t = truth.at("cMo").at("translation_m");
+    const std::vector<double> tu = truth.at("cMo").at("theta_u_rad");
+    out << i << ",pose," << t[0] + kShiftTxM << "," << t[1] << "," << t[2] << "," << tu[0] << ","
+        << tu[1] << "," << tu[2] << "\n";
+  }
+}
+
+// A directory with one video (and the renderer's camera.xml next to it).
+std::string VideoDir(const test::TestDir& dir, const std::string& frames_dir,
+                     const std::string& name, const std::vector<std::string>& videos) {
+  const fs::path videos_dir = dir / name;
+  fs::create_directories(videos_dir);
+  fs::copy_file(frames_dir + "/camera.xml", videos_dir / "camera.xml",
+                fs::copy_options::overwrite_existing);
+  for (const std::string& video : videos)
+    WriteVideo(frames_dir, kFrames, (videos_dir / video).string());
+  return videos_dir.string();
+}
+
+json ReadJson(const fs::path& path) {
+  return json::parse(test::ReadText(path));
+}
+
+EvaluateOptions Options(const std::vector<std::string>& inputs, const std::string& out) {
+  EvaluateOptions options;
+  options.inputs = inputs;
+  options.out_dir = out;
+  options.thumbnails = 3;
+  return options;
+}
+
+// Every file below `dir`, relative path -> bytes; the timing files left out and the reports'
+// timing block removed (timings differ from run to run: evaluate.h).
+std::map<std::string, std::string> DeterministicFiles(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  const std::regex timing_block(
+      R"(<script type="application/json" id="oal-timing">[^<]*</script>)");
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (!entry.is_regular_file()) continue;
+    const std::string name = entry.path().filename().string();
+    if (name == "timing.json" || name == "timing.jsonl") continue;
+    std::string bytes = test::ReadText(entry.path());
+    if (entry.path().extension() == ".html") bytes = std::regex_replace(bytes, timing_block, "");
+    files[fs::relative(entry.path(), dir).string()] = std::move(bytes);
+  }
+  return files;
+}
+
+TEST(TruthFile, ReadsLineAndPoseRowsAndRejectsBadOnes) {
+  test::TestDir dir;
+  test::WriteText(dir / "t.csv",
+                  "frame,line,rho,theta\n# comment\n\n3,0,10.5,0.25\n3,1,-4,3.5\n"
+                  "3,pose,0.1,0.2,0.5,0,0,0.3\n");
+  const TruthCsv truth = LoadTruthCsvWithPoses(dir / "t.csv");
+  ASSERT_EQ(truth.lines.at(3).size(), 2u);
+  EXPECT_DOUBLE_EQ(truth.lines.at(3)[0].image_line.rho_px, 10.5);
+  EXPECT_NEAR(truth.lines.at(3)[1].image_line.theta_rad, 3.5 - kPi, 1e-12);
+  const vpHomogeneousMatrix& cMo = truth.poses.at(3);
+  EXPECT_DOUBLE_EQ(cMo[2][3], 0.5);
+  EXPECT_NEAR(vpThetaUVector(cMo.getRotationMatrix())[2], 0.3, 1e-12);
+
+  test::WriteText(dir / "bad.csv", "1,0,2\n");
+  EXPECT_THAT([&] { LoadTruthCsvWithPoses(dir / "bad.csv"); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("bad.csv:1: expected")));
+  test::WriteText(dir / "twice.csv", "1,pose,0,0,1,0,0,0\n1,pose,0,0,1,0,0,0\n");
+  EXPECT_THAT([&] { LoadTruthCsvWithPoses(dir / "twice.csv"); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("twice.csv:2: the pose")));
+}
+
+TEST(Evaluate, ParsesShardsAndPlansNamesThatDoNotCollide) {
+  EXPECT_EQ(ParseShard("1/4"), std::make_pair(1, 4));
+  EXPECT_THROW(ParseShard("4/4"), std::invalid_argument);
+  EXPECT_THROW(ParseShard("1"), std::invalid_argument);
+  EXPECT_THROW(ParseShard("a/2"), std::invalid_argument);
+  test::TestDir dir;
+  fs::create_directories(dir / "a");
+  fs::create_directories(dir / "b/a");
+  test::WriteText(dir / "a/clip.avi", "x");
+  test::WriteText(dir / "a/clip.mp4", "x");
+  test::WriteText(dir / "a/notes.txt", "x");
+  test::WriteText(dir / "b/a/f.png", "x");
+  const InputPlan plan = PlanInputs({dir / "a", dir / "b"});
+  ASSERT_EQ(plan.inputs.size(), 3u);
+  EXPECT_EQ(plan.inputs[0].name, "clip");
+  EXPECT_EQ(plan.inputs[1].name, "clip-2");
+  EXPECT_EQ(plan.inputs[2].name, "a");
+  ASSERT_EQ(plan.skipped.size(), 1u);
+  EXPECT_THAT(plan.skipped[0], HasSubstr("notes.txt"));
+}
+
+TEST(Evaluate, VideoWithTruthCsvReportsTheKnownErrors) {
+  test::TestDir dir;
+  const std::string frames = RenderFrames(dir, "frames", kFrames);
+  const std::string videos = VideoDir(dir, frames, "videos", {"clip.avi"});
+  WriteShiftedTruthCsv(frames, kFrames, videos + "/clip.truth.csv");
+  const EvaluateResult result = Evaluate(Options({videos + "/clip.avi"}, dir / "out"));
+  ASSERT_EQ(result.inputs.size(), 1u);
+  ASSERT_EQ(result.inputs[0].status, "complete") << result.inputs[0].error;
+  const json summary = ReadJson(dir / "out/clip/summary.json");
+  EXPECT_EQ(summary.at("frames"), kFrames);
+  EXPECT_EQ(summary.at("frames_unreadable"), 0);
+  EXPECT_EQ(summary.at("truth").at("kind"), "csv");
+  const json& truth = summary.at("truth");
+  EXPECT_GE(truth.at("found_lines").get<int>(), truth.at("truth_lines").get<int>() * 9 / 10);
+  EXPECT_NEAR(truth.at("offset_px").at("mean").get<double>(), kRhoShiftPx, kOffsetTolerancePx);
+  ASSERT_GE(summary.at("pose").at("frames_ok").get<int>(), kFrames / 2);
+  EXPECT_NEAR(truth.at("pose_translation_mm").at("mean").get<double>(), 1000.0 * kShiftTxM,
+              kTranslationToleranceMm);
+  // One JSON object per frame, and the annotated video holds every frame.
+  const auto records = test::ParseJsonLines(test::ReadText(dir / "out/clip/frames.jsonl"));
+  ASSERT_EQ(records.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(records[0].at("truth").at("lines").size(), 4u);
+  cv::VideoCapture annotated(dir / "out/clip/annotated.avi");
+  EXPECT_EQ(static_cast<int>(annotated.get(cv::CAP_PROP_FRAME_COUNT)), kFrames);
+  EXPECT_TRUE(test::TempFilesIn(dir / "out").empty());
+}
+
+TEST(Evaluate, RenderedJsonTruthNextToTheImagesGivesSmallErrors) {
+  test::TestDir dir;
+  const std::string frames = RenderFrames(dir, "frames", kFrames);
+  EvaluateOptions options = Options({frames}, dir / "out");
+  options.write_video = false;
+  const EvaluateResult result = Evaluate(options);
+  ASSERT_EQ(result.inputs.at(0).status, "complete") << result.inputs[0].error;
+  const json summary = ReadJson(dir / "out/frames/summary.json");
+  const json& truth = summary.at("truth");
+  EXPECT_EQ(truth.at("kind"), "json");
+  EXPECT_LT(truth.at("offset_px").at("mean").get<double>(), 0.5);
+  EXPECT_LT(truth.at("pose_translation_mm").at("mean").get<double>(), 10.0);
+  EXPECT_FALSE(fs::exists(dir / "out/frames/annotated.avi"));
+}
+
+TEST(Evaluate, TruncatedVideoAndNonVideoFilesAreListedNotFatal) {
+  test::TestDir dir;
+  const std::string frames = RenderFrames(dir, "frames", kFrames);
+  const std::string videos = VideoDir(dir, frames, "videos", {"good.avi", "whole.avi"});
+  // truncated.avi: the first 60 % of a good video.
+  const std::string bytes = test::ReadText(videos + "/whole.avi");
+  test::WriteText(videos + "/truncated.avi", bytes.substr(0, bytes.size() * 6 / 10));
+  fs::remove(videos + "/whole.avi");
+  test::WriteText(videos + "/garbage.avi", "not a video at all");
+  test::WriteText(videos + "/notes.txt", "recorded on Monday");
+  EvaluateOptions options = Options({videos}, dir / "out");
+  options.write_video = false;
+  const EvaluateResult result = Evaluate(options);
+  ASSERT_EQ(result.inputs.size(), 3u);  // garbage, good, truncated (camera.xml, notes skipped)
+  EXPECT_EQ(result.inputs[0].name, "garbage");
+  EXPECT_EQ(result.inputs[0].status, "failed");
+  EXPECT_THAT(result.inputs[0].error, HasSubstr("garbage.avi"));
+  EXPECT_EQ(result.inputs[1].status, "complete");
+  EXPECT_EQ(result.inputs[1].summary.at("frames"), kFrames);
+  ASSERT_EQ(result.inputs[2].status, "complete") << result.inputs[2].error;
+  const json& truncated = result.inputs[2].summary;
+  EXPECT_LT(truncated.at("frames_readable").get<int>(), kFrames);
+  EXPECT_GT(truncated.at("frames_unreadable").get<int>(), 0);
+  EXPECT_THAT(truncated.at("warnings").dump(), HasSubstr("truncated"));
+  ASSERT_EQ(result.skipped.size(), 2u);
+  EXPECT_THAT(result.skipped[1], HasSubstr("notes.txt"));
+  // The index lists the failure and the skipped files; the truncated report its frames.
+  const std::string index = test::ReadText(dir / "out/index.html");
+  EXPECT_THAT(index, HasSubstr("garbage.avi"));
+  EXPECT_THAT(index, HasSubstr("notes.txt"));
+  EXPECT_THAT(test::ReadText(dir / "out/truncated/report.html"), HasSubstr("announces"));
+}
+
+TEST(Evaluate, UndecodableImageIsSkippedCountedAndListed) {
+  test::TestDir dir;
+  const std::string frames = RenderFrames(dir, "frames", 4);
+  test::WriteText(frames + "/" + FrameName(2, ".png"), "\x89PNG truncated");
+  EvaluateOptions options = Options({frames}, dir / "out");
+  options.write_video = false;
+  const EvaluateResult result = Evaluate(options);
+  ASSERT_EQ(result.inputs.at(0).status, "complete") << result.inputs[0].error;
+  const json& summary = result.inputs[0].summary;
+  EXPECT_EQ(summary.at("frames"), 4);
+  EXPECT_EQ(summary.at("frames_unreadable"), 1);
+  EXPECT_EQ(summary.at("unreadable").at(0).at("frame"), 2);
+  const auto records = test::ParseJsonLines(test::ReadText(dir / "out/frames/frames.jsonl"));
+  ASSERT_EQ(records.size(), 4u);
+  EXPECT_EQ(records[2].at("status"), "unreadable");
+  EXPECT_EQ(records[3].at("status"), "pose");
+  EXPECT_THAT(test::ReadText(dir / "out/frames/report.html"), HasSubstr("cannot decode image"));
+}
+
+TEST(Evaluate, ResumeSkipsCompletedInputsAndRedoesInterruptedOnes) {
+  test::TestDir dir;
+  const std::string a = RenderFrames(dir, "a", 4, 3);
+  const std::string b = RenderFrames(dir, "b", 4, 5);
+  EvaluateOptions options = Options({a, b}, dir / "out");
+  options.write_video = false;
+  ASSERT_EQ(Evaluate(options).inputs.at(1).status, "complete");
+  const std::string b_frames = test::ReadText(dir / "out/b/frames.jsonl");
+  const auto a_time = fs::last_write_time(dir / "out/a/summary.json");
+  // An interrupted run: b has no summary, a temporary file of a killed process, and an
+  // older frames.jsonl.
+  fs::remove(dir / "out/b/summary.json");
+  test::WriteText(dir / "out/b/frames.jsonl.tmp-999999", "{\"frame\":0");
+  test::WriteText(dir / "out/b/frames.jsonl", "stale\n");
+  options.resume = true;
+  const EvaluateResult resumed = Evaluate(options);
+  EXPECT_EQ(resumed.inputs.at(0).status, "resumed");
+  EXPECT_EQ(resumed.inputs.at(1).status, "complete");
+  EXPECT_EQ(resumed.frames, 4);
+  EXPECT_EQ(fs::last_write_time(dir / "out/a/summary.json"), a_time);
+  EXPECT_EQ(test::ReadText(dir / "out/b/frames.jsonl"), b_frames);
+  EXPECT_TRUE(fs::exists(dir / "out/b/summary.json"));
+  EXPECT_TRUE(test::TempFilesIn(dir / "out").empty());
+  EXPECT_THAT(test::ReadText(dir / "out/index.html"), HasSubstr("a/report.html"));
+}
+
+TEST(Evaluate, TwoJobsWriteWhatOneJobWrites) {
+  test::TestDir dir;
+  const std::string frames = RenderFrames(dir, "frames", kFrames);
+  const std::string videos = VideoDir(dir, frames, "videos", {"v1.avi", "v2.avi"});
+  const std::string other = RenderFrames(dir, "other", 4, 7);
+  EvaluateOptions options = Options({videos, other}, dir / "serial");
+  Evaluate(options);
+  options.out_dir = dir / "parallel";
+  options.jobs = 2;
+  Evaluate(options);
+  const auto serial = DeterministicFiles(dir / "serial");
+  const auto parallel = DeterministicFiles(dir / "parallel");
+  ASSERT_EQ(serial.size(), parallel.size());
+  EXPECT_TRUE(serial.count("v1/annotated.avi"));
+  for (const auto& [name, bytes] : serial) {
+    ASSERT_TRUE(parallel.count(name)) << name;
+    EXPECT_TRUE(parallel.at(name) == bytes) << name << " differs";
+  }
+}
+
+TEST(Evaluate, ShardTakesEveryNthInputAndNamesItsIndex) {
+  test::TestDir dir;
+  const std::string a = RenderFrames(dir, "a", 2, 3);
+  const std::string b = RenderFrames(dir, "b", 2, 5);
+  const std::string c = RenderFrames(dir, "c", 2, 7);
+  EvaluateOptions options = Options({a, b, c}, dir / "out");
+  options.write_video = false;
+  options.shard_index = 1;
+  options.shard_count = 2;
+  const EvaluateResult result = Evaluate(options);
+  ASSERT_EQ(result.inputs.size(), 1u);
+  EXPECT_EQ(result.inputs[0].name, "b");
+  EXPECT_TRUE(fs::exists(dir / "out/index-1-of-2.html"));
+  EXPECT_FALSE(fs::exists(dir / "out/a"));
+  // Gathering: a run over everything with --resume evaluates only what is missing.
+  options.shard_count = 1;
+  options.shard_index = 0;
+  options.resume = true;
+  const EvaluateResult all = Evaluate(options);
+  EXPECT_EQ(all.frames, 4);
+  EXPECT_EQ(all.inputs[1].status, "resumed");
+}
+
+// The report of a rendered input: written, `dir` / out.
+std::string EvaluateRendered(const test::TestDir& dir) {
+  const std::string frames = RenderFrames(dir, "frames", kFrames);
+  EvaluateOptions options = Options({frames}, dir / "out");
+  options.write_video = false;
+  EXPECT_EQ(Evaluate(options).inputs.at(0).status, "complete");
+  return dir / "out";
+}
+
+TEST(EvaluateReport, IsOneSelfContainedPageWithPlotsAndThumbnails) {
+  test::TestDir dir;
+  const std::string out = EvaluateRendered(dir);
+  const std::string html = test::ReadText(out + "/frames/report.html");
+  EXPECT_THAT(html, HasSubstr("Chart.js v"));  // inlined, not linked
+  EXPECT_THAT(html, ::testing::Not(HasSubstr("src=\"http")));
+  EXPECT_THAT(html, ::testing::Not(HasSubstr("<link")));
+  for (const char* id : {"chart-status", "chart-rho", "chart-theta", "chart-line-errors",
+                         "chart-pose-errors", "chart-timing"}) {
+    EXPECT_THAT(html, HasSubstr(std::string("id=\"") + id + "\"")) << id;
+  }
+  EXPECT_THAT(html, HasSubstr("id=\"oal-data\""));
+  EXPECT_THAT(html, HasSubstr("id=\"oal-timing\""));
+  EXPECT_THAT(html, HasSubstr("data:image/jpeg;base64,/9j/"));  // a JPEG thumbnail
+  EXPECT_THAT(test::ReadText(out + "/index.html"), HasSubstr("frames/report.html"));
+}
+
+// Runs Debian's chromium headless on `page`; returns the dumped DOM, `log` gets stderr.
+std::string DumpDom(const test::TestDir& dir, const std::string& page, std::string* log) {
+  const std::string dom = dir / "dom.html", err = dir / "chromium.log";
+  const std::string command =
+      "chromium --headless=new --no-sandbox --disable-gpu --no-first-run "
+      "--user-data-dir='" +
+      (dir / "profile") +
+      "' --enable-logging=stderr --v=0 "
+      "--virtual-time-budget=5000 --dump-dom 'file://" +
+      page + "' > '" + dom + "' 2> '" + err + "'";
+  const int status = std::system(command.c_str());
+  *log = test::ReadText(err);
+  EXPECT_EQ(status, 0) << command << "\n" << *log;
+  return test::ReadText(dom);
+}
+
+TEST(EvaluateReport, LoadsInHeadlessChromiumWithEveryPlotDrawn) {
+  ASSERT_EQ(std::system("command -v chromium > /dev/null 2>&1"), 0)
+      << "chromium is missing: the report's browser test needs Debian's chromium "
+         "(scripts/install-deps.sh installs it)";
+  test::TestDir dir;
+  const std::string out = EvaluateRendered(dir);
+  const std::regex canvas(R"(<canvas class="oal-chart" id="[^"]+"([^>]*)>)");
+  for (const std::string& page : {out + "/frames/report.html", out + "/index.html"}) {
+    std::string log;
+    const std::string dom = DumpDom(dir, fs::absolute(page).string(), &log);
+    int canvases = 0, drawn = 0;
+    for (auto it = std::sregex_iterator(dom.begin(), dom.end(), canvas);
+         it != std::sregex_iterator(); ++it) {
+      ++canvases;
+      drawn += (*it)[1].str().find("data-drawn=\"1\"") != std::string::npos;
+    }
+    EXPECT_GE(canvases, 1) << page;
+    EXPECT_EQ(drawn, canvases) << page << ": not every plot was drawn";
+    EXPECT_THAT(dom, HasSubstr("data-charts=\"" + std::to_string(canvases) + "\"")) << page;
+    EXPECT_THAT(log, ::testing::Not(HasSubstr("Uncaught"))) << page << "\n" << log;
+    EXPECT_THAT(log, ::testing::Not(::testing::ContainsRegex("CONSOLE.*[Ee]rror"))) << log;
+  }
+}
+
+}  // namespace
+}  // namespace oal
