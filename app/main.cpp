@@ -19,6 +19,7 @@
 #include "app/pose_accuracy_command.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"
+#include "app/scorbot_sim_command.h"
 #include "app/servo_accuracy_command.h"
 #include "app/servo_command.h"
 #include "app/target_command.h"
@@ -49,6 +50,8 @@ constexpr oal::Command kCommands[] = {
      "evaluate the tracker and the pose on recorded videos: JSON, annotated video, HTML report"},
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
     {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
+    {"scorbot-sim", &oal::RunScorbotSim,
+     "Scorbot ER-VII controller simulator (ACL) on a pseudo-terminal; --measure: link budget"},
 };
 
 void PrintUsage(std::ostream& out) {

@@ -1,0 +1,347 @@
+#include "robots/acl_client.h"
+
+#include <cctype>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+
+#include "robots/check_option.h"
+
+namespace oal {
+namespace {
+
+constexpr char kXon = 0x11;
+constexpr char kXoff = 0x13;
+constexpr char kCtrlA = 0x01;
+
+std::string Trim(const std::string& s) {
+  std::size_t b = 0, e = s.size();
+  while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
+  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
+  return s.substr(b, e - b);
+}
+
+std::string Upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string StripFlowControl(std::string s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    if (c != kXon && c != kXoff) out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::string line;
+  std::istringstream in(text);
+  while (std::getline(in, line)) {
+    line = Trim(line);
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+// The number after "AXIS" in an upper-cased line, 0 if none.
+int AxisOf(const std::string& upper) {
+  const std::size_t at = upper.find("AXIS");
+  if (at == std::string::npos) return 0;
+  std::size_t i = at + 4;
+  while (i < upper.size() && (upper[i] == ' ' || upper[i] == ':')) ++i;
+  return std::atoi(upper.c_str() + i);
+}
+
+// Position of the first '>' that starts a line in s[from..], npos if none.
+std::size_t FindPrompt(const std::string& s, std::size_t from) {
+  for (std::size_t i = from; i < s.size(); ++i) {
+    if (s[i] == '>' && (i == from || s[i - 1] == '\n' || s[i - 1] == '\r')) return i;
+  }
+  return std::string::npos;
+}
+
+// Reads a signed integer after `key` (e.g. "X:", "3:") in `s`; spaces allowed after the colon.
+bool ValueAfter(const std::string& s, std::size_t at, long* value) {
+  std::size_t i = at;
+  while (i < s.size() && s[i] == ' ') ++i;
+  if (i >= s.size()) return false;
+  const char* begin = s.c_str() + i;
+  char* end = nullptr;
+  const long v = std::strtol(begin, &end, 10);
+  if (end == begin) return false;
+  *value = v;
+  return true;
+}
+
+}  // namespace
+
+std::string ToString(AclErrorKind kind) {
+  switch (kind) {
+    case AclErrorKind::kImpact:
+      return "impact";
+    case AclErrorKind::kOutOfRange:
+      return "out-of-range";
+    case AclErrorKind::kHomeFailure:
+      return "home-failure";
+    case AclErrorKind::kControlDisabled:
+      return "control-disabled";
+    case AclErrorKind::kBadCartesian:
+      return "bad-cartesian-point";
+    case AclErrorKind::kBadCoordinate:
+      return "bad-point-coordinate";
+    case AclErrorKind::kNumbered:
+      return "numbered";
+    case AclErrorKind::kOther:
+      return "other";
+  }
+  return "unknown";
+}
+
+std::string ToString(AclStatus status) {
+  switch (status) {
+    case AclStatus::kOk:
+      return "ok";
+    case AclStatus::kControllerError:
+      return "controller-error";
+    case AclStatus::kTimeout:
+      return "timeout";
+    case AclStatus::kLinkError:
+      return "link-error";
+  }
+  return "unknown";
+}
+
+std::vector<AclError> ParseAclErrors(const std::string& text) {
+  std::vector<AclError> errors;
+  for (const std::string& raw : Lines(StripFlowControl(text))) {
+    std::string line = raw;
+    bool starred = false;
+    while (!line.empty() && line[0] == '*') {
+      starred = true;
+      line.erase(0, 1);
+    }
+    line = Trim(line);
+    const std::string up = Upper(line);
+    AclError e;
+    e.text = Trim(raw);
+    // A numbered error: digits, a space, then an upper-case word.
+    std::size_t digits = 0;
+    while (digits < up.size() && std::isdigit(static_cast<unsigned char>(up[digits]))) ++digits;
+    const bool numbered = digits > 0 && digits < up.size() && up[digits] == ' ' &&
+                          digits + 1 < up.size() &&
+                          std::isupper(static_cast<unsigned char>(up[digits + 1]));
+    if (up.find("IMPACT PROTECTION") != std::string::npos) {
+      e.kind = AclErrorKind::kImpact;
+      e.axis = AxisOf(up);
+    } else if (up.find("OUT OF RANGE") != std::string::npos) {
+      e.kind = AclErrorKind::kOutOfRange;
+      e.axis = AxisOf(up);
+    } else if (up.find("HOME FAILURE") != std::string::npos) {
+      e.kind = AclErrorKind::kHomeFailure;
+      e.axis = AxisOf(up);
+    } else if (up.find("CONTROL DISABLED") != std::string::npos) {
+      e.kind = AclErrorKind::kControlDisabled;
+    } else if (numbered) {
+      e.code = std::atoi(up.c_str());
+      e.kind = e.code == 317   ? AclErrorKind::kBadCartesian
+               : e.code == 312 ? AclErrorKind::kBadCoordinate
+                               : AclErrorKind::kNumbered;
+    } else if (starred) {
+      e.kind = AclErrorKind::kOther;
+    } else {
+      continue;
+    }
+    errors.push_back(e);
+  }
+  return errors;
+}
+
+bool ParseListpv(const std::string& text, AclPositionValues* out, std::string* why) {
+  AclPositionValues v;
+  bool have[5] = {false, false, false, false, false};
+  bool have_c[5] = {false, false, false, false, false};
+  long* cart[5] = {&v.cartesian.x, &v.cartesian.y, &v.cartesian.z, &v.cartesian.p, &v.cartesian.r};
+  const char* keys = "XYZPR";
+  for (const std::string& line : Lines(StripFlowControl(text))) {
+    const std::string up = Upper(line);
+    if (up.rfind("POSITION", 0) == 0) {
+      v.name = Trim(line.substr(8));
+      continue;
+    }
+    for (std::size_t i = 0; i + 1 < up.size(); ++i) {
+      if (up[i + 1] != ':') continue;
+      const bool token_start = i == 0 || up[i - 1] == ' ' || up[i - 1] == '\t';
+      if (!token_start) continue;
+      const char c = up[i];
+      if (c >= '1' && c <= '5') {
+        long value = 0;
+        if (ValueAfter(up, i + 2, &value)) {
+          v.counts[c - '1'] = value;
+          have[c - '1'] = true;
+        }
+      } else if (const char* k = std::strchr(keys, c); k != nullptr && c != '\0') {
+        long value = 0;
+        if (ValueAfter(up, i + 2, &value)) {
+          *cart[k - keys] = value;
+          have_c[k - keys] = true;
+        }
+      }
+    }
+  }
+  v.has_counts = have[0] && have[1] && have[2] && have[3] && have[4];
+  v.has_cartesian = have_c[0] && have_c[1] && have_c[2] && have_c[3] && have_c[4];
+  if (!v.has_counts && !v.has_cartesian) {
+    if (why) *why = "LISTPV reply without the counts of axes 1-5 or X Y Z P R: '" + text + "'";
+    return false;
+  }
+  *out = v;
+  return true;
+}
+
+std::string AclReply::text() const {
+  std::string s;
+  for (const std::string& line : lines) {
+    if (!s.empty()) s += '\n';
+    s += line;
+  }
+  return s;
+}
+
+void AclClientOptions::Check() const {
+  RequireRobotOption(reply_timeout_s > 0 && reply_timeout_s <= 600,
+                     "AclClientOptions::reply_timeout_s", reply_timeout_s, "0 < value <= 600");
+}
+
+AclClient::AclClient(ByteLink& link, const AclClientOptions& options)
+    : link_(link), options_(options) {
+  options_.Check();
+}
+
+AclReply AclClient::Finish(AclReply reply, const std::string& async, const std::string& body) {
+  if (!async.empty()) async_text_ += async;
+  std::vector<AclError> errors = ParseAclErrors(async);
+  for (const AclError& e : ParseAclErrors(body)) errors.push_back(e);
+  reply.lines = Lines(StripFlowControl(body));
+  reply.errors = std::move(errors);
+  if (reply.status == AclStatus::kOk && !reply.errors.empty()) {
+    reply.status = AclStatus::kControllerError;
+    reply.message = "controller: " + reply.errors.front().text;
+    for (std::size_t i = 1; i < reply.errors.size(); ++i)
+      reply.message += "; " + reply.errors[i].text;
+  }
+  return reply;
+}
+
+AclReply AclClient::Command(const std::string& command, double timeout_s) {
+  ++commands_;
+  const double timeout = timeout_s > 0 ? timeout_s : options_.reply_timeout_s;
+  std::string async = StripFlowControl(link_.DrainInput());
+  AclReply reply;
+  if (IoResult w = link_.Write(command + "\r", timeout); !w.ok()) {
+    reply.status = w.status == IoStatus::kTimeout ? AclStatus::kTimeout : AclStatus::kLinkError;
+    reply.message = "sending '" + command + "': " + w.message;
+    return Finish(reply, async, "");
+  }
+  const std::string echo = command + "\r\n";
+  std::string in;
+  std::size_t body_from = 0;
+  bool echo_seen = !options_.echo;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::microseconds(static_cast<long long>(timeout * 1e6));
+  for (;;) {
+    in = StripFlowControl(in);
+    if (!echo_seen) {
+      const std::size_t at = in.find(echo);
+      if (at != std::string::npos) {
+        async += in.substr(0, at);
+        body_from = at + echo.size();
+        echo_seen = true;
+      }
+    }
+    if (echo_seen) {
+      const std::size_t prompt = FindPrompt(in, body_from);
+      if (prompt != std::string::npos) {
+        const std::string body = in.substr(body_from, prompt - body_from);
+        // Anything after the prompt (should be nothing) is kept for the next command.
+        async_text_ += in.substr(prompt + 1);
+        return Finish(reply, async, body);
+      }
+    }
+    const double left_s =
+        std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    IoResult r = left_s > 0 ? link_.ReadSome(&in, left_s) : IoResult{IoStatus::kTimeout, "timeout"};
+    if (!r.ok()) {
+      std::ostringstream s;
+      if (r.status == IoStatus::kTimeout) {
+        reply.status = AclStatus::kTimeout;
+        s << "no reply to '" << command << "' within " << timeout << " s ("
+          << (echo_seen ? "no prompt" : "no echo") << "; controller silent?)";
+      } else {
+        reply.status = AclStatus::kLinkError;
+        s << "'" << command << "': " << r.message;
+      }
+      reply.message = s.str();
+      return Finish(reply, async, echo_seen ? in.substr(body_from) : in);
+    }
+  }
+}
+
+AclReply AclClient::Ping() {
+  return Command("");
+}
+
+AclReply AclClient::Abort() {
+  // Ctrl-A first, on its own: the controller acts on it as it arrives.
+  if (IoResult w = link_.Write(std::string(1, kCtrlA), options_.reply_timeout_s); !w.ok()) {
+    AclReply reply;
+    reply.status = w.status == IoStatus::kTimeout ? AclStatus::kTimeout : AclStatus::kLinkError;
+    reply.message = "sending Ctrl-A: " + w.message;
+    return reply;
+  }
+  return Command("CLRBUF");
+}
+
+AclReply AclClient::SetEcho(bool on) {
+  // The command itself is echoed or not depending on the state before it, which may be
+  // unknown (at Connect): read it as if without echo (the prompt at a line start ends the
+  // reply; an echo would only add a reply line).
+  const bool before = options_.echo;
+  options_.echo = false;
+  AclReply reply = Command(on ? "ECHO" : "NOECHO");
+  if (reply.status == AclStatus::kOk || reply.status == AclStatus::kControllerError) {
+    options_.echo = on;
+  } else {
+    options_.echo = before;
+  }
+  return reply;
+}
+
+AclReply AclClient::ListPosition(const std::string& position, AclPositionValues* values) {
+  AclReply reply = Command("LISTPV " + position);
+  if (!reply.ok()) return reply;
+  std::string why;
+  if (!ParseListpv(reply.text(), values, &why)) {
+    reply.status = AclStatus::kControllerError;
+    reply.message = why;
+  }
+  return reply;
+}
+
+std::string AclClient::TakeAsyncText() {
+  std::string s = std::move(async_text_);
+  async_text_.clear();
+  return s;
+}
+
+AclStats AclClient::stats() const {
+  AclStats s;
+  s.commands = commands_;
+  s.link = link_.counters();
+  return s;
+}
+
+}  // namespace oal

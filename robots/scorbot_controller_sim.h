@@ -1,0 +1,200 @@
+// A simulator of the Scorbot ER-VII's Controller-A speaking ACL on a pseudo-terminal (issue 6),
+// so that the real driver (SerialPort + AclClient + ScorbotRobot) runs against it unchanged.
+//
+// Start() opens a pty pair (openpty, raw mode), optionally points a symlink at the slave, prints
+// "SYSTEM READY!" and serves the master end from a background thread until Stop() (or the
+// destructor) closes it. Open DevicePath() (or the link) as the serial port.
+//
+// WHAT IT DOES (docs/SCORBOT.md says which parts follow the manual and which are our guesses)
+//   - Echoes every received character (CR as CR LF) unless NOECHO; ECHO turns it back on.
+//     Commands end with CR; LF is ignored; commands are case-insensitive. After each command
+//     its reply lines (each ending CR LF), then the prompt '>'.
+//   - Position table: DEFP P, HERE P (joint point), SETPV P axis counts (joint), SETPVC P X|Y|Z|P|R
+//     value (makes the point Cartesian), LISTPV P / LISTPV POSITION in the format
+//     "Position P" / " 1:c1 2:c2 3:c3 4:c4 5:c5" / " X:x Y:y Z:z P:p R:r".
+//   - CON / COFF (control on / off), SPEED n (1..100 %), HOME (moves to encoder zero at the
+//     configured homing speed, then "Homing complete(ROBOT)"; the prompt comes after),
+//     MOVE P [t] / MOVEL P [t] / MOVED P [t] (queued, the command returns at once (MOVED too:
+//     its waiting is not simulated); executed in order,
+//     joint-interpolated with a smooth cosine profile over max(t/100 s, the time the slowest
+//     joint needs at SPEED % of its maximum speed); MOVEL is executed like MOVE), CLRBUF (clears
+//     queued moves), A (abort), Ctrl-A (0x01: stops motion where it is, clears the queue,
+//     discards the partial input line; prints nothing), SHOW PAR n ("PAR n = v" from a small
+//     table of made-up values), ECHO / NOECHO.
+//   - Errors: MOVE to a Cartesian point the arm cannot reach: "317 BAD CARTESIAN POINT"; to a
+//     point whose joints (or whose IK) leave a range: "*** OUT OF RANGE axis n"; a bad SETPVC /
+//     SETPV argument: "312 BAD POINT COORDINATE"; MOVE or HOME with control off:
+//     "*** CONTROL DISABLED"; unknown commands "*** INVALID COMMAND", undefined points
+//     "*** POSITION P NOT DEFINED", points without values "*** POSITION P HAS NO VALUES".
+//   - Asynchronous messages (impact) are printed between commands (never inside an echoed
+//     line), as "\r\n*** IMPACT PROTECTION axis n\r\n", without a new prompt.
+//   - Time: simulated time = wall time x time_scale (tests run moves fast). With
+//     throttle_to_baud, every byte in each direction takes 10 bits at the baud rate (8N1), the
+//     two directions independently (full duplex), so link timing is realistic.
+// FAULT INJECTION (thread-safe, for tests): an impact on axis n halfway through the next move;
+// silence (a hung controller: input discarded, nothing executed, echoed or answered); "317 BAD
+// CARTESIAN POINT" for the next MOVE; a home failure on axis n for the next HOME; XOFF / XON sent
+// to the host.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "robots/scorbot_kinematics.h"
+
+namespace oal {
+
+struct ScorbotSimOptions {
+  /// The arm (joint ranges, encoder scale, home) the simulator moves.
+  ScorbotGeometry geometry;
+  /// Simulated seconds per wall-clock second; in [0.01, 1000]. Tests use 10-50.
+  double time_scale = 1.0;
+  /// Pace every byte at 10 bits per baud period, both directions.
+  bool throttle_to_baud = false;
+  /// The baud rate for throttle_to_baud; > 0.
+  int baud = 9600;
+  /// Maximum joint speeds at SPEED 100, deg/s; > 0.
+  std::array<double, 5> max_joint_speed_dps{60.0, 60.0, 75.0, 110.0, 160.0};
+  /// Speed of HOME, % of the maximum; in [1, 100].
+  int home_speed_percent = 50;
+  /// If not empty, a symlink created at Start() pointing at the pty slave (replaced if it is
+  /// already a symlink), removed at Stop().
+  std::string link_path;
+  /// Joint angles at start-up, degrees (default: the home position, encoders at 0).
+  std::array<double, 5> start_deg{0.0, 60.0, -90.0, -60.0, 0.0};
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// Byte and command counts of a simulator run.
+struct ScorbotSimStats {
+  std::uint64_t bytes_received = 0;
+  std::uint64_t bytes_sent = 0;
+  long commands = 0;
+  long moves_started = 0;
+  long moves_completed = 0;
+};
+
+class ScorbotControllerSim {
+ public:
+  /// Throws std::invalid_argument on bad options.
+  explicit ScorbotControllerSim(const ScorbotSimOptions& options = ScorbotSimOptions());
+  /// Stops the thread and closes the pty.
+  ~ScorbotControllerSim();
+  ScorbotControllerSim(const ScorbotControllerSim&) = delete;
+  ScorbotControllerSim& operator=(const ScorbotControllerSim&) = delete;
+
+  /// Opens the pty, prints "SYSTEM READY!" and starts serving. Throws std::runtime_error if the
+  /// pty or the symlink cannot be created. A stopped simulator can be started again (a new
+  /// pty; the arm keeps its joints); the symlink then points at the new slave.
+  void Start();
+  /// Stops serving and closes the pty (the host sees the link closed). Idempotent.
+  void Stop() noexcept;
+  bool running() const { return running_.load(); }
+  /// The pty slave to open (valid after Start()).
+  std::string DevicePath() const;
+  /// link_path if set, else DevicePath().
+  std::string ConnectPath() const;
+
+  // --- fault injection ---
+  /// The next move stops halfway with "*** IMPACT PROTECTION axis n"; control goes off.
+  void InjectImpact(int axis);
+  /// While silent, input is discarded unexecuted and nothing is sent (no echo, no reply, no
+  /// prompt, no asynchronous message): a hung controller.
+  void SetSilent(bool silent);
+  /// The next MOVE answers "317 BAD CARTESIAN POINT" and does not move.
+  void InjectBadCartesianPoint();
+  /// The next HOME fails with "*** HOME FAILURE AXIS n".
+  void InjectHomeFailure(int axis);
+  /// Sends XOFF (0x13) / XON (0x11) to the host: a host with XON/XOFF stops / resumes sending.
+  void SendXoff();
+  void SendXon();
+
+  // --- state (thread-safe snapshots) ---
+  ScorbotJoints joints() const;
+  bool moving() const;
+  bool control_enabled() const;
+  bool echo() const;
+  int speed_percent() const;
+  ScorbotSimStats stats() const;
+
+ private:
+  struct Point {
+    bool has_values = false;
+    bool cartesian = false;
+    ScorbotCounts counts{};
+    AclPose pose;
+  };
+  struct Move {
+    ScorbotJoints target{};  // the point's joints when MOVE was received
+    double duration_s = -1;  // requested (MOVE P t), < 0: from SPEED
+  };
+  struct Motion {
+    bool active = false;
+    bool homing = false;
+    ScorbotJoints from{}, to{};
+    double start_s = 0, duration_s = 0;
+    double impact_at_s = -1;  // sim time of an injected impact, < 0: none
+    int impact_axis = 0;
+  };
+
+  void Run();
+  double SimTime() const;  // s
+  void Receive(char c);
+  void Execute(const std::string& line);
+  void Emit(const std::string& text);  // reply text, subject to silence
+  void EmitAsync(const std::string& text);
+  void Prompt();
+  void StartNextMove();
+  void Advance();
+  void FlushOutput();
+  ScorbotJoints CurrentJoints() const;
+  std::string ListPoint(const std::string& name, const Point& p) const;
+  bool PointJoints(const Point& p, ScorbotJoints* q, std::string* error) const;
+  void CmdMove(const std::string& arg, bool linear);
+  void CmdSetpvc(const std::string& args);
+  void CmdSetpv(const std::string& args);
+  void AbortMotion();
+
+  ScorbotSimOptions options_;
+  mutable std::mutex mutex_;
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> stop_requested_{false};
+  int master_ = -1;
+  int slave_ = -1;
+  std::string slave_path_;
+  std::chrono::steady_clock::time_point epoch_;
+
+  // Controller state (under mutex_).
+  ScorbotJoints joints_{};
+  Motion motion_;
+  std::deque<Move> queue_;
+  std::map<std::string, Point> points_;
+  bool control_ = true;
+  bool echo_ = true;
+  int speed_ = 50;
+  std::string line_;
+  std::string pending_async_;
+  bool silent_ = false;
+  int impact_axis_ = 0;
+  bool bad_cartesian_ = false;
+  int home_failure_axis_ = 0;
+  bool homing_reply_pending_ = false;
+  std::string out_;  // bytes to send
+  // Baud pacing: when the next byte may leave / the last received byte has arrived.
+  double tx_free_s_ = 0;
+  std::deque<std::pair<double, char>> rx_;  // received bytes with their arrival times
+  double rx_last_s_ = 0;
+  ScorbotSimStats stats_;
+};
+
+}  // namespace oal
