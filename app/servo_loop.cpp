@@ -305,6 +305,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   std::optional<vpHomogeneousMatrix> previous_cMo;
   vpHomogeneousMatrix previous_wMc;
   cv::Mat gray;
+  std::vector<LineSeed> seeds;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   log << "iter     X mm     Y mm     Z mm    pitch     roll   err mm   err deg  status\n";
   for (int iteration = 0;; ++iteration) {
@@ -373,8 +374,14 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     report.iterations.push_back(row);
     ServoIteration& current = report.iterations.back();
 
-    const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray));
+    const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray), seeds);
     const PoseResult pose = EstimatePose(lines, config.target, pose_options, previous_cMo);
+    seeds.clear();
+    if (pose.status == PoseStatus::kOk) {
+      // The target's lines seed the next frame's accumulator list: a line the camera sees at a
+      // grazing place (an image corner) keeps its entry instead of being culled early.
+      for (int k = 0; k < 4; ++k) seeds.push_back(LineSeed{k + 1, lines[pose.line_index[k]].line});
+    }
     std::optional<ServoStep> step;
     if (pose.status == PoseStatus::kOk) {
       step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);
