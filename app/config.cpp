@@ -516,15 +516,131 @@ Field<RobotConfig> SafetyField(const char* key, T SafetyOptions::*member) {
           }};
 }
 
+// [a, b, c, d, e], finite (the Scorbot's five axes).
+std::array<double, 5> ReadArray5(const Value& value, const char* unit) {
+  const YAML::Node& node = value.node;
+  if (!node.IsSequence() || node.size() != 5) {
+    value.Fail("'" + value.key + "' must be a list of 5 numbers (" + unit + "), one per axis");
+  }
+  std::array<double, 5> v{};
+  for (std::size_t i = 0; i < 5; ++i) {
+    v[i] = Value{node[i], value.file, value.key + "[" + std::to_string(i) + "]"}.FiniteDouble();
+  }
+  return v;
+}
+
+template <typename Options>
+Field<Options> Array5Field(const char* key, std::array<double, 5> Options::*member,
+                           const char* unit) {
+  return {key, [member, unit](const Value& value, Options* options) {
+            options->*member = ReadArray5(value, unit);
+          }};
+}
+
+template <typename Options>
+Field<Options> StringField(const char* key, std::string Options::*member) {
+  return {key, [member](const Value& value, Options* options) {
+            options->*member = value.As<std::string>("a string");
+          }};
+}
+
+// A map nested in a section (robot.scorbot, robot.scorbot.geometry): its own fields, the
+// whole key in messages.
+template <typename Options>
+Lines ReadNested(const Value& value, const std::vector<Field<Options>>& fields, Options* options) {
+  if (!value.node.IsMap()) value.Fail("'" + value.key + "' must be a map of keys");
+  Lines lines;
+  ReadFields(value.node, value.file, value.key, fields, "", options, &lines);
+  return lines;
+}
+
+const std::vector<Field<ScorbotGeometry>>& ScorbotGeometryFields() {
+  using O = ScorbotGeometry;
+  static const std::vector<Field<O>> fields = {
+      DoubleField("shoulder_height_m", &O::shoulder_height_m),
+      DoubleField("shoulder_offset_m", &O::shoulder_offset_m),
+      DoubleField("upper_arm_m", &O::upper_arm_m),
+      DoubleField("forearm_m", &O::forearm_m),
+      DoubleField("pitch_to_flange_m", &O::pitch_to_flange_m),
+      DoubleField("tool_length_m", &O::tool_length_m),
+      Array5Field("joint_min_deg", &O::joint_min_deg, "degrees"),
+      Array5Field("joint_max_deg", &O::joint_max_deg, "degrees"),
+      Array5Field("home_deg", &O::home_deg, "degrees"),
+      Array5Field("counts_per_deg", &O::counts_per_deg, "encoder counts per degree"),
+  };
+  return fields;
+}
+
+const std::vector<Field<ScorbotSimOptions>>& ScorbotSimFields() {
+  using O = ScorbotSimOptions;
+  static const std::vector<Field<O>> fields = {
+      DoubleField("time_scale", &O::time_scale),
+      BoolField("throttle_to_baud", &O::throttle_to_baud),
+      Array5Field("max_joint_speed_dps", &O::max_joint_speed_dps, "degrees per second"),
+      IntField("home_speed_percent", &O::home_speed_percent),
+      StringField("link_path", &O::link_path),
+  };
+  return fields;
+}
+
+const std::vector<Field<RobotConfig>>& ScorbotFields() {
+  using O = RobotConfig;
+  const auto option = [](const char* key, auto ScorbotOptions::*member) -> Field<O> {
+    return {key, [member](const Value& value, O* robot) {
+              using T = std::remove_reference_t<decltype(robot->scorbot.*member)>;
+              if constexpr (std::is_same_v<T, bool>) {
+                robot->scorbot.*member = value.Bool();
+              } else if constexpr (std::is_same_v<T, int>) {
+                robot->scorbot.*member = value.Int();
+              } else if constexpr (std::is_same_v<T, double>) {
+                robot->scorbot.*member = value.Double();
+              } else {
+                robot->scorbot.*member = value.As<std::string>("a string");
+              }
+            }};
+  };
+  static const std::vector<Field<O>> fields = {
+      option("port", &ScorbotOptions::port),
+      option("baud", &ScorbotOptions::baud),
+      option("xonxoff", &ScorbotOptions::xonxoff),
+      option("echo", &ScorbotOptions::echo),
+      option("reply_timeout_s", &ScorbotOptions::reply_timeout_s),
+      option("move_timeout_s", &ScorbotOptions::move_timeout_s),
+      option("home_timeout_s", &ScorbotOptions::home_timeout_s),
+      option("speed_percent", &ScorbotOptions::speed_percent),
+      option("sampling_time_s", &ScorbotOptions::sampling_time_s),
+      option("arrive_tolerance_mm", &ScorbotOptions::arrive_tolerance_mm),
+      option("arrive_tolerance_deg", &ScorbotOptions::arrive_tolerance_deg),
+      option("point_name", &ScorbotOptions::point_name),
+      {"geometry",
+       [](const Value& value, O* robot) {
+         const Lines lines = ReadNested(value, ScorbotGeometryFields(), &robot->scorbot.geometry);
+         CheckAt(robot->scorbot.geometry, value.file, value.key, lines);
+       }},
+      {"simulator",
+       [](const Value& value, O* robot) {
+         const Lines lines = ReadNested(value, ScorbotSimFields(), &robot->simulator);
+         CheckAt(robot->simulator, value.file, value.key, lines);
+       }},
+  };
+  return fields;
+}
+
 const std::vector<Field<RobotConfig>>& RobotFields() {
   using O = RobotConfig;
   static const std::vector<Field<O>> fields = {
       {"type",
        [](const Value& value, O* robot) {
          robot->type = value.As<std::string>("a string");
-         if (robot->type != "simulated") {
-           value.Fail("'" + value.key + "' must be one of simulated, got '" + robot->type + "'");
+         if (robot->type != "simulated" && robot->type != "scorbot") {
+           value.Fail("'" + value.key + "' must be one of simulated, scorbot, got '" + robot->type +
+                      "'");
          }
+       }},
+      {"scorbot",
+       [](const Value& value, O* robot) {
+         const Lines lines = ReadNested(value, ScorbotFields(), robot);
+         CheckAt(robot->scorbot, value.file, value.key, lines);
        }},
       PoseField("start", &O::start_wMc),
       DoubleField("sampling_time_s", &O::sampling_time_s),
@@ -533,6 +649,8 @@ const std::vector<Field<RobotConfig>>& RobotFields() {
       SafetyField("workspace_enabled", &SafetyOptions::workspace_enabled),
       SafetyField("workspace_min_m", &SafetyOptions::workspace_min_m),
       SafetyField("workspace_max_m", &SafetyOptions::workspace_max_m),
+      SafetyField("reach_tolerance_m", &SafetyOptions::reach_tolerance_m),
+      SafetyField("reach_tolerance_rad", &SafetyOptions::reach_tolerance_rad),
   };
   return fields;
 }
@@ -776,11 +894,17 @@ void CameraConfig::Check() const {
 }
 
 void RobotConfig::Check() const {
-  if (type != "simulated") Violated("RobotConfig::type", type, "type is simulated");
+  if (type != "simulated" && type != "scorbot") {
+    Violated("RobotConfig::type", type, "type is simulated or scorbot");
+  }
   if (!(sampling_time_s > 0.0 && sampling_time_s <= 1.0)) {
     Violated("RobotConfig::sampling_time_s", Num(sampling_time_s), "0 < sampling_time_s <= 1");
   }
   safety.Check();
+  if (type == "scorbot") {
+    scorbot.Check();
+    if (scorbot.port == "simulator") simulator.Check();
+  }
 }
 
 void SourceConfig::Check() const {

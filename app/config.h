@@ -25,7 +25,8 @@
 // The servo app's sections (config/servo-sim.yaml documents every key):
 //
 //   camera:   px, py, u0, v0, kdu, width, height, noise, blur, eMc    (CameraConfig)
-//   robot:    type: simulated, start (wMc), velocity limits, workspace box (RobotConfig)
+//   robot:    type: simulated | scorbot, start (wMc), velocity limits, workspace box,
+//             scorbot: {port, baud, ..., geometry, simulator} (RobotConfig)
 //   servo:    the law (ServoOptions) and the loop's limits             (ServoLoopOptions)
 //   goal:     cdMo, the target as the camera should see it at the goal, or image: a taught goal
 //   target_pose: wMo, the target's pose in the world (robot base) frame
@@ -46,6 +47,8 @@
 
 #include "detector/options.h"
 #include "robots/safe_robot.h"
+#include "robots/scorbot_controller_sim.h"
+#include "robots/scorbot_robot.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"
@@ -74,10 +77,17 @@ struct CameraConfig {
 
 /// `robot:` which robot, where it starts, and the runner's safety limits.
 struct RobotConfig {
-  std::string type = "simulated";  ///< only "simulated" (a free-flying camera) for now
-  vpHomogeneousMatrix start_wMc;   ///< start pose of the camera in the world (simulated)
-  double sampling_time_s = 0.04;   ///< one velocity command / move poll, s, (0, 1]
-  SafetyOptions safety;            ///< velocity limits and workspace box
+  /// "simulated" (a free-flying camera, vpSimulatorCamera) or "scorbot" (the ER-VII over
+  /// RS-232 in ACL; robot.scorbot.port "simulator" runs the Controller-A simulator on a
+  /// pseudo-terminal in the process).
+  std::string type = "simulated";
+  /// Start pose of the camera in the world: the simulated robot's, or the Scorbot
+  /// simulator's (nearest reachable); a real arm starts where it stands.
+  vpHomogeneousMatrix start_wMc;
+  double sampling_time_s = 0.04;  ///< one velocity command / move poll, s, (0, 1] (simulated)
+  SafetyOptions safety;           ///< velocity limits, workspace box, reach tolerances
+  ScorbotOptions scorbot;         ///< `robot.scorbot:` (its eMc comes from camera.eMc)
+  ScorbotSimOptions simulator;    ///< `robot.scorbot.simulator:` (port: simulator)
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;

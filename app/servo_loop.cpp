@@ -19,6 +19,9 @@
 #include "app/image_source.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
+#include "robots/scorbot_controller_sim.h"
+#include "robots/scorbot_kinematics.h"
+#include "robots/scorbot_robot.h"
 #include "robots/simulated_camera.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
@@ -158,6 +161,51 @@ class SourceCamera : public LoopCamera {
   Frame frame_;
 };
 
+// The robot the configuration names. For the Scorbot with port "simulator", the Controller-A
+// simulator runs on a pseudo-terminal in this process and the real driver talks to it; it is
+// declared before the driver so that it outlives it.
+struct RobotRig {
+  std::unique_ptr<ScorbotControllerSim> controller;
+  std::unique_ptr<Robot> driver;
+};
+
+// The simulated controller's start: the arm's joints for the nearest reachable pose to the
+// configured camera start.
+ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
+  ScorbotSimOptions sim = config.robot.simulator;
+  const ScorbotGeometry& geometry = config.robot.scorbot.geometry;
+  sim.geometry = geometry;
+  sim.baud = config.robot.scorbot.baud;
+  const ScorbotReach start = NearestReachable(geometry, config.robot.start_wMc, config.camera.eMc);
+  if (!start.ok) {
+    throw std::invalid_argument("robot.start is out of the Scorbot's reach: " + start.why);
+  }
+  for (std::size_t i = 0; i < 5; ++i) sim.start_deg[i] = vpMath::deg(start.q[i]);
+  return sim;
+}
+
+RobotRig OpenRobot(const ServoAppConfig& config) {
+  RobotRig rig;
+  if (config.robot.type == "scorbot") {
+    ScorbotOptions options = config.robot.scorbot;
+    options.eMc = config.camera.eMc;
+    if (options.port == "simulator") {
+      rig.controller = std::make_unique<ScorbotControllerSim>(ControllerSimOptions(config));
+      rig.controller->Start();
+      options.port = rig.controller->ConnectPath();
+    }
+    rig.driver = std::make_unique<ScorbotRobot>(options);
+    return rig;
+  }
+  SimulatedCameraOptions options;
+  options.sampling_time_s = config.robot.sampling_time_s;
+  options.move_mode = SimulatedCameraOptions::MoveMode::kJump;
+  options.wMc = config.robot.start_wMc;
+  options.eMc = config.camera.eMc;
+  rig.driver = std::make_unique<SimulatedCamera>(options);
+  return rig;
+}
+
 std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
   const SourceConfig& source = config.source;
   if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
@@ -257,6 +305,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
         "source: {type: replay, path: " +
         config.source.device + "}");
   }
+  const bool velocity_law = config.servo.law.mode == ServoMode::kVelocity;
   const LoopModel model(config);
   OalDetector detector(config.detector, model.camera);
   const PoseOptions pose_options = model.PoseOptionsFor(detector);
@@ -264,13 +313,13 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   const bool moves_robot = config.source.type != "replay";
   const bool simulated = config.source.type == "simulated";
 
-  SimulatedCameraOptions sim_options;
-  sim_options.sampling_time_s = config.robot.sampling_time_s;
-  sim_options.move_mode = SimulatedCameraOptions::MoveMode::kJump;
-  sim_options.wMc = config.robot.start_wMc;
-  sim_options.eMc = config.camera.eMc;
-  SimulatedCamera simulated_robot(sim_options);
-  SafeRobot robot(simulated_robot, config.robot.safety);
+  const RobotRig rig = OpenRobot(config);
+  if (velocity_law && !rig.driver->Capabilities().velocity) {
+    throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
+                                rig.driver->Name() +
+                                " takes position moves only: use exponential or point-and-go");
+  }
+  SafeRobot robot(*rig.driver, config.robot.safety);
 
   ServoRunReport report;
   report.cdMo = config.goal_image.empty() ? config.goal_cdMo : TeachGoal(config);
@@ -286,7 +335,9 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     report.message = std::move(message);
     robot.Stop();
     report.robot_stopped = robot.state() == SafeRobotState::kStopped;
-    report.final_wMc = simulated_robot.wMc();
+    if (const RobotPose where = robot.GetPosition(RobotFrame::kCamera); where.result.ok()) {
+      report.final_wMc = where.pose;
+    }
     if (!report.iterations.empty()) report.iterations.back().status = ToString(status);
     return report;
   };
@@ -300,7 +351,6 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   }
 
   const ServoLoopOptions& loop = config.servo;
-  const bool velocity = loop.law.mode == ServoMode::kVelocity;
   const auto start = std::chrono::steady_clock::now();
   std::optional<vpHomogeneousMatrix> previous_cMo;
   vpHomogeneousMatrix previous_wMc;
@@ -337,7 +387,17 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
 
     ServoIteration row;
     row.iteration = iteration;
-    Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg);
+    if (config.robot.type == "scorbot") {
+      // The controller's own columns: the TCP's X, Y, Z and the tool's P, R (ACL).
+      const AclPose acl = ToAclPose(wMc * config.camera.eMc.inverse());
+      row.x_mm = acl.x / 10.0;
+      row.y_mm = acl.y / 10.0;
+      row.z_mm = acl.z / 10.0;
+      row.pitch_deg = acl.p / 10.0;
+      row.roll_deg = acl.r / 10.0;
+    } else {
+      Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg);
+    }
     row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
     if (simulated) {
       const PoseDistance truth = Distance(report.cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
@@ -428,7 +488,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (!moves_robot) continue;
 
     RobotResult moved;
-    if (velocity) {
+    if (velocity_law) {
       moved = robot.SetVelocity(RobotFrame::kCamera, step->twist).result;
     } else {
       moved = robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew).result;

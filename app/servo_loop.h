@@ -71,7 +71,9 @@ std::string ToString(ServoRunStatus status);
 
 /// One iteration (one frame): where the camera was when the frame was taken and what the law
 /// saw. Table 3's columns: X, Y, Z of the camera in the base frame and pitch, roll with
-/// wRc = Rx(π)·Rx(pitch)·Rz(roll) (the camera looks down at pitch = roll = 0).
+/// wRc = Rx(π)·Rx(pitch)·Rz(roll) (the camera looks down at pitch = roll = 0); for the
+/// Scorbot, the controller's own X, Y, Z of the tool centre point and P (the tool axis' angle
+/// above the horizontal), R (robots/scorbot_kinematics.h).
 struct ServoIteration {
   int iteration = 0;
   double x_mm = 0, y_mm = 0, z_mm = 0;

@@ -90,8 +90,6 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
               HasSubstr("servo.yaml:3: 'camera.width' is invalid"));
   EXPECT_THAT(ErrorOf("camera:\n  noise: -1\n"),
               HasSubstr("servo.yaml:2: 'camera.noise' is invalid"));
-  EXPECT_THAT(ErrorOf("robot:\n  type: scorbot\n"),
-              HasSubstr("servo.yaml:2: 'robot.type' must be one of simulated"));
   EXPECT_THAT(ErrorOf("robot:\n  max_translation_mps: -0.1\n"),
               HasSubstr("servo.yaml:2: 'robot.max_translation_mps' is invalid"));
   EXPECT_THAT(ErrorOf("robot:\n  start: {translation_m: [0, 0], rxyz_deg: [0, 0, 0]}\n"),

@@ -1,0 +1,98 @@
+// The servo app driving the Scorbot ER-VII through the real ACL driver over a pseudo-terminal,
+// against the Controller-A simulator started by the loop (config/scorbot-sim.yaml; issue 6).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+
+#include "app/config.h"
+#include "app/servo_loop.h"
+#include "servo_test_util.h"
+
+namespace oal {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The shipped Scorbot run on small images, the simulated arm 20 times faster than real time
+// and the link not paced at 9600 baud, so the test takes a second.
+ServoAppConfig FastScorbot() {
+  ServoAppConfig config = test::Small(test::ShippedServoConfig("scorbot-sim.yaml"));
+  config.robot.simulator.time_scale = 20.0;
+  config.robot.simulator.throttle_to_baud = false;
+  return config;
+}
+
+TEST(ServoScorbot, Table3ThroughTheDriverAndTheControllerSimulatorConverges) {
+  for (const ServoMode mode : {ServoMode::kExponential, ServoMode::kPointAndGo}) {
+    ServoAppConfig config = FastScorbot();
+    config.servo.law.mode = mode;
+    std::ostringstream log;
+    const ServoRunReport report = RunServo(config, log);
+    ASSERT_EQ(report.status, ServoRunStatus::kConverged) << log.str() << report.message;
+    EXPECT_LE(report.moves, 10) << log.str();  // 640x480 figures: docs/BENCHMARKS.md
+    EXPECT_TRUE(report.robot_stopped);
+    const ServoIteration& first = report.iterations.front();
+    // The table shows the controller's own coordinates: Table 3's start point.
+    EXPECT_NEAR(first.x_mm, 490.0, 0.2);
+    EXPECT_NEAR(first.y_mm, 15.0, 0.2);
+    EXPECT_NEAR(first.z_mm, 610.0, 0.2);
+    EXPECT_NEAR(first.pitch_deg, -5.0, 0.11);
+    const ServoIteration& last = report.iterations.back();
+    EXPECT_NEAR(last.x_mm, 550.0, 2.0);  // 320x240 images: within a couple of mm
+    EXPECT_NEAR(last.y_mm, -35.0, 2.0);
+    EXPECT_NEAR(last.z_mm, 550.0, 2.0);
+    EXPECT_LT(last.true_translation_error_mm, 3.0) << ToString(mode);
+  }
+}
+
+TEST(ServoScorbot, VelocityLawIsRefusedBeforeTheArmMoves) {
+  ServoAppConfig config = FastScorbot();
+  config.servo.law.mode = ServoMode::kVelocity;
+  std::ostringstream log;
+  try {
+    RunServo(config, log);
+    FAIL() << "the position-only Scorbot must refuse the velocity law";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("servo.mode velocity needs a robot driven in velocity"));
+  }
+}
+
+TEST(ServoScorbot, AStartOutOfReachOrAMissingPortFailsClearly) {
+  ServoAppConfig config = FastScorbot();
+  config.robot.start_wMc = vpHomogeneousMatrix(2.0, 0.0, 0.5, 0.0, 0.0, 0.0);  // 2 m away
+  std::ostringstream log;
+  try {
+    RunServo(config, log);
+    FAIL();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("robot.start is out of the Scorbot's reach"));
+  }
+  config = FastScorbot();
+  config.robot.scorbot.port = "/dev/ttyOAL-missing";
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kError);
+  EXPECT_THAT(report.message, HasSubstr("cannot connect the robot"));
+  EXPECT_THAT(report.message, HasSubstr("/dev/ttyOAL-missing"));
+  EXPECT_TRUE(report.iterations.empty());
+}
+
+TEST(ServoScorbot, ConfigErrorsNameTheNestedKeyAndLine) {
+  const auto error = [](const std::string& yaml) { return test::ConfigErrorOf(yaml, "arm.yaml"); };
+  EXPECT_THAT(error("robot:\n  type: scorbot\n  scorbot:\n    speed_percent: 0\n"),
+              HasSubstr("arm.yaml:4: 'robot.scorbot.speed_percent' is invalid"));
+  EXPECT_THAT(error("robot:\n  scorbot:\n    geometry:\n      upper_arm_m: -0.3\n"),
+              HasSubstr("arm.yaml:4: 'robot.scorbot.geometry.upper_arm_m' is invalid"));
+  EXPECT_THAT(error("robot:\n  scorbot:\n    geometry:\n      home_deg: [0, 60]\n"),
+              HasSubstr("'robot.scorbot.geometry.home_deg' must be a list of 5 numbers"));
+  EXPECT_THAT(error("robot:\n  scorbot:\n    simulator:\n      time_scale: 0\n"),
+              HasSubstr("arm.yaml:4: 'robot.scorbot.simulator.time_scale' is invalid"));
+  EXPECT_THAT(error("robot:\n  scorbot:\n    parity: even\n"),
+              HasSubstr("arm.yaml:3: key 'robot.scorbot.parity' is unknown"));
+  EXPECT_THAT(error("robot:\n  type: puma\n"),
+              HasSubstr("arm.yaml:2: 'robot.type' must be one of simulated, scorbot"));
+}
+
+}  // namespace
+}  // namespace oal
