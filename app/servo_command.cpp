@@ -129,6 +129,7 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
   }
   const ServoRunReport report = RunServo(config, out, run_hooks);
   out << "oalservo servo: " << ToString(report.status) << ": " << report.message << '\n';
+  if (!report.link_summary.empty()) out << "oalservo servo: " << report.link_summary << '\n';
   if (!dir.empty()) {
     AtomicFile file(csv);
     WriteServoCsv(report, file.stream());

@@ -206,6 +206,21 @@ RobotRig OpenRobot(const ServoAppConfig& config) {
   return rig;
 }
 
+// Bytes and serial time the run cost on the Scorbot's link ("" for other robots).
+std::string LinkSummary(const Robot& driver, int baud, int moves) {
+  const auto* scorbot = dynamic_cast<const ScorbotRobot*>(&driver);
+  if (scorbot == nullptr) return "";
+  const AclStats stats = scorbot->link_stats();
+  const double bytes = static_cast<double>(stats.link.bytes_written + stats.link.bytes_read);
+  const double serial_s = bytes * 10.0 / baud;  // 8N1: 10 bits a byte
+  std::string summary = "ACL link: " + std::to_string(stats.commands) + " commands, " +
+                        std::to_string(stats.link.bytes_written) + " bytes sent, " +
+                        std::to_string(stats.link.bytes_read) + " received: " + Fixed(serial_s, 2) +
+                        " s of serial time at " + std::to_string(baud) + " baud";
+  if (moves > 0) summary += ", " + Fixed(serial_s / moves, 2) + " s per move";
+  return summary;
+}
+
 std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
   const SourceConfig& source = config.source;
   if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
@@ -338,6 +353,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (const RobotPose where = robot.GetPosition(RobotFrame::kCamera); where.result.ok()) {
       report.final_wMc = where.pose;
     }
+    report.link_summary = LinkSummary(*rig.driver, config.robot.scorbot.baud, report.moves);
     if (!report.iterations.empty()) report.iterations.back().status = ToString(status);
     return report;
   };

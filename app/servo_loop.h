@@ -93,6 +93,8 @@ struct ServoRunReport {
   vpHomogeneousMatrix final_wMc;  ///< the camera where the run left it
   bool robot_stopped = false;     ///< the robot was stopped at the end (always true)
   int moves = 0;                  ///< motion commands sent
+  /// For a robot on a serial link (the Scorbot): what the run cost on it, one line; else empty.
+  std::string link_summary;
 };
 
 /// Hooks for the command: `interrupt` is polled every iteration (and on set, the robot's
