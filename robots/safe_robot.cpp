@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "robots/check_option.h"
+
 namespace oal {
 namespace {
 
@@ -16,12 +18,6 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point from) {
   return std::chrono::duration<double>(Clock::now() - from).count();
-}
-
-[[noreturn]] void Reject(const std::string& field, const std::string& value,
-                         const std::string& constraint) {
-  throw std::invalid_argument("SafetyOptions::" + field + " = " + value +
-                              ". Violated constraint: " + constraint);
 }
 
 std::string Str(double v) {
@@ -36,27 +32,25 @@ constexpr const char* kBoxAxis[3] = {"x", "y", "z"};
 }  // namespace
 
 void SafetyOptions::Check() const {
-  if (!(max_translation_mps > 0 && std::isfinite(max_translation_mps))) {
-    Reject("max_translation_mps", Str(max_translation_mps), "finite and > 0");
-  }
-  if (!(max_rotation_radps > 0 && std::isfinite(max_rotation_radps))) {
-    Reject("max_rotation_radps", Str(max_rotation_radps), "finite and > 0");
-  }
+  const std::string p = "SafetyOptions::";
+  RequireRobotOption(max_translation_mps > 0 && std::isfinite(max_translation_mps),
+                     p + "max_translation_mps", max_translation_mps, "finite and > 0");
+  RequireRobotOption(max_rotation_radps > 0 && std::isfinite(max_rotation_radps),
+                     p + "max_rotation_radps", max_rotation_radps, "finite and > 0");
   for (int i = 0; i < 3; ++i) {
-    if (!(std::isfinite(workspace_min_m[i]) && std::isfinite(workspace_max_m[i]) &&
-          workspace_min_m[i] < workspace_max_m[i])) {
-      Reject(std::string("workspace_min_m/workspace_max_m [") + kBoxAxis[i] + "]",
-             Str(workspace_min_m[i]) + " / " + Str(workspace_max_m[i]), "finite and min < max");
-    }
+    RequireRobotOption(std::isfinite(workspace_min_m[i]) && std::isfinite(workspace_max_m[i]) &&
+                           workspace_min_m[i] < workspace_max_m[i],
+                       p + "workspace_min_m/workspace_max_m [" + kBoxAxis[i] + "]",
+                       Str(workspace_min_m[i]) + " / " + Str(workspace_max_m[i]),
+                       "finite and min < max");
   }
-  if (!(move_timeout_s > 0 && std::isfinite(move_timeout_s))) {
-    Reject("move_timeout_s", Str(move_timeout_s), "finite and > 0");
-  }
-  if (!(reach_tolerance_m > 0)) Reject("reach_tolerance_m", Str(reach_tolerance_m), "> 0");
-  if (!(reach_tolerance_rad > 0)) Reject("reach_tolerance_rad", Str(reach_tolerance_rad), "> 0");
-  if (!(max_cycle_s >= 0 && std::isfinite(max_cycle_s))) {
-    Reject("max_cycle_s", Str(max_cycle_s), "finite and >= 0");
-  }
+  RequireRobotOption(move_timeout_s > 0 && std::isfinite(move_timeout_s), p + "move_timeout_s",
+                     move_timeout_s, "finite and > 0");
+  RequireRobotOption(reach_tolerance_m > 0, p + "reach_tolerance_m", reach_tolerance_m, "> 0");
+  RequireRobotOption(reach_tolerance_rad > 0, p + "reach_tolerance_rad", reach_tolerance_rad,
+                     "> 0");
+  RequireRobotOption(max_cycle_s >= 0 && std::isfinite(max_cycle_s), p + "max_cycle_s", max_cycle_s,
+                     "finite and >= 0");
 }
 
 std::string ToString(SafeRobotState state) {

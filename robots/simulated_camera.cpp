@@ -9,15 +9,10 @@
 #include <stdexcept>
 #include <utility>
 
+#include "robots/check_option.h"
+
 namespace oal {
 namespace {
-
-[[noreturn]] void Reject(const std::string& field, double value, const std::string& constraint) {
-  std::ostringstream s;
-  s << "SimulatedCameraOptions::" << field << " = " << value
-    << ". Violated constraint: " << constraint;
-  throw std::invalid_argument(s.str());
-}
 
 void CheckTwistSize(const vpColVector& v) {
   if (v.size() != 6) {
@@ -29,20 +24,17 @@ void CheckTwistSize(const vpColVector& v) {
 }  // namespace
 
 void SimulatedCameraOptions::Check() const {
-  if (!(sampling_time_s > 0 && sampling_time_s <= 1)) {
-    Reject("sampling_time_s", sampling_time_s, "0 < sampling_time_s <= 1");
-  }
-  if (!(max_translation_mps > 0 && std::isfinite(max_translation_mps))) {
-    Reject("max_translation_mps", max_translation_mps, "finite and > 0");
-  }
-  if (!(max_rotation_radps > 0 && std::isfinite(max_rotation_radps))) {
-    Reject("max_rotation_radps", max_rotation_radps, "finite and > 0");
-  }
-  if (!(move_duration_s >= 0 && std::isfinite(move_duration_s))) {
-    Reject("move_duration_s", move_duration_s, "finite and >= 0");
-  }
-  if (!wMc.isAnHomogeneousMatrix()) Reject("wMc", 0, "a rigid transform");
-  if (!eMc.isAnHomogeneousMatrix()) Reject("eMc", 0, "a rigid transform");
+  const std::string p = "SimulatedCameraOptions::";
+  RequireRobotOption(sampling_time_s > 0 && sampling_time_s <= 1, p + "sampling_time_s",
+                     sampling_time_s, "0 < sampling_time_s <= 1");
+  RequireRobotOption(max_translation_mps > 0 && std::isfinite(max_translation_mps),
+                     p + "max_translation_mps", max_translation_mps, "finite and > 0");
+  RequireRobotOption(max_rotation_radps > 0 && std::isfinite(max_rotation_radps),
+                     p + "max_rotation_radps", max_rotation_radps, "finite and > 0");
+  RequireRobotOption(move_duration_s >= 0 && std::isfinite(move_duration_s), p + "move_duration_s",
+                     move_duration_s, "finite and >= 0");
+  RequireRobotOption(wMc.isAnHomogeneousMatrix(), p + "wMc", 0, "a rigid transform");
+  RequireRobotOption(eMc.isAnHomogeneousMatrix(), p + "eMc", 0, "a rigid transform");
 }
 
 SimulatedCamera::SimulatedCamera(const SimulatedCameraOptions& options) : options_(options) {

@@ -11,15 +11,14 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "detector/options.h"
+
 namespace oal {
 namespace {
 
+// The ceres-style message of every Options::Check() (detector/options.h).
 void Require(bool ok, const char* field, double value, const char* constraint) {
-  if (!ok) {
-    std::ostringstream out;
-    out << "ServoOptions." << field << " = " << value << ": must be " << constraint;
-    throw std::invalid_argument(out.str());
-  }
+  RequireOption(ok, std::string("ServoOptions::") + field, value, constraint);
 }
 
 vpAdaptiveGain GainOf(const ServoOptions& options) {
