@@ -206,6 +206,30 @@ RobotRig OpenRobot(const ServoAppConfig& config) {
   return rig;
 }
 
+// The target's centre lines seen from cMo, in the detector's coordinates (undistorted pixels;
+// the model camera's pinhole image), as detector seeds 1..n; lines behind the camera are left out.
+std::vector<LineSeed> PredictedSeeds(const LineTarget& target, const vpHomogeneousMatrix& cMo,
+                                     const vpCameraParameters& camera) {
+  const auto project = [&](double x, double y, Point2d* pixel) {
+    const double xc = cMo[0][0] * x + cMo[0][1] * y + cMo[0][3];
+    const double yc = cMo[1][0] * x + cMo[1][1] * y + cMo[1][3];
+    const double zc = cMo[2][0] * x + cMo[2][1] * y + cMo[2][3];
+    if (!(zc > 0.0)) return false;
+    *pixel = Point2d{camera.get_u0() + camera.get_px() * xc / zc,
+                     camera.get_v0() + camera.get_py() * yc / zc};
+    return true;
+  };
+  std::vector<LineSeed> seeds;
+  for (std::size_t i = 0; i < target.lines.size(); ++i) {
+    const TargetLine& line = target.lines[i];
+    Point2d a, b;
+    if (project(line.x1_m, line.y1_m, &a) && project(line.x2_m, line.y2_m, &b)) {
+      seeds.push_back(LineSeed{static_cast<int>(i) + 1, LineThrough(a, b)});
+    }
+  }
+  return seeds;
+}
+
 // Bytes and serial time the run cost on the Scorbot's link ("" for other robots).
 std::string LinkSummary(const Robot& driver, int baud, int moves) {
   const auto* scorbot = dynamic_cast<const ScorbotRobot*>(&driver);
@@ -450,14 +474,15 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     report.iterations.push_back(row);
     ServoIteration& current = report.iterations.back();
 
+    // The target's lines where the robot's motion since the last estimate puts them seed the
+    // accumulator list: a line seen at a grazing place (an image corner) keeps its entry
+    // instead of being culled before it gathers its votes.
+    if (previous_cMo) {
+      seeds =
+          PredictedSeeds(config.target, wMc.inverse() * previous_wMc * *previous_cMo, model.camera);
+    }
     const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray), seeds);
     const PoseResult pose = EstimatePose(lines, config.target, pose_options, previous_cMo);
-    seeds.clear();
-    if (pose.status == PoseStatus::kOk) {
-      // The target's lines seed the next frame's accumulator list: a line the camera sees at a
-      // grazing place (an image corner) keeps its entry instead of being culled early.
-      for (int k = 0; k < 4; ++k) seeds.push_back(LineSeed{k + 1, lines[pose.line_index[k]].line});
-    }
     std::optional<ServoStep> step;
     if (pose.status == PoseStatus::kOk) {
       step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);

@@ -12,8 +12,8 @@
 //   1. stop (interrupted) if the interrupt flag is set, (time-limit) past servo.max_time_s;
 //   2. render the frame from the true cMo (camera intrinsics, kdu, noise and blur from the
 //      config), detect (OalDetector with the camera: undistorted lines; its accumulator list
-//      seeded with the target's four lines of the previous frame), EstimatePose seeded by the
-//      previous estimate;
+//      seeded with the target's lines projected from the odometry prediction of step 4),
+//      EstimatePose seeded by the previous estimate;
 //   3. stop (target-lost) when the pose status is not ok;
 //   4. stop (pose-jump) when the estimate disagrees with the previous estimate carried by the
 //      robot's own motion (odometry: predicted cMo = wMc⁻¹·wMc_prev·cMo_prev) by more than
