@@ -169,8 +169,7 @@ void ScorbotControllerSim::Stop() noexcept {
 }
 
 std::string ScorbotControllerSim::DevicePath() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return slave_path_;
+  return Snapshot(slave_path_);
 }
 
 std::string ScorbotControllerSim::ConnectPath() const {
@@ -218,23 +217,19 @@ bool ScorbotControllerSim::moving() const {
 }
 
 bool ScorbotControllerSim::control_enabled() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return control_;
+  return Snapshot(control_);
 }
 
 bool ScorbotControllerSim::echo() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return echo_;
+  return Snapshot(echo_);
 }
 
 int ScorbotControllerSim::speed_percent() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return speed_;
+  return Snapshot(speed_);
 }
 
 ScorbotSimStats ScorbotControllerSim::stats() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return stats_;
+  return Snapshot(stats_);
 }
 
 double ScorbotControllerSim::SimTime() const {

@@ -147,6 +147,12 @@ class ScorbotControllerSim {
   };
 
   void Run();
+  // A copy of a member taken under the lock (the state getters).
+  template <typename T>
+  T Snapshot(const T& member) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return member;
+  }
   double SimTime() const;  // s
   void Receive(char c);
   void Execute(const std::string& line);
