@@ -1,14 +1,17 @@
 #include "app/command_line.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <mutex>
 
 #include "app/atomic_file.h"
 
@@ -85,6 +88,70 @@ void CheckFrameCommand(const char* options_name, const std::vector<std::string>&
 
 void Warn(const std::string& command, const std::string& message) {
   std::cerr << "oalservo " << command << ": warning: " << message << '\n';
+}
+
+namespace {
+
+std::mutex quiet_mutex;
+int quiet_count = 0;      // QuietStderr objects alive
+int quiet_saved_fd = -1;  // the real stderr while they live
+
+}  // namespace
+
+QuietStderr::QuietStderr() {
+  std::lock_guard<std::mutex> lock(quiet_mutex);
+  if (quiet_count++ > 0) return;
+  std::cerr.flush();
+  std::fflush(stderr);
+  quiet_saved_fd = ::dup(2);
+  const int null = ::open("/dev/null", O_WRONLY);
+  if (quiet_saved_fd >= 0 && null >= 0) ::dup2(null, 2);
+  if (null >= 0) ::close(null);
+}
+
+QuietStderr::~QuietStderr() {
+  std::lock_guard<std::mutex> lock(quiet_mutex);
+  if (--quiet_count > 0) return;
+  std::cerr.flush();
+  std::fflush(stderr);
+  if (quiet_saved_fd >= 0) {
+    ::dup2(quiet_saved_fd, 2);
+    ::close(quiet_saved_fd);
+    quiet_saved_fd = -1;
+  }
+}
+
+std::string MarkupEscaped(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+SigintScope::SigintScope(void (*handler)(int)) : previous_(std::signal(SIGINT, handler)) {}
+
+SigintScope::~SigintScope() {
+  std::signal(SIGINT, previous_);
 }
 
 }  // namespace oal

@@ -54,8 +54,38 @@ std::function<void(int done, int total)> FrameProgress(const std::string& label,
 void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
                        int max_frames, const std::string& out_path);
 
+/// Installs `handler` for SIGINT (Ctrl-C) for the scope's lifetime and restores the previous
+/// handler after. The handler must be async-signal-safe: store to lock-free atomics only.
+class SigintScope {
+ public:
+  explicit SigintScope(void (*handler)(int));
+  ~SigintScope();
+  SigintScope(const SigintScope&) = delete;
+  SigintScope& operator=(const SigintScope&) = delete;
+
+ private:
+  void (*previous_)(int);
+};
+
 /// A warning for the user on stderr: "oalservo <command>: warning: <message>". Libraries
 /// never print; commands report through this.
 void Warn(const std::string& command, const std::string& message);
+
+/// While one lives, file descriptor 2 goes to /dev/null (restored after, also on an
+/// exception, so that main's error message still reaches the user). For ViSP's vpMeLine,
+/// which reports every tracking failure on stderr itself (vpERROR_TRACE, through both
+/// std::cerr and stderr): a comparison counts those failures instead. Process-wide and
+/// counted: with several alive (threads of `evaluate --jobs`), stderr comes back when the
+/// last one ends; meanwhile every thread's stderr is silenced.
+class QuietStderr {
+ public:
+  QuietStderr();
+  ~QuietStderr();
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+};
+
+/// `text` with & < > " ' escaped, for HTML and XML (SVG) text and attribute values.
+std::string MarkupEscaped(const std::string& text);
 
 }  // namespace oal

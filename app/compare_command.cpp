@@ -1,48 +1,13 @@
 #include "app/compare_command.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
-#include <cstdio>
 #include <iostream>
+#include <optional>
 
 #include "app/command_line.h"
 #include "app/compare.h"
 
 namespace oal {
-namespace {
-
-// ViSP's vpMeLine reports every tracking failure on stderr itself (vpERROR_TRACE, through
-// both std::cerr and stderr); a comparison counts those failures instead. This sends file
-// descriptor 2 to /dev/null while it lives and restores it after, also on an exception, so
-// that our own error message (printed by main) still reaches the user.
-class QuietStderr {
- public:
-  QuietStderr() {
-    std::cerr.flush();
-    std::fflush(stderr);
-    saved_ = ::dup(2);
-    const int null = ::open("/dev/null", O_WRONLY);
-    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
-    if (null >= 0) ::close(null);
-  }
-  ~QuietStderr() {
-    std::cerr.flush();
-    std::fflush(stderr);
-    if (saved_ >= 0) {
-      ::dup2(saved_, 2);
-      ::close(saved_);
-    }
-  }
-  QuietStderr(const QuietStderr&) = delete;
-  QuietStderr& operator=(const QuietStderr&) = delete;
-
- private:
-  int saved_ = -1;
-};
-
-}  // namespace
 
 int RunCompare(int argc, char** argv) {
   CompareOptions options;

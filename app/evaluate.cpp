@@ -5,6 +5,7 @@
 #include <visp3/core/vpThetaUVector.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -22,10 +23,12 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 #include "app/annotate.h"
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
+#include "app/command_line.h"
 #include "app/compare.h"
 #include "app/config.h"
 #include "app/detector_accuracy.h"
@@ -55,6 +58,12 @@ constexpr int kThumbnailWidth = 320;
 constexpr double kVideoFps = 25.0;
 constexpr double kVideoQuality = 75.0;      // JPEG quality of the annotated video, [0, 100]
 constexpr std::size_t kPlottedTracks = 10;  // the tracks seen longest get a series
+// A pose is flagged as a jump when, against the last trusted pose of at most kJumpFrames
+// frames before, the same four tracks are identified as other target lines, or the rotation
+// exceeds kJumpRotationDeg (docs/EVALUATE.md, frames.jsonl).
+constexpr int kJumpFrames = 10;
+constexpr double kJumpRotationDeg = 90.0;
+constexpr std::size_t kListedJumps = 100;  // jump frames named in the summary
 
 double Us(Clock::duration d) {
   return std::chrono::duration<double, std::micro>(d).count();
@@ -430,19 +439,64 @@ class WorstFrames {
 const cv::Scalar kTrackColours[] = {{80, 80, 255},  {80, 255, 80},  {255, 160, 80}, {255, 80, 255},
                                     {80, 255, 255}, {255, 255, 80}, {160, 80, 255}, {80, 160, 255}};
 
-// The frame with every held track (thin, labelled #id), lines 1-4 and the target frame's
-// axes (AnnotatePose), and the frame number.
+// The size of the annotated video for a frame: `scale` of it, rounded to even sizes.
+cv::Size VideoSize(const cv::Size& frame, double scale) {
+  return cv::Size(std::max(2, 2 * cvRound(0.5 * scale * frame.width)),
+                  std::max(2, 2 * cvRound(0.5 * scale * frame.height)));
+}
+
+// Pixel coordinates of a frame scaled by (sx, sy): pixel centres at integers on both sides,
+// u' = sx (u + 0.5) - 0.5. Lines and cameras are moved into the scaled frame so that the
+// drawing is done at the output size (a quarter of the pixels at 0.5), not drawn at full
+// size and scaled.
+struct PixelScale {
+  double sx = 1.0, sy = 1.0;
+
+  // u cos + v sin = rho  ->  a u' + b v' = rho + (cos + sin) / 2 - (a + b) / 2.
+  LineParams Line(const LineParams& line) const {
+    const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
+    const double a = c / sx, b = s / sy, n = std::hypot(a, b);
+    return LineParams{(line.rho_px + 0.5 * (c + s) - 0.5 * (a + b)) / n, std::atan2(b, a)};
+  }
+  // The distortion coefficients are in normalised coordinates: unchanged.
+  vpCameraParameters Camera(const vpCameraParameters& camera) const {
+    vpCameraParameters scaled = camera;
+    const double u0 = sx * (camera.get_u0() + 0.5) - 0.5, v0 = sy * (camera.get_v0() + 0.5) - 0.5;
+    if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
+      scaled.initPersProjWithDistortion(sx * camera.get_px(), sy * camera.get_py(), u0, v0,
+                                        camera.get_kud(), camera.get_kdu());
+    } else {
+      scaled.initPersProjWithoutDistortion(sx * camera.get_px(), sy * camera.get_py(), u0, v0);
+    }
+    return scaled;
+  }
+};
+
+// The frame at `size` with every held track (thin, labelled #id), lines 1-4 and the target
+// frame's axes (AnnotatePose), and the frame number, drawn at that size.
 cv::Mat Annotate(const TrackedFrame& frame, const std::optional<CameraFile>& camera,
-                 const std::optional<vpCameraParameters>& undistorted_by) {
+                 const std::optional<vpCameraParameters>& undistorted_by, const cv::Size& size) {
+  const bool scaled = size != frame.gray.size();
+  const PixelScale scale{static_cast<double>(size.width) / frame.gray.cols,
+                         static_cast<double>(size.height) / frame.gray.rows};
+  cv::Mat gray = frame.gray;
+  std::vector<DetectedLine> held = frame.held;
+  std::optional<vpCameraParameters> undistorted = undistorted_by;
+  if (scaled) {
+    cv::resize(frame.gray, gray, size, 0.0, 0.0, cv::INTER_AREA);
+    for (DetectedLine& line : held) line.line = scale.Line(line.line);
+    if (undistorted) undistorted = scale.Camera(*undistorted);
+  }
   cv::Mat image;
   if (camera && frame.pose) {
-    image = AnnotatePose(frame.gray, frame.held, *frame.pose, camera->camera, undistorted_by);
+    image = AnnotatePose(gray, held, *frame.pose,
+                         scaled ? scale.Camera(camera->camera) : camera->camera, undistorted);
   } else {
-    cv::cvtColor(frame.gray, image, cv::COLOR_GRAY2BGR);
+    cv::cvtColor(gray, image, cv::COLOR_GRAY2BGR);
   }
-  for (std::size_t i = 0; i < frame.held.size(); ++i) {
+  for (std::size_t i = 0; i < held.size(); ++i) {
     const cv::Scalar& colour = kTrackColours[static_cast<std::size_t>(frame.ids[i]) % 8];
-    const auto runs = LineInFrame(frame.held[i].line, image.cols, image.rows, undistorted_by);
+    const auto runs = LineInFrame(held[i].line, image.cols, image.rows, undistorted);
     for (const auto& run : runs) {
       for (std::size_t k = 1; k < run.size(); ++k) {
         cv::line(image, run[k - 1], run[k], colour, 1, cv::LINE_AA);
@@ -459,10 +513,17 @@ cv::Mat Annotate(const TrackedFrame& frame, const std::optional<CameraFile>& cam
   return image;
 }
 
+// The thumbnail's size: kThumbnailWidth wide at most.
+cv::Size ThumbnailSize(const cv::Size& image) {
+  const double scale = std::min(1.0, static_cast<double>(kThumbnailWidth) / image.width);
+  return cv::Size(std::max(1, cvRound(scale * image.width)),
+                  std::max(1, cvRound(scale * image.height)));
+}
+
 std::vector<unsigned char> ThumbnailJpeg(const cv::Mat& annotated) {
-  cv::Mat small;
-  const double scale = std::min(1.0, static_cast<double>(kThumbnailWidth) / annotated.cols);
-  cv::resize(annotated, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  cv::Mat small = annotated;
+  const cv::Size size = ThumbnailSize(annotated.size());
+  if (size != annotated.size()) cv::resize(annotated, small, size, 0.0, 0.0, cv::INTER_AREA);
   std::vector<unsigned char> jpeg;
   if (!cv::imencode(".jpg", small, jpeg, {cv::IMWRITE_JPEG_QUALITY, 85})) {
     throw std::runtime_error("cannot encode a thumbnail");
@@ -471,11 +532,12 @@ std::vector<unsigned char> ThumbnailJpeg(const cv::Mat& annotated) {
 }
 
 // The annotated video, written under a temporary name ending in .avi (the writer picks the
-// container from it) and renamed at Commit().
+// container from it) and renamed at Commit(). The images come at Size(frame size).
 class AnnotatedVideo {
  public:
-  AnnotatedVideo(fs::path target, double scale)
+  AnnotatedVideo(fs::path target, double scale, std::string codec)
       : scale_(scale),
+        codec_(std::move(codec)),
         target_(std::move(target)),
         temp_(target_.parent_path() /
               (target_.stem().string() + ".tmp-" + std::to_string(::getpid()) + ".avi")) {}
@@ -486,19 +548,32 @@ class AnnotatedVideo {
   AnnotatedVideo(const AnnotatedVideo&) = delete;
   AnnotatedVideo& operator=(const AnnotatedVideo&) = delete;
 
+  cv::Size Size(const cv::Size& frame) const { return VideoSize(frame, scale_); }
+
   void Write(const cv::Mat& image) {
     if (!writer_.isOpened()) {
-      size_ = cv::Size(std::max(2, 2 * cvRound(0.5 * scale_ * image.cols)),
-                       std::max(2, 2 * cvRound(0.5 * scale_ * image.rows)));
-      if (!writer_.open(temp_.string(), cv::CAP_OPENCV_MJPEG,
-                        cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), kVideoFps, size_, true)) {
-        throw std::runtime_error("cannot write the video " + temp_.string());
+      // XVID: libavcodec's MPEG-4 part 2 encoder (OpenCV's FFmpeg backend), ~3x faster than
+      // MJPG on noisy frames and ~5x smaller; MJPG: OpenCV's own encoder, every frame a
+      // key frame (docs/EVALUATE.md, figures).
+      const bool xvid = codec_ == "xvid";
+      const bool opened = xvid ? writer_.open(temp_.string(), cv::CAP_FFMPEG,
+                                              cv::VideoWriter::fourcc('X', 'V', 'I', 'D'),
+                                              kVideoFps, image.size(), true)
+                               : writer_.open(temp_.string(), cv::CAP_OPENCV_MJPEG,
+                                              cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                                              kVideoFps, image.size(), true);
+      if (!opened) {
+        throw std::runtime_error("cannot write the video " + temp_.string() +
+                                 (xvid ? " with XVID (OpenCV's FFmpeg backend); try "
+                                         "--video-codec mjpg"
+                                       : ""));
       }
-      writer_.set(cv::VIDEOWRITER_PROP_QUALITY, kVideoQuality);
+      if (!xvid) writer_.set(cv::VIDEOWRITER_PROP_QUALITY, kVideoQuality);
+      size_ = image.size();
     }
     if (image.size() == size_) {
       writer_.write(image);
-    } else {
+    } else {  // a sequence whose images change size: the video keeps the first one's
       cv::Mat resized;
       cv::resize(image, resized, size_, 0.0, 0.0, cv::INTER_AREA);
       writer_.write(resized);
@@ -513,6 +588,7 @@ class AnnotatedVideo {
 
  private:
   double scale_;
+  std::string codec_;
   fs::path target_, temp_;
   cv::VideoWriter writer_;
   cv::Size size_;
@@ -522,6 +598,10 @@ class AnnotatedVideo {
 struct WriterResult {
   std::vector<Thumbnail> thumbnails;
   double busy_us = 0.0;
+  double annotate_us = 0.0;   ///< scaling, colour conversion and drawing
+  double encode_us = 0.0;     ///< VideoWriter::write (the encoder's colour conversion included)
+  double thumbnail_us = 0.0;  ///< the thumbnails' scaling and JPEG encoding
+  int annotated = 0;          ///< frames annotated
   std::string error;
 };
 
@@ -534,9 +614,20 @@ void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::
       const Clock::time_point start = Clock::now();
       const bool wanted = worst.Wants(frame->index, frame->badness);
       if (video != nullptr || wanted) {
-        const cv::Mat annotated = Annotate(*frame, camera, undistorted_by);
+        // Drawn at the video's size, or at the thumbnail's without a video.
+        const cv::Size size =
+            video != nullptr ? video->Size(frame->gray.size()) : ThumbnailSize(frame->gray.size());
+        const cv::Mat annotated = Annotate(*frame, camera, undistorted_by, size);
+        ++result->annotated;
+        const Clock::time_point drawn = Clock::now();
+        result->annotate_us += Us(drawn - start);
         if (video != nullptr) video->Write(annotated);
-        if (wanted) worst.Add({frame->index, frame->why, ThumbnailJpeg(annotated)}, frame->badness);
+        const Clock::time_point encoded = Clock::now();
+        result->encode_us += Us(encoded - drawn);
+        if (wanted) {
+          worst.Add({frame->index, frame->why, ThumbnailJpeg(annotated)}, frame->badness);
+          result->thumbnail_us += Us(Clock::now() - encoded);
+        }
       }
       result->busy_us += Us(Clock::now() - start);
     }
@@ -641,13 +732,53 @@ Json TrackJson(const TrackedLine& track) {
               {"frames_lost", track.frames_lost}};
 }
 
-Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids) {
-  Json lines = Json::array();
-  for (int k = 0; k < 4; ++k) {
-    const int index = pose.line_index[static_cast<std::size_t>(k)];
-    lines.push_back(index >= 0 && index < static_cast<int>(ids.size()) ? ids[index] : -1);
+// The track ids identified as target lines 1-4 (-1: not identified).
+std::array<int, 4> IdentifiedTracks(const PoseResult& pose, const std::vector<int>& ids) {
+  std::array<int, 4> tracks{{-1, -1, -1, -1}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const int index = pose.line_index[k];
+    if (index >= 0 && index < static_cast<int>(ids.size())) tracks[k] = ids[index];
   }
+  return tracks;
+}
+
+// An ok pose and the tracks it identified: the reference against which jumps are found.
+struct TrustedPose {
+  int frame = 0;
+  vpHomogeneousMatrix cMo;
+  std::array<int, 4> tracks{};
+};
+
+// A pose that jumped from the last trusted one (kJumpFrames, kJumpRotationDeg).
+struct PoseJump {
+  int from_frame = 0;
+  double rotation_deg = 0.0, translation_mm = 0.0;
+  bool relabelled = false;  ///< the same four tracks, identified as other target lines
+};
+
+std::optional<PoseJump> JumpFrom(const std::optional<TrustedPose>& trusted, int frame,
+                                 const vpHomogeneousMatrix& cMo, const std::array<int, 4>& tracks) {
+  if (!trusted || frame - trusted->frame > kJumpFrames) return std::nullopt;
+  std::array<int, 4> now = tracks, before = trusted->tracks;
+  std::sort(now.begin(), now.end());
+  std::sort(before.begin(), before.end());
+  const bool same_tracks = now == before && now[0] >= 0;
+  PoseJump jump;
+  jump.from_frame = trusted->frame;
+  std::tie(jump.translation_mm, jump.rotation_deg) = PoseError(cMo, trusted->cMo);
+  jump.relabelled = same_tracks && tracks != trusted->tracks;
+  if (!jump.relabelled && !(jump.rotation_deg > kJumpRotationDeg)) return std::nullopt;
+  return jump;
+}
+
+Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids,
+                   const std::optional<PoseJump>& jump) {
+  Json lines = Json::array();
+  for (int track : IdentifiedTracks(pose, ids)) lines.push_back(track);
   const bool ok = pose.status == PoseStatus::kOk;
+  // Step 1 ran to its end: an assignment was scored (kOk, kNotIdentifiable, or kDegenerate
+  // after the identification).
+  const bool identified = pose.line_index[0] >= 0;
   Json t, tu;
   if (ok) {
     const vpTranslationVector tv = pose.cMo.getTranslationVector();
@@ -655,10 +786,20 @@ Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids) {
     t = Json::array({tv[0], tv[1], tv[2]});
     tu = Json::array({r[0], r[1], r[2]});
   }
-  return Json{
-      {"status", ToString(pose.status)}, {"message", pose.message},
-      {"tracks", std::move(lines)},      {"t_m", std::move(t)},
-      {"thetau_rad", std::move(tu)},     {"residual_px", ok ? Json(pose.residual_px) : Json()}};
+  return Json{{"status", ToString(pose.status)},
+              {"message", pose.message},
+              {"tracks", std::move(lines)},
+              {"t_m", std::move(t)},
+              {"thetau_rad", std::move(tu)},
+              {"residual_px", ok ? Json(pose.residual_px) : Json()},
+              {"identification", identified ? Json{{"cost", pose.identification_cost},
+                                                   {"margin", pose.identification_margin}}
+                                            : Json()},
+              {"jump", jump ? Json{{"from_frame", jump->from_frame},
+                                   {"rotation_deg", jump->rotation_deg},
+                                   {"translation_mm", jump->translation_mm},
+                                   {"relabelled", jump->relabelled}}
+                            : Json()}};
 }
 
 // Counters of one input, turned into its summary.
@@ -673,6 +814,8 @@ struct Tally {
   int truth_frames = 0, truth_lines = 0, found_lines = 0, pose_truth_frames = 0;
   std::vector<double> angle_deg, offset_px, pose_t_mm, pose_r_deg;
   std::set<int> track_ids;
+  int pose_jumps = 0;
+  std::vector<int> jump_frames;
 };
 
 // The evaluation of one input: decoder, tracker and writer (file comment of evaluate.h).
@@ -709,7 +852,9 @@ class InputEvaluation {
     AtomicFile frames_file(dir_ / "frames.jsonl");
     AtomicFile timing_file(dir_ / "timing.jsonl");
     std::optional<AnnotatedVideo> video;
-    if (run_.options.write_video) video.emplace(dir_ / "annotated.avi", run_.options.video_scale);
+    if (run_.options.write_video) {
+      video.emplace(dir_ / "annotated.avi", run_.options.video_scale, run_.options.video_codec);
+    }
 
     BoundedQueue<DecodedFrame> decoded(kQueueFrames);
     BoundedQueue<TrackedFrame> tracked(kQueueFrames);
@@ -752,18 +897,25 @@ class InputEvaluation {
     Json summary = Summary(source, decode_stats);
     if (run_.options.compare) summary["compare"] = Compare();
     const double wall_us = Us(Clock::now() - start);
-    *timing = Json{{"input", input_.spec},
-                   {"frames", tally_.frames},
-                   {"video", run_.options.write_video},
-                   {"video_scale", run_.options.video_scale},
-                   {"decode_us", Stats(decode_us_)},
-                   {"track_us", Stats(track_us)},
-                   {"pose_us", Stats(pose_us)},
-                   {"decode_total_s", decode_stats.total_us * 1e-6},
-                   {"writer_busy_s", writer_result.busy_us * 1e-6},
-                   {"wall_s", wall_us * 1e-6},
-                   {"overhead_vs_decode",
-                    decode_stats.total_us > 0 ? wall_us / decode_stats.total_us - 1.0 : 0.0}};
+    *timing =
+        Json{{"input", input_.spec},
+             {"frames", tally_.frames},
+             {"video", run_.options.write_video},
+             {"video_scale", run_.options.video_scale},
+             {"video_codec", run_.options.write_video ? Json(run_.options.video_codec) : Json()},
+             {"decode_us", Stats(decode_us_)},
+             {"track_us", Stats(track_us)},
+             {"pose_us", Stats(pose_us)},
+             {"decode_total_s", decode_stats.total_us * 1e-6},
+             {"writer_busy_s", writer_result.busy_us * 1e-6},
+             {"writer",
+              {{"frames_annotated", writer_result.annotated},
+               {"annotate_s", writer_result.annotate_us * 1e-6},
+               {"encode_s", writer_result.encode_us * 1e-6},
+               {"thumbnails_s", writer_result.thumbnail_us * 1e-6}}},
+             {"wall_s", wall_us * 1e-6},
+             {"overhead_vs_decode",
+              decode_stats.total_us > 0 ? wall_us / decode_stats.total_us - 1.0 : 0.0}};
     Json timing_with_series = *timing;
     timing_with_series["series"] = Json{{"decode_us", series_.decode_us},
                                         {"track_us", series_.track_us},
@@ -837,17 +989,27 @@ class InputEvaluation {
       out.ids.push_back(track->id);
     }
     Json pose_json;
+    std::optional<PoseJump> jump;
     const Clock::time_point t2 = Clock::now();
     if (camera_) {
       pose_options.image_width = w;
       pose_options.image_height = h;
       out.pose = EstimatePose(out.held, run_.config.target, pose_options, *previous_cMo);
+      // Only a trusted pose (ok, no jump) seeds the next frame's and is the reference for
+      // the next jumps: a pose turned by 180 degrees must not seed the next frame's.
+      previous_cMo->reset();
       if (out.pose->status == PoseStatus::kOk) {
-        *previous_cMo = out.pose->cMo;
-      } else {
-        previous_cMo->reset();
+        const std::array<int, 4> identified = IdentifiedTracks(*out.pose, out.ids);
+        jump = JumpFrom(trusted_, frame.index, out.pose->cMo, identified);
+        if (jump) {
+          ++tally_.pose_jumps;
+          if (tally_.jump_frames.size() < kListedJumps) tally_.jump_frames.push_back(frame.index);
+        } else {
+          trusted_ = TrustedPose{frame.index, out.pose->cMo, identified};
+          *previous_cMo = out.pose->cMo;
+        }
       }
-      pose_json = PoseFrameJson(*out.pose, out.ids);
+      pose_json = PoseFrameJson(*out.pose, out.ids, jump);
     }
     const Clock::time_point t3 = Clock::now();
     const double track_us = Us(t1 - t0), pose_us = Us(t3 - t2);
@@ -912,7 +1074,8 @@ class InputEvaluation {
       truth_json = Json{{"lines", std::move(lines)}, {"pose", std::move(pose_error_json)}};
     }
 
-    // How bad the frame is, for the thumbnails: lost > partial > no pose > truth errors.
+    // How bad the frame is, for the thumbnails: lost > partial > pose jump > no pose > truth
+    // errors.
     std::ostringstream why;
     out.badness = 0.0;
     if (status <= 1) {
@@ -922,6 +1085,11 @@ class InputEvaluation {
     if (camera_ && !pose_ok) {
       out.badness += 100.0;
       why << "pose " << ToString(out.pose->status) << "; ";
+    }
+    if (jump) {
+      out.badness += 200.0;
+      why << "pose jumped " << std::round(jump->rotation_deg * 10.0) / 10.0 << " deg from frame "
+          << jump->from_frame << (jump->relabelled ? " (lines relabelled)" : "") << "; ";
     }
     if (missed > 0) {
       out.badness += 50.0 * missed;
@@ -999,7 +1167,9 @@ class InputEvaluation {
       for (const auto& [status, count] : t.pose_status) by_status[status] = count;
       pose = Json{{"frames_ok", t.pose_ok},
                   {"availability", t.pose_ok / readable},
-                  {"by_status", std::move(by_status)}};
+                  {"by_status", std::move(by_status)},
+                  {"jumps", t.pose_jumps},
+                  {"jump_frames", t.jump_frames}};
     }
     Json truth;
     if (truth_.kind() != "none" && truth_.kind() != "auto") {
@@ -1056,6 +1226,7 @@ class InputEvaluation {
       if (truth_.kind() == "json") compare.truth = truth_.path();
     }
     try {
+      const QuietStderr quiet;  // vpMeLine's failure messages: compare counts them
       return CompareJson(RunComparison(compare));
     } catch (const std::exception& error) {
       return Json{{"error", error.what()}};
@@ -1073,6 +1244,7 @@ class InputEvaluation {
   std::optional<PointUndistorter> undistorter_;
   std::vector<std::string> warnings_;
   Tally tally_;
+  std::optional<TrustedPose> trusted_;  ///< the last trusted pose (JumpFrom)
   Series series_;
   std::vector<double> decode_us_;
 };
@@ -1124,6 +1296,8 @@ void EvaluateOptions::Check() const {
   Require(max_frames >= 0, "max_frames", max_frames, "max_frames >= 0");
   Require(video_scale >= 0.1 && video_scale <= 1.0, "video_scale", video_scale,
           "0.1 <= video_scale <= 1");
+  Require(video_codec == "xvid" || video_codec == "mjpg", "video_codec", video_codec,
+          "\"xvid\" or \"mjpg\"");
   Require(thumbnails >= 0 && thumbnails <= 50, "thumbnails", thumbnails, "0 <= thumbnails <= 50");
   Require(target_lines >= 0 && target_lines <= 64, "target_lines", target_lines,
           "0 <= target_lines <= 64");

@@ -14,7 +14,7 @@
 //   NAME/frames.jsonl    one JSON object per frame: tracks, pose, status, truth errors
 //   NAME/timing.jsonl    per frame: decode, track and pose times (microseconds)
 //   NAME/annotated.avi   the frames with the tracks (ids), lines 1-4 and the target frame
-//                        (MJPG; unless --no-video)
+//                        (XVID, half size by default; unless --no-video)
 //   NAME/compare/        with --compare: `oalservo compare`'s compare.md, compare.json
 //   NAME/timing.json     timing statistics, decode time against the wall time
 //   NAME/report.html     the input's report: plots (Chart.js, inlined) and worst frames
@@ -63,9 +63,13 @@ struct EvaluateOptions {
   bool resume = false;
   /// Write NAME/annotated.avi.
   bool write_video = true;
-  /// Size of the annotated video relative to the frames, [0.1, 1]: drawing and encoding it
-  /// is the slowest stage (docs/EVALUATE.md, figures).
-  double video_scale = 1.0;
+  /// Size of the annotated video relative to the frames, [0.1, 1]; the frames are scaled
+  /// first and drawn on at that size. Encoding it is the writer's main cost: half size by
+  /// default, a quarter of the pixels (docs/EVALUATE.md, figures).
+  double video_scale = 0.5;
+  /// The annotated video's codec: "xvid" (MPEG-4 part 2 by OpenCV's FFmpeg backend, the
+  /// fastest here) or "mjpg" (OpenCV's own encoder, quality 75, every frame a key frame).
+  std::string video_codec = "xvid";
   /// Lines held for the target to count as detected in a frame; 0: the configuration's
   /// target's line count (4 for the four-line target). [0, 64].
   int target_lines = 0;

@@ -41,8 +41,13 @@ int RunEvaluate(int argc, char** argv) {
                "skip the inputs a previous run completed (their summary.json exists)");
   cli.add_flag("--no-video", no_video, "do not write the annotated videos");
   cli.add_option("--video-scale", options.video_scale,
-                 "size of the annotated videos relative to the frames (0.5: a quarter of the "
-                 "pixels, smaller files, faster to encode)")
+                 "size of the annotated videos relative to the frames (1: full size, four to five "
+                 "times the encoding time of the default)")
+      ->capture_default_str();
+  cli.add_option("--video-codec", options.video_codec,
+                 "codec of the annotated videos: xvid (MPEG-4 part 2, fastest) or mjpg "
+                 "(every frame a key frame)")
+      ->check(CLI::IsMember({"xvid", "mjpg"}))
       ->capture_default_str();
   cli.add_option("--lines", options.target_lines,
                  "lines held for the target to count as detected (0: the target's lines)")

@@ -6,34 +6,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/command_line.h"
+
 namespace oal {
 namespace {
 
 constexpr const char* kDefaultChartJs = "/usr/share/javascript/chart.js/chart.min.js";
-
-std::string Escaped(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 std::string Base64(const std::vector<unsigned char>& bytes) {
   static const char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -197,7 +175,7 @@ document.body.setAttribute('data-charts', String(charts));
 
 std::string Head(const std::string& title, const std::string& chart_js) {
   return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
-         Escaped(title) + "</title>\n" + kStyle + "<script>\n" + chart_js + "\n</script>\n" +
+         MarkupEscaped(title) + "</title>\n" + kStyle + "<script>\n" + chart_js + "\n</script>\n" +
          "</head>\n";
 }
 
@@ -220,7 +198,8 @@ std::string Percent(const Json& value) {
 }
 
 std::string Row(const std::string& name, const std::string& value) {
-  return "<tr><th class=\"l\">" + Escaped(name) + "</th><td class=\"l\">" + value + "</td></tr>\n";
+  return "<tr><th class=\"l\">" + MarkupEscaped(name) + "</th><td class=\"l\">" + value +
+         "</td></tr>\n";
 }
 
 // "mean / p95 / max" of a Stats() object.
@@ -234,7 +213,8 @@ std::string List(const Json& items, const std::string& empty) {
   if (!items.is_array() || items.empty()) return "<p>" + empty + "</p>\n";
   std::string out = "<ul>\n";
   for (const Json& item : items) {
-    out += "<li>" + Escaped(item.is_string() ? item.get<std::string>() : item.dump()) + "</li>\n";
+    out += "<li>" + MarkupEscaped(item.is_string() ? item.get<std::string>() : item.dump()) +
+           "</li>\n";
   }
   return out + "</ul>\n";
 }
@@ -243,9 +223,10 @@ std::string CompareTable(const Json& compare) {
   if (compare.is_null()) return "";
   std::string out = "<h2>Comparison with other methods</h2>\n";
   if (compare.contains("error")) {
-    return out + "<p class=\"bad\">" + Escaped(compare["error"].get<std::string>()) + "</p>\n";
+    return out + "<p class=\"bad\">" + MarkupEscaped(compare["error"].get<std::string>()) +
+           "</p>\n";
   }
-  out += "<p>Truth: " + Escaped(compare.value("truth", "")) +
+  out += "<p>Truth: " + MarkupEscaped(compare.value("truth", "")) +
          " (oalservo compare; NAME/compare/compare.md)</p>\n<table><tr><th class=\"l\">method</th>"
          "<th>frames all found</th><th>angle err mean (°)</th><th>offset err mean (px)</th>"
          "<th>time / frame median (µs)</th></tr>\n";
@@ -256,11 +237,25 @@ std::string CompareTable(const Json& compare) {
                                   ? std::to_string(m["frames_all_found"].get<int>()) + " / " +
                                         std::to_string(m["frames"].get<int>())
                                   : "—";
-    out += "<tr><td class=\"l\">" + Escaped(m.value("name", "")) + "</td><td>" + found +
+    out += "<tr><td class=\"l\">" + MarkupEscaped(m.value("name", "")) + "</td><td>" + found +
            "</td><td>" + Number(angle, 3) + "</td><td>" + Number(offset, 2) + "</td><td>" +
            Number(m.value("time_us_per_frame_median", Json()), 0) + "</td></tr>\n";
   }
   return out + "</table>\n";
+}
+
+// "0", or "2: frames 2089, 2119" (the frames the summary lists).
+std::string Jumps(const Json& pose) {
+  const int count = pose.value("jumps", 0);
+  std::string text = std::to_string(count);
+  if (count == 0 || !pose.contains("jump_frames")) return text;
+  text += ": frame" + std::string(count > 1 ? "s " : " ");
+  const Json& frames = pose["jump_frames"];
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    text += (i > 0 ? ", " : "") + frames[i].dump();
+  }
+  if (static_cast<std::size_t>(count) > frames.size()) text += ", ...";
+  return "<span class=\"bad\">" + text + "</span>";
 }
 
 }  // namespace
@@ -287,9 +282,9 @@ std::string InputReportHtml(const Json& summary, const Json& series, const Json&
                             const std::vector<Thumbnail>& thumbnails, const std::string& chart_js) {
   const std::string name = summary.value("name", "input");
   std::string html = Head("oalservo evaluate: " + name, chart_js);
-  html += "<body>\n<h1>oalservo evaluate: " + Escaped(name) + "</h1>\n";
+  html += "<body>\n<h1>oalservo evaluate: " + MarkupEscaped(name) + "</h1>\n";
   html += "<p><a href=\"../index.html\">index</a> · input <code>" +
-          Escaped(summary.value("input", "")) + "</code></p>\n";
+          MarkupEscaped(summary.value("input", "")) + "</code></p>\n";
 
   const Json& detection = summary["detection"];
   const Json& pose = summary["pose"];
@@ -315,14 +310,16 @@ std::string InputReportHtml(const Json& summary, const Json& series, const Json&
                   std::to_string(detection.value("track_losses", 0)));
   html += Row("pose availability",
               pose.is_null() ? "no camera: no pose" : Percent(pose["availability"]));
-  html += Row("camera", summary["camera"].is_string()
-                            ? "<code>" + Escaped(summary["camera"].get<std::string>()) + "</code>"
-                            : "none");
+  if (!pose.is_null()) html += Row("pose jumps (lines relabelled, or turned > 90°)", Jumps(pose));
+  html +=
+      Row("camera", summary["camera"].is_string()
+                        ? "<code>" + MarkupEscaped(summary["camera"].get<std::string>()) + "</code>"
+                        : "none");
   if (truth.is_null()) {
     html += Row("truth", "none");
   } else {
-    html += Row("truth", Escaped(truth.value("kind", "")) + " <code>" +
-                             Escaped(truth.value("path", "")) + "</code>");
+    html += Row("truth", MarkupEscaped(truth.value("kind", "")) + " <code>" +
+                             MarkupEscaped(truth.value("path", "")) + "</code>");
     html += Row("truth lines found", std::to_string(truth.value("found_lines", 0)) + " / " +
                                          std::to_string(truth.value("truth_lines", 0)));
     html += Row("line angle error mean / p95 / max (°)", Spread(truth["angle_deg"], 3));
@@ -342,7 +339,7 @@ std::string InputReportHtml(const Json& summary, const Json& series, const Json&
             "does not hold are counted, see the warnings).</p>\n<ul>\n";
     for (const Json& item : summary["unreadable"]) {
       html += "<li>frame " + std::to_string(item.value("frame", 0)) + ": " +
-              Escaped(item.value("error", "")) + "</li>\n";
+              MarkupEscaped(item.value("error", "")) + "</li>\n";
     }
     html += "</ul>\n";
   }
@@ -369,7 +366,7 @@ std::string InputReportHtml(const Json& summary, const Json& series, const Json&
       html += "<figure><img alt=\"frame " + std::to_string(thumbnail.frame) +
               "\" src=\"data:image/jpeg;base64," + Base64(thumbnail.jpeg) +
               "\"><figcaption>frame " + std::to_string(thumbnail.frame) + ": " +
-              Escaped(thumbnail.why) + "</figcaption></figure>\n";
+              MarkupEscaped(thumbnail.why) + "</figcaption></figure>\n";
     }
     html += "</div>\n";
   }
@@ -388,7 +385,7 @@ std::string IndexHtml(const Json& run, const std::vector<Json>& timing,
   std::string html = Head("oalservo evaluate", chart_js);
   html += "<body>\n<h1>oalservo evaluate</h1>\n";
   if (run["shard"].is_string()) {
-    html += "<p>Shard " + Escaped(run["shard"].get<std::string>()) + " of the inputs.</p>\n";
+    html += "<p>Shard " + MarkupEscaped(run["shard"].get<std::string>()) + " of the inputs.</p>\n";
   }
   html +=
       "<h2>Inputs</h2>\n<table>\n<tr><th class=\"l\">input</th><th>frames</th>"
@@ -401,19 +398,19 @@ std::string IndexHtml(const Json& run, const std::vector<Json>& timing,
     const std::string name = input.value("name", "");
     const Json& summary = input["summary"];
     if (summary.is_null()) {
-      failed += "<li><code>" + Escaped(input.value("input", "")) +
-                "</code>: " + Escaped(input.value("error", "")) + "</li>\n";
-      html += "<tr><td class=\"l bad\">" + Escaped(name) +
+      failed += "<li><code>" + MarkupEscaped(input.value("input", "")) +
+                "</code>: " + MarkupEscaped(input.value("error", "")) + "</li>\n";
+      html += "<tr><td class=\"l bad\">" + MarkupEscaped(name) +
               " (failed)</td><td colspan=\"8\" class=\"l bad\">" +
-              Escaped(input.value("error", "")) + "</td></tr>\n";
+              MarkupEscaped(input.value("error", "")) + "</td></tr>\n";
       ++i;
       continue;
     }
     const Json& truth = summary["truth"];
     const Json& pose = summary["pose"];
-    html += "<tr><td class=\"l\"><a href=\"" + Escaped(name) + "/report.html\">" + Escaped(name) +
-            "</a></td><td>" + std::to_string(summary.value("frames", 0)) + "</td><td" +
-            (summary.value("frames_unreadable", 0) > 0 ? " class=\"bad\"" : "") + ">" +
+    html += "<tr><td class=\"l\"><a href=\"" + MarkupEscaped(name) + "/report.html\">" +
+            MarkupEscaped(name) + "</a></td><td>" + std::to_string(summary.value("frames", 0)) +
+            "</td><td" + (summary.value("frames_unreadable", 0) > 0 ? " class=\"bad\"" : "") + ">" +
             std::to_string(summary.value("frames_unreadable", 0)) + "</td><td>" +
             Percent(summary["detection"]["rate"]) + "</td><td>" +
             std::to_string(summary["detection"].value("lost_episodes", 0)) + "</td><td>" +

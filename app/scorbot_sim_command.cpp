@@ -26,17 +26,6 @@ extern "C" void OnScorbotSimSigint(int /*signal*/) {
   g_interrupt.store(true);
 }
 
-class SigintScope {
- public:
-  SigintScope() { previous_ = std::signal(SIGINT, &OnScorbotSimSigint); }
-  ~SigintScope() { std::signal(SIGINT, previous_); }
-  SigintScope(const SigintScope&) = delete;
-  SigintScope& operator=(const SigintScope&) = delete;
-
- private:
-  void (*previous_)(int) = SIG_DFL;
-};
-
 ScorbotSimOptions SimOptions(const ScorbotSimCommandOptions& options) {
   ScorbotSimOptions sim;
   sim.time_scale = options.time_scale;
@@ -200,7 +189,7 @@ int RunScorbotSim(int argc, char** argv) {
     return kExitOk;
   }
   g_interrupt.store(false);
-  SigintScope sigint;
+  SigintScope sigint(&OnScorbotSimSigint);
   return RunScorbotSimServer(options, std::cout, &g_interrupt);
 }
 

@@ -28,18 +28,6 @@ extern "C" void OnSigint(int /*signal*/) {
   if (SafeRobot* robot = g_robot.load()) robot->RequestEmergencyStop();
 }
 
-// Installs the handler for the lifetime of the run and restores the previous one.
-class SigintScope {
- public:
-  SigintScope() { previous_ = std::signal(SIGINT, &OnSigint); }
-  ~SigintScope() { std::signal(SIGINT, previous_); }
-  SigintScope(const SigintScope&) = delete;
-  SigintScope& operator=(const SigintScope&) = delete;
-
- private:
-  void (*previous_)(int) = SIG_DFL;
-};
-
 }  // namespace
 
 ServoAppConfig DefaultServoConfig() {
@@ -176,7 +164,7 @@ int RunServoMain(int argc, char** argv) {
       "  oalservo servo --config config/table3-sim.yaml --mode point-and-go --display off");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   g_interrupt.store(false);
-  SigintScope sigint;
+  SigintScope sigint(&OnSigint);
   ServoRunHooks hooks;
   hooks.interrupt = &g_interrupt;
   hooks.on_robot = [](SafeRobot* robot) { g_robot.store(robot); };

@@ -57,32 +57,6 @@ std::string Mm(double value) {
   return out;
 }
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 // The page for a drawing of need_w x need_h mm (margins included), or nothing if none fits.
 bool FitOnSheet(const Sheet& sheet, double need_w, double need_h, TargetDrawing* drawing) {
   if (need_w <= sheet.width_mm && need_h <= sheet.height_mm) {
@@ -191,7 +165,7 @@ TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page) {
   const double board_x = cx - 0.5 * board_w, board_y = top;
   const double footer_x = cx - 0.5 * kFooterWidthMm;
   const double footer_y = top + board_h + kFooterGapMm;
-  const std::string name = Escape(target.name.empty() ? "unnamed" : target.name);
+  const std::string name = MarkupEscaped(target.name.empty() ? "unnamed" : target.name);
 
   std::ostringstream svg;
   svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\""

@@ -2,6 +2,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <visp3/core/vpThetaUVector.h>
 
 #include <array>
@@ -13,12 +14,14 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "app/command_line.h"
 #include "app/render_command.h"
 #include "app/report.h"
 #include "app/truth_file.h"
@@ -152,6 +155,36 @@ TEST(TruthFile, ReadsLineAndPoseRowsAndRejectsBadOnes) {
               ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("twice.csv:2: the pose")));
 }
 
+// The file behind descriptor 2: (device, inode).
+std::pair<dev_t, ino_t> StderrFile() {
+  struct stat status {};
+  EXPECT_EQ(::fstat(2, &status), 0);
+  return {status.st_dev, status.st_ino};
+}
+
+TEST(EvaluateSharedHelpers, QuietStderrNestsAndRestoresStderr) {
+  struct stat null {};
+  ASSERT_EQ(::stat("/dev/null", &null), 0);
+  const auto before = StderrFile();
+  {
+    std::optional<QuietStderr> outer(std::in_place);
+    EXPECT_EQ(StderrFile(), std::make_pair(null.st_dev, null.st_ino));
+    {
+      const QuietStderr inner;  // as a second evaluate job would
+      EXPECT_EQ(StderrFile(), std::make_pair(null.st_dev, null.st_ino));
+    }
+    EXPECT_EQ(StderrFile(), std::make_pair(null.st_dev, null.st_ino));  // outer still alive
+    outer.reset();
+    EXPECT_EQ(StderrFile(), before);
+  }
+  EXPECT_EQ(StderrFile(), before);
+}
+
+TEST(EvaluateSharedHelpers, MarkupEscapedEscapesTheFiveCharacters) {
+  EXPECT_EQ(MarkupEscaped("a<b>&\"c\"'d'"), "a&lt;b&gt;&amp;&quot;c&quot;&apos;d&apos;");
+  EXPECT_EQ(MarkupEscaped("plain é"), "plain é");
+}
+
 TEST(Evaluate, ParsesShardsAndPlansNamesThatDoNotCollide) {
   EXPECT_EQ(ParseShard("1/4"), std::make_pair(1, 4));
   EXPECT_THROW(ParseShard("4/4"), std::invalid_argument);
@@ -191,13 +224,66 @@ TEST(Evaluate, VideoWithTruthCsvReportsTheKnownErrors) {
   ASSERT_GE(summary.at("pose").at("frames_ok").get<int>(), kFrames / 2);
   EXPECT_NEAR(truth.at("pose_translation_mm").at("mean").get<double>(), 1000.0 * kShiftTxM,
               kTranslationToleranceMm);
-  // One JSON object per frame, and the annotated video holds every frame.
+  // One JSON object per frame, and the annotated video holds every frame, at half size
+  // (the default video_scale) in XVID.
   const auto records = test::ParseJsonLines(test::ReadText(dir / "out/clip/frames.jsonl"));
   ASSERT_EQ(records.size(), static_cast<std::size_t>(kFrames));
   EXPECT_EQ(records[0].at("truth").at("lines").size(), 4u);
+  // Independent random poses: a pose may turn by more than 90 degrees from the previous one,
+  // and is then flagged as a jump.
+  int jumps = 0;
+  for (const json& record : records) {
+    const json& pose = record.at("pose");
+    if (pose.at("status") != "ok") continue;
+    EXPECT_TRUE(pose.at("identification").at("cost").is_number());
+    if (pose.at("jump").is_null()) continue;
+    ++jumps;
+    EXPECT_LT(pose.at("jump").at("from_frame").get<int>(), record.at("frame").get<int>());
+    EXPECT_TRUE(pose.at("jump").at("relabelled").get<bool>() ||
+                pose.at("jump").at("rotation_deg").get<double>() > 90.0);
+  }
+  EXPECT_EQ(summary.at("pose").at("jumps"), jumps);
   cv::VideoCapture annotated(dir / "out/clip/annotated.avi");
   EXPECT_EQ(static_cast<int>(annotated.get(cv::CAP_PROP_FRAME_COUNT)), kFrames);
+  EXPECT_EQ(annotated.get(cv::CAP_PROP_FRAME_WIDTH), 160.0);
+  EXPECT_EQ(annotated.get(cv::CAP_PROP_FRAME_HEIGHT), 120.0);
+  EXPECT_EQ(static_cast<int>(annotated.get(cv::CAP_PROP_FOURCC)),
+            cv::VideoWriter::fourcc('X', 'V', 'I', 'D'));
   EXPECT_TRUE(test::TempFilesIn(dir / "out").empty());
+}
+
+TEST(Evaluate, SmoothSequenceHasNoPoseJump) {
+  test::TestDir dir;
+  RenderCommandOptions render;
+  render.out_dir = dir / "slow";
+  render.sequence = "slow";
+  render.count = 12;
+  render.seed = 3;
+  ASSERT_EQ(RenderDataset(render), 12);
+  EvaluateOptions options = Options({render.out_dir}, dir / "out");
+  options.write_video = false;
+  ASSERT_EQ(Evaluate(options).inputs.at(0).status, "complete");
+  const json pose = ReadJson(dir / "out/slow/summary.json").at("pose");
+  EXPECT_GE(pose.at("frames_ok").get<int>(), 10);
+  EXPECT_EQ(pose.at("jumps"), 0);
+  EXPECT_TRUE(pose.at("jump_frames").empty());
+}
+
+TEST(Evaluate, FullSizeMjpgVideoOnRequest) {
+  test::TestDir dir;
+  const std::string frames = RenderFrames(dir, "frames", 3);
+  EvaluateOptions options = Options({frames}, dir / "out");
+  options.video_scale = 1.0;
+  options.video_codec = "mjpg";
+  ASSERT_EQ(Evaluate(options).inputs.at(0).status, "complete");
+  cv::VideoCapture annotated(dir / "out/frames/annotated.avi");
+  EXPECT_EQ(static_cast<int>(annotated.get(cv::CAP_PROP_FRAME_COUNT)), 3);
+  EXPECT_EQ(annotated.get(cv::CAP_PROP_FRAME_WIDTH), 320.0);
+  EXPECT_EQ(annotated.get(cv::CAP_PROP_FRAME_HEIGHT), 240.0);
+  EXPECT_EQ(static_cast<int>(annotated.get(cv::CAP_PROP_FOURCC)),
+            cv::VideoWriter::fourcc('M', 'J', 'P', 'G'));
+  options.video_codec = "h264";
+  EXPECT_THROW(Evaluate(options), std::invalid_argument);
 }
 
 TEST(Evaluate, RenderedJsonTruthNextToTheImagesGivesSmallErrors) {
