@@ -76,8 +76,12 @@ void ServoOptions::Check() const {
           rotation_tolerance_deg, "in (0, 180]");
 }
 
-PbvsTaskState EvaluatePbvsTask(const vpHomogeneousMatrix& cMo, const vpHomogeneousMatrix& cdMo,
-                               const ServoOptions& options) {
+namespace {
+
+// The task for cMo, cdMo; the velocity (interaction matrix and its pseudo-inverse, most of the
+// cost) only when asked: the position laws need the error alone.
+PbvsTaskState Evaluate(const vpHomogeneousMatrix& cMo, const vpHomogeneousMatrix& cdMo,
+                       const ServoOptions& options, bool with_velocity) {
   options.Check();
   PbvsTaskState state;
   state.cdMc = cdMo * cMo.inverse();
@@ -95,8 +99,13 @@ PbvsTaskState EvaluatePbvsTask(const vpHomogeneousMatrix& cMo, const vpHomogeneo
   task.setLambda(gain);
   task.addFeature(t);
   task.addFeature(tu);
-  state.velocity = task.computeControlLaw();
-  state.error = task.getError();
+  if (with_velocity) {
+    state.velocity = task.computeControlLaw();
+    state.error = task.getError();
+  } else {
+    state.error = task.computeError();
+    state.velocity = vpColVector(6, 0.0);
+  }
   state.gain = gain(state.error);
 
   state.translation_error_m = std::sqrt(vpMath::sqr(state.error[0]) + vpMath::sqr(state.error[1]) +
@@ -104,6 +113,13 @@ PbvsTaskState EvaluatePbvsTask(const vpHomogeneousMatrix& cMo, const vpHomogeneo
   state.rotation_error_rad = std::sqrt(vpMath::sqr(state.error[3]) + vpMath::sqr(state.error[4]) +
                                        vpMath::sqr(state.error[5]));
   return state;
+}
+
+}  // namespace
+
+PbvsTaskState EvaluatePbvsTask(const vpHomogeneousMatrix& cMo, const vpHomogeneousMatrix& cdMo,
+                               const ServoOptions& options) {
+  return Evaluate(cMo, cdMo, options, true);
 }
 
 vpColVector Se3Log(const vpHomogeneousMatrix& M) {
@@ -116,7 +132,7 @@ vpHomogeneousMatrix Se3Exp(const vpColVector& xi) {
 
 ServoStep ComputeServoStep(const vpHomogeneousMatrix& cMo, const vpHomogeneousMatrix& cdMo,
                            const ServoOptions& options) {
-  const PbvsTaskState task = EvaluatePbvsTask(cMo, cdMo, options);
+  const PbvsTaskState task = Evaluate(cMo, cdMo, options, options.mode == ServoMode::kVelocity);
   ServoStep step;
   step.mode = options.mode;
   step.translation_error_m = task.translation_error_m;
