@@ -414,6 +414,7 @@ const std::vector<Field<PoseOptions>>& PoseFields() {
       DoubleField("width_sigma", &O::width_sigma),
       DoubleField("max_identification_cost", &O::max_identification_cost),
       DoubleField("min_identification_margin", &O::min_identification_margin),
+      DoubleField("previous_max_deg", &O::previous_max_deg),
       DoubleField("max_residual_px", &O::max_residual_px),
       DoubleField("previous_tolerance_px", &O::previous_tolerance_px),
       DoubleField("min_depth_m", &O::min_depth_m),

@@ -89,8 +89,8 @@ struct SubsetResult {
 class Identifier {
  public:
   Identifier(const std::vector<DetectedLine>& lines, const HashTarget& target,
-             const PoseOptions& options)
-      : lines_(lines), target_(target), options_(options) {
+             const PoseOptions& options, const vpRotationMatrix* previous_cRo)
+      : lines_(lines), target_(target), options_(options), previous_cRo_(previous_cRo) {
     const vpCameraParameters& camera = options.camera;
     k_inv_ = {1.0 / camera.get_px(),
               0.0,
@@ -113,12 +113,38 @@ class Identifier {
   }
   // Homography board -> pixels of one assignment, its cost (infinite if invalid).
   double Cost(const Mat3& h, const std::array<int, 4>& image_line_of_target) const;
+  // Angle between the rotation of the board -> pixels homography h and the previous pose's.
+  double PreviousAngleDeg(const Mat3& h) const;
 
   const std::vector<DetectedLine>& lines_;
   const HashTarget& target_;
   const PoseOptions& options_;
+  const vpRotationMatrix* previous_cRo_;
   Mat3 k_inv_{};
 };
+
+double Identifier::PreviousAngleDeg(const Mat3& h) const {
+  // K^-1 H = s [r1 r2 t]; the sign that puts the board in front of the camera (t_z > 0).
+  const Mat3 g = Multiply(k_inv_, h);
+  const double sign = g[8] >= 0.0 ? 1.0 : -1.0;
+  double r1[3] = {sign * g[0], sign * g[3], sign * g[6]};
+  double r2[3] = {sign * g[1], sign * g[4], sign * g[7]};
+  const double n1 = std::sqrt(r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]);
+  const double n2 = std::sqrt(r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]);
+  if (!(n1 > 0.0 && n2 > 0.0)) return 180.0;
+  for (int i = 0; i < 3; ++i) {
+    r1[i] /= n1;
+    r2[i] /= n2;
+  }
+  const double r3[3] = {r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2],
+                        r1[0] * r2[1] - r1[1] * r2[0]};
+  const vpRotationMatrix& p = *previous_cRo_;
+  // trace(Pᵀ R) over the columns r1, r2, r3 of R.
+  double trace = 0.0;
+  for (int i = 0; i < 3; ++i) trace += p[i][0] * r1[i] + p[i][1] * r2[i] + p[i][2] * r3[i];
+  const double cosine = 0.5 * (trace - 1.0);
+  return std::isfinite(cosine) ? std::acos(std::clamp(cosine, -1.0, 1.0)) * kDegPerRad : 180.0;
+}
 
 double Identifier::Cost(const Mat3& h, const std::array<int, 4>& image_line_of_target) const {
   // Orthonormality of the first two columns of K^-1 H.
@@ -250,6 +276,7 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
   static constexpr int kPairs[2][2] = {{0, 2}, {1, 3}};  // target lines 1, 3 and 2, 4
   struct Assignment {
     double cost;
+    double previous_angle_deg;  // from the previous pose's rotation (180 without one)
     std::array<int, 4> line_index;
     std::array<Point2d, 4> corners;
   };
@@ -287,6 +314,7 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
           for (int j = 0; j < 2; ++j)
             a.corners[corner_of(target_g[i], target_h[j])] = Point2d{q[i][j].x, q[i][j].y};
         a.cost = Cost(h, a.line_index);
+        a.previous_angle_deg = previous_cRo_ != nullptr ? PreviousAngleDeg(h) : 180.0;
       }
     }
   }
@@ -304,6 +332,28 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
     result.message = "no assignment of the target lines fits the intersections";
     result.status = PoseStatus::kNotIdentifiable;
     return result;
+  }
+  // Continuity (PoseOptions::previous_max_deg): the frame's winner turned away from the
+  // previous pose loses to the assignment that agrees with it, unless that one's own cost
+  // rules it out.
+  const double keep_deg = options_.previous_max_deg;
+  if (previous_cRo_ != nullptr && keep_deg > 0.0 && kept[best].previous_angle_deg > keep_deg) {
+    int agreeing = -1;
+    for (int k = 0; k < n_kept; ++k) {
+      if (kept[k].previous_angle_deg <= keep_deg &&
+          kept[k].cost <= options_.max_identification_cost &&
+          (agreeing < 0 || kept[k].cost < kept[agreeing].cost)) {
+        agreeing = k;
+      }
+    }
+    if (agreeing >= 0) {
+      result.line_index = kept[agreeing].line_index;
+      result.corners_px = kept[agreeing].corners;
+      result.cost = kept[agreeing].cost;
+      result.margin = kInf;  // chosen by the previous pose, not by its margin
+      result.status = PoseStatus::kOk;
+      return result;
+    }
   }
   result.line_index = kept[best].line_index;
   result.corners_px = kept[best].corners;
@@ -381,14 +431,14 @@ void PixelToMetre(const vpCameraParameters& camera, bool undistorted, const Poin
 }
 
 PoseResult Identify(const std::vector<DetectedLine>& lines, const HashTarget& target,
-                    const PoseOptions& options) {
+                    const PoseOptions& options, const vpRotationMatrix* previous_cRo) {
   PoseResult result;
   if (lines.size() < 4) {
     result.status = PoseStatus::kNotEnoughLines;
     result.message = "only " + std::to_string(lines.size()) + " lines detected, the target needs 4";
     return result;
   }
-  const Identifier identifier(lines, target, options);
+  const Identifier identifier(lines, target, options, previous_cRo);
   SubsetResult chosen = identifier.Evaluate({{0, 1, 2, 3}});
   if (chosen.status != PoseStatus::kOk) {
     const int n =
@@ -496,6 +546,8 @@ void PoseOptions::Check() const {
                 dementhon_above_px, "0 <= dementhon_above_px <= 1000");
   RequireOption(InRange(previous_accept_px, 0.0, 1000.0), "PoseOptions::previous_accept_px",
                 previous_accept_px, "0 <= previous_accept_px <= 1000");
+  RequireOption(InRange(previous_max_deg, 0.0, 180.0), "PoseOptions::previous_max_deg",
+                previous_max_deg, "0 <= previous_max_deg <= 180");
   RequireOption(vvs_max_iterations >= 1 && vvs_max_iterations <= 1000,
                 "PoseOptions::vvs_max_iterations", vvs_max_iterations,
                 "1 <= vvs_max_iterations <= 1000");
@@ -504,7 +556,7 @@ void PoseOptions::Check() const {
 PoseResult IdentifyTargetLines(const std::vector<DetectedLine>& lines, const LineTarget& target,
                                const PoseOptions& options) {
   options.Check();
-  return pose_internal::Identify(lines, pose_internal::HashTargetFrom(target), options);
+  return pose_internal::Identify(lines, pose_internal::HashTargetFrom(target), options, nullptr);
 }
 
 }  // namespace oal

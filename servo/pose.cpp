@@ -178,7 +178,11 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
   options.Check();
   const HashTarget hash = pose_internal::HashTargetFrom(target);
   // Step 1.
-  PoseResult result = pose_internal::Identify(lines, hash, options);
+  const bool have_previous = previous_cMo && IsFinite(*previous_cMo);
+  const vpRotationMatrix previous_cRo =
+      have_previous ? previous_cMo->getRotationMatrix() : vpRotationMatrix();
+  PoseResult result =
+      pose_internal::Identify(lines, hash, options, have_previous ? &previous_cRo : nullptr);
   if (result.status != PoseStatus::kOk) return result;
 
   const vpCameraParameters& camera = options.camera;
@@ -193,7 +197,6 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
 
   // In a loop the previous pose is a good seed: its refinement alone is kept when it fits
   // well (previous_accept_px), and the linear methods are skipped.
-  const bool have_previous = previous_cMo && IsFinite(*previous_cMo);
   if (have_previous && options.previous_accept_px > 0.0) {
     vpHomogeneousMatrix seeded = *previous_cMo;
     corners.Set(&seeded, &result, &pose);

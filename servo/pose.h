@@ -109,6 +109,13 @@ struct PoseOptions {
   double max_identification_cost = 50.0;
   /// The runner-up's cost must exceed the winner's by at least this. Range [0, 1e9].
   double min_identification_margin = 9.0;
+  /// Continuity of lines 1-4 with a previous pose (tracking, servo): when the frame's best
+  /// assignment is turned by more than this from the previous pose and another assignment is
+  /// within it with a cost under max_identification_cost, that one is taken (one badly
+  /// measured stripe width must not turn the target by 90 or 180 deg between frames); the
+  /// four assignments differ by 90 or 180 deg. 0: the frame alone decides. Degrees,
+  /// range [0, 180].
+  double previous_max_deg = 45.0;
 
   // --- Steps 3-4: pose -----------------------------------------------------------------
   /// Largest acceptable reprojection RMS, undistorted pixels. Range (0, 1000].

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpRotationMatrix.h>
 
 #include <array>
 #include <vector>
@@ -34,8 +35,9 @@ HashTarget HashTargetFrom(const LineTarget& target);
 void PixelToMetre(const vpCameraParameters& camera, bool undistorted, const Point2d& p, double* x,
                   double* y);
 
-/// Step 1 (IdentifyTargetLines) without the checks.
+/// Step 1 (IdentifyTargetLines) without the checks; `previous_cRo` (may be null) keeps the
+/// identity of lines 1-4 consistent with the previous pose (PoseOptions::previous_max_deg).
 PoseResult Identify(const std::vector<DetectedLine>& lines, const HashTarget& target,
-                    const PoseOptions& options);
+                    const PoseOptions& options, const vpRotationMatrix* previous_cRo);
 
 }  // namespace oal::pose_internal

@@ -595,3 +595,43 @@ TEST(EstimatePose, TimePerFrame) {
 
 }  // namespace
 }  // namespace oal
+
+namespace oal {
+namespace {
+
+// One stripe measured with a wrong width can make a turned assignment the frame's best (as an
+// occluder did in evaluate's long sequence, frames 2089 and 2119); the previous pose keeps the
+// identity of lines 1-4 (PoseOptions::previous_max_deg) whenever the right assignment is still
+// plausible on its own (cost under max_identification_cost).
+TEST(EstimatePose, APreviousPoseKeepsLines1To4FromTurningOnABadWidth) {
+  const RenderOptions render = SmallRender(false);
+  const SceneRenderer renderer(FourLineTarget(), render);
+  PoseOptions options = OptionsFor(render);
+  PoseOptions frame_alone = options;
+  frame_alone.previous_max_deg = 0.0;
+  std::mt19937 rng(12);
+  int turned_alone = 0, kept_by_previous = 0;
+  for (int pose = 0; pose < 12; ++pose) {
+    const vpHomogeneousMatrix cMo = PoseAt(0.5, 30.0 * pose, 15.0, 20.0 + 7.0 * pose);
+    const std::vector<DetectedLine> good =
+        SyntheticLines(renderer.Truth(cMo), {0, 1, 2, 3}, render.camera, &rng);
+    for (int line = 0; line < 4; ++line) {
+      for (double factor = 0.5; factor <= 2.0; factor += 0.05) {
+        std::vector<DetectedLine> lines = good;
+        lines[line].width_px *= factor;
+        const PoseResult alone = EstimatePose(lines, FourLineTarget(), frame_alone, cMo);
+        if (alone.status != PoseStatus::kOk || RotationErrorDeg(alone.cMo, cMo) < 45.0) continue;
+        ++turned_alone;
+        const PoseResult tracked = EstimatePose(lines, FourLineTarget(), options, cMo);
+        ASSERT_EQ(tracked.status, PoseStatus::kOk) << tracked.message;
+        if (RotationErrorDeg(tracked.cMo, cMo) < 1.0) ++kept_by_previous;
+      }
+    }
+  }
+  EXPECT_GT(turned_alone, 0) << "no width error turned the frame's own identification";
+  EXPECT_GT(kept_by_previous, 0) << "of " << turned_alone << " turned frames";
+  std::cout << kept_by_previous << " of " << turned_alone << " turned frames kept\n";
+}
+
+}  // namespace
+}  // namespace oal
