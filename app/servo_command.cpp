@@ -58,6 +58,13 @@ class FrameOutput {
       window_ = std::make_unique<ServoWindow>();
     } else if (output.save_frames && !frames_dir.empty()) {
       fs::create_directories(frames_dir);
+      // The directory shows this run only: an earlier, longer run's frames would mislead.
+      for (const fs::directory_entry& entry : fs::directory_iterator(frames_dir)) {
+        const std::string name = entry.path().filename().string();
+        if (name.rfind("iter_", 0) == 0 && entry.path().extension() == ".png") {
+          RemoveQuietly(entry.path());
+        }
+      }
       save_ = true;
     }
   }

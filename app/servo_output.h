@@ -5,7 +5,8 @@
 //   DIR/servo-error.png    translation (mm) and rotation (deg) error per iteration, estimated
 //                          and (simulation) true, against the tolerances, drawn by gnuplot
 //   DIR/frames/iter_NNNN.png  each iteration's frame with the identified lines 1-4, the
-//                          target frame and the errors (no window, output.save_frames)
+//                          target frame and the errors (no window, output.save_frames); a
+//                          run first removes the iter_*.png an earlier run left there
 // Every file is written atomically.
 #pragma once
 

@@ -210,6 +210,9 @@ TEST(ServoOutput, CommandWritesCsvPlotAndAnnotatedFrames) {
   options.out_dir = dir / "out";
   options.display = "off";
   options.mode = "point-and-go";
+  // A frame an earlier, longer run left behind is removed.
+  fs::create_directories(dir.path() / "out" / "frames");
+  test::WriteText(dir.path() / "out" / "frames" / "iter_0099.png", "stale");
   std::ostringstream out;
   const ServoRunReport report = RunServoCommand(options, out);
   ASSERT_EQ(report.status, ServoRunStatus::kConverged) << out.str();
@@ -226,6 +229,7 @@ TEST(ServoOutput, CommandWritesCsvPlotAndAnnotatedFrames) {
     EXPECT_EQ(frame.cols, 320);
     EXPECT_EQ(frame.channels(), 3);
   }
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "frames" / "iter_0099.png"));
   // Nothing temporary is left behind.
   for (const auto& entry : fs::directory_iterator(dir.path() / "out")) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
