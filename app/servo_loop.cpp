@@ -258,6 +258,139 @@ std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
   return std::make_unique<SourceCamera>(OpenImageSource(source.path));
 }
 
+// Why the loop ends, for the report.
+struct Stop {
+  ServoRunStatus status;
+  std::string message;
+};
+
+// The combinations of sections the loop cannot run, before anything moves.
+void CheckServoConfig(const ServoAppConfig& config) {
+  config.camera.Check();
+  config.robot.Check();
+  config.servo.Check();
+  config.source.Check();
+  if (config.source.type == "v4l2" && config.robot.type == "simulated") {
+    throw std::invalid_argument(
+        "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
+        "whose motion the camera would not see); to watch a camera without moving anything use "
+        "source: {type: replay, path: " +
+        config.source.device + "}");
+  }
+}
+
+// Step 1: the operator's stop, the time and the iteration limits.
+std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int iteration,
+                                 std::chrono::steady_clock::time_point start, bool interrupted) {
+  if (interrupted) {
+    return Stop{ServoRunStatus::kInterrupted,
+                "interrupted (Ctrl-C or a stop from the window) after " +
+                    std::to_string(iteration) + " iterations; robot stopped"};
+  }
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (elapsed_s > loop.max_time_s) {
+    return Stop{ServoRunStatus::kTimeLimit,
+                "time limit: " + Fixed(elapsed_s, 2) + " s > servo.max_time_s = " +
+                    Fixed(loop.max_time_s, 2) + " s without converging"};
+  }
+  if (iteration >= loop.max_iterations) {
+    return Stop{ServoRunStatus::kIterationLimit,
+                "iteration limit: servo.max_iterations = " + std::to_string(loop.max_iterations) +
+                    " frames without converging"};
+  }
+  return std::nullopt;
+}
+
+// The frame of this iteration, of the camera's size; a stop when there is none.
+std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
+                         const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) {
+  bool have_frame = false;
+  try {
+    have_frame = frames.Grab(true_cMo, iteration, gray);
+  } catch (const std::exception& error) {
+    return Stop{ServoRunStatus::kError, "cannot read the next frame at iteration " +
+                                            std::to_string(iteration) + ": " + error.what() +
+                                            "; robot stopped"};
+  }
+  if (!have_frame) {
+    return Stop{ServoRunStatus::kEndOfInput,
+                "end of " + frames.Name() + " after " + std::to_string(iteration) + " frames"};
+  }
+  if (gray->cols != camera.width || gray->rows != camera.height) {
+    return Stop{ServoRunStatus::kError, frames.Name() + " gives " + std::to_string(gray->cols) +
+                                            "x" + std::to_string(gray->rows) +
+                                            " frames but camera.width x camera.height is " +
+                                            std::to_string(camera.width) + "x" +
+                                            std::to_string(camera.height) + "; robot stopped"};
+  }
+  return std::nullopt;
+}
+
+// The table row of a camera pose: the Table 3 columns (the Scorbot's own X Y Z P R) and, in
+// simulation, the true error to the goal; the estimate's columns are filled in later.
+ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomogeneousMatrix& wMc,
+                     const vpHomogeneousMatrix& true_cMo, const vpHomogeneousMatrix& cdMo) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  ServoIteration row;
+  row.iteration = iteration;
+  if (config.robot.type == "scorbot") {
+    const AclPose acl = ToAclPose(wMc * config.camera.eMc.inverse());
+    row.x_mm = acl.x / 10.0;
+    row.y_mm = acl.y / 10.0;
+    row.z_mm = acl.z / 10.0;
+    row.pitch_deg = acl.p / 10.0;
+    row.roll_deg = acl.r / 10.0;
+  } else {
+    Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg);
+  }
+  row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
+  if (config.source.type == "simulated") {
+    const PoseDistance truth = Distance(cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
+    row.true_translation_error_mm = truth.translation_m * 1e3;
+    row.true_rotation_error_deg = vpMath::deg(truth.rotation_rad);
+  }
+  row.translation_error_mm = row.rotation_error_deg = kNaN;
+  row.status = "running";
+  return row;
+}
+
+// Steps 3 and 4: no pose, or a pose that disagrees with the odometry's prediction.
+std::optional<Stop> PoseStop(const PoseResult& pose,
+                             const std::optional<vpHomogeneousMatrix>& predicted_cMo,
+                             const ServoLoopOptions& loop, int iteration) {
+  if (pose.status != PoseStatus::kOk) {
+    return Stop{ServoRunStatus::kTargetLost,
+                "target lost at iteration " + std::to_string(iteration) + ": " +
+                    ToString(pose.status) +
+                    (pose.message.empty() ? "" : " (" + pose.message + ")") + "; robot stopped"};
+  }
+  if (!predicted_cMo) return std::nullopt;
+  const PoseDistance jump = Distance(*predicted_cMo, pose.cMo);
+  if (jump.translation_m <= loop.max_pose_jump_m &&
+      vpMath::deg(jump.rotation_rad) <= loop.max_pose_jump_deg) {
+    return std::nullopt;
+  }
+  return Stop{ServoRunStatus::kPoseJump,
+              "pose jump at iteration " + std::to_string(iteration) + ": the estimate is " +
+                  Fixed(jump.translation_m * 1e3, 1) + " mm and " +
+                  Fixed(vpMath::deg(jump.rotation_rad), 2) +
+                  " deg from the previous one moved by the robot (limits " +
+                  Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " +
+                  Fixed(loop.max_pose_jump_deg, 2) + " deg); robot stopped"};
+}
+
+// A motion the SafeRobot refused.
+Stop RefusalStop(const RobotResult& moved, const SafeRobot& robot, int iteration) {
+  const ServoRunStatus status = StatusOfRefusal(moved, robot);
+  if (status == ServoRunStatus::kInterrupted) {
+    return {status, "interrupted (Ctrl-C or a stop from the window) during the move of iteration " +
+                        std::to_string(iteration) + "; robot stopped"};
+  }
+  return {status, ToString(status) + " at iteration " + std::to_string(iteration) + ": " +
+                      moved.message + "; robot stopped"};
+}
+
 }  // namespace
 
 std::string ToString(ServoRunStatus status) {
@@ -333,24 +466,13 @@ vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
 ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
                         const ServoRunHooks& hooks) {
   // Everything checked, and the goal taught, before the robot moves.
-  config.camera.Check();
-  config.robot.Check();
-  config.servo.Check();
-  config.source.Check();
-  if (config.source.type == "v4l2" && config.robot.type == "simulated") {
-    throw std::invalid_argument(
-        "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
-        "whose motion the camera would not see); to watch a camera without moving anything use "
-        "source: {type: replay, path: " +
-        config.source.device + "}");
-  }
+  CheckServoConfig(config);
   const bool velocity_law = config.servo.law.mode == ServoMode::kVelocity;
   const LoopModel model(config);
   OalDetector detector(config.detector, model.camera);
   const PoseOptions pose_options = model.PoseOptionsFor(detector);
   const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config);
   const bool moves_robot = config.source.type != "replay";
-  const bool simulated = config.source.type == "simulated";
 
   const RobotRig rig = OpenRobot(config);
   if (velocity_law && !rig.driver->Capabilities().velocity) {
@@ -367,27 +489,28 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     log << "goal taught from " << config.goal_image << ": target at (" << Fixed(t[0], 4) << ", "
         << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
   }
-  if (!moves_robot)
+  if (!moves_robot) {
     log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
-  auto finish = [&](ServoRunStatus status, std::string message) {
-    report.status = status;
-    report.message = std::move(message);
+  }
+  auto finish = [&](Stop stop) {
+    report.status = stop.status;
+    report.message = std::move(stop.message);
     robot.Stop();
     report.robot_stopped = robot.state() == SafeRobotState::kStopped;
     if (const RobotPose where = robot.GetPosition(RobotFrame::kCamera); where.result.ok()) {
       report.final_wMc = where.pose;
     }
     report.link_summary = LinkSummary(*rig.driver, config.robot.scorbot.baud, report.moves);
-    if (!report.iterations.empty()) report.iterations.back().status = ToString(status);
+    if (!report.iterations.empty()) report.iterations.back().status = ToString(stop.status);
     return report;
   };
 
   if (RobotResult r = robot.Connect(); !r.ok()) {
-    return finish(ServoRunStatus::kError, "cannot connect the robot: " + r.message);
+    return finish({ServoRunStatus::kError, "cannot connect the robot: " + r.message});
   }
   StopGuard guard(robot, hooks);
   if (RobotResult r = robot.Enable(); !r.ok()) {
-    return finish(ServoRunStatus::kError, "cannot enable the robot: " + r.message);
+    return finish({ServoRunStatus::kError, "cannot enable the robot: " + r.message});
   }
 
   const ServoLoopOptions& loop = config.servo;
@@ -396,91 +519,35 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   vpHomogeneousMatrix previous_wMc;
   cv::Mat gray;
   std::vector<LineSeed> seeds;
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   log << "iter     X mm     Y mm     Z mm    pitch     roll   err mm   err deg  status\n";
   for (int iteration = 0;; ++iteration) {
-    if ((hooks.interrupt != nullptr && hooks.interrupt->load()) || robot.EmergencyStopRequested()) {
-      robot.RequestEmergencyStop();
-      return finish(ServoRunStatus::kInterrupted,
-                    "interrupted (Ctrl-C or a stop from the window) after " +
-                        std::to_string(iteration) + " iterations; robot stopped");
-    }
-    const double elapsed_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (elapsed_s > loop.max_time_s) {
-      return finish(ServoRunStatus::kTimeLimit,
-                    "time limit: " + Fixed(elapsed_s, 2) + " s > servo.max_time_s = " +
-                        Fixed(loop.max_time_s, 2) + " s without converging");
-    }
-    if (iteration >= loop.max_iterations) {
-      return finish(ServoRunStatus::kIterationLimit, "iteration limit: servo.max_iterations = " +
-                                                         std::to_string(loop.max_iterations) +
-                                                         " frames without converging");
+    const bool interrupted =
+        (hooks.interrupt != nullptr && hooks.interrupt->load()) || robot.EmergencyStopRequested();
+    if (interrupted) robot.RequestEmergencyStop();
+    if (std::optional<Stop> stop = LimitReached(loop, iteration, start, interrupted)) {
+      return finish(*stop);
     }
 
     const RobotPose read = robot.GetPosition(RobotFrame::kCamera);
     if (!read.result.ok()) {
-      return finish(ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message);
+      return finish(
+          {ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message});
     }
     const vpHomogeneousMatrix wMc = read.pose;
     const vpHomogeneousMatrix true_cMo = wMc.inverse() * config.target_wMo;
-
-    ServoIteration row;
-    row.iteration = iteration;
-    if (config.robot.type == "scorbot") {
-      // The controller's own columns: the TCP's X, Y, Z and the tool's P, R (ACL).
-      const AclPose acl = ToAclPose(wMc * config.camera.eMc.inverse());
-      row.x_mm = acl.x / 10.0;
-      row.y_mm = acl.y / 10.0;
-      row.z_mm = acl.z / 10.0;
-      row.pitch_deg = acl.p / 10.0;
-      row.roll_deg = acl.r / 10.0;
-    } else {
-      Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg);
-    }
-    row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
-    if (simulated) {
-      const PoseDistance truth = Distance(report.cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
-      row.true_translation_error_mm = truth.translation_m * 1e3;
-      row.true_rotation_error_deg = vpMath::deg(truth.rotation_rad);
-    }
-    row.translation_error_mm = row.rotation_error_deg = kNaN;
-    row.status = "running";
-
-    std::string source_error;
-    bool have_frame = false;
-    try {
-      have_frame = frames->Grab(true_cMo, iteration, &gray);
-    } catch (const std::exception& error) {
-      source_error = error.what();
-    }
-    if (!source_error.empty()) {
-      return finish(ServoRunStatus::kError, "cannot read the next frame at iteration " +
-                                                std::to_string(iteration) + ": " + source_error +
-                                                "; robot stopped");
-    }
-    if (!have_frame) {
-      return finish(ServoRunStatus::kEndOfInput,
-                    "end of " + frames->Name() + " after " + std::to_string(iteration) + " frames");
-    }
-    if (gray.cols != config.camera.width || gray.rows != config.camera.height) {
-      return finish(ServoRunStatus::kError,
-                    frames->Name() + " gives " + std::to_string(gray.cols) + "x" +
-                        std::to_string(gray.rows) + " frames but camera.width x camera.height is " +
-                        std::to_string(config.camera.width) + "x" +
-                        std::to_string(config.camera.height) + "; robot stopped");
+    if (std::optional<Stop> stop = Grab(*frames, config.camera, true_cMo, iteration, &gray)) {
+      return finish(*stop);
     }
     if (hooks.on_grab) hooks.on_grab(iteration, &gray);
-    report.iterations.push_back(row);
+    report.iterations.push_back(RowAt(config, iteration, wMc, true_cMo, report.cdMo));
     ServoIteration& current = report.iterations.back();
 
-    // The target's lines where the robot's motion since the last estimate puts them seed the
-    // accumulator list: a line seen at a grazing place (an image corner) keeps its entry
-    // instead of being culled before it gathers its votes.
-    if (previous_cMo) {
-      seeds =
-          PredictedSeeds(config.target, wMc.inverse() * previous_wMc * *previous_cMo, model.camera);
-    }
+    // Where the robot's motion since the last estimate puts the target.
+    std::optional<vpHomogeneousMatrix> predicted_cMo;
+    if (previous_cMo) predicted_cMo = wMc.inverse() * previous_wMc * *previous_cMo;
+    // Its lines seed the accumulator list: a line seen at a grazing place (an image corner)
+    // keeps its entry instead of being culled before it gathers its votes.
+    if (predicted_cMo) seeds = PredictedSeeds(config.target, *predicted_cMo, model.camera);
     const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray), seeds);
     const PoseResult pose = EstimatePose(lines, config.target, pose_options, previous_cMo);
     std::optional<ServoStep> step;
@@ -493,58 +560,25 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (hooks.on_frame) {
       hooks.on_frame(ServoFrame{gray, lines, pose, current, model.camera, detector.Undistorts()});
     }
-    if (pose.status != PoseStatus::kOk) {
-      current.status = ToString(ServoRunStatus::kTargetLost);
-      LogRow(current, log);
-      return finish(
-          ServoRunStatus::kTargetLost,
-          "target lost at iteration " + std::to_string(iteration) + ": " + ToString(pose.status) +
-              (pose.message.empty() ? "" : " (" + pose.message + ")") + "; robot stopped");
-    }
-    if (previous_cMo) {
-      const vpHomogeneousMatrix predicted = wMc.inverse() * previous_wMc * *previous_cMo;
-      const PoseDistance jump = Distance(predicted, pose.cMo);
-      if (jump.translation_m > loop.max_pose_jump_m ||
-          vpMath::deg(jump.rotation_rad) > loop.max_pose_jump_deg) {
-        current.status = ToString(ServoRunStatus::kPoseJump);
-        LogRow(current, log);
-        return finish(ServoRunStatus::kPoseJump,
-                      "pose jump at iteration " + std::to_string(iteration) + ": the estimate is " +
-                          Fixed(jump.translation_m * 1e3, 1) + " mm and " +
-                          Fixed(vpMath::deg(jump.rotation_rad), 2) +
-                          " deg from the previous one moved by the robot (limits " +
-                          Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " +
-                          Fixed(loop.max_pose_jump_deg, 2) + " deg); robot stopped");
-      }
-    }
+    std::optional<Stop> stop = PoseStop(pose, predicted_cMo, loop, iteration);
+    if (stop) current.status = ToString(stop->status);
+    LogRow(current, log);
+    if (stop) return finish(*stop);
     previous_cMo = pose.cMo;
     previous_wMc = wMc;
-    LogRow(current, log);
     if (step->status == ServoStatus::kConverged) {
-      return finish(ServoRunStatus::kConverged,
-                    "converged in " + std::to_string(iteration) + " moves: estimated error " +
-                        Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
-                        Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg");
+      return finish({ServoRunStatus::kConverged,
+                     "converged in " + std::to_string(iteration) + " moves: estimated error " +
+                         Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
+                         Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"});
     }
     if (!moves_robot) continue;
 
-    RobotResult moved;
-    if (velocity_law) {
-      moved = robot.SetVelocity(RobotFrame::kCamera, step->twist).result;
-    } else {
-      moved = robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew).result;
-    }
+    const RobotResult moved =
+        velocity_law ? robot.SetVelocity(RobotFrame::kCamera, step->twist).result
+                     : robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew).result;
     ++report.moves;
-    if (!moved.ok()) {
-      const ServoRunStatus status = StatusOfRefusal(moved, robot);
-      if (status == ServoRunStatus::kInterrupted) {
-        return finish(
-            status, "interrupted (Ctrl-C or a stop from the window) during the move of iteration " +
-                        std::to_string(iteration) + "; robot stopped");
-      }
-      return finish(status, ToString(status) + " at iteration " + std::to_string(iteration) + ": " +
-                                moved.message + "; robot stopped");
-    }
+    if (!moved.ok()) return finish(RefusalStop(moved, robot, iteration));
   }
 }
 
