@@ -3,10 +3,12 @@
 #include "servo/pose.h"
 
 #include <visp3/core/vpException.h>
+#include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpPoint.h>
 #include <visp3/core/vpRzyxVector.h>
 #include <visp3/vision/vpPose.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -139,6 +141,7 @@ struct Corners {
   const HashTarget& hash;
   const PoseOptions& options;
 
+  // `pose` may be null: the corners only (the previous-pose path refines without vpPose).
   void Set(const vpHomogeneousMatrix* seen_from, PoseResult* result, vpPose* pose) const {
     const bool any_stripe = is_stripe[0] || is_stripe[1] || is_stripe[2] || is_stripe[3];
     std::array<Point2d, 4> shift{};
@@ -146,7 +149,7 @@ struct Corners {
         !StripeCentreShifts(*seen_from, hash, options.camera, is_stripe, &shift)) {
       shift = {};
     }
-    pose->clearPoint();
+    if (pose != nullptr) pose->clearPoint();
     for (int k = 0; k < 4; ++k) {
       result->corners_px[k] = Point2d{measured_px[k].u + shift[k].u, measured_px[k].v + shift[k].v};
       double x = 0.0, y = 0.0;
@@ -155,6 +158,7 @@ struct Corners {
       result->corners_m[k].resize(2, false);
       result->corners_m[k][0] = x;
       result->corners_m[k][1] = y;
+      if (pose == nullptr) continue;
       vpPoint point(hash.corner[k].x, hash.corner[k].y, 0.0);
       point.set_x(x);
       point.set_y(y);
@@ -162,6 +166,43 @@ struct Corners {
     }
   }
 };
+
+// Gauss-Newton refinement of cMo on the four corners, the model of vpPose::VIRTUAL_VS (same
+// reprojection error in normalised coordinates, same camera-frame update
+// cMo <- exp(v)^-1 · cMo), on fixed-size matrices: the previous-pose path runs it on every
+// frame of a loop, where vpPose's per-iteration allocations cost more than the arithmetic.
+// False when a corner falls behind the camera or the normal equations are singular.
+bool RefineOnCorners(const HashTarget& hash, const std::array<vpColVector, 4>& corners_m,
+                     vpHomogeneousMatrix* cMo) {
+  constexpr int kMaxIterations = 20;
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    Eigen::Matrix<double, 8, 6> L;
+    Eigen::Matrix<double, 8, 1> e;
+    const vpHomogeneousMatrix& M = *cMo;
+    for (int k = 0; k < 4; ++k) {
+      const double X = hash.corner[k].x, Y = hash.corner[k].y;
+      const double xc = M[0][0] * X + M[0][1] * Y + M[0][3];
+      const double yc = M[1][0] * X + M[1][1] * Y + M[1][3];
+      const double zc = M[2][0] * X + M[2][1] * Y + M[2][3];
+      if (!(zc > 0.0)) return false;
+      const double x = xc / zc, y = yc / zc, iz = 1.0 / zc;
+      e(2 * k) = x - corners_m[k][0];
+      e(2 * k + 1) = y - corners_m[k][1];
+      L.row(2 * k) << -iz, 0.0, x * iz, x * y, -(1.0 + x * x), y;
+      L.row(2 * k + 1) << 0.0, -iz, y * iz, 1.0 + y * y, -x * y, -x;
+    }
+    const Eigen::Matrix<double, 6, 6> normal = L.transpose() * L;
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
+    if (solver.info() != Eigen::Success) return false;
+    const Eigen::Matrix<double, 6, 1> v = -solver.solve(L.transpose() * e);
+    if (!v.allFinite()) return false;
+    vpColVector twist(6);
+    for (int i = 0; i < 6; ++i) twist[i] = v(i);
+    *cMo = vpExponentialMap::direct(twist).inverse() * *cMo;
+    if (v.norm() < 1e-12) break;
+  }
+  return IsFinite(*cMo);
+}
 
 PoseResult Fail(PoseResult result, const std::string& message) {
   result.status = PoseStatus::kDegenerate;
@@ -199,8 +240,8 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
   // well (previous_accept_px), and the linear methods are skipped.
   if (have_previous && options.previous_accept_px > 0.0) {
     vpHomogeneousMatrix seeded = *previous_cMo;
-    corners.Set(&seeded, &result, &pose);
-    if (Compute(&pose, vpPose::VIRTUAL_VS, &seeded)) {
+    corners.Set(&seeded, &result, nullptr);
+    if (RefineOnCorners(hash, result.corners_m, &seeded)) {
       const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
       if (seeded_px < options.previous_accept_px) {
         cMo = seeded;
@@ -258,6 +299,8 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
   }
   vpMatrix covariance;
   if (options.compute_covariance && std::isfinite(residual_px)) {
+    // The previous-pose path refined without vpPose: give it the same corners.
+    if (result.method == PoseMethod::kPrevious) corners.Set(&*previous_cMo, &result, &pose);
     // From the converged pose the refinement stops after an iteration or two.
     pose.setCovarianceComputation(true);
     vpHomogeneousMatrix refined = cMo;

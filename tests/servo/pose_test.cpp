@@ -635,3 +635,37 @@ TEST(EstimatePose, APreviousPoseKeepsLines1To4FromTurningOnABadWidth) {
 
 }  // namespace
 }  // namespace oal
+
+namespace oal {
+namespace {
+
+// The previous-pose path refines on the corners with its own fixed-size Gauss-Newton
+// (pose.cpp, RefineOnCorners): it must end where vpPose's virtual visual servoing ends, up to
+// the stripe-centre shifts, which it takes from the previous pose instead of the linear one
+// (micrometres; the pose's accuracy is a tenth of a millimetre).
+TEST(EstimatePose, ThePreviousPosePathEndsWhereVpPoseEnds) {
+  const RenderOptions render = SmallRender(false);
+  const SceneRenderer renderer(FourLineTarget(), render);
+  const PoseOptions options = OptionsFor(render);
+  std::mt19937 rng(13);
+  for (int pose = 0; pose < 8; ++pose) {
+    const vpHomogeneousMatrix cMo = PoseAt(0.45 + 0.05 * pose, 45.0 * pose, 25.0, 10.0 * pose);
+    const std::vector<DetectedLine> lines =
+        SyntheticLines(renderer.Truth(cMo), {0, 1, 2, 3}, render.camera, &rng);
+    const PoseResult alone = EstimatePose(lines, FourLineTarget(), options);
+    ASSERT_EQ(alone.status, PoseStatus::kOk) << alone.message;
+    // A previous pose 5 mm and 1 deg away, as in a loop.
+    const vpHomogeneousMatrix previous =
+        vpHomogeneousMatrix(0.005, 0.0, 0.0, 0.0, 0.017, 0.0) * cMo;
+    const PoseResult tracked = EstimatePose(lines, FourLineTarget(), options, previous);
+    ASSERT_EQ(tracked.status, PoseStatus::kOk) << tracked.message;
+    EXPECT_EQ(tracked.method, PoseMethod::kPrevious) << "pose " << pose;
+    const vpHomogeneousMatrix between = alone.cMo.inverse() * tracked.cMo;
+    EXPECT_LT(between.getTranslationVector().frobeniusNorm(), 2e-5) << "pose " << pose;
+    EXPECT_LT(RotationErrorDeg(alone.cMo, tracked.cMo), 0.01) << "pose " << pose;
+    EXPECT_NEAR(tracked.residual_px, alone.residual_px, 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace oal
