@@ -485,14 +485,26 @@ std::string ScorbotControllerSim::ListPoint(const std::string& name, const Point
   return s.str();
 }
 
+ScorbotControllerSim::Point* ScorbotControllerSim::PointWithValues(const std::string& name) {
+  auto it = points_.find(name);
+  if (it == points_.end()) {
+    Emit("*** POSITION " + name + " NOT DEFINED\r\n");
+    return nullptr;
+  }
+  if (!it->second.has_values) {
+    Emit("*** POSITION " + name + " HAS NO VALUES\r\n");
+    return nullptr;
+  }
+  return &it->second;
+}
+
 void ScorbotControllerSim::CmdSetpvc(const std::string& args) {
   const std::vector<std::string> w = Split(args);
   if (w.size() != 3) {
     Emit("312 BAD POINT COORDINATE\r\n");
     return;
   }
-  auto it = points_.find(w[0]);
-  if (it == points_.end()) {
+  if (points_.count(w[0]) == 0) {
     Emit("*** POSITION " + w[0] + " NOT DEFINED\r\n");
     return;
   }
@@ -502,11 +514,9 @@ void ScorbotControllerSim::CmdSetpvc(const std::string& args) {
     Emit("312 BAD POINT COORDINATE\r\n");
     return;
   }
-  Point& p = it->second;
-  if (!p.has_values) {
-    Emit("*** POSITION " + w[0] + " HAS NO VALUES\r\n");
-    return;
-  }
+  Point* point = PointWithValues(w[0]);
+  if (point == nullptr) return;
+  Point& p = *point;
   if (!p.cartesian) {
     p.pose = AclPoseOfJoints(options_.geometry, FromCounts(options_.geometry, p.counts));
     p.cartesian = true;
@@ -523,16 +533,9 @@ void ScorbotControllerSim::CmdSetpv(const std::string& args) {
     Emit("312 BAD POINT COORDINATE\r\n");
     return;
   }
-  auto it = points_.find(w[0]);
-  if (it == points_.end()) {
-    Emit("*** POSITION " + w[0] + " NOT DEFINED\r\n");
-    return;
-  }
-  Point& p = it->second;
-  if (!p.has_values) {
-    Emit("*** POSITION " + w[0] + " HAS NO VALUES\r\n");
-    return;
-  }
+  Point* point = PointWithValues(w[0]);
+  if (point == nullptr) return;
+  Point& p = *point;
   if (p.cartesian) {
     const ScorbotIk ik = InverseKinematics(options_.geometry, FromAclPose(p.pose), 1e-3);
     if (!ik.ok && ik.axis == 0) {
@@ -553,15 +556,8 @@ void ScorbotControllerSim::CmdMove(const std::string& args, bool /*linear*/) {
     Emit("*** INVALID COMMAND\r\n");
     return;
   }
-  auto it = points_.find(w[0]);
-  if (it == points_.end()) {
-    Emit("*** POSITION " + w[0] + " NOT DEFINED\r\n");
-    return;
-  }
-  if (!it->second.has_values) {
-    Emit("*** POSITION " + w[0] + " HAS NO VALUES\r\n");
-    return;
-  }
+  const Point* point = PointWithValues(w[0]);
+  if (point == nullptr) return;
   if (!control_) {
     Emit("*** CONTROL DISABLED\r\n");
     return;
@@ -573,7 +569,7 @@ void ScorbotControllerSim::CmdMove(const std::string& args, bool /*linear*/) {
   }
   ScorbotJoints q{};
   std::string error;
-  if (!PointJoints(it->second, &q, &error)) {
+  if (!PointJoints(*point, &q, &error)) {
     Emit(error + "\r\n");
     return;
   }
@@ -630,12 +626,8 @@ void ScorbotControllerSim::Execute(const std::string& raw) {
       p.has_values = true;
       p.counts = ToCounts(options_.geometry, CurrentJoints());
       Emit(ListPoint("POSITION", p));
-    } else if (auto it = points_.find(w[1]); it == points_.end()) {
-      Emit("*** POSITION " + w[1] + " NOT DEFINED\r\n");
-    } else if (!it->second.has_values) {
-      Emit("*** POSITION " + w[1] + " HAS NO VALUES\r\n");
-    } else {
-      Emit(ListPoint(w[1], it->second));
+    } else if (const Point* point = PointWithValues(w[1])) {
+      Emit(ListPoint(w[1], *point));
     }
   } else if (cmd == "MOVE" || cmd == "MOVEL" || cmd == "MOVED") {
     CmdMove(args, cmd == "MOVEL");

@@ -165,6 +165,8 @@ class ScorbotControllerSim {
   ScorbotJoints CurrentJoints() const;
   std::string ListPoint(const std::string& name, const Point& p) const;
   bool PointJoints(const Point& p, ScorbotJoints* q, std::string* error) const;
+  // The point `name`, or null after emitting why not (not defined, no values).
+  Point* PointWithValues(const std::string& name);
   void CmdMove(const std::string& arg, bool linear);
   void CmdSetpvc(const std::string& args);
   void CmdSetpv(const std::string& args);
