@@ -101,7 +101,7 @@ struct RobotCapabilities {
 };
 
 /// The driver interface (see the contract above). Implementations: SimulatedCamera; the
-/// Scorbot ER-VII driver (issue 6).
+/// ScorbotRobot (scorbot_robot.h), the Scorbot ER-VII over ACL.
 class Robot {
  public:
   virtual ~Robot() = default;
