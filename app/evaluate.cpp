@@ -994,7 +994,12 @@ class InputEvaluation {
     if (camera_) {
       pose_options.image_width = w;
       pose_options.image_height = h;
-      out.pose = EstimatePose(out.held, run_.config.target, pose_options, *previous_cMo);
+      // The previous frame's pose, or after frames without one the last trusted pose of at
+      // most kJumpFrames before: it holds the identity of lines 1-4 (PoseOptions::
+      // previous_max_deg) across a frame where the target was not identified.
+      std::optional<vpHomogeneousMatrix> seed = *previous_cMo;
+      if (!seed && trusted_ && frame.index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
+      out.pose = EstimatePose(out.held, run_.config.target, pose_options, seed);
       // Only a trusted pose (ok, no jump) seeds the next frame's and is the reference for
       // the next jumps: a pose turned by 180 degrees must not seed the next frame's.
       previous_cMo->reset();
