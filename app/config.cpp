@@ -259,44 +259,36 @@ TargetLine ReadTargetLine(const Value& value) {
     value.Fail("'" + value.key + "' must be a map {from: [x, y], to: [x, y], width: w}, got '" +
                value.Text() + "'");
   }
-  std::optional<PointValue> from, to;
-  std::optional<double> width;
-  std::map<std::string, int> seen;
-  for (const auto& entry : value.node) {
-    const std::string key = entry.first.Scalar();
-    const std::string full_key = value.key + "." + key;
-    const auto [first, inserted] = seen.emplace(key, entry.first.Mark().line + 1);
-    if (!inserted) {
-      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
-                               "' is repeated (first at line " + std::to_string(first->second) +
-                               ")");
-    }
-    const Value item{entry.second, value.file, full_key};
-    if (key == "from") {
-      from = ReadPoint(item);
-    } else if (key == "to") {
-      to = ReadPoint(item);
-    } else if (key == "width") {
-      width = item.FiniteDouble();
-      if (*width <= 0.0) {
-        item.Fail("'" + full_key + "' must be > 0 (metres), got '" + item.Text() + "'");
-      }
-    } else {
-      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
-                               "' is unknown (known: from, to, width)");
-    }
-  }
-  for (const auto& [key, present] : {std::pair<const char*, bool>{"from", from.has_value()},
-                                     {"to", to.has_value()},
-                                     {"width", width.has_value()}}) {
-    if (!present)
+  struct Parts {
+    std::optional<PointValue> from, to;
+    std::optional<double> width;
+  };
+  static const std::vector<Field<Parts>> fields = {
+      {"from", [](const Value& item, Parts* parts) { parts->from = ReadPoint(item); }},
+      {"to", [](const Value& item, Parts* parts) { parts->to = ReadPoint(item); }},
+      {"width",
+       [](const Value& item, Parts* parts) {
+         parts->width = item.FiniteDouble();
+         if (*parts->width <= 0.0) {
+           item.Fail("'" + item.key + "' must be > 0 (metres), got '" + item.Text() + "'");
+         }
+       }},
+  };
+  Parts parts;
+  Lines lines;
+  ReadFields(value.node, value.file, value.key, fields, "", &parts, &lines);
+  for (const char* key : {"from", "to", "width"}) {
+    if (lines.count(key) == 0) {
       value.Fail("'" + value.key + "' has no '" + key + "' (a line needs from, to, width)");
+    }
   }
-  if (from->x == to->x && from->y == to->y) {
-    value.Fail("'" + value.key + "' has from == to = [" + Number(from->x) + ", " + Number(from->y) +
+  const PointValue& from = *parts.from;
+  const PointValue& to = *parts.to;
+  if (from.x == to.x && from.y == to.y) {
+    value.Fail("'" + value.key + "' has from == to = [" + Number(from.x) + ", " + Number(from.y) +
                "]: a line needs two different ends");
   }
-  return TargetLine{from->x, from->y, to->x, to->y, *width};
+  return TargetLine{from.x, from.y, to.x, to.y, *parts.width};
 }
 
 const std::vector<Field<LineTarget>>& TargetFields() {
@@ -456,27 +448,20 @@ vpHomogeneousMatrix ReadPose(const Value& value) {
                "' must be a pose {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]}, got '" +
                value.Text() + "'");
   }
-  std::array<double, 3> t{}, r{};
-  std::map<std::string, int> seen;
-  for (const auto& entry : value.node) {
-    const std::string key = entry.first.Scalar();
-    const std::string full_key = value.key + "." + key;
-    const auto [first, inserted] = seen.emplace(key, entry.first.Mark().line + 1);
-    if (!inserted) {
-      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
-                               "' is repeated (first at line " + std::to_string(first->second) +
-                               ")");
-    }
-    const Value item{entry.second, value.file, full_key};
-    if (key == "translation_m") {
-      t = ReadVector3(item, "metres");
-    } else if (key == "rxyz_deg") {
-      r = ReadVector3(item, "degrees");
-    } else {
-      throw std::runtime_error(At(value.file, entry.first) + ": key '" + full_key +
-                               "' is unknown (known: translation_m, rxyz_deg)");
-    }
-  }
+  struct Parts {
+    std::array<double, 3> t{}, r{};
+  };
+  static const std::vector<Field<Parts>> fields = {
+      {"translation_m",
+       [](const Value& item, Parts* parts) { parts->t = ReadVector3(item, "metres"); }},
+      {"rxyz_deg",
+       [](const Value& item, Parts* parts) { parts->r = ReadVector3(item, "degrees"); }},
+  };
+  Parts parts;
+  Lines lines;
+  ReadFields(value.node, value.file, value.key, fields, "", &parts, &lines);
+  const std::array<double, 3>& t = parts.t;
+  const std::array<double, 3>& r = parts.r;
   const vpRxyzVector rxyz(vpMath::rad(r[0]), vpMath::rad(r[1]), vpMath::rad(r[2]));
   return vpHomogeneousMatrix(vpTranslationVector(t[0], t[1], t[2]), vpRotationMatrix(rxyz));
 }
