@@ -865,16 +865,14 @@ class InputEvaluation {
     Joined writer(std::thread(WriteFrames, &tracked, video ? &*video : nullptr,
                               static_cast<std::size_t>(run_.options.thumbnails), std::cref(camera_),
                               std::cref(undistorted_by_), &writer_result));
-    std::optional<vpHomogeneousMatrix> previous_cMo;
     std::vector<double> track_us, pose_us;
     try {
       while (std::optional<DecodedFrame> frame = decoded.Pop()) {
         if (!frame->error.empty()) {
           Unreadable(*frame, frames_file.stream(), timing_file.stream());
         } else {
-          TrackedFrame out =
-              Process(*frame, &tracker, pose_options, &previous_cMo, frames_file.stream(),
-                      timing_file.stream(), &track_us, &pose_us);
+          TrackedFrame out = Process(*frame, &tracker, pose_options, frames_file.stream(),
+                                     timing_file.stream(), &track_us, &pose_us);
           if (!tracked.Push(std::move(out))) break;  // the writer failed
         }
         if (on_frame) on_frame();
@@ -956,8 +954,7 @@ class InputEvaluation {
   }
 
   TrackedFrame Process(DecodedFrame& frame, OalLineTracker* tracker, PoseOptions pose_options,
-                       std::optional<vpHomogeneousMatrix>* previous_cMo, std::ostream& frames,
-                       std::ostream& timing, std::vector<double>* track_times,
+                       std::ostream& frames, std::ostream& timing, std::vector<double>* track_times,
                        std::vector<double>* pose_times) {
     const int w = frame.gray.cols, h = frame.gray.rows;
     if (tally_.readable == 0) tally_.width = w, tally_.height = h;
@@ -994,15 +991,13 @@ class InputEvaluation {
     if (camera_) {
       pose_options.image_width = w;
       pose_options.image_height = h;
-      // The previous frame's pose, or after frames without one the last trusted pose of at
-      // most kJumpFrames before: it holds the identity of lines 1-4 (PoseOptions::
-      // previous_max_deg) across a frame where the target was not identified.
-      std::optional<vpHomogeneousMatrix> seed = *previous_cMo;
-      if (!seed && trusted_ && frame.index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
+      // The last trusted pose (ok, no jump) of at most kJumpFrames before seeds the pose: the
+      // previous frame's, or across frames without one the one before them; it holds the
+      // identity of lines 1-4 (PoseOptions::previous_max_deg). A pose turned by 180 degrees
+      // never becomes the seed.
+      std::optional<vpHomogeneousMatrix> seed;
+      if (trusted_ && frame.index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
       out.pose = EstimatePose(out.held, run_.config.target, pose_options, seed);
-      // Only a trusted pose (ok, no jump) seeds the next frame's and is the reference for
-      // the next jumps: a pose turned by 180 degrees must not seed the next frame's.
-      previous_cMo->reset();
       if (out.pose->status == PoseStatus::kOk) {
         const std::array<int, 4> identified = IdentifiedTracks(*out.pose, out.ids);
         jump = JumpFrom(trusted_, frame.index, out.pose->cMo, identified);
@@ -1011,7 +1006,6 @@ class InputEvaluation {
           if (tally_.jump_frames.size() < kListedJumps) tally_.jump_frames.push_back(frame.index);
         } else {
           trusted_ = TrustedPose{frame.index, out.pose->cMo, identified};
-          *previous_cMo = out.pose->cMo;
         }
       }
       pose_json = PoseFrameJson(*out.pose, out.ids, jump);

@@ -314,7 +314,9 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
           for (int j = 0; j < 2; ++j)
             a.corners[corner_of(target_g[i], target_h[j])] = Point2d{q[i][j].x, q[i][j].y};
         a.cost = Cost(h, a.line_index);
-        a.previous_angle_deg = previous_cRo_ != nullptr ? PreviousAngleDeg(h) : 180.0;
+        a.previous_angle_deg = previous_cRo_ != nullptr && options_.previous_max_deg > 0.0
+                                   ? PreviousAngleDeg(h)
+                                   : 180.0;
       }
     }
   }
