@@ -294,6 +294,27 @@ TEST(ServoAccuracy, EveryLawConvergesFromRandomStarts) {
   }
 }
 
+TEST(ServoAccuracy, BadOptionsNameTheField) {
+  const ServoAppConfig config = Small(DefaultServoConfig());
+  const auto error = [&](ServoAccuracyOptions options) {
+    try {
+      SampleServoStarts(config, options);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  ServoAccuracyOptions options;
+  options.starts = 0;
+  EXPECT_THAT(error(options), HasSubstr("ServoAccuracyOptions::starts = 0"));
+  options = ServoAccuracyOptions();
+  options.max_distance_m = 0.2;  // below min_distance_m = 0.3
+  EXPECT_THAT(error(options), HasSubstr("ServoAccuracyOptions::max_distance_m = 0.2"));
+  options = ServoAccuracyOptions();
+  options.modes.clear();
+  EXPECT_THAT(error(options), HasSubstr("ServoAccuracyOptions::modes is empty"));
+}
+
 TEST(ServoLoopTable3, PointAndGoReachesTheGoalWithinThreeMoves) {
   ServoAppConfig config = test::ShippedServoConfig("table3-sim.yaml");
   config.servo.law.mode = ServoMode::kPointAndGo;
