@@ -29,6 +29,16 @@ void RotateSmall(double a, double* c, double* s) {
   *s = new_s * norm;
 }
 
+// Turns the normal half a turn (theta +- pi, -rho) when it points below the u axis, so that
+// theta stays in [0, pi): sin > 0, or sin = 0 and cos > 0.
+void KeepUpperHalf(double* cos_theta, double* sin_theta, double* rho_px) {
+  if (*sin_theta < 0.0 || (*sin_theta == 0.0 && *cos_theta < 0.0)) {
+    *cos_theta = -*cos_theta;
+    *sin_theta = -*sin_theta;
+    *rho_px = -*rho_px;
+  }
+}
+
 // FirstMatch tests kMatchLanes entries per vector, two vectors per loop iteration; the
 // match arrays are padded to whole iterations.
 constexpr int kMatchLanes = 4;                // one 16-byte SIMD register of floats
@@ -144,6 +154,13 @@ int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, doubl
 }
 #endif
 
+LineParams OalEntry::Line() const {
+  // atan2 is in [0, pi] for the upper half-plane; pi itself (sin = +0, cos < 0) is the
+  // same line as theta 0.
+  const double theta = std::atan2(sin_theta, cos_theta);
+  return theta < kPi ? LineParams{rho_px, std::max(theta, 0.0)} : LineParams{-rho_px, 0.0};
+}
+
 int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_px, int border) {
   const int size = static_cast<int>(entries_.size());
   const int i = FirstMatch(cos_theta, sin_theta, rho_px);
@@ -155,16 +172,10 @@ int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_
     const double c = sign * cos_theta, s = sign * sin_theta;
     const double cross = entry.cos_theta * s - entry.sin_theta * c;  // sin(theta_new - theta_old)
     const double prior = static_cast<double>(entry.weight);
-    const double step = SmallAsin(cross) / (prior + 1.0);
-    entry.theta_rad += step;
-    RotateSmall(step, &entry.cos_theta, &entry.sin_theta);
+    // theta moves to the vote-weighted mean of the angles: the normal turns by that step.
+    RotateSmall(SmallAsin(cross) / (prior + 1.0), &entry.cos_theta, &entry.sin_theta);
     entry.rho_px = (prior * entry.rho_px + rho) / (prior + 1.0);
-    if (entry.theta_rad < 0.0 || entry.theta_rad >= kPi) {  // keep theta in [0, pi)
-      entry.theta_rad += entry.theta_rad < 0.0 ? kPi : -kPi;
-      entry.rho_px = -entry.rho_px;
-      entry.cos_theta = -entry.cos_theta;
-      entry.sin_theta = -entry.sin_theta;
-    }
+    KeepUpperHalf(&entry.cos_theta, &entry.sin_theta, &entry.rho_px);
     ++entry.weight;
     if (entry.last_border != border) {
       ++entry.borders;
@@ -188,19 +199,13 @@ int OrderedAccumulatorList::Seed(double cos_theta, double sin_theta, double rho_
 }
 
 OalEntry& OrderedAccumulatorList::Append(double cos_theta, double sin_theta, double rho_px) {
-  if (sin_theta < 0.0 || (sin_theta == 0.0 && cos_theta < 0.0)) {
-    cos_theta = -cos_theta;
-    sin_theta = -sin_theta;
-    rho_px = -rho_px;
-  }
+  KeepUpperHalf(&cos_theta, &sin_theta, &rho_px);
   // Built in place: a local entry copied in was written field by field and read back in
   // wider moves, which stalled on store forwarding.
   entries_.emplace_back();
   OalEntry& entry = entries_.back();
   entry.cos_theta = cos_theta;
   entry.sin_theta = sin_theta;
-  entry.theta_rad = std::atan2(sin_theta, cos_theta);
-  if (entry.theta_rad >= kPi) entry.theta_rad = 0.0;
   entry.rho_px = rho_px;
   Mirror(entries_.size() - 1);
   return entry;

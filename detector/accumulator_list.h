@@ -1,9 +1,10 @@
 // Steps 3 to 5 of the paper: the ordered accumulator list (OAL).
 //
-// Inside the list a line is kept with rho measured from an origin the caller chooses (the
-// detector uses the image centre, so that `rchange` means the same at every angle), theta
-// in [0, pi), and its unit normal (cos theta, sin theta) so that matching needs no
-// trigonometry.
+// Inside the list a line is kept as its unit normal (cos theta, sin theta), theta in
+// [0, pi), and rho measured from an origin the caller chooses (the detector uses the image
+// centre, so that `rchange` means the same at every angle). Matching and averaging work on
+// the normal, so the list needs no trigonometry; theta itself is computed only when a line
+// is read off (Line()).
 #pragma once
 
 #include <algorithm>
@@ -15,7 +16,6 @@ namespace oal {
 
 struct OalEntry {
   double rho_px = 0.0;
-  double theta_rad = 0.0;
   double cos_theta = 1.0;
   double sin_theta = 0.0;
   int weight = 1;   ///< votes (paper: "weighting")
@@ -24,7 +24,8 @@ struct OalEntry {
   int last_border = -1;
   int seed_id = -1;  ///< id of the tracked line that seeded the entry, or -1 (Seed())
 
-  LineParams Line() const { return LineParams{rho_px, theta_rad}; }
+  /// The line (rho from the list's origin, theta in [0, pi)).
+  LineParams Line() const;
   /// Ordering measure of Eq. 3.
   double Score() const { return weight - 0.5 * count; }
   /// 2 * Score(), exactly, as an integer sort key.

@@ -51,15 +51,15 @@ std::uint8_t BorderRect::Sides(double s, double corner_px) const {
   const auto c = Corners(*this);
   const int p = Perimeter();
   s = WrapLoop(s, p);
-  std::uint8_t sides = s <= c[1] ? kTop : s <= c[2] ? kRight : s <= c[3] ? kBottom : kLeft;
-  // Corner k joins side k-1 (before it on the loop) and side k (after it).
-  constexpr std::array<std::uint8_t, 4> kBefore = {kLeft, kTop, kRight, kBottom};
-  constexpr std::array<std::uint8_t, 4> kAfter = {kTop, kRight, kBottom, kLeft};
-  for (int k = 0; k < 4; ++k) {
-    double distance = std::fabs(s - c[k]);
-    distance = std::min(distance, p - distance);
-    if (distance <= corner_px) sides |= kBefore[k] | kAfter[k];
-  }
+  // The side holding s runs from corner k to corner k + 1 (corner 4 is corner 0 at s = p).
+  const int k = s <= c[1] ? 0 : s <= c[2] ? 1 : s <= c[3] ? 2 : 3;
+  const double side_end = k == 3 ? p : c[static_cast<std::size_t>(k + 1)];
+  // Corner k joins side k - 1 (before it on the loop) and side k (after it).
+  constexpr std::array<std::uint8_t, 4> kSide = {kTop, kRight, kBottom, kLeft};
+  std::uint8_t sides = kSide[static_cast<std::size_t>(k)];
+  if (s - c[static_cast<std::size_t>(k)] <= corner_px)
+    sides |= kSide[static_cast<std::size_t>((k + 3) % 4)];
+  if (side_end - s <= corner_px) sides |= kSide[static_cast<std::size_t>((k + 1) % 4)];
   return sides;
 }
 
@@ -108,7 +108,7 @@ void GatherBorder(const GrayImageView& image, const BorderRect& rect,
   ReverseCopy(row + u0, row + u1, right);
 }
 
-void BorderColumns::Prepare(int width, int height, int first_px, int step_px) {
+void BorderLoops::Prepare(int width, int height, int first_px, int step_px) {
   if (width == width_ && height == height_ && first_px == first_px_ && step_px == step_px_) {
     return;
   }
@@ -116,22 +116,30 @@ void BorderColumns::Prepare(int width, int height, int first_px, int step_px) {
   height_ = height;
   first_px_ = first_px;
   step_px_ = step_px;
-  start_.clear();
-  std::ptrdiff_t size = 0;
+  loops_.clear();
   for (int d = first_px; BorderAt(width, height, d).Valid(); d += step_px) {
-    start_.push_back(size - (d + 1));  // inner rows d + 1 .. height - 2 - d
-    size += height - 2 - 2 * d;
+    loops_.emplace_back(static_cast<std::size_t>(BorderAt(width, height, d).Perimeter()));
   }
-  left_.assign(static_cast<std::size_t>(size), 0);
-  right_.assign(static_cast<std::size_t>(size), 0);
+  right_at_.assign(loops_.size(), nullptr);
+  left_at_.assign(loops_.size(), nullptr);
 }
 
-void BorderColumns::Read(const GrayImageView& image) {
-  // Locals, because the byte stores could alias the members and would force reloads.
-  const int first = first_px_, step = step_px_, count = this->count();
-  const std::ptrdiff_t* start = start_.data();
-  std::uint8_t* left = left_.data();
-  std::uint8_t* right = right_.data();
+void BorderLoops::Read(const GrayImageView& image) {
+  // Loop order: top row, right column down, bottom row leftwards, left column up. Row v of
+  // border k's right column is at right_at[k][v], of its left column at left_at[k][-v].
+  // (Set here rather than in Prepare, as a copied object's loops are elsewhere; locals,
+  // because the byte stores could alias the members and would force reloads.)
+  const int count = this->count();
+  for (int k = 0; k < count; ++k) {
+    const BorderRect rect = Rect(k);
+    std::uint8_t* loop = loops_[static_cast<std::size_t>(k)].data();
+    // Row v0 + 1 is at loop index Width() on the right, Perimeter() - 1 on the left.
+    right_at_[static_cast<std::size_t>(k)] = loop + rect.Width() - (rect.v0 + 1);
+    left_at_[static_cast<std::size_t>(k)] = loop + rect.Perimeter() - 1 + (rect.v0 + 1);
+  }
+  std::uint8_t* const* right_at = right_at_.data();
+  std::uint8_t* const* left_at = left_at_.data();
+  const int first = first_px_, step = step_px_;
   // Rows in pairs the same distance from the top and the bottom edge (the middle row of an
   // odd height twice, harmlessly): both are inner rows of the same borders, those with
   // d < top, so one pass over those borders serves four pixels.
@@ -141,33 +149,28 @@ void BorderColumns::Read(const GrayImageView& image) {
     const std::uint8_t* bottom_row = image.data + bottom * image.stride;
     int u_left = first, u_right = width_ - 1 - first;
     for (int k = 0; k < active; ++k, u_left += step, u_right -= step) {
-      const std::ptrdiff_t i = start[k] + top, j = start[k] + bottom;
-      left[i] = top_row[u_left];
-      right[i] = top_row[u_right];
-      left[j] = bottom_row[u_left];
-      right[j] = bottom_row[u_right];
+      std::uint8_t* right = right_at[k];
+      std::uint8_t* left = left_at[k];
+      right[top] = top_row[u_right];
+      left[-top] = top_row[u_left];
+      right[bottom] = bottom_row[u_right];
+      left[-bottom] = bottom_row[u_left];
     }
   }
 }
 
-void BorderColumns::GatherBorder(const GrayImageView& image, int k,
-                                 std::vector<std::uint8_t>* samples) const {
+const std::vector<std::uint8_t>& BorderLoops::Gather(const GrayImageView& image, int k) {
   const BorderRect rect = Rect(k);
-  const int perimeter = rect.Perimeter(), width = rect.Width(), inner_rows = rect.Height() - 2;
-  samples->resize(static_cast<std::size_t>(perimeter));
-  std::uint8_t* out = samples->data();
+  std::vector<std::uint8_t>& loop = loops_[static_cast<std::size_t>(k)];
+  const int width = rect.Width(), inner_rows = rect.Height() - 2;
+  std::uint8_t* out = loop.data();
   const std::uint8_t* top = image.data + rect.v0 * image.stride;
   const std::uint8_t* bottom = image.data + rect.v1 * image.stride;
-  const std::ptrdiff_t first_inner = start_[static_cast<std::size_t>(k)] + rect.v0 + 1;
-  // Loop order: top row, right column down, bottom row leftwards, left column up.
   std::memcpy(out, top + rect.u0, static_cast<std::size_t>(width));
-  out += width;
-  std::memcpy(out, right_.data() + first_inner, static_cast<std::size_t>(inner_rows));
-  out += inner_rows;
+  out += width + inner_rows;
   *out++ = bottom[rect.u1];
   ReverseCopy(bottom + rect.u0, bottom + rect.u1, out);
-  out += width - 1;
-  ReverseCopy(left_.data() + first_inner, left_.data() + first_inner + inner_rows, out);
+  return loop;
 }
 
 namespace {
@@ -203,29 +206,29 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
   // levels anyway.
   constexpr int kBins = 32, kShift = 3;
   const std::array<int, kBins> histogram = SampledHistogram<kBins, kShift>(samples);
-  // Counts and sums are whole numbers far below 2^53, so double arithmetic on them is exact
-  // (and needs no int-to-double conversions in the loop).
-  double total = 0.0, sum_all = 0.0;
+  int total = 0, sum_all = 0;
   for (int b = 0; b < kBins; ++b) {
     total += histogram[b];
-    sum_all += static_cast<double>(b) * histogram[b];
+    sum_all += b * histogram[b];
   }
   int lowest = 0, highest = kBins - 1;  // the occupied bins (none: lowest > highest)
   while (lowest < kBins && histogram[lowest] == 0) ++lowest;
   while (highest > lowest && histogram[highest] == 0) --highest;
   // Between-class variance ∝ (sum_all·w_low − sum_low·total)² / (w_low·w_high); candidates
-  // are compared by cross-multiplication, so the loop has no division.
+  // are compared by cross-multiplication, so the loop has no division. The running sums are
+  // integers (a one-cycle dependency chain); the squares and products, below 2^53, are
+  // exact in double.
   double best_numerator = -1.0, best_denominator = 1.0;
-  double weight_low = 0.0, sum_low = 0.0, best_weight_low = 0.0, best_sum_low = 0.0;
+  int weight_low = 0, sum_low = 0, best_weight_low = 0, best_sum_low = 0;
   int best = kBins / 2;
   // Splits below the lowest or from the highest occupied bin leave a class empty.
   for (int b = lowest; b < highest; ++b) {
     weight_low += histogram[b];
-    sum_low += static_cast<double>(b) * histogram[b];
-    const double weight_high = total - weight_low;
-    const double spread = sum_all * weight_low - sum_low * total;
+    sum_low += b * histogram[b];
+    const auto spread = static_cast<double>(static_cast<std::int64_t>(sum_all) * weight_low -
+                                            static_cast<std::int64_t>(sum_low) * total);
     const double numerator = spread * spread;
-    const double denominator = weight_low * weight_high;
+    const auto denominator = static_cast<double>(weight_low * (total - weight_low));
     if (numerator * best_denominator > best_numerator * denominator) {
       best_numerator = numerator;
       best_denominator = denominator;
@@ -236,9 +239,9 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
   }
   if (contrast) {
     *contrast = 0;
-    if (best_weight_low > 0.0 && best_weight_low < total) {
-      const double gap =
-          (sum_all - best_sum_low) / (total - best_weight_low) - best_sum_low / best_weight_low;
+    if (best_weight_low > 0 && best_weight_low < total) {
+      const double gap = static_cast<double>(sum_all - best_sum_low) / (total - best_weight_low) -
+                         static_cast<double>(best_sum_low) / best_weight_low;
       *contrast = static_cast<int>(gap * (1 << kShift));
     }
   }
@@ -347,9 +350,16 @@ int ScanRuns(const std::uint8_t* s, int p, int threshold, int min_gap, Run* runs
   int run_first = 0;
   for (int base = 0; base < p; base += 64) {
     const int n = std::min(64, p - base);
-    const std::uint64_t mask = n == 64 && vector_ok
-                                   ? LineMask64<kLight>(s + base, threshold)
-                                   : LineMaskScalar<kLight>(s + base, n, threshold);
+    std::uint64_t mask = 0;
+    if (!vector_ok) {
+      mask = LineMaskScalar<kLight>(s + base, n, threshold);
+    } else if (n == 64) {
+      mask = LineMask64<kLight>(s + base, threshold);
+    } else {  // the last, partial block: vectorised too, from a copy (the bits past n are masked)
+      std::uint8_t tail[64] = {};
+      std::memcpy(tail, s + base, static_cast<std::size_t>(n));
+      mask = LineMask64<kLight>(tail, threshold);
+    }
     const std::uint64_t valid = n == 64 ? ~0ULL : (1ULL << n) - 1;
     for (int k = 0; k < n;) {
       // In a run look for its end (a clear bit), outside for the next start (a set bit).
@@ -448,8 +458,11 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
   }
 
   const auto corners = Corners(rect);
-  const double max_run =
-      options.max_width_px / std::sin(options.min_crossing_angle_deg * kPi / 180.0);
+  // (Computed only for runs wider than max_width_px, which are rare: sin is not cheap.)
+  auto longer_than_max_run = [&](double length) {
+    return length > options.max_width_px &&
+           length > options.max_width_px / std::sin(options.min_crossing_angle_deg * kPi / 180.0);
+  };
   const bool edges = options.polarity == Polarity::kEdges;
   int added = 0;
   // Appends a point, built in place (copying in a just-built local point stalled on store
@@ -481,7 +494,7 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
       if (!push(rect.ToPixel(s_b), 0.0, rect.Sides(s_b), true)) break;
       continue;
     }
-    if (length > max_run) continue;
+    if (longer_than_max_run(length)) continue;
 
     const bool straight = !HasCornerInside(run, corners, p);
     Point2d pixel;

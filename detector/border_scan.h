@@ -32,7 +32,8 @@ struct BorderRect {
   /// Pixel position of loop coordinate s (pixel i of the loop is at s = i; fractional s
   /// interpolates along the loop, wrapping at Perimeter()).
   Point2d ToPixel(double s) const;
-  /// Sides holding loop coordinate s; within `corner_px` of a corner both sides are set.
+  /// Sides holding loop coordinate s; within `corner_px` (at most 1, the shortest side) of a
+  /// corner both sides are set.
   std::uint8_t Sides(double s, double corner_px = 0.5) const;
 };
 
@@ -52,29 +53,30 @@ struct BorderPoint {
 void GatherBorder(const GrayImageView& image, const BorderRect& rect,
                   std::vector<std::uint8_t>* samples);
 
-/// The left and right columns of a frame's concentric borders d = first_px, first_px +
-/// step_px, ... (while valid), read in one pass over the image's rows. Read column by column,
-/// every pixel costs a cache line for one border; read row by row, one cache line serves the
-/// columns of all the borders that cross it (about 64 / step_px of them).
-class BorderColumns {
+/// The loops of a frame's concentric borders d = first_px, first_px + step_px, ... (while
+/// valid), each in GatherBorder's order. Their left and right columns are read in one pass
+/// over the image's rows, straight into the loops: read column by column, every pixel would
+/// cost a cache line for one border; read row by row, one cache line serves the columns of
+/// all the borders that cross it (about 64 / step_px of them).
+class BorderLoops {
  public:
-  /// Sizes the buffers for width x height images; allocates only when the size changes.
+  /// Sizes the loops for width x height images; allocates only when the size changes.
   void Prepare(int width, int height, int first_px, int step_px);
   /// Reads the inner rows (all but the top and bottom one) of every border's two columns.
   /// `image` must have the size given to Prepare.
   void Read(const GrayImageView& image);
-  /// GatherBorder of border k (0 = outermost), its columns taken from the last Read.
-  void GatherBorder(const GrayImageView& image, int k, std::vector<std::uint8_t>* samples) const;
+  /// Border k's loop (0 = outermost), as GatherBorder writes it: its top and bottom rows are
+  /// copied now, its columns were taken by the last Read.
+  const std::vector<std::uint8_t>& Gather(const GrayImageView& image, int k);
   /// Number of borders.
-  int count() const { return static_cast<int>(start_.size()); }
+  int count() const { return static_cast<int>(loops_.size()); }
   /// The rectangle of border k.
   BorderRect Rect(int k) const { return BorderAt(width_, height_, first_px_ + k * step_px_); }
 
  private:
   int width_ = 0, height_ = 0, first_px_ = 0, step_px_ = 1;
-  /// Row v of border k's columns is at left_[start_[k] + v] and right_[start_[k] + v].
-  std::vector<std::ptrdiff_t> start_;
-  std::vector<std::uint8_t> left_, right_;
+  std::vector<std::vector<std::uint8_t>> loops_;
+  std::vector<std::uint8_t*> right_at_, left_at_;  ///< Read's working memory
 };
 
 /// Otsu's threshold of `samples`; `contrast` receives the difference of the two class means.

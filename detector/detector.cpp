@@ -60,53 +60,45 @@ void RectangleOutline(const BorderRect& rect, int per_side, std::vector<Point2d>
   }
 }
 
-// A border's outline points as fixed-size coordinate arrays, padded by repeating the last
-// point, so that Crossed is a short loop, unrolled and two points at a time with SSE2.
-struct OutlineArrays {
-  static constexpr std::size_t kPoints = 8;  // even: Crossed takes two at a time
-  std::array<double, kPoints> u, v;
-
-  explicit OutlineArrays(const std::vector<Point2d>& outline) {  // outline not empty
-    for (std::size_t k = 0; k < kPoints; ++k) {
-      const Point2d& p = outline[std::min(k, outline.size() - 1)];
-      u[k] = p.u;
-      v[k] = p.v;
-    }
-  }
-
-  // Whether the entry's line crosses the outline: some point is strictly on each side of
-  // it, that is the highest distance of a point along the line's normal is above rho and
-  // the lowest below (the same decisions as testing each point's sign of distance - rho).
-  bool Crossed(const OalEntry& entry) const {
-#if defined(__SSE2__)
-    // Two points at a time.
-    const __m128d c = _mm_set1_pd(entry.cos_theta), s = _mm_set1_pd(entry.sin_theta);
-    auto distances = [&](std::size_t k) {
-      return _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(&u[k]), c), _mm_mul_pd(_mm_loadu_pd(&v[k]), s));
-    };
-    __m128d highest = distances(0), lowest = highest;
-    for (std::size_t k = 2; k < kPoints; k += 2) {
-      const __m128d distance = distances(k);
-      highest = _mm_max_pd(highest, distance);
-      lowest = _mm_min_pd(lowest, distance);
-    }
-    const __m128d rho = _mm_set1_pd(entry.rho_px);
-    const int above = _mm_movemask_pd(_mm_cmpgt_pd(highest, rho));  // a bit per lane
-    const int below = _mm_movemask_pd(_mm_cmplt_pd(lowest, rho));
-    return (above != 0) & (below != 0);  // (& rather than &&: no branch)
-#else
-    double highest = u[0] * entry.cos_theta + v[0] * entry.sin_theta, lowest = highest;
-    for (std::size_t k = 1; k < kPoints; ++k) {
-      const double distance = u[k] * entry.cos_theta + v[k] * entry.sin_theta;
-      highest = std::max(highest, distance);
-      lowest = std::min(lowest, distance);
-    }
-    return highest > entry.rho_px && lowest < entry.rho_px;
-#endif
-  }
-};
-
 }  // namespace
+
+OalDetector::BorderOutline::BorderOutline(const std::vector<Point2d>& outline) {
+  for (std::size_t k = 0; k < kPoints; ++k) {
+    const Point2d& p = outline[std::min(k, outline.size() - 1)];
+    u[k] = p.u;
+    v[k] = p.v;
+  }
+}
+
+// The highest distance of a point along the line's normal is above rho and the lowest
+// below: the same decisions as testing each point's sign of distance - rho.
+bool OalDetector::BorderOutline::Crossed(const OalEntry& entry) const {
+#if defined(__SSE2__)
+  // Two points at a time.
+  const __m128d c = _mm_set1_pd(entry.cos_theta), s = _mm_set1_pd(entry.sin_theta);
+  auto distances = [&](std::size_t k) {
+    return _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(&u[k]), c), _mm_mul_pd(_mm_loadu_pd(&v[k]), s));
+  };
+  __m128d highest = distances(0), lowest = highest;
+  for (std::size_t k = 2; k < kPoints; k += 2) {
+    const __m128d distance = distances(k);
+    highest = _mm_max_pd(highest, distance);
+    lowest = _mm_min_pd(lowest, distance);
+  }
+  const __m128d rho = _mm_set1_pd(entry.rho_px);
+  const int above = _mm_movemask_pd(_mm_cmpgt_pd(highest, rho));  // a bit per lane
+  const int below = _mm_movemask_pd(_mm_cmplt_pd(lowest, rho));
+  return (above != 0) & (below != 0);  // (& rather than &&: no branch)
+#else
+  double highest = u[0] * entry.cos_theta + v[0] * entry.sin_theta, lowest = highest;
+  for (std::size_t k = 1; k < kPoints; ++k) {
+    const double distance = u[k] * entry.cos_theta + v[k] * entry.sin_theta;
+    highest = std::max(highest, distance);
+    lowest = std::min(lowest, distance);
+  }
+  return highest > entry.rho_px && lowest < entry.rho_px;
+#endif
+}
 
 OalDetector::OalDetector(const DetectorOptions& options)
     : options_((options.Check(), options)),
@@ -129,12 +121,25 @@ void OalDetector::PrepareFor(int width, int height) {
   height_ = height;
   centre_u_ = 0.5 * (width - 1);
   centre_v_ = 0.5 * (height - 1);
-  columns_.Prepare(width, height, options_.start_px, options_.step_px);
-  const int borders = columns_.count();
-  samples_.reserve(static_cast<std::size_t>(2 * (width + height)));
+  loops_.Prepare(width, height, options_.start_px, options_.step_px);
+  const int borders = loops_.count();
   border_points_.reserve(static_cast<std::size_t>(options_.max_points_per_border));
   frame_points_.reserve(static_cast<std::size_t>(borders * options_.max_points_per_border));
-  border_outline_.reserve(32);
+  // Each border's outline in working coordinates, centred: its corners, and with distortion
+  // also the middles of its sides, which undistortion bends outward or inward.
+  outlines_.clear();
+  std::vector<Point2d> outline;
+  for (int border = 0; border < borders; ++border) {
+    RectangleOutline(loops_.Rect(border), undistorter_ ? 2 : 1, &outline);
+    for (Point2d& p : outline) {
+      const Point2d working = ToWorking(p);
+      p = Point2d{working.u - centre_u_, working.v - centre_v_};
+    }
+    outlines_.emplace_back(outline);
+  }
+  // The image border, where read-off lines end (undistorted when correcting).
+  RectangleOutline(BorderAt(width, height, 0), 8, &image_outline_);
+  for (Point2d& p : image_outline_) p = ToWorking(p);
   candidates_.reserve(static_cast<std::size_t>(oal_.capacity()));
   lines_.reserve(static_cast<std::size_t>(options_.max_output_lines));
 }
@@ -153,26 +158,26 @@ const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
     const double c = std::cos(seed.line.theta_rad), s = std::sin(seed.line.theta_rad);
     oal_.Seed(c, s, seed.line.rho_px - centre_u_ * c - centre_v_ * s, seed.id);
   }
-  columns_.Read(image);
-  for (int border = 0; border < columns_.count(); ++border) ScanBorder(image, border);
+  loops_.Read(image);
+  for (int border = 0; border < loops_.count(); ++border) ScanBorder(image, border);
   ReadOff(image.width, image.height);
   return lines_;
 }
 
 void OalDetector::ScanBorder(const GrayImageView& image, int border) {
-  const BorderRect rect = columns_.Rect(border);
-  columns_.GatherBorder(image, border, &samples_);
+  const BorderRect rect = loops_.Rect(border);
+  const std::vector<std::uint8_t>& samples = loops_.Gather(image, border);
   int threshold = options_.fixed_threshold;
   bool has_contrast = true;
   if (options_.threshold_mode == ThresholdMode::kOtsu) {
     int contrast = 0;
-    threshold = OtsuThreshold(samples_, &contrast);
+    threshold = OtsuThreshold(samples, &contrast);
     has_contrast = contrast >= options_.min_contrast;
   }
   const std::size_t first_point = frame_points_.size();
   if (has_contrast) {
     border_points_.clear();
-    FindBorderPoints(samples_, rect, threshold, options_, &border_points_);
+    FindBorderPoints(samples, rect, threshold, options_, &border_points_);
     for (const BorderPoint& point : border_points_) {
       // Built in place: copying in a just-built local stalled on store forwarding.
       FramePoint& frame_point = frame_points_.emplace_back();
@@ -189,17 +194,9 @@ void OalDetector::ScanBorder(const GrayImageView& image, int border) {
     oal_.EndBorder([](const OalEntry&) { return true; });
     return;
   }
-  // The border's outline in working coordinates: its corners, and with distortion also the
-  // middles of its sides, which undistortion bends outward or inward.
-  RectangleOutline(rect, undistorter_ ? 2 : 1, &border_outline_);
-  for (Point2d& p : border_outline_) {
-    const Point2d working = ToWorking(p);  // (updating p in place stalled on store forwarding)
-    p.u = working.u - centre_u_;
-    p.v = working.v - centre_v_;
-  }
   // A local copy, captured by value: the compiler keeps it in registers across the entries
   // (it would reload member arrays after every count update, which might alias them).
-  const OutlineArrays outline(border_outline_);
+  const BorderOutline outline = outlines_[static_cast<std::size_t>(border)];
   oal_.EndBorder([outline](const OalEntry& entry) { return outline.Crossed(entry); });
 }
 
@@ -242,7 +239,7 @@ void OalDetector::ReadOff(int width, int height) {
     // From the list's centred origin to the image's top-left origin.
     const double rho = entry.rho_px + centre_u_ * entry.cos_theta + centre_v_ * entry.sin_theta;
     DetectedLine line;
-    line.line = Normalized(rho, entry.theta_rad);
+    line.line = Normalized(rho, entry.Line().theta_rad);
     if (options_.refit_lines) {
       const double wide = std::max(options_.r_change_px, 2.0 * tolerance);
       line.line = RefitLine(line.line, frame_points_, wide);
@@ -284,14 +281,9 @@ void OalDetector::ReadOff(int width, int height) {
   }
 
   // End points on the image border (the undistorted image border when correcting).
-  const BorderRect image_rect = BorderAt(width, height, 0);
-  if (undistorter_) {
-    RectangleOutline(image_rect, 8, &border_outline_);
-    for (Point2d& p : border_outline_) p = ToWorking(p);
-  }
   for (DetectedLine& line : lines_) {
     if (undistorter_) {
-      ClipToOutline(line.line, border_outline_, &line.end_a, &line.end_b);
+      ClipToOutline(line.line, image_outline_, &line.end_a, &line.end_b);
     } else {
       ClipToRect(line.line, 0.0, 0.0, width - 1.0, height - 1.0, &line.end_a, &line.end_b);
     }

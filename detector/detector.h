@@ -17,6 +17,7 @@
 
 #include <visp3/core/vpCameraParameters.h>
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -77,6 +78,18 @@ class OalDetector {
   const OrderedAccumulatorList& accumulator_list() const { return oal_; }
 
  private:
+  /// A border's outline (detector.cpp: RectangleOutline) in working coordinates centred on
+  /// the image centre, as fixed-size arrays padded by repeating the last point, so that
+  /// Crossed is a short loop, unrolled and two points at a time with SSE2.
+  struct BorderOutline {
+    static constexpr std::size_t kPoints = 8;  // even: Crossed takes two at a time
+    std::array<double, kPoints> u, v;
+
+    explicit BorderOutline(const std::vector<Point2d>& outline);  // outline not empty
+    /// Whether the entry's line crosses the outline: some point strictly on each side.
+    bool Crossed(const OalEntry& entry) const;
+  };
+
   void PrepareFor(int width, int height);
   void ScanBorder(const GrayImageView& image, int border);
   void VotePairs(int border, std::size_t first_point);
@@ -92,11 +105,11 @@ class OalDetector {
   // Working memory, sized once per image size (no allocation per frame after that).
   int width_ = 0, height_ = 0;
   double centre_u_ = 0.0, centre_v_ = 0.0;
-  BorderColumns columns_;
-  std::vector<std::uint8_t> samples_;
+  BorderLoops loops_;
   std::vector<BorderPoint> border_points_;
   std::vector<FramePoint> frame_points_;
-  std::vector<Point2d> border_outline_;  ///< current border's outline, centred coordinates
+  std::vector<BorderOutline> outlines_;  ///< per border
+  std::vector<Point2d> image_outline_;   ///< the image border in working coordinates
   std::vector<DetectedLine> candidates_;
   std::vector<DetectedLine> lines_;
 };

@@ -21,7 +21,7 @@ TEST(OrderedAccumulatorList, NewEntryHasWeightOneCountZero) {
   ASSERT_EQ(list.entries().size(), 1u);
   EXPECT_EQ(list.entries()[0].weight, 1);
   EXPECT_EQ(list.entries()[0].count, 0);
-  EXPECT_NEAR(list.entries()[0].theta_rad, 0.5, kTol);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5, kTol);
   EXPECT_NEAR(list.entries()[0].rho_px, 10.0, kTol);
 }
 
@@ -30,10 +30,10 @@ TEST(OrderedAccumulatorList, MatchesAverageWeightedByPriorVotes) {
   VoteFor(&list, 10.0, 0.50);
   EXPECT_EQ(VoteFor(&list, 12.0, 0.51), 0);  // (10*1 + 12) / 2, (0.50*1 + 0.51) / 2
   EXPECT_NEAR(list.entries()[0].rho_px, 11.0, kTol);
-  EXPECT_NEAR(list.entries()[0].theta_rad, 0.505, kTol);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.505, kTol);
   EXPECT_EQ(VoteFor(&list, 14.0, 0.52), 0);  // (11*2 + 14) / 3, (0.505*2 + 0.52) / 3
   EXPECT_NEAR(list.entries()[0].rho_px, 12.0, kTol);
-  EXPECT_NEAR(list.entries()[0].theta_rad, 0.51, kTol);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.51, kTol);
   EXPECT_NEAR(list.entries()[0].cos_theta, std::cos(0.51), kTol);
   EXPECT_NEAR(list.entries()[0].sin_theta, std::sin(0.51), kTol);
   EXPECT_EQ(list.entries()[0].weight, 3);
@@ -52,14 +52,14 @@ TEST(OrderedAccumulatorList, AveragesAcrossTheThetaWrap) {
   VoteFor(&list, 5.0, 0.01);
   // theta = pi - 0.01 with rho = -5 is theta = -0.01 with rho = 5: the same family.
   EXPECT_EQ(VoteFor(&list, -5.0, kPi - 0.01), 0);
-  EXPECT_NEAR(list.entries()[0].theta_rad, 0.0, kTol);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.0, kTol);
   EXPECT_NEAR(list.entries()[0].rho_px, 5.0, kTol);
   // Another vote at -0.02 pulls the mean below 0: it is stored as pi - 0.00667, rho -5.
   EXPECT_EQ(VoteFor(&list, -5.0, kPi - 0.02), 0);
-  EXPECT_NEAR(list.entries()[0].theta_rad, kPi - 0.02 / 3.0, kTol);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, kPi - 0.02 / 3.0, kTol);
   EXPECT_NEAR(list.entries()[0].rho_px, -5.0, kTol);
-  EXPECT_GE(list.entries()[0].theta_rad, 0.0);
-  EXPECT_LT(list.entries()[0].theta_rad, kPi);
+  EXPECT_GE(list.entries()[0].Line().theta_rad, 0.0);
+  EXPECT_LT(list.entries()[0].Line().theta_rad, kPi);
 }
 
 TEST(OrderedAccumulatorList, ReordersByWeightMinusHalfCount) {

@@ -57,19 +57,18 @@ TEST(BorderScan, GatherWalksTheLoopClockwise) {
   }
 }
 
-TEST(BorderScan, ColumnsReadOnceGatherTheSameLoops) {
+TEST(BorderScan, LoopsReadOnceGatherTheSameLoops) {
   testing::TestImage image(37, 29, 0);
   for (int v = 0; v < 29; ++v)
     for (int u = 0; u < 37; ++u) image.At(u, v) = static_cast<std::uint8_t>((7 * u + 13 * v) % 251);
-  BorderColumns columns;
-  columns.Prepare(37, 29, 2, 3);
-  columns.Read(image.View());
-  ASSERT_EQ(columns.count(), 4);  // d = 2, 5, 8, 11; at d = 14 the ring would be 1 px high
-  std::vector<std::uint8_t> expected, actual;
-  for (int k = 0; k < columns.count(); ++k) {
-    GatherBorder(image.View(), columns.Rect(k), &expected);
-    columns.GatherBorder(image.View(), k, &actual);
-    EXPECT_EQ(actual, expected) << "border " << k;
+  BorderLoops loops;
+  loops.Prepare(37, 29, 2, 3);
+  loops.Read(image.View());
+  ASSERT_EQ(loops.count(), 4);  // d = 2, 5, 8, 11; at d = 14 the ring would be 1 px high
+  std::vector<std::uint8_t> expected;
+  for (int k = 0; k < loops.count(); ++k) {
+    GatherBorder(image.View(), loops.Rect(k), &expected);
+    EXPECT_EQ(loops.Gather(image.View(), k), expected) << "border " << k;
   }
 }
 
