@@ -17,14 +17,16 @@ double SmallAsin(double s) {
 }
 
 // Rotates the unit vector (c, s) by a small angle a, with sin/cos series good to 1e-12 for
-// |a| < 0.1 rad, and renormalises.
+// |a| < 0.1 rad, and renormalises: the squared norm n is 1 to about 1e-12, so one Newton
+// step for 1 / sqrt(n), (3 - n) / 2, is exact to double precision (and costs no sqrt or
+// division).
 void RotateSmall(double a, double* c, double* s) {
   const double a2 = a * a;
   const double cos_a = 1.0 - a2 / 2.0 + a2 * a2 / 24.0 - a2 * a2 * a2 / 720.0;
   const double sin_a = a * (1.0 - a2 / 6.0 + a2 * a2 / 120.0 - a2 * a2 * a2 / 5040.0);
   const double new_c = *c * cos_a - *s * sin_a;
   const double new_s = *s * cos_a + *c * sin_a;
-  const double norm = 1.0 / std::sqrt(new_c * new_c + new_s * new_s);
+  const double norm = 0.5 * (3.0 - (new_c * new_c + new_s * new_s));
   *c = new_c * norm;
   *s = new_s * norm;
 }
@@ -173,8 +175,9 @@ int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_
     const double cross = entry.cos_theta * s - entry.sin_theta * c;  // sin(theta_new - theta_old)
     const double prior = static_cast<double>(entry.weight);
     // theta moves to the vote-weighted mean of the angles: the normal turns by that step.
-    RotateSmall(SmallAsin(cross) / (prior + 1.0), &entry.cos_theta, &entry.sin_theta);
-    entry.rho_px = (prior * entry.rho_px + rho) / (prior + 1.0);
+    const double share = 1.0 / (prior + 1.0);  // the new vote's share of the mean
+    RotateSmall(SmallAsin(cross) * share, &entry.cos_theta, &entry.sin_theta);
+    entry.rho_px = (prior * entry.rho_px + rho) * share;
     KeepUpperHalf(&entry.cos_theta, &entry.sin_theta, &entry.rho_px);
     ++entry.weight;
     if (entry.last_border != border) {
@@ -216,8 +219,15 @@ bool OrderedAccumulatorList::InsertionSort(std::vector<SortKey>::iterator first,
   bool moved = false;
   for (auto it = first == last ? last : first + 1; it != last; ++it) {
     if (!Higher(*it, *(it - 1))) continue;  // already in place: the common case
-    // After every key at least as high (stability).
-    std::rotate(std::upper_bound(first, it, *it, Higher), it, it + 1);
+    // Shifted past the lower keys only, so it stays after every key at least as high
+    // (stability); the lists are short and nearly sorted, so a linear search is fastest.
+    const SortKey key = *it;
+    auto hole = it;
+    do {
+      *hole = *(hole - 1);
+      --hole;
+    } while (hole != first && Higher(key, *(hole - 1)));
+    *hole = key;
     moved = true;
   }
   return moved;
