@@ -6,6 +6,10 @@
 #include <iterator>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace oal {
 namespace {
 
@@ -22,8 +26,9 @@ double SmallAsin(double s) {
 // division).
 void RotateSmall(double a, double* c, double* s) {
   const double a2 = a * a;
-  const double cos_a = 1.0 - a2 / 2.0 + a2 * a2 / 24.0 - a2 * a2 * a2 / 720.0;
-  const double sin_a = a * (1.0 - a2 / 6.0 + a2 * a2 / 120.0 - a2 * a2 * a2 / 5040.0);
+  // Horner form with constant coefficients (x / 24.0 would be a real division).
+  const double cos_a = 1.0 + a2 * (-1.0 / 2.0 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0)));
+  const double sin_a = a * (1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0))));
   const double new_c = *c * cos_a - *s * sin_a;
   const double new_s = *s * cos_a + *c * sin_a;
   const double norm = 0.5 * (3.0 - (new_c * new_c + new_s * new_s));
@@ -124,16 +129,22 @@ int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, doubl
   const int size = static_cast<int>(entries_.size());
   for (int i = 0; i < size; i += kMatchBlock) {
     const Ints low = matches(i), high = matches(i + kMatchLanes);
-    std::uint64_t words[2];  // one OR of both halves tells whether any lane matched
-    std::memcpy(words, &low, sizeof(words));
-    std::uint64_t any = words[0] | words[1];
-    std::memcpy(words, &high, sizeof(words));
-    if ((any | words[0] | words[1]) == 0) continue;
-    for (int k = 0; k < kMatchBlock; ++k) {
-      const bool match = k < kMatchLanes ? low[k] != 0 : high[k - kMatchLanes] != 0;
-      // Lanes past the end hold stale values: a match there means no match.
-      if (match) return i + k < size ? i + k : -1;
-    }
+#if defined(__SSE2__)
+    // One bit per lane, from the lanes' sign bits.
+    __m128 low_lanes, high_lanes;
+    std::memcpy(&low_lanes, &low, sizeof(low_lanes));
+    std::memcpy(&high_lanes, &high, sizeof(high_lanes));
+    const unsigned lanes = static_cast<unsigned>(_mm_movemask_ps(low_lanes)) |
+                           static_cast<unsigned>(_mm_movemask_ps(high_lanes)) << kMatchLanes;
+    if (lanes == 0) continue;
+    const int k = __builtin_ctz(lanes);
+#else
+    int k = 0;
+    while (k < kMatchBlock && (k < kMatchLanes ? low[k] : high[k - kMatchLanes]) == 0) ++k;
+    if (k == kMatchBlock) continue;
+#endif
+    // Lanes past the end hold stale values: a match there means no match.
+    return i + k < size ? i + k : -1;
   }
   return -1;
 }

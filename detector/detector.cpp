@@ -210,25 +210,32 @@ void OalDetector::VotePairs(int border, std::size_t first_point) {
       const double du = b.p.u - a.p.u, dv = b.p.v - a.p.v;
       const double length_sq = du * du + dv * dv;
       if (length_sq < 1e-6) continue;
+      if (!WidthsAgree(a, b, du, dv, length_sq)) continue;
       const double inverse = 1.0 / std::sqrt(length_sq);
       const double c = -dv * inverse, s = du * inverse;  // unit normal of the chord
-      if (!WidthsAgree(a, b, c, s)) continue;
       const double rho = c * (a.p.u - centre_u_) + s * (a.p.v - centre_v_);
       oal_.Vote(c, s, rho, border);
     }
   }
 }
 
-bool OalDetector::WidthsAgree(const FramePoint& a, const FramePoint& b, double cos_theta,
-                              double sin_theta) const {
+bool OalDetector::WidthsAgree(const FramePoint& a, const FramePoint& b, double du, double dv,
+                              double length_sq) const {
   const double ratio = options_.max_pair_width_ratio;
   if (ratio == 0.0 || options_.polarity == Polarity::kEdges) return true;
-  const double width_a = WidthAcross(a, cos_theta, sin_theta);
-  const double width_b = WidthAcross(b, cos_theta, sin_theta);
+  // Widths across the chord times its length (WidthAcross is linear in the normal, here the
+  // chord's unnormalised normal (-dv, du)); the width limits are compared squared against
+  // length_sq, so that a rejected pair costs no square root or division.
+  const double width_a = WidthAcross(a, -dv, du);
+  const double width_b = WidthAcross(b, -dv, du);
   if (width_a <= 0.0 || width_b <= 0.0) return true;  // a corner run: width unknown
-  if (std::max(width_a, width_b) > options_.max_width_px) return false;
-  // The min_width_px slack keeps thin lines, whose widths are a pixel or two, comparable.
-  return std::max(width_a, width_b) <= ratio * std::min(width_a, width_b) + options_.min_width_px;
+  const double wider = std::max(width_a, width_b), narrower = std::min(width_a, width_b);
+  const double max_width = options_.max_width_px, slack = options_.min_width_px;
+  if (wider * wider > max_width * max_width * length_sq) return false;
+  // The min_width_px slack keeps thin lines, whose widths are a pixel or two, comparable:
+  // wider <= ratio * narrower + slack, that is excess <= slack (times the length).
+  const double excess = wider - ratio * narrower;
+  return excess <= 0.0 || excess * excess <= slack * slack * length_sq;
 }
 
 void OalDetector::ReadOff(int width, int height) {

@@ -93,8 +93,10 @@ class OalDetector {
   void PrepareFor(int width, int height);
   void ScanBorder(const GrayImageView& image, int border);
   void VotePairs(int border, std::size_t first_point);
-  bool WidthsAgree(const FramePoint& a, const FramePoint& b, double cos_theta,
-                   double sin_theta) const;
+  /// The pair width test of DetectorOptions::max_pair_width_ratio for the chord from a to b,
+  /// (du, dv) = b - a, length_sq = du² + dv².
+  bool WidthsAgree(const FramePoint& a, const FramePoint& b, double du, double dv,
+                   double length_sq) const;
   void ReadOff(int width, int height);
   Point2d ToWorking(const Point2d& pixel) const;
 
