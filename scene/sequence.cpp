@@ -170,16 +170,25 @@ RenderOptions BaseOptions(double kdu) {
   return options;
 }
 
-// The slow motion shared by slow, occlusion, illumination and leave-reenter.
+// The motions of the sequences, as Motion's first fields: mean distance, in-and-out
+// amplitude, sideways amplitude and rate, tilt, roll amplitude and rate.
+// The slow motion is shared by slow, occlusion, illumination and leave-reenter.
 Motion SlowMotion() {
-  Motion m;
-  m.distance_m = 0.7;
-  m.distance_amplitude_m = 0.04;
-  m.shift_amplitude_m = 0.05;
-  m.shift_rate_rad = 0.06;
-  m.tilt_rad = 12.0 * kDeg;
-  m.roll_amplitude_rad = 3.0 * kDeg;
-  m.roll_rate_rad = 0.04;
+  return Motion{0.7, 0.04, 0.05, 0.06, 12.0 * kDeg, 3.0 * kDeg, 0.04};
+}
+Motion FastMotion() {
+  return Motion{0.65, 0.08, 0.13, 0.3, 12.0 * kDeg, 15.0 * kDeg, 0.35};
+}
+Motion DistortionMotion() {
+  return Motion{0.5, 0.05, 0.08, 0.06, 10.0 * kDeg, 10.0 * kDeg, 0.05};
+}
+
+// Draws m's phases (roll0 within +-roll0_range_rad) and sets every frame's pose from it.
+Motion Follow(Motion m, double roll0_range_rad, std::mt19937_64& gen, Sequence* s) {
+  m.Draw(gen, roll0_range_rad);
+  for (std::size_t i = 0; i < s->frames.size(); ++i) {
+    s->frames[i].cMo = m.At(static_cast<double>(i));
+  }
   return m;
 }
 
@@ -257,31 +266,18 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
 
   switch (kind) {
     case SequenceKind::kSlow: {
-      Motion m = SlowMotion();
-      m.Draw(gen, kPi);
-      for (int i = 0; i < frame_count; ++i) s.frames[i].cMo = m.At(i);
+      const Motion m = Follow(SlowMotion(), kPi, gen, &s);
       text << "Slow smooth motion (lines move about 1-2 px per frame): " << MotionText(m) << ".";
       break;
     }
     case SequenceKind::kFast: {
-      Motion m;
-      m.distance_m = 0.65;
-      m.distance_amplitude_m = 0.08;
-      m.shift_amplitude_m = 0.13;
-      m.shift_rate_rad = 0.3;
-      m.tilt_rad = 12.0 * kDeg;
-      m.roll_amplitude_rad = 15.0 * kDeg;
-      m.roll_rate_rad = 0.35;
-      m.Draw(gen, kPi);
-      for (int i = 0; i < frame_count; ++i) s.frames[i].cMo = m.At(i);
+      const Motion m = Follow(FastMotion(), kPi, gen, &s);
       text << "Fast shaking motion with roll (lines move 20-40 px per frame): " << MotionText(m)
            << ".";
       break;
     }
     case SequenceKind::kOcclusion: {
-      Motion m = SlowMotion();
-      m.Draw(gen, kPi);
-      for (int i = 0; i < frame_count; ++i) s.frames[i].cMo = m.At(i);
+      const Motion m = Follow(SlowMotion(), kPi, gen, &s);
       // The occluder crosses the image on a straight line through the crossing of target
       // lines 0 and 1 as seen in the middle frame, during the middle 70 % of the frames,
       // entering and leaving just outside the image.
@@ -318,18 +314,14 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
       break;
     }
     case SequenceKind::kIllumination: {
-      Motion m = SlowMotion();
-      m.Draw(gen, kPi);
+      const Motion m = Follow(SlowMotion(), kPi, gen, &s);
       s.options.illumination_gradient = 0.3;
       s.options.gradient_angle_rad = Uniform(gen, 0.0, 2.0 * kPi);
       const int change = frame_count / 2;
       constexpr double kGain = 0.5, kOffset = 15.0;
-      for (int i = 0; i < frame_count; ++i) {
-        s.frames[i].cMo = m.At(i);
-        if (i >= change) {
-          s.frames[i].effects.gain = kGain;
-          s.frames[i].effects.offset = kOffset;
-        }
+      for (int i = change; i < frame_count; ++i) {
+        s.frames[i].effects.gain = kGain;
+        s.frames[i].effects.offset = kOffset;
       }
       text << "Slow motion: " << MotionText(m) << ". Illumination falls by 30 % across the image "
            << "towards " << s.options.gradient_angle_rad / kDeg << " deg; from frame " << change
@@ -352,16 +344,7 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
       break;
     }
     case SequenceKind::kDistortion: {
-      Motion m;
-      m.distance_m = 0.5;
-      m.distance_amplitude_m = 0.05;
-      m.shift_amplitude_m = 0.08;
-      m.shift_rate_rad = 0.06;
-      m.tilt_rad = 10.0 * kDeg;
-      m.roll_amplitude_rad = 10.0 * kDeg;
-      m.roll_rate_rad = 0.05;
-      m.Draw(gen, kPi);
-      for (int i = 0; i < frame_count; ++i) s.frames[i].cMo = m.At(i);
+      const Motion m = Follow(DistortionMotion(), kPi, gen, &s);
       text << "Heavy barrel distortion, kdu = " << kDistortionKdu
            << " (kud = " << s.options.camera.get_kud()
            << "), moderate motion (lines move about 3-5 px per frame): " << MotionText(m) << ".";
