@@ -175,22 +175,22 @@ const std::vector<std::uint8_t>& BorderLoops::Gather(const GrayImageView& image,
 
 namespace {
 
-// Histogram of every fourth sample in kBins bins of 2^kShift grey levels. Four interleaved
+// Histogram of every fourth sample in kBins bins of 2^kShift grey levels. Eight interleaved
 // partial histograms let consecutive increments of the same bin (the background's) proceed
-// without waiting for each other.
+// without waiting for each other: an increment of memory waits for the previous one's store
+// to forward, about five cycles, so one histogram would take five cycles a sample.
 template <int kBins, int kShift>
 std::array<int, kBins> SampledHistogram(const std::vector<std::uint8_t>& samples) {
-  std::array<std::array<int, kBins>, 4> partial{};
+  constexpr std::size_t kPartials = 8, kStride = 4;
+  // 16-bit counts (half the memory to clear): a partial counts at most one sample in 32.
+  std::array<std::array<std::uint16_t, kBins>, kPartials> partial{};
   const std::uint8_t* s = samples.data();
   const std::size_t n = samples.size();
   std::size_t i = 0;
-  for (; i + 16 <= n; i += 16) {
-    ++partial[0][s[i] >> kShift];
-    ++partial[1][s[i + 4] >> kShift];
-    ++partial[2][s[i + 8] >> kShift];
-    ++partial[3][s[i + 12] >> kShift];
+  for (; i + kPartials * kStride <= n; i += kPartials * kStride) {
+    for (std::size_t k = 0; k < kPartials; ++k) ++partial[k][s[i + k * kStride] >> kShift];
   }
-  for (; i < n; i += 4) ++partial[0][s[i] >> kShift];
+  for (; i < n; i += kStride) ++partial[0][s[i] >> kShift];
   std::array<int, kBins> histogram{};
   for (const auto& part : partial) {
     for (int b = 0; b < kBins; ++b) histogram[b] += part[b];
