@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
-#include <iterator>
 #include <limits>
 
 #if defined(__SSE2__)
@@ -66,9 +66,6 @@ OrderedAccumulatorList::OrderedAccumulatorList(double angle_change_rad, double r
       capacity_(std::max(capacity, max_lines)) {
   const auto reserved = static_cast<std::size_t>(capacity_);
   entries_.reserve(reserved);
-  order_.reserve(reserved);
-  merged_order_.reserve(reserved);
-  reordered_.reserve(reserved);
   const auto padded = static_cast<std::size_t>(RoundUpToBlocks(capacity_));
   match_cos_.assign(padded, 0.0f);
   match_sin_.assign(padded, 0.0f);
@@ -79,10 +76,6 @@ void OrderedAccumulatorList::Mirror(std::size_t i) {
   match_cos_[i] = static_cast<float>(entries_[i].cos_theta);
   match_sin_[i] = static_cast<float>(entries_[i].sin_theta);
   match_rho_[i] = static_cast<float>(entries_[i].rho_px);
-}
-
-void OrderedAccumulatorList::MirrorAll() {
-  for (std::size_t i = 0; i < entries_.size(); ++i) Mirror(i);
 }
 
 #if defined(__GNUC__)
@@ -225,67 +218,28 @@ OalEntry& OrderedAccumulatorList::Append(double cos_theta, double sin_theta, dou
   return entry;
 }
 
-bool OrderedAccumulatorList::InsertionSort(std::vector<SortKey>::iterator first,
-                                           std::vector<SortKey>::iterator last) {
-  bool moved = false;
-  for (auto it = first == last ? last : first + 1; it != last; ++it) {
-    if (!Higher(*it, *(it - 1))) continue;  // already in place: the common case
-    // Shifted past the lower keys only, so it stays after every key at least as high
-    // (stability); the lists are short and nearly sorted, so a linear search is fastest.
-    const SortKey key = *it;
-    auto hole = it;
-    do {
-      *hole = *(hole - 1);
-      --hole;
-    } while (hole != first && Higher(key, *(hole - 1)));
-    *hole = key;
-    moved = true;
-  }
-  return moved;
-}
-
-bool OrderedAccumulatorList::SortOrder() {
-  // Filled field by field: push_back of the small struct went through a stack copy that
-  // stalled on store forwarding.
-  order_.resize(entries_.size());  // within the reserved capacity
-  for (std::size_t i = 0; i < entries_.size(); ++i) {
-    order_[i].double_score = entries_[i].DoubleScore();
-    order_[i].index = static_cast<int>(i);
-  }
-  // The entries that were in order after the last border are still nearly so (the paper's
-  // argument for reordering each border): only the ones voted for or not counted move.
-  // The entries new on this border are sorted apart and merged in, rather than each being
-  // inserted past the older entries.
-  const auto old_end = order_.begin() + static_cast<std::ptrdiff_t>(sorted_size_);
-  bool moved = InsertionSort(order_.begin(), old_end);
-  moved |= InsertionSort(old_end, order_.end());
-  if (old_end != order_.begin() && old_end != order_.end() && Higher(*old_end, *(old_end - 1))) {
-    merged_order_.clear();
-    // std::merge is stable: of equal keys, the older entry stays first.
-    std::merge(order_.begin(), old_end, old_end, order_.end(), std::back_inserter(merged_order_),
-               Higher);
-    order_.swap(merged_order_);
-    moved = true;
-  }
-  return moved;
-}
-
 void OrderedAccumulatorList::SortAndCull() {
-  const bool moved = SortOrder();
-  // Entries past the culling point are never copied.
-  std::size_t keep = order_.size();
-  while (static_cast<int>(keep) > max_lines_ && order_[keep - 1].double_score < 0) --keep;
-  if (moved) {
-    reordered_.clear();
-    for (std::size_t k = 0; k < keep; ++k) {
-      reordered_.push_back(entries_[static_cast<std::size_t>(order_[k].index)]);
-    }
-    entries_.swap(reordered_);
-    MirrorAll();
-  } else {
-    entries_.resize(keep);  // only shrinks: no allocation
+  // A stable insertion sort of the entries themselves: after a border the list is nearly in
+  // order (the paper's argument for reordering every border), so few entries move: those
+  // voted for, and the new ones at the end, which rise past the stale hypotheses. An entry
+  // moves past lower scores only, so of equal scores the older stays first.
+  const std::size_t size = entries_.size();
+  for (std::size_t i = 1; i < size; ++i) {
+    const int score = entries_[i].DoubleScore();
+    if (score <= entries_[i - 1].DoubleScore()) continue;  // in place: the common case
+    const OalEntry moving = entries_[i];
+    std::size_t hole = i;
+    do {
+      entries_[hole] = entries_[hole - 1];
+      --hole;
+    } while (hole > 0 && score > entries_[hole - 1].DoubleScore());
+    entries_[hole] = moving;
+    for (std::size_t k = hole; k <= i; ++k) Mirror(k);
   }
-  sorted_size_ = keep;
+  // Step 5: cull from the bottom while the list is longer than max_lines.
+  std::size_t keep = size;
+  while (static_cast<int>(keep) > max_lines_ && entries_[keep - 1].DoubleScore() < 0) --keep;
+  entries_.resize(keep);  // only shrinks: no allocation
 }
 
 }  // namespace oal

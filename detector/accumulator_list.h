@@ -39,10 +39,7 @@ class OrderedAccumulatorList {
   /// while the list is full is dropped, so memory never grows past it.
   OrderedAccumulatorList(double angle_change_rad, double r_change_px, int max_lines, int capacity);
 
-  void Clear() {
-    entries_.clear();
-    sorted_size_ = 0;
-  }
+  void Clear() { entries_.clear(); }
 
   /// Step 3 for one pair-line of border `border`, given as its unit normal (cos, sin) and
   /// rho. The entries are tried best first; the first one within anglechange and rchange
@@ -80,19 +77,6 @@ class OrderedAccumulatorList {
   /// Index of the first entry within anglechange and rchange of the line, or -1.
   int FirstMatch(double cos_theta, double sin_theta, double rho_px) const;
   void Mirror(std::size_t i);
-  void MirrorAll();
-
-  struct SortKey {
-    int double_score;
-    int index;
-  };
-  static bool Higher(const SortKey& a, const SortKey& b) { return a.double_score > b.double_score; }
-
-  /// Sorts order_ by Eq. 3; false if the entries are already in that order.
-  bool SortOrder();
-  /// Stable binary insertion sort of [first, last) by descending score; false if it was sorted.
-  static bool InsertionSort(std::vector<SortKey>::iterator first,
-                            std::vector<SortKey>::iterator last);
 
   double cos_angle_change_;
   double sin_angle_change_;
@@ -100,13 +84,6 @@ class OrderedAccumulatorList {
   int max_lines_;
   int capacity_;
   std::vector<OalEntry> entries_;
-  /// Entries [0, sorted_size_) were in order after the last SortAndCull; the rest were
-  /// appended since.
-  std::size_t sorted_size_ = 0;
-  // SortAndCull's working memory (capacity reserved): the order is found on small keys and
-  // the entries are moved once, into reordered_, which is then swapped in.
-  std::vector<SortKey> order_, merged_order_;
-  std::vector<OalEntry> reordered_;
   // The entries' normals and rho in float, in list order (capacity rounded up to whole
   // SIMD blocks): matching, the detector's hottest loop, scans these compact arrays rather
   // than the entries.

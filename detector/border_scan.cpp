@@ -38,29 +38,36 @@ BorderRect BorderAt(int width, int height, int d) {
   return BorderRect{d, d, width - 1 - d, height - 1 - d};
 }
 
-Point2d BorderRect::ToPixel(double s) const {
-  const auto c = Corners(*this);
-  s = WrapLoop(s, Perimeter());
-  if (s <= c[1]) return {u0 + s, static_cast<double>(v0)};
-  if (s <= c[2]) return {static_cast<double>(u1), v0 + (s - c[1])};
-  if (s <= c[3]) return {u1 - (s - c[2]), static_cast<double>(v1)};
-  return {static_cast<double>(u0), v1 - (s - c[3])};
-}
-
-std::uint8_t BorderRect::Sides(double s, double corner_px) const {
+std::uint8_t BorderRect::Locate(double s, Point2d* pixel, double corner_px) const {
   const auto c = Corners(*this);
   const int p = Perimeter();
   s = WrapLoop(s, p);
   // The side holding s runs from corner k to corner k + 1 (corner 4 is corner 0 at s = p).
   const int k = s <= c[1] ? 0 : s <= c[2] ? 1 : s <= c[3] ? 2 : 3;
-  const double side_end = k == 3 ? p : c[static_cast<std::size_t>(k + 1)];
+  const double along = s - c[static_cast<std::size_t>(k)];
+  const double u_0 = u0, v_0 = v0, u_1 = u1, v_1 = v1;
+  *pixel = k == 0   ? Point2d{u_0 + along, v_0}
+           : k == 1 ? Point2d{u_1, v_0 + along}
+           : k == 2 ? Point2d{u_1 - along, v_1}
+                    : Point2d{u_0, v_1 - along};
   // Corner k joins side k - 1 (before it on the loop) and side k (after it).
+  const double side_end = k == 3 ? p : c[static_cast<std::size_t>(k + 1)];
   constexpr std::array<std::uint8_t, 4> kSide = {kTop, kRight, kBottom, kLeft};
   std::uint8_t sides = kSide[static_cast<std::size_t>(k)];
-  if (s - c[static_cast<std::size_t>(k)] <= corner_px)
-    sides |= kSide[static_cast<std::size_t>((k + 3) % 4)];
+  if (along <= corner_px) sides |= kSide[static_cast<std::size_t>((k + 3) % 4)];
   if (side_end - s <= corner_px) sides |= kSide[static_cast<std::size_t>((k + 1) % 4)];
   return sides;
+}
+
+Point2d BorderRect::ToPixel(double s) const {
+  Point2d pixel;
+  Locate(s, &pixel);
+  return pixel;
+}
+
+std::uint8_t BorderRect::Sides(double s, double corner_px) const {
+  Point2d unused;
+  return Locate(s, &unused, corner_px);
 }
 
 namespace {
@@ -394,10 +401,10 @@ bool HasCornerInside(const Run& run, const std::array<int, 4>& corners, int p) {
 
 // Adds the contrast weights of loop coordinates [lo, hi], stored at samples s[i + shift].
 // Chunks of kChunk pixels are summed in 32-bit integers, relative to the chunk's start,
-// which cannot overflow (255 * 2048 * 2047 / 2 < 2^31) and lets the compiler vectorise.
+// which cannot overflow (255 * 2048 * 2047 / 2 < 2^31).
 template <bool kLight>
-void AddWeights(const std::uint8_t* s, int lo, int hi, int shift, int threshold,
-                std::int64_t* weight_sum, std::int64_t* weighted) {
+void AddWeightsScalar(const std::uint8_t* s, int lo, int hi, int shift, int threshold,
+                      std::int64_t* weight_sum, std::int64_t* weighted) {
   constexpr int kChunk = 2048;
   for (int start = lo; start <= hi; start += kChunk) {
     const std::uint8_t* chunk = s + start + shift;
@@ -414,6 +421,53 @@ void AddWeights(const std::uint8_t* s, int lo, int hi, int shift, int threshold,
   }
 }
 
+// AddWeightsScalar with the same integer sums, 16 samples at a time with SSE2: the weights
+// are saturating byte differences, their sum one psadbw, their sum times the lane index one
+// pmaddwd. The 16-sample windows stay inside s[0, n) (n >= 16, 0 <= threshold <= 255): the
+// last one is moved back to end at n and its lanes already counted or outside [lo, hi] are
+// zeroed. Runs are short (tens of samples), so this saves the scalar loop's per-sample cost.
+template <bool kLight>
+void AddWeights(const std::uint8_t* s, int n, int lo, int hi, int shift, int threshold,
+                std::int64_t* weight_sum, std::int64_t* weighted) {
+#if defined(__SSE2__)
+  if (hi < lo) return;
+  if (n < 16 || threshold < 0 || threshold > 255) {
+    AddWeightsScalar<kLight>(s, lo, hi, shift, threshold, weight_sum, weighted);
+    return;
+  }
+  const __m128i t = _mm_set1_epi8(static_cast<char>(threshold));
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i lane = _mm_setr_epi8(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const __m128i lane_low = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m128i lane_high = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+  const int first = lo + shift, last = hi + shift;  // in s
+  std::int64_t total = 0, indexed = 0;              // sum of w, sum of (index in s) * w
+  for (int window = first; window <= last; window += 16) {
+    const int start = std::min(window, n - 16);
+    const __m128i pixels = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + start));
+    const __m128i all = kLight ? _mm_subs_epu8(pixels, t) : _mm_subs_epu8(t, pixels);
+    // Lanes before `window` (counted by the previous window) or after `last` are dropped.
+    const __m128i before = _mm_cmplt_epi8(lane, _mm_set1_epi8(static_cast<char>(window - start)));
+    const __m128i after =
+        _mm_cmpgt_epi8(lane, _mm_set1_epi8(static_cast<char>(std::min(last - start, 15))));
+    const __m128i weights = _mm_andnot_si128(_mm_or_si128(before, after), all);
+    const __m128i sums = _mm_sad_epu8(weights, zero);
+    const int block_weight = _mm_cvtsi128_si32(sums) + _mm_extract_epi16(sums, 4);
+    __m128i products = _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi8(weights, zero), lane_low),
+                                     _mm_madd_epi16(_mm_unpackhi_epi8(weights, zero), lane_high));
+    products = _mm_add_epi32(products, _mm_shuffle_epi32(products, _MM_SHUFFLE(1, 0, 3, 2)));
+    products = _mm_add_epi32(products, _mm_shuffle_epi32(products, _MM_SHUFFLE(2, 3, 0, 1)));
+    total += block_weight;
+    indexed += _mm_cvtsi128_si32(products) + static_cast<std::int64_t>(start) * block_weight;
+  }
+  *weight_sum += total;
+  *weighted += indexed - static_cast<std::int64_t>(shift) * total;  // loop coordinates
+#else
+  (void)n;
+  AddWeightsScalar<kLight>(s, lo, hi, shift, threshold, weight_sum, weighted);
+#endif
+}
+
 // The contrast-weighted centre of a run in loop coordinates (its midpoint if it has no
 // contrast). Weights are integers, so integer sums give the double sums exactly, faster.
 // A run across the loop's seam is summed in contiguous pieces.
@@ -421,10 +475,10 @@ template <bool kLight>
 double WeightedCentre(const std::uint8_t* s, int p, const Run& run, int threshold, double s_a,
                       double s_b) {
   std::int64_t weight_sum = 0, weighted = 0;
-  AddWeights<kLight>(s, run.first, std::min(run.last, -1), p, threshold, &weight_sum, &weighted);
-  AddWeights<kLight>(s, std::max(run.first, 0), std::min(run.last, p - 1), 0, threshold,
+  AddWeights<kLight>(s, p, run.first, std::min(run.last, -1), p, threshold, &weight_sum, &weighted);
+  AddWeights<kLight>(s, p, std::max(run.first, 0), std::min(run.last, p - 1), 0, threshold,
                      &weight_sum, &weighted);
-  AddWeights<kLight>(s, std::max(run.first, p), run.last, -p, threshold, &weight_sum, &weighted);
+  AddWeights<kLight>(s, p, std::max(run.first, p), run.last, -p, threshold, &weight_sum, &weighted);
   return weight_sum > 0 ? static_cast<double>(weighted) / static_cast<double>(weight_sum)
                         : 0.5 * (s_a + s_b);
 }
@@ -490,8 +544,10 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
 
     if (edges) {
       if (length >= p - options.min_width_px) continue;
-      if (!push(rect.ToPixel(s_a), 0.0, rect.Sides(s_a), true)) break;
-      if (!push(rect.ToPixel(s_b), 0.0, rect.Sides(s_b), true)) break;
+      Point2d a, b;
+      const std::uint8_t sides_a = rect.Locate(s_a, &a), sides_b = rect.Locate(s_b, &b);
+      if (!push(a, 0.0, sides_a, true)) break;
+      if (!push(b, 0.0, sides_b, true)) break;
       continue;
     }
     if (longer_than_max_run(length)) continue;
@@ -503,12 +559,11 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
       const double centre =
           light ? WeightedCentre<true>(samples.data(), p, run, threshold, s_a, s_b)
                 : WeightedCentre<false>(samples.data(), p, run, threshold, s_a, s_b);
-      pixel = rect.ToPixel(centre);
-      sides = rect.Sides(centre);
+      sides = rect.Locate(centre, &pixel);
     } else {
-      const Point2d a = rect.ToPixel(s_a), b = rect.ToPixel(s_b);
+      Point2d a, b;
+      sides = rect.Locate(s_a, &a) | rect.Locate(s_b, &b);
       pixel = Point2d{0.5 * (a.u + b.u), 0.5 * (a.v + b.v)};
-      sides = rect.Sides(s_a) | rect.Sides(s_b);
     }
     if (!push(pixel, length, sides, straight)) break;
   }

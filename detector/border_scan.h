@@ -35,6 +35,8 @@ struct BorderRect {
   /// Sides holding loop coordinate s; within `corner_px` (at most 1, the shortest side) of a
   /// corner both sides are set.
   std::uint8_t Sides(double s, double corner_px = 0.5) const;
+  /// ToPixel and Sides at once: returns Sides(s, corner_px) and sets *pixel to ToPixel(s).
+  std::uint8_t Locate(double s, Point2d* pixel, double corner_px = 0.5) const;
 };
 
 /// The border at distance d from the edges of a width x height image (may be invalid).

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <utility>
+#include <vector>
+
 #include "test_images.h"
 
 namespace oal {
@@ -89,6 +93,52 @@ TEST(BorderScan, RunMidpointIsIntensityWeighted) {
   EXPECT_EQ(points[0].sides, kTop);
   // Sub-pixel run ends: 9 + 72/100 and 13 + 68/140.
   EXPECT_NEAR(points[0].run_px, (13.0 + 68.0 / 140.0) - (9.0 + 72.0 / 100.0), kSubPixelTol);
+}
+
+// The weighted centres are summed 16 samples at a time where SSE2 is available: runs spanning
+// several windows, short runs, and runs in the last 16 samples of the loop (whose window is
+// moved back to end at the loop's end) must give the brute-force centroids, for both
+// polarities.
+TEST(BorderScan, WeightedCentresOfRunsAnywhereOnTheLoop) {
+  const BorderRect rect = BorderAt(60, 40, 0);  // loop of 196 samples, left side 157..195
+  const int p = rect.Perimeter();
+  std::vector<std::uint8_t> dark(static_cast<std::size_t>(p));
+  std::uint32_t state = 12345;  // a fixed linear congruential sequence: deterministic
+  auto next = [&state](int range) {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<int>((state >> 16) % static_cast<std::uint32_t>(range));
+  };
+  for (std::uint8_t& value : dark) value = static_cast<std::uint8_t>(190 + next(20));
+  const std::vector<std::pair<int, int>> runs = {{5, 9}, {20, 45}, {100, 103}, {180, 195}};
+  for (const auto& [first, last] : runs) {
+    for (int i = first; i <= last; ++i) dark[static_cast<std::size_t>(i)] = 20 + next(80);
+  }
+  DetectorOptions options = LineOptions();
+  options.max_width_px = 40.0;
+  for (const Polarity polarity : {Polarity::kDarkLines, Polarity::kLightLines}) {
+    options.polarity = polarity;
+    const bool light = polarity == Polarity::kLightLines;
+    std::vector<std::uint8_t> samples = dark;
+    if (light) {
+      for (std::uint8_t& value : samples) value = static_cast<std::uint8_t>(255 - value);
+    }
+    const int threshold = light ? 127 : 128;
+    std::vector<BorderPoint> points;
+    ASSERT_EQ(FindBorderPoints(samples, rect, threshold, options, &points),
+              static_cast<int>(runs.size()));
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      double weight_sum = 0.0, weighted = 0.0;
+      for (int i = runs[k].first; i <= runs[k].second; ++i) {
+        const int value = samples[static_cast<std::size_t>(i)];
+        const double weight = std::max(0, light ? value - threshold : threshold - value);
+        weight_sum += weight;
+        weighted += weight * i;
+      }
+      const Point2d expected = rect.ToPixel(weighted / weight_sum);
+      EXPECT_NEAR(points[k].pixel.u, expected.u, kSubPixelTol) << "run " << k;
+      EXPECT_NEAR(points[k].pixel.v, expected.v, kSubPixelTol) << "run " << k;
+    }
+  }
 }
 
 TEST(BorderScan, DeadPixelsAndTooWideRunsGiveNoPoint) {
