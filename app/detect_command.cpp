@@ -2,7 +2,6 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -13,6 +12,7 @@
 #include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
+#include "app/frame_command.h"
 #include "app/image_source.h"
 #include "app/json_io.h"
 #include "detector/detector.h"
@@ -20,20 +20,12 @@
 namespace oal {
 namespace {
 
-namespace fs = std::filesystem;
-
 DetectorOptions LoadDetectorOptions(const DetectCommandOptions& options) {
   AppConfig config;
   if (options.paper) config.detector = DetectorOptions::Paper();
   if (!options.config_path.empty()) config = LoadConfig(options.config_path, config);
   config.detector.Check();
   return config.detector;
-}
-
-std::string AnnotationName(int frame) {
-  std::string number = std::to_string(frame);
-  if (number.size() < 4) number.insert(0, 4 - number.size(), '0');
-  return "lines_" + number + ".png";
 }
 
 // Everything one run needs, opened before any output is started so that a bad input or
@@ -89,7 +81,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
       WriteJsonLine(sink, FrameJson(summary->frames, frame, time_us, undistorted, lines),
                     flush_each);
       if (!options.annotate_dir.empty()) {
-        WritePng(fs::path(options.annotate_dir) / AnnotationName(summary->frames),
+        WritePng(AnnotationPath(options, "lines", summary->frames),
                  AnnotateLines(frame.gray, lines, run->undistorted_by));
       }
       summary->lines += static_cast<int>(lines.size());
@@ -110,11 +102,8 @@ DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& ou
   std::optional<CameraFile> camera = LoadCamera(options);
   DetectRun run{MakeDetector(LoadDetectorOptions(options), camera), std::move(camera), {}, {}};
   if (run.detector.Undistorts()) run.undistorted_by = run.camera->camera;
-  for (const std::string& input : options.inputs) {
-    run.sources.push_back(OpenImageSource(input, &summary.warnings));
-  }
-  if (!options.annotate_dir.empty()) fs::create_directories(options.annotate_dir);
-  WriteToFileOrConsole(options.out_path, out, [&](std::ostream& sink, bool flush_each) {
+  run.sources = OpenInputs(options, &summary.warnings);
+  WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
   return summary;
@@ -126,10 +115,7 @@ int RunDetect(int argc, char** argv) {
       "Detect lines with the OAL detector. Prints one JSON object per frame (JSON "
       "Lines) to stdout, or writes them to --out.",
       "oalservo detect");
-  cli.add_option("INPUT", options.inputs,
-                 "image, directory of images, printf pattern (frames/img%04d.png), video file, "
-                 "or V4L2 device /dev/videoN")
-      ->required();
+  AddInputsArgument(cli, &options);
   cli.add_option("--config", options.config_path, "YAML configuration (see config/detector.yaml)");
   cli.add_flag("--paper", options.paper,
                "start from the paper's algorithm (every remedy off); --config still overrides");
@@ -137,10 +123,8 @@ int RunDetect(int argc, char** argv) {
                  "ViSP camera XML; with distortion (kdu), lines are in undistorted pixels");
   cli.add_option("--camera-name", options.camera_name,
                  "camera to read from --camera (default: the first in the file)");
-  cli.add_option("--out", options.out_path, "JSON Lines output file (written atomically)");
-  cli.add_option("--annotate", options.annotate_dir,
-                 "directory for one PNG per frame with the lines drawn (created if missing)");
-  cli.add_option("--max-frames", options.max_frames, "stop after N frames (0: all)");
+  AddOutputOptions(cli, &options,
+                   "directory for one PNG per frame with the lines drawn (created if missing)");
   cli.footer(
       "Examples:\n"
       "  oalservo detect frames/ --out lines.jsonl --annotate annotated/\n"

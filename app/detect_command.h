@@ -13,25 +13,19 @@
 #include <string>
 #include <vector>
 
+#include "app/frame_command.h"
+
 namespace oal {
 
-struct DetectCommandOptions {
-  /// Image, directory, printf pattern, video or /dev/videoN; read one after the other.
-  std::vector<std::string> inputs;
+/// FrameCommandOptions: inputs; camera_name from camera_path; out_path (empty: the stream
+/// passed to DetectImages()); annotate_dir (lines_0000.png...); max_frames.
+struct DetectCommandOptions : FrameCommandOptions {
   /// YAML configuration (config/detector.yaml); empty: none.
   std::string config_path;
   /// Start from DetectorOptions::Paper() instead of the defaults; the config still overrides.
   bool paper = false;
   /// ViSP camera XML; empty: no camera (lines in image coordinates).
   std::string camera_path;
-  /// Camera to read from camera_path; empty: the first camera of the file.
-  std::string camera_name;
-  /// JSON Lines output, written atomically; empty: the stream passed to DetectImages().
-  std::string out_path;
-  /// Directory for one annotated PNG per frame (lines_0000.png...); empty: none.
-  std::string annotate_dir;
-  /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
-  int max_frames = 0;
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;

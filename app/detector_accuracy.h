@@ -3,26 +3,19 @@
 // same frames. Deterministic for a given seed.
 #pragma once
 
-#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "app/accuracy_frames.h"
 #include "detector/options.h"
 #include "scene/scene.h"
 
 namespace oal {
 
-struct AccuracyOptions {
+/// RenderedFrameOptions (frames, seed, camera, degradations) and what this evaluation adds.
+struct AccuracyOptions : RenderedFrameOptions {
   std::string target = "four-line";
-  int frames = 1000;       ///< rendered frames, [1, 1000000]
-  std::uint64_t seed = 1;  ///< poses and noise
-  int width = 640, height = 480;
-  double focal_px = 600.0;
-  double kdu = 0.33;         ///< cheap wide lens (barrel, k1 ≈ -0.25)
-  double noise_sigma = 8.0;  ///< grey levels
-  double blur_sigma_px = 1.0;
-  double illumination_gradient = 0.2;
   /// A target line fails when its best match among the first N detected lines (N = number
   /// of target lines) is further than either bound.
   double max_angle_deg = 1.0;

@@ -3,11 +3,10 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iomanip>
-#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/atomic_file.h"
+#include "app/accuracy_frames.h"
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/detector_accuracy.h"
@@ -35,19 +34,11 @@ std::string Table(const AccuracyReport& report) {
 nlohmann::json ToJson(const AccuracyReport& report) {
   const AccuracyOptions& o = report.options;
   nlohmann::json json;
-  json["options"] = {{"target", o.target},
-                     {"frames", o.frames},
-                     {"seed", o.seed},
-                     {"width", o.width},
-                     {"height", o.height},
-                     {"focal_px", o.focal_px},
-                     {"kdu", o.kdu},
-                     {"noise_sigma", o.noise_sigma},
-                     {"blur_sigma_px", o.blur_sigma_px},
-                     {"illumination_gradient", o.illumination_gradient},
-                     {"max_angle_deg", o.max_angle_deg},
-                     {"max_offset_px", o.max_offset_px},
-                     {"min_visible_length_px", o.sampling.min_visible_length_px}};
+  json["options"] = RenderedFrameJson(o);
+  json["options"]["target"] = o.target;
+  json["options"]["max_angle_deg"] = o.max_angle_deg;
+  json["options"]["max_offset_px"] = o.max_offset_px;
+  json["options"]["min_visible_length_px"] = o.sampling.min_visible_length_px;
   for (const MethodAccuracy& m : report.methods) {
     json["methods"].push_back({{"name", m.name},
                                {"reference", m.reference},
@@ -77,14 +68,7 @@ int RunDetectAccuracy(int argc, char** argv) {
   AccuracyOptions options;
   std::string config_path, out_path;
   cli.add_option("--target", options.target, "two-line or four-line")->capture_default_str();
-  cli.add_option("--frames", options.frames, "number of rendered frames")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
-  cli.add_option("--seed", options.seed, "seed of poses and noise")->capture_default_str();
-  cli.add_option("--kdu", options.kdu, "lens distortion (ViSP kdu; 0.33 = cheap wide lens)")
-      ->capture_default_str();
-  cli.add_option("--noise", options.noise_sigma, "noise sigma, grey levels")->capture_default_str();
-  cli.add_option("--blur", options.blur_sigma_px, "blur sigma, pixels")->capture_default_str();
+  AddRenderedFrameOptions(cli, &options, "lens distortion (ViSP kdu; 0.33 = cheap wide lens)");
   cli.add_option("--gradient", options.illumination_gradient, "illumination fall-off, 0..0.9")
       ->capture_default_str();
   cli.add_option("--min-visible-px", options.sampling.min_visible_length_px,
@@ -103,8 +87,7 @@ int RunDetectAccuracy(int argc, char** argv) {
 
   if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
   const AccuracyReport report = EvaluateDetectorAccuracy(options, TerminalFrameProgress());
-  std::cout << Table(report);
-  if (!out_path.empty()) WriteFileAtomically(out_path, ToJson(report).dump(2) + '\n');
+  PrintAccuracyReport(Table(report), ToJson(report), out_path);
   return kExitOk;
 }
 

@@ -40,15 +40,7 @@ void PoseAccuracyOptions::Check() const {
 PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
                                         const std::function<void(int, int)>& progress) {
   options.Check();
-  RenderOptions render;
-  render.width = options.width;
-  render.height = options.height;
-  render.camera =
-      CameraWithKdu(options.focal_px, options.focal_px, 0.5 * (options.width - 1),
-                    0.5 * (options.height - 1), options.kdu, options.width, options.height);
-  render.noise_sigma = options.noise_sigma;
-  render.blur_sigma_px = options.blur_sigma_px;
-  render.illumination_gradient = options.illumination_gradient;
+  const RenderOptions render = MakeRenderOptions(options);
   const SceneRenderer renderer(FourLineTarget(), render);
 
   OalDetector detector(options.detector, render.camera);

@@ -4,25 +4,18 @@
 #pragma once
 
 #include <array>
-#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "app/accuracy_frames.h"
 #include "detector/options.h"
 #include "scene/scene.h"
 
 namespace oal {
 
-struct PoseAccuracyOptions {
-  int frames = 1000;       ///< [1, 1000000]
-  std::uint64_t seed = 1;  ///< poses and noise
-  int width = 640, height = 480;
-  double focal_px = 600.0;
-  double kdu = 0.33;  ///< the detector evaluation's cheap wide lens
-  double noise_sigma = 8.0;
-  double blur_sigma_px = 1.0;
-  double illumination_gradient = 0.2;
+/// RenderedFrameOptions (the detector evaluation's frames and lens) and the pose sampling.
+struct PoseAccuracyOptions : RenderedFrameOptions {
   PoseSampling sampling = DefaultSampling();
   DetectorOptions detector;
 

@@ -3,11 +3,10 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iomanip>
-#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/atomic_file.h"
+#include "app/accuracy_frames.h"
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/detector_accuracy.h"  // Quantile
@@ -46,20 +45,12 @@ std::string Table(const PoseAccuracyReport& r) {
 
 nlohmann::json ToJson(const PoseAccuracyReport& r) {
   const PoseAccuracyOptions& o = r.options;
-  return {{"options",
-           {{"frames", o.frames},
-            {"seed", o.seed},
-            {"width", o.width},
-            {"height", o.height},
-            {"focal_px", o.focal_px},
-            {"kdu", o.kdu},
-            {"noise_sigma", o.noise_sigma},
-            {"blur_sigma_px", o.blur_sigma_px},
-            {"illumination_gradient", o.illumination_gradient},
-            {"min_distance_m", o.sampling.min_distance_m},
-            {"max_distance_m", o.sampling.max_distance_m},
-            {"max_tilt_deg", o.sampling.max_tilt_deg},
-            {"min_visible_length_px", o.sampling.min_visible_length_px}}},
+  nlohmann::json options = RenderedFrameJson(o);
+  options["min_distance_m"] = o.sampling.min_distance_m;
+  options["max_distance_m"] = o.sampling.max_distance_m;
+  options["max_tilt_deg"] = o.sampling.max_tilt_deg;
+  options["min_visible_length_px"] = o.sampling.min_visible_length_px;
+  return {{"options", std::move(options)},
           {"frames", r.frames},
           {"posed", r.posed()},
           {"status_counts", r.status_counts},
@@ -84,13 +75,7 @@ int RunPoseAccuracy(int argc, char** argv) {
       "oalservo pose-accuracy"};
   PoseAccuracyOptions options;
   std::string config_path, out_path;
-  cli.add_option("--frames", options.frames, "number of rendered frames")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
-  cli.add_option("--seed", options.seed, "seed of poses and noise")->capture_default_str();
-  cli.add_option("--kdu", options.kdu, "lens distortion (ViSP kdu)")->capture_default_str();
-  cli.add_option("--noise", options.noise_sigma, "noise sigma, grey levels")->capture_default_str();
-  cli.add_option("--blur", options.blur_sigma_px, "blur sigma, pixels")->capture_default_str();
+  AddRenderedFrameOptions(cli, &options, "lens distortion (ViSP kdu)");
   cli.add_option("--min-distance", options.sampling.min_distance_m, "metres")
       ->capture_default_str();
   cli.add_option("--max-distance", options.sampling.max_distance_m, "metres")
@@ -104,8 +89,7 @@ int RunPoseAccuracy(int argc, char** argv) {
 
   if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
   const PoseAccuracyReport report = EvaluatePoseAccuracy(options, TerminalFrameProgress());
-  std::cout << Table(report);
-  if (!out_path.empty()) WriteFileAtomically(out_path, ToJson(report).dump(2) + '\n');
+  PrintAccuracyReport(Table(report), ToJson(report), out_path);
   return kExitOk;
 }
 

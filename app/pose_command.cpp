@@ -16,6 +16,7 @@
 #include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
+#include "app/frame_command.h"
 #include "app/image_source.h"
 #include "app/json_io.h"
 #include "detector/detector.h"
@@ -26,12 +27,6 @@ namespace oal {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string AnnotationName(int frame) {
-  std::string number = std::to_string(frame);
-  if (number.size() < 4) number.insert(0, 4 - number.size(), '0');
-  return "pose_" + number + ".png";
-}
 
 // The camera file: --camera, or the camera.xml `oalservo render` writes next to its frames
 // (in the first input if it is a directory, else in the first input's directory).
@@ -153,7 +148,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
       WriteJsonLine(sink, FrameJson(summary->frames, frame, undistorted, pose, detect_us, pose_us),
                     flush_each);
       if (!options.annotate_dir.empty()) {
-        WritePng(fs::path(options.annotate_dir) / AnnotationName(summary->frames),
+        WritePng(AnnotationPath(options, "pose", summary->frames),
                  AnnotatePose(frame.gray, lines, pose, run->camera.camera, run->undistorted_by));
       }
       if (pose.status == PoseStatus::kOk) {
@@ -189,11 +184,8 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   OalDetector detector(config.detector, camera.camera);
   PoseRun run{std::move(config), std::move(camera), std::move(detector), {}, {}};
   if (run.detector.Undistorts()) run.undistorted_by = run.camera.camera;
-  for (const std::string& input : options.inputs) {
-    run.sources.push_back(OpenImageSource(input, &summary.warnings));
-  }
-  if (!options.annotate_dir.empty()) fs::create_directories(options.annotate_dir);
-  WriteToFileOrConsole(options.out_path, out, [&](std::ostream& sink, bool flush_each) {
+  run.sources = OpenInputs(options, &summary.warnings);
+  WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
   return summary;
@@ -205,10 +197,7 @@ int RunPose(int argc, char** argv) {
       "Camera pose from the four-line target (or the config's target) in every frame. Prints "
       "one JSON object per frame (JSON Lines) to stdout, or writes them to --out.",
       "oalservo pose");
-  cli.add_option("INPUT", options.inputs,
-                 "image, directory of images, printf pattern (frames/img%04d.png), video file, "
-                 "or V4L2 device /dev/videoN")
-      ->required();
+  AddInputsArgument(cli, &options);
   cli.add_option("--config", options.config_path,
                  "YAML configuration: detector, target and pose sections (see config/pose.yaml)");
   cli.add_option("--camera", options.camera_path,
@@ -216,11 +205,9 @@ int RunPose(int argc, char** argv) {
                  "camera.xml, as `oalservo render` writes)");
   cli.add_option("--camera-name", options.camera_name,
                  "camera to read from the camera file (default: the first in the file)");
-  cli.add_option("--out", options.out_path, "JSON Lines output file (written atomically)");
-  cli.add_option("--annotate", options.annotate_dir,
-                 "directory for one PNG per frame with lines 1-4 and the target's axes drawn "
-                 "(created if missing)");
-  cli.add_option("--max-frames", options.max_frames, "stop after N frames (0: all)");
+  AddOutputOptions(cli, &options,
+                   "directory for one PNG per frame with lines 1-4 and the target's axes drawn "
+                   "(created if missing)");
   cli.footer(
       "Examples:\n"
       "  oalservo render --count 20 --out data/ && oalservo pose data/ --out poses.jsonl\n"

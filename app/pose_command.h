@@ -26,24 +26,18 @@
 #include <string>
 #include <vector>
 
+#include "app/frame_command.h"
+
 namespace oal {
 
-struct PoseCommandOptions {
-  /// Image, directory, printf pattern, video or /dev/videoN (app/image_source.h).
-  std::vector<std::string> inputs;
+/// FrameCommandOptions: inputs; camera_name from the camera file; out_path (empty: the
+/// stream passed to EstimatePoses()); annotate_dir (pose_0000.png...); max_frames.
+struct PoseCommandOptions : FrameCommandOptions {
   /// YAML configuration: `detector:`, `target:` (default four-line) and `pose:` sections
   /// (config/detector.yaml, config/four-line-target.yaml, config/pose.yaml); empty: none.
   std::string config_path;
   /// ViSP camera XML; empty: camera.xml in the first input's directory, else an error.
   std::string camera_path;
-  /// Camera to read from the camera file; empty: the first camera of the file.
-  std::string camera_name;
-  /// JSON Lines output, written atomically; empty: the stream passed to EstimatePoses().
-  std::string out_path;
-  /// Directory for one annotated PNG per frame (pose_0000.png...); empty: none.
-  std::string annotate_dir;
-  /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
-  int max_frames = 0;
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;

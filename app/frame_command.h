@@ -1,0 +1,58 @@
+// What the commands over image sources (`oalservo detect`, `oalservo pose`) share: their
+// inputs and outputs, opened and written the same way.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/atomic_file.h"
+
+namespace CLI {
+class App;
+}  // namespace CLI
+
+namespace oal {
+
+class ImageSource;
+
+/// The inputs and outputs of a command over image sources; each command adds its own options.
+struct FrameCommandOptions {
+  /// Image, directory, printf pattern, video or /dev/videoN (app/image_source.h); read one
+  /// after the other.
+  std::vector<std::string> inputs;
+  /// Camera to read from the command's camera file; empty: the first camera of the file.
+  std::string camera_name;
+  /// JSON Lines output, written atomically; empty: the stream passed to the command's function.
+  std::string out_path;
+  /// Directory for one annotated PNG per frame (<prefix>_0000.png...); empty: none.
+  std::string annotate_dir;
+  /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
+  int max_frames = 0;
+};
+
+/// Opens every input of `options` in order; files skipped in a directory go to `warnings`.
+std::vector<std::unique_ptr<ImageSource>> OpenInputs(const FrameCommandOptions& options,
+                                                     std::vector<std::string>* warnings);
+
+/// Where frame `frame`'s annotated PNG goes: annotate_dir / "<prefix>_0007.png".
+std::filesystem::path AnnotationPath(const FrameCommandOptions& options, const std::string& prefix,
+                                     int frame);
+
+/// Creates annotate_dir if set, then WriteToFileOrConsole(out_path, console, write).
+template <typename Write>
+void WriteFrameRecords(const FrameCommandOptions& options, std::ostream& console, Write write) {
+  if (!options.annotate_dir.empty()) std::filesystem::create_directories(options.annotate_dir);
+  WriteToFileOrConsole(options.out_path, console, write);
+}
+
+/// Adds the INPUT argument (required) to a command's command line.
+void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options);
+
+/// Adds --out, --annotate (described by `annotate_help`) and --max-frames.
+void AddOutputOptions(CLI::App& cli, FrameCommandOptions* options,
+                      const std::string& annotate_help);
+
+}  // namespace oal
