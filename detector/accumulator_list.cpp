@@ -66,6 +66,8 @@ OrderedAccumulatorList::OrderedAccumulatorList(double angle_change_rad, double r
       capacity_(std::max(capacity, max_lines)) {
   const auto reserved = static_cast<std::size_t>(capacity_);
   entries_.reserve(reserved);
+  order_.reserve(reserved);
+  moved_.reserve(reserved);
   const auto padded = static_cast<std::size_t>(RoundUpToBlocks(capacity_));
   match_cos_.assign(padded, 0.0f);
   match_sin_.assign(padded, 0.0f);
@@ -219,26 +221,41 @@ OalEntry& OrderedAccumulatorList::Append(double cos_theta, double sin_theta, dou
 }
 
 void OrderedAccumulatorList::SortAndCull() {
-  // A stable insertion sort of the entries themselves: after a border the list is nearly in
-  // order (the paper's argument for reordering every border), so few entries move: those
-  // voted for, and the new ones at the end, which rise past the stale hypotheses. An entry
-  // moves past lower scores only, so of equal scores the older stays first.
+  // The order is found on small keys, by a stable insertion sort: after a border the list
+  // is nearly in order (the paper's argument for reordering every border), so few keys move:
+  // those of the entries voted for, and of the new ones at the end, which rise past the
+  // stale hypotheses. A key moves past lower scores only, so of equal scores the older entry
+  // stays first. Then only the entries from the first moved place on are rewritten.
   const std::size_t size = entries_.size();
+  order_.resize(size);  // within the reserved capacity
+  for (std::size_t i = 0; i < size; ++i) {
+    order_[i].double_score = entries_[i].DoubleScore();
+    order_[i].index = static_cast<int>(i);
+  }
+  std::size_t first_moved = size;
   for (std::size_t i = 1; i < size; ++i) {
-    const int score = entries_[i].DoubleScore();
-    if (score <= entries_[i - 1].DoubleScore()) continue;  // in place: the common case
-    const OalEntry moving = entries_[i];
+    const SortKey key = order_[i];
+    if (key.double_score <= order_[i - 1].double_score) continue;  // in place: the common case
     std::size_t hole = i;
     do {
-      entries_[hole] = entries_[hole - 1];
+      order_[hole] = order_[hole - 1];
       --hole;
-    } while (hole > 0 && score > entries_[hole - 1].DoubleScore());
-    entries_[hole] = moving;
-    for (std::size_t k = hole; k <= i; ++k) Mirror(k);
+    } while (hole > 0 && key.double_score > order_[hole - 1].double_score);
+    order_[hole] = key;
+    first_moved = std::min(first_moved, hole);
   }
   // Step 5: cull from the bottom while the list is longer than max_lines.
   std::size_t keep = size;
-  while (static_cast<int>(keep) > max_lines_ && entries_[keep - 1].DoubleScore() < 0) --keep;
+  while (static_cast<int>(keep) > max_lines_ && order_[keep - 1].double_score < 0) --keep;
+  if (first_moved < keep) {
+    moved_.clear();
+    for (std::size_t k = first_moved; k < keep; ++k) {
+      moved_.push_back(entries_[static_cast<std::size_t>(order_[k].index)]);
+    }
+    std::copy(moved_.begin(), moved_.end(),
+              entries_.begin() + static_cast<std::ptrdiff_t>(first_moved));
+    for (std::size_t k = first_moved; k < keep; ++k) Mirror(k);
+  }
   entries_.resize(keep);  // only shrinks: no allocation
 }
 

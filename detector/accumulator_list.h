@@ -84,6 +84,13 @@ class OrderedAccumulatorList {
   int max_lines_;
   int capacity_;
   std::vector<OalEntry> entries_;
+  // SortAndCull's working memory (capacity reserved).
+  struct SortKey {
+    int double_score;
+    int index;
+  };
+  std::vector<SortKey> order_;
+  std::vector<OalEntry> moved_;
   // The entries' normals and rho in float, in list order (capacity rounded up to whole
   // SIMD blocks): matching, the detector's hottest loop, scans these compact arrays rather
   // than the entries.
