@@ -85,6 +85,21 @@ void Oal(benchmark::State& state, const std::string& target, bool undistort) {
   state.counters["lines"] = static_cast<double>(found);
 }
 
+// The four-line 640x480 frame with a border every state.range(0) px (the paper: 5; the servo
+// configuration, config/servo-sim.yaml: 10), points undistorted.
+void OalBorderStep(benchmark::State& state) {
+  const RenderedFrame& frame = Frame("four-line", 640, 480);
+  DetectorOptions options;
+  options.step_px = static_cast<int>(state.range(0));
+  OalDetector detector(options, CheapCamera(640, 480).camera);
+  std::size_t found = 0;
+  for (auto _ : state) {
+    found = detector.Detect(frame.image).size();
+    benchmark::ClobberMemory();
+  }
+  state.counters["lines"] = static_cast<double>(found);
+}
+
 void OalPaper(benchmark::State& state) {
   const RenderedFrame& frame = Frame("four-line", 640, 480);
   OalDetector detector(DetectorOptions::Paper());
@@ -165,6 +180,7 @@ BENCHMARK_CAPTURE(Oal, four_line, std::string("four-line"), true)
 BENCHMARK_CAPTURE(Oal, four_line_no_undistortion, std::string("four-line"), false)
     ->Args({640, 480})
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK(OalBorderStep)->Arg(5)->Arg(10)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalPaper)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalLineCount)->Arg(1)->Arg(2)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK(CvThresholdCannyHough)->Unit(benchmark::kMicrosecond);
