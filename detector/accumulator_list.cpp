@@ -6,9 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "detector/simd.h"
 
 namespace oal {
 namespace {
@@ -80,7 +78,7 @@ void OrderedAccumulatorList::Mirror(std::size_t i) {
   match_rho_[i] = static_cast<float>(entries_[i].rho_px);
 }
 
-#if defined(__GNUC__)
+#if OAL_HAVE_VECTOR_EXTENSIONS
 // The scalar loop below, kMatchBlock entries at a time (GCC/Clang vector extensions: SSE2 on
 // x86-64, NEON on ARM). The lanes compute exactly the scalar loop's float expressions.
 int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, double rho_px) const {
@@ -124,7 +122,7 @@ int OrderedAccumulatorList::FirstMatch(double cos_theta, double sin_theta, doubl
   const int size = static_cast<int>(entries_.size());
   for (int i = 0; i < size; i += kMatchBlock) {
     const Ints low = matches(i), high = matches(i + kMatchLanes);
-#if defined(__SSE2__)
+#if OAL_HAVE_SSE2
     // One bit per lane, from the lanes' sign bits.
     __m128 low_lanes, high_lanes;
     std::memcpy(&low_lanes, &low, sizeof(low_lanes));

@@ -5,9 +5,7 @@
 #include <cmath>
 #include <cstring>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "detector/simd.h"
 
 namespace oal {
 namespace {
@@ -268,13 +266,13 @@ std::uint64_t LineMaskScalar(const std::uint8_t* s, int n, int threshold) {
   return mask;
 }
 
-#if defined(__GNUC__)
+#if OAL_HAVE_VECTOR_EXTENSIONS
 typedef std::uint8_t Bytes16 __attribute__((vector_size(16)));
 typedef std::int8_t ByteMasks16 __attribute__((vector_size(16)));  // comparison results
 
 // Bit k of the result is the top bit of byte k of `on`.
 std::uint32_t MoveMask(ByteMasks16 on) {
-#if defined(__SSE2__)
+#if OAL_HAVE_SSE2
   __m128i bytes;
   std::memcpy(&bytes, &on, sizeof(bytes));
   return static_cast<std::uint32_t>(_mm_movemask_epi8(bytes));
@@ -300,7 +298,7 @@ std::uint32_t MoveMask(ByteMasks16 on) {
 // 0 <= threshold <= 255.
 template <bool kLight>
 std::uint64_t LineMask64(const std::uint8_t* s, int threshold) {
-#if defined(__GNUC__)
+#if OAL_HAVE_VECTOR_EXTENSIONS
   const auto t = static_cast<std::uint8_t>(threshold);
   std::uint64_t mask = 0;
   for (int block = 0; block < 4; ++block) {
@@ -429,7 +427,7 @@ void AddWeightsScalar(const std::uint8_t* s, int lo, int hi, int shift, int thre
 template <bool kLight>
 void AddWeights(const std::uint8_t* s, int n, int lo, int hi, int shift, int threshold,
                 std::int64_t* weight_sum, std::int64_t* weighted) {
-#if defined(__SSE2__)
+#if OAL_HAVE_SSE2
   if (hi < lo) return;
   if (n < 16 || threshold < 0 || threshold > 255) {
     AddWeightsScalar<kLight>(s, lo, hi, shift, threshold, weight_sum, weighted);

@@ -6,9 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "detector/simd.h"
 
 namespace oal {
 namespace {
@@ -73,7 +71,7 @@ OalDetector::BorderOutline::BorderOutline(const std::vector<Point2d>& outline) {
 // The highest distance of a point along the line's normal is above rho and the lowest
 // below: the same decisions as testing each point's sign of distance - rho.
 bool OalDetector::BorderOutline::Crossed(const OalEntry& entry) const {
-#if defined(__SSE2__)
+#if OAL_HAVE_SSE2
   // Two points at a time.
   const __m128d c = _mm_set1_pd(entry.cos_theta), s = _mm_set1_pd(entry.sin_theta);
   auto distances = [&](std::size_t k) {
