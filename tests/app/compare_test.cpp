@@ -10,6 +10,7 @@
 #include <string>
 
 #include "app/render_command.h"
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -31,28 +32,17 @@ const char* const kMethods[] = {"oal",
 
 // Six rendered frames of 320x240 (fx scaled from 600 at 640x480), lines long enough to find.
 std::string RenderShort(const test::TestDir& dir) {
-  RenderCommandOptions render;
-  render.out_dir = dir / "data";
-  render.count = kFrames;
-  render.seed = 3;
-  render.width = 320;
-  render.height = 240;
-  render.fx_px = 300.0;
+  RenderCommandOptions render = test::ScaledRender(dir / "data", kFrames, 3, 320, 240);
   render.noise_sigma = 2.0;
   render.blur_sigma_px = 0.7;
   render.max_tilt_deg = 20.0;
   render.min_visible_px = 100.0;
-  EXPECT_EQ(RenderDataset(render), kFrames);
-  return render.out_dir;
+  return test::RenderChecked(render);
 }
 
+// The message RunComparison throws with, or "" if it succeeds.
 std::string CompareError(const CompareOptions& options) {
-  try {
-    RunComparison(options);
-  } catch (const std::exception& error) {
-    return error.what();
-  }
-  return "";
+  return test::ErrorMessageOf([&] { RunComparison(options); });
 }
 
 TEST(Compare, RenderedSequenceGivesOneRowPerMethod) {

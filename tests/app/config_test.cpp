@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -15,12 +16,7 @@ using ::testing::HasSubstr;
 
 // The message of the std::runtime_error `yaml` raises, or "" if it loads.
 std::string ErrorOf(const std::string& yaml) {
-  try {
-    ParseConfig(yaml, "cfg.yaml");
-  } catch (const std::runtime_error& error) {
-    return error.what();
-  }
-  return "";
+  return test::ConfigErrorOf(yaml, "cfg.yaml");
 }
 
 void ExpectSameOptions(const DetectorOptions& a, const DetectorOptions& b) {
@@ -272,32 +268,37 @@ std::string TargetWithLine(const std::string& line) {
 }
 
 TEST(ConfigTarget, MalformedLinesNameFileLineAndKey) {
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0, 0], width: 0.01}")),
-            "cfg.yaml:6: 'target.lines[0]' has from == to = [0, 0]: a line needs two different "
-            "ends");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0}")),
-            "cfg.yaml:6: 'target.lines[0].width' must be > 0 (metres), got '0'");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: -0.01}")),
-            "cfg.yaml:6: 'target.lines[0].width' must be > 0 (metres), got '-0.01'");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.25, 0], width: 0.01}")),
-            "cfg.yaml:6: 'target.lines[0].to' = [0.25, 0] lies outside the board (|x| <= 0.2, "
-            "|y| <= 0.15 m: the board is centred on the origin)");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1], width: 0.01}")),
-            "cfg.yaml:6: 'target.lines[0].to' must be a point [x, y] in metres, got 'a "
-            "sequence of 1'");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, a], to: [0.1, 0], width: 0.01}")),
-            "cfg.yaml:6: 'target.lines[0].from[1]' must be a number, got 'a'");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, .inf], to: [0.1, 0], width: 0.01}")),
-            "cfg.yaml:6: 'target.lines[0].from[1]' must be a finite number, got '.inf'");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0]}")),
-            "cfg.yaml:6: 'target.lines[0]' has no 'width' (a line needs from, to, width)");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0.01, colour: 3}")),
-            "cfg.yaml:6: key 'target.lines[0].colour' is unknown (known: from, to, width)");
-  EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], from: [0, 0.1], width: 1}")),
-            "cfg.yaml:6: key 'target.lines[0].from' is repeated (first at line 6)");
-  EXPECT_EQ(ErrorOf(TargetWithLine("[0, 0, 0.1, 0]")),
-            "cfg.yaml:6: 'target.lines[0]' must be a map {from: [x, y], to: [x, y], width: w}, got "
-            "'a sequence'");
+  // The only entry of `lines:` and the message it raises.
+  const struct {
+    const char* line;
+    const char* message;
+  } kCases[] = {
+      {"{from: [0, 0], to: [0, 0], width: 0.01}",
+       "cfg.yaml:6: 'target.lines[0]' has from == to = [0, 0]: a line needs two different ends"},
+      {"{from: [0, 0], to: [0.1, 0], width: 0}",
+       "cfg.yaml:6: 'target.lines[0].width' must be > 0 (metres), got '0'"},
+      {"{from: [0, 0], to: [0.1, 0], width: -0.01}",
+       "cfg.yaml:6: 'target.lines[0].width' must be > 0 (metres), got '-0.01'"},
+      {"{from: [0, 0], to: [0.25, 0], width: 0.01}",
+       "cfg.yaml:6: 'target.lines[0].to' = [0.25, 0] lies outside the board (|x| <= 0.2, "
+       "|y| <= 0.15 m: the board is centred on the origin)"},
+      {"{from: [0, 0], to: [0.1], width: 0.01}",
+       "cfg.yaml:6: 'target.lines[0].to' must be a point [x, y] in metres, got 'a sequence of 1'"},
+      {"{from: [0, a], to: [0.1, 0], width: 0.01}",
+       "cfg.yaml:6: 'target.lines[0].from[1]' must be a number, got 'a'"},
+      {"{from: [0, .inf], to: [0.1, 0], width: 0.01}",
+       "cfg.yaml:6: 'target.lines[0].from[1]' must be a finite number, got '.inf'"},
+      {"{from: [0, 0], to: [0.1, 0]}",
+       "cfg.yaml:6: 'target.lines[0]' has no 'width' (a line needs from, to, width)"},
+      {"{from: [0, 0], to: [0.1, 0], width: 0.01, colour: 3}",
+       "cfg.yaml:6: key 'target.lines[0].colour' is unknown (known: from, to, width)"},
+      {"{from: [0, 0], to: [0.1, 0], from: [0, 0.1], width: 1}",
+       "cfg.yaml:6: key 'target.lines[0].from' is repeated (first at line 6)"},
+      {"[0, 0, 0.1, 0]",
+       "cfg.yaml:6: 'target.lines[0]' must be a map {from: [x, y], to: [x, y], width: w}, got "
+       "'a sequence'"},
+  };
+  for (const auto& c : kCases) EXPECT_EQ(ErrorOf(TargetWithLine(c.line)), c.message) << c.line;
   // The second entry, on its own line.
   EXPECT_EQ(ErrorOf(TargetWithLine("{from: [0, 0], to: [0.1, 0], width: 0.01}\n"
                                    "    - {from: [0, 0], to: [0.1, -0.2], width: 0.01}")),

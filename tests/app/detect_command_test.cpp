@@ -12,6 +12,7 @@
 #include <string>
 
 #include "app/render_command.h"
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -23,17 +24,10 @@ using ::testing::HasSubstr;
 
 // A small rendered data set: `count` frames of 160x120 (fx scaled from 600 at 640x480).
 std::string RenderSmall(const test::TestDir& dir, int count, double kdu) {
-  RenderCommandOptions render;
-  render.out_dir = dir / "data";
-  render.count = count;
-  render.seed = 7;
-  render.width = 160;
-  render.height = 120;
-  render.fx_px = 150.0;
+  RenderCommandOptions render = test::ScaledRender(dir / "data", count, 7, 160, 120);
   render.kdu = kdu;
   render.min_visible_px = 30.0;
-  EXPECT_EQ(RenderDataset(render), count);
-  return render.out_dir;
+  return test::RenderChecked(render);
 }
 
 using test::ParseJsonLines;
@@ -62,12 +56,7 @@ void ExpectWellFormedFrame(const json& frame, int index, int width, int height,
 // The message DetectImages throws with, or "" if it succeeds.
 std::string DetectError(const DetectCommandOptions& options) {
   std::ostringstream out;
-  try {
-    DetectImages(options, out);
-  } catch (const std::exception& error) {
-    return error.what();
-  }
-  return "";
+  return test::ErrorMessageOf([&] { DetectImages(options, out); });
 }
 
 TEST(Detect, RenderedDirectoryGivesOneJsonLinePerFrame) {

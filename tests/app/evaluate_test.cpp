@@ -25,6 +25,7 @@
 #include "app/render_command.h"
 #include "app/report.h"
 #include "app/truth_file.h"
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -49,17 +50,10 @@ std::string FrameName(int index, const char* extension) {
 // `count` rendered 320x240 frames of the four-line target, with truth JSON and camera.xml.
 std::string RenderFrames(const test::TestDir& dir, const std::string& name, int count,
                          std::uint64_t seed = 11) {
-  RenderCommandOptions render;
-  render.out_dir = dir / name;
-  render.count = count;
-  render.seed = seed;
-  render.width = 320;
-  render.height = 240;
-  render.fx_px = 300.0;
+  RenderCommandOptions render = test::ScaledRender(dir / name, count, seed, 320, 240);
   render.noise_sigma = 2.0;
   render.min_visible_px = 60.0;
-  EXPECT_EQ(RenderDataset(render), count);
-  return render.out_dir;
+  return test::RenderChecked(render);
 }
 
 // The rendered frames of `frames_dir` as an MJPG AVI (OpenCV's own encoder).
@@ -254,11 +248,7 @@ TEST(Evaluate, VideoWithTruthCsvReportsTheKnownErrors) {
 
 TEST(Evaluate, SmoothSequenceHasNoPoseJump) {
   test::TestDir dir;
-  RenderCommandOptions render;
-  render.out_dir = dir / "slow";
-  render.sequence = "slow";
-  render.count = 12;
-  render.seed = 3;
+  const RenderCommandOptions render = test::SequenceRender(dir / "slow", "slow", 12, 3);
   ASSERT_EQ(RenderDataset(render), 12);
   EvaluateOptions options = Options({render.out_dir}, dir / "out");
   options.write_video = false;

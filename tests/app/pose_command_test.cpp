@@ -14,6 +14,7 @@
 
 #include "app/config.h"
 #include "app/render_command.h"
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -29,18 +30,11 @@ constexpr double kTranslationTolerance = 0.02;  // of the true translation's nor
 // from 600 at 640x480), with camera.xml.
 std::string RenderSmall(const test::TestDir& dir, const std::string& name, int count, double kdu,
                         const std::string& target = "four-line") {
-  RenderCommandOptions render;
-  render.out_dir = dir / name;
+  RenderCommandOptions render = test::ScaledRender(dir / name, count, 11, 320, 240);
   render.target = target;
-  render.count = count;
-  render.seed = 11;
-  render.width = 320;
-  render.height = 240;
-  render.fx_px = 300.0;
   render.kdu = kdu;
   render.min_visible_px = 60.0;
-  EXPECT_EQ(RenderDataset(render), count);
-  return render.out_dir;
+  return test::RenderChecked(render);
 }
 
 using test::ParseJsonLines;
@@ -89,12 +83,7 @@ void ExpectPoseNearTruth(const json& frame, const std::string& truth_path) {
 // The message EstimatePoses throws with, or "" if it succeeds.
 std::string PoseError(const PoseCommandOptions& options) {
   std::ostringstream out;
-  try {
-    EstimatePoses(options, out);
-  } catch (const std::exception& error) {
-    return error.what();
-  }
-  return "";
+  return test::ErrorMessageOf([&] { EstimatePoses(options, out); });
 }
 
 TEST(Pose, RenderedDirectoryGivesThePoseOfEveryFrame) {
@@ -220,12 +209,7 @@ TEST(Pose, BadPoseConfigNamesFileAndLineAndLeavesNoOutput) {
 
 // The message of the std::runtime_error `yaml` raises, or "" if it loads.
 std::string ConfigError(const std::string& yaml) {
-  try {
-    ParseConfig(yaml, "cfg.yaml");
-  } catch (const std::runtime_error& error) {
-    return error.what();
-  }
-  return "";
+  return test::ConfigErrorOf(yaml, "cfg.yaml");
 }
 
 TEST(ConfigPose, ErrorsNameFileLineAndKey) {

@@ -13,6 +13,7 @@
 #include "app/camera_file.h"
 #include "app/command_line.h"
 #include "scene/scene.h"
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -23,13 +24,7 @@ using nlohmann::json;
 using ::testing::HasSubstr;
 
 RenderCommandOptions SmallRender(const std::string& out_dir) {
-  RenderCommandOptions options;
-  options.out_dir = out_dir;
-  options.count = 3;
-  options.seed = 3;
-  options.width = 160;
-  options.height = 120;
-  options.fx_px = 150.0;
+  RenderCommandOptions options = test::ScaledRender(out_dir, 3, 3, 160, 120);
   options.kdu = 0.2;
   options.noise_sigma = 3.0;
   options.min_visible_px = 30.0;
@@ -125,11 +120,7 @@ TEST(Render, BadOptionsNameTheField) {
 
 TEST(RenderSequence, WritesFramesTruthAndSequenceJson) {
   test::TestDir dir;
-  RenderCommandOptions options;
-  options.out_dir = dir / "occlusion";
-  options.sequence = "occlusion";
-  options.count = 10;
-  options.seed = 5;
+  const RenderCommandOptions options = test::SequenceRender(dir / "occlusion", "occlusion", 10, 5);
   EXPECT_EQ(RenderDataset(options), 10);
   int frames_with_occluder = 0;
   for (int i = 0; i < 10; ++i) {
@@ -169,12 +160,8 @@ TEST(RenderSequence, WritesFramesTruthAndSequenceJson) {
 
 TEST(RenderSequence, SameSeedSameFilesAndDistortionCamera) {
   test::TestDir dir;
-  RenderCommandOptions a;
-  a.sequence = "distortion";
-  a.count = 2;
-  a.seed = 9;
+  const RenderCommandOptions a = test::SequenceRender(dir / "a", "distortion", 2, 9);
   RenderCommandOptions b = a;
-  a.out_dir = dir / "a";
   b.out_dir = dir / "b";
   RenderDataset(a);
   RenderDataset(b);
@@ -206,18 +193,16 @@ TEST(RenderSequence, UnknownSequenceNamesTheValidOnes) {
 TEST(RenderSequence, CommandLineDefaultsAndConflicts) {
   test::TestDir dir;
   const std::string out = dir / "slow";
-  std::vector<std::string> args = {"render", "--sequence", "slow", "--count", "3", "--out", out};
-  std::vector<char*> argv;
-  for (std::string& arg : args) argv.push_back(arg.data());
-  EXPECT_EQ(RunRender(static_cast<int>(argv.size()), argv.data()), 0);
+  EXPECT_EQ(
+      test::RunWithArgs(RunRender, {"render", "--sequence", "slow", "--count", "3", "--out", out}),
+      0);
   EXPECT_TRUE(fs::exists(out + "/frame_0002.png"));
   EXPECT_FALSE(fs::exists(out + "/frame_0003.png"));
   EXPECT_EQ(json::parse(test::ReadText(out + "/sequence.json")).at("count"), 3);
 
-  std::vector<std::string> bad = {"render", "--sequence", "slow", "--kdu", "0.3", "--out", out};
-  std::vector<char*> bad_argv;
-  for (std::string& arg : bad) bad_argv.push_back(arg.data());
-  EXPECT_THROW(RunRender(static_cast<int>(bad_argv.size()), bad_argv.data()), UsageError);
+  EXPECT_THROW(
+      test::RunWithArgs(RunRender, {"render", "--sequence", "slow", "--kdu", "0.3", "--out", out}),
+      UsageError);
 }
 
 }  // namespace

@@ -1,12 +1,12 @@
 // Helpers shared by the servo app's tests.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 
 #include "app/config.h"
 #include "app/servo_command.h"
 #include "robots/robot.h"
+#include "tests/app/command_test_util.h"
 
 namespace oal::test {
 
@@ -18,16 +18,6 @@ inline ServoAppConfig Small(ServoAppConfig config) {
   config.camera.u0 = 159.5;
   config.camera.v0 = 119.5;
   return config;
-}
-
-/// The message ParseConfig throws for `yaml` read as `file_name`; empty if it is accepted.
-inline std::string ConfigErrorOf(const std::string& yaml, const std::string& file_name) {
-  try {
-    ParseConfig(yaml, file_name);
-  } catch (const std::runtime_error& error) {
-    return error.what();
-  }
-  return "";
 }
 
 /// A shipped config/ file as `oalservo servo --config` reads it: over the built-in default.

@@ -1,0 +1,73 @@
+// Helpers shared by the app command tests: small rendered data sets, the message a call
+// throws with, and running a `Run*(argc, argv)` command on a list of arguments.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <exception>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/config.h"
+#include "app/render_command.h"
+
+namespace oal::test {
+
+/// Options rendering `count` frames of `width`x`height` into `out_dir` from `seed`, with fx
+/// scaled from 600 px at 640x480 (the full-size field of view); the rest as RenderCommandOptions.
+inline RenderCommandOptions ScaledRender(const std::string& out_dir, int count, std::uint64_t seed,
+                                         int width, int height) {
+  RenderCommandOptions options;
+  options.out_dir = out_dir;
+  options.count = count;
+  options.seed = seed;
+  options.width = width;
+  options.height = height;
+  options.fx_px = 600.0 * width / 640.0;
+  return options;
+}
+
+/// Options rendering `count` frames of the sequence `sequence` (scene/sequence.h) into `out_dir`.
+inline RenderCommandOptions SequenceRender(const std::string& out_dir, const std::string& sequence,
+                                           int count, std::uint64_t seed) {
+  RenderCommandOptions options;
+  options.out_dir = out_dir;
+  options.sequence = sequence;
+  options.count = count;
+  options.seed = seed;
+  return options;
+}
+
+/// Renders `options`, expecting every frame to be written; returns the data set's directory.
+inline std::string RenderChecked(const RenderCommandOptions& options) {
+  EXPECT_EQ(RenderDataset(options), options.count);
+  return options.out_dir;
+}
+
+/// The message of the `Exception` that `call` throws, or "" if it returns.
+template <typename Exception = std::exception, typename Call>
+std::string ErrorMessageOf(Call&& call) {
+  try {
+    call();
+  } catch (const Exception& error) {
+    return error.what();
+  }
+  return "";
+}
+
+/// The message ParseConfig throws for `yaml` read as `file_name`; empty if it is accepted.
+inline std::string ConfigErrorOf(const std::string& yaml, const std::string& file_name) {
+  return ErrorMessageOf<std::runtime_error>([&] { ParseConfig(yaml, file_name); });
+}
+
+/// What `run` (a command's `Run*(argc, argv)`) returns for the command line `args`.
+template <typename Run>
+int RunWithArgs(Run&& run, std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  return run(static_cast<int>(argv.size()), argv.data());
+}
+
+}  // namespace oal::test
