@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -148,10 +149,33 @@ std::string MarkupEscaped(const std::string& text) {
   return out;
 }
 
-SigintScope::SigintScope(void (*handler)(int)) : previous_(std::signal(SIGINT, handler)) {}
+namespace {
+
+// The handler can reach only globals; both are lock-free atomics (async-signal-safe).
+std::atomic<bool> g_sigint{false};
+std::atomic<void (*)()> g_sigint_also{nullptr};
+static_assert(std::atomic<void (*)()>::is_always_lock_free, "the callback must be lock-free");
+
+extern "C" void OnSigint(int /*signal*/) {
+  g_sigint.store(true);
+  if (void (*also)() = g_sigint_also.load()) also();
+}
+
+}  // namespace
+
+SigintScope::SigintScope(void (*also)()) {
+  g_sigint.store(false);
+  g_sigint_also.store(also);
+  previous_ = std::signal(SIGINT, &OnSigint);
+}
 
 SigintScope::~SigintScope() {
   std::signal(SIGINT, previous_);
+  g_sigint_also.store(nullptr);
+}
+
+const std::atomic<bool>* SigintScope::interrupted() const {
+  return &g_sigint;
 }
 
 }  // namespace oal

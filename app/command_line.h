@@ -2,6 +2,7 @@
 // main() tells apart, and CLI11 parsing that turns --help into a normal exit.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -54,14 +55,18 @@ std::function<void(int done, int total)> FrameProgress(const std::string& label,
 void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
                        int max_frames, const std::string& out_path);
 
-/// Installs `handler` for SIGINT (Ctrl-C) for the scope's lifetime and restores the previous
-/// handler after. The handler must be async-signal-safe: store to lock-free atomics only.
+/// While one lives, Ctrl-C (SIGINT) sets interrupted() instead of ending the process, and
+/// then calls `also` if given (which must be async-signal-safe: store to lock-free atomics
+/// only); the previous handler comes back after. One at a time: the flag is process-wide.
 class SigintScope {
  public:
-  explicit SigintScope(void (*handler)(int));
+  explicit SigintScope(void (*also)() = nullptr);
   ~SigintScope();
   SigintScope(const SigintScope&) = delete;
   SigintScope& operator=(const SigintScope&) = delete;
+
+  /// Set by Ctrl-C; false when the scope begins.
+  const std::atomic<bool>* interrupted() const;
 
  private:
   void (*previous_)(int);

@@ -4,7 +4,6 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
-#include <csignal>
 #include <iomanip>
 #include <iostream>
 #include <stdexcept>
@@ -19,12 +18,6 @@ namespace oal {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::atomic<bool> g_interrupt{false};
-
-extern "C" void OnScorbotSimSigint(int /*signal*/) {
-  g_interrupt.store(true);
-}
 
 ScorbotSimOptions SimOptions(const ScorbotSimCommandOptions& options) {
   ScorbotSimOptions sim;
@@ -188,9 +181,8 @@ int RunScorbotSim(int argc, char** argv) {
     MeasureScorbotLink(options, std::cout);
     return kExitOk;
   }
-  g_interrupt.store(false);
-  SigintScope sigint(&OnScorbotSimSigint);
-  return RunScorbotSimServer(options, std::cout, &g_interrupt);
+  const SigintScope sigint;
+  return RunScorbotSimServer(options, std::cout, sigint.interrupted());
 }
 
 }  // namespace oal

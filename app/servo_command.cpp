@@ -2,7 +2,6 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -18,13 +17,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Ctrl-C: the handler only stores to lock-free atomics (async-signal-safe).
-std::atomic<bool> g_interrupt{false};
+// Ctrl-C also stops the robot at once (SigintScope: only lock-free atomics, which a signal
+// handler may touch; RequestEmergencyStop stores to one).
 std::atomic<SafeRobot*> g_robot{nullptr};
 static_assert(std::atomic<SafeRobot*>::is_always_lock_free, "the robot pointer must be lock-free");
 
-extern "C" void OnSigint(int /*signal*/) {
-  g_interrupt.store(true);
+void StopRobotOnSigint() {
   if (SafeRobot* robot = g_robot.load()) robot->RequestEmergencyStop();
 }
 
@@ -170,10 +168,9 @@ int RunServoMain(int argc, char** argv) {
       "  oalservo servo --config config/table3-sim.yaml --out out/table3\n"
       "  oalservo servo --config config/table3-sim.yaml --mode point-and-go --display off");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
-  g_interrupt.store(false);
-  SigintScope sigint(&OnSigint);
+  const SigintScope sigint(&StopRobotOnSigint);
   ServoRunHooks hooks;
-  hooks.interrupt = &g_interrupt;
+  hooks.interrupt = sigint.interrupted();
   hooks.on_robot = [](SafeRobot* robot) { g_robot.store(robot); };
   const ServoRunReport report = RunServoCommand(options, std::cout, hooks);
   const bool ok =

@@ -6,7 +6,9 @@
 #include <visp3/core/vpThetaUVector.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -177,6 +179,22 @@ TEST(EvaluateSharedHelpers, QuietStderrNestsAndRestoresStderr) {
 TEST(EvaluateSharedHelpers, MarkupEscapedEscapesTheFiveCharacters) {
   EXPECT_EQ(MarkupEscaped("a<b>&\"c\"'d'"), "a&lt;b&gt;&amp;&quot;c&quot;&apos;d&apos;");
   EXPECT_EQ(MarkupEscaped("plain é"), "plain é");
+}
+
+std::atomic<int> g_sigint_callbacks{0};
+
+TEST(CommandLine, SigintScopeSetsItsFlagCallsBackAndRestoresTheHandler) {
+  const auto previous = std::signal(SIGINT, SIG_IGN);
+  {
+    const SigintScope sigint([] { g_sigint_callbacks.fetch_add(1); });
+    EXPECT_FALSE(sigint.interrupted()->load());
+    std::raise(SIGINT);  // handled: the test process goes on
+    EXPECT_TRUE(sigint.interrupted()->load());
+    EXPECT_EQ(g_sigint_callbacks.load(), 1);
+  }
+  EXPECT_EQ(std::signal(SIGINT, previous), SIG_IGN);  // the scope put SIG_IGN back
+  const SigintScope again;                            // a new scope starts clear
+  EXPECT_FALSE(again.interrupted()->load());
 }
 
 TEST(Evaluate, ParsesShardsAndPlansNamesThatDoNotCollide) {
