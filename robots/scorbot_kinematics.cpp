@@ -3,6 +3,7 @@
 #include <visp3/core/vpMath.h>
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "robots/check_option.h"
@@ -54,19 +55,39 @@ std::string FormatDeg(double rad) {
   return s.str();
 }
 
+// The vertical plane through the base axis and the TCP of wMe, in which a 5-axis arm's tool
+// axis must lie: its azimuth q1 (joint 1), the TCP's distance r from the base axis, the
+// unit radial direction u and normal n, and wMe's rotation R. None when the TCP is on the
+// base axis, where the plane is undefined.
+struct ArmPlane {
+  double q1 = 0.0, r = 0.0;
+  vpColVector u, n;
+  vpRotationMatrix R;
+};
+
+std::optional<ArmPlane> ArmPlaneOf(const vpHomogeneousMatrix& wMe) {
+  ArmPlane plane;
+  plane.r = std::hypot(wMe[0][3], wMe[1][3]);
+  if (plane.r < 1e-9) return std::nullopt;
+  plane.q1 = std::atan2(wMe[1][3], wMe[0][3]);
+  plane.u = Vec3(std::cos(plane.q1), std::sin(plane.q1), 0);
+  plane.n = Vec3(-std::sin(plane.q1), std::cos(plane.q1), 0);
+  plane.R = wMe.getRotationMatrix();
+  return plane;
+}
+
 // The part of NearestReachable that does not look at the joints: position kept, tool axis
 // projected into the arm plane, roll chosen.
 bool ProjectOrientation(const vpHomogeneousMatrix& wMe, vpHomogeneousMatrix* out,
                         std::string* why) {
-  const double px = wMe[0][3], py = wMe[1][3];
-  if (std::hypot(px, py) < 1e-9) {
+  const std::optional<ArmPlane> plane = ArmPlaneOf(wMe);
+  if (!plane) {
     *why = "the TCP is on the base axis: the arm plane is undefined";
     return false;
   }
-  const double q1 = std::atan2(py, px);
-  const vpColVector u = Vec3(std::cos(q1), std::sin(q1), 0);
-  const vpColVector n = Vec3(-std::sin(q1), std::cos(q1), 0);
-  const vpRotationMatrix R = wMe.getRotationMatrix();
+  const double q1 = plane->q1;
+  const vpColVector &u = plane->u, &n = plane->n;
+  const vpRotationMatrix& R = plane->R;
   const vpColVector a = Column(R, 2);
   const vpColVector ap = a - Dot(a, n) * n;
   if (ap.frobeniusNorm() < 1e-6) {
@@ -155,16 +176,14 @@ int JointLimitViolation(const ScorbotGeometry& g, const ScorbotJoints& q) {
 ScorbotIk InverseKinematics(const ScorbotGeometry& g, const vpHomogeneousMatrix& wMe,
                             double plane_tol_rad) {
   ScorbotIk ik;
-  const double px = wMe[0][3], py = wMe[1][3], pz = wMe[2][3];
-  const double r = std::hypot(px, py);
-  if (r < 1e-9) {
+  const std::optional<ArmPlane> plane = ArmPlaneOf(wMe);
+  if (!plane) {
     ik.why = "the TCP is on the base axis";
     return ik;
   }
-  const double q1 = std::atan2(py, px);
-  const vpColVector u = Vec3(std::cos(q1), std::sin(q1), 0);
-  const vpColVector n = Vec3(-std::sin(q1), std::cos(q1), 0);
-  const vpRotationMatrix R = wMe.getRotationMatrix();
+  const double q1 = plane->q1, r = plane->r, pz = wMe[2][3];
+  const vpColVector &u = plane->u, &n = plane->n;
+  const vpRotationMatrix& R = plane->R;
   const vpColVector a = Column(R, 2);
   if (std::abs(Dot(a, n)) > std::sin(plane_tol_rad)) {
     ik.why = "the tool axis is " + FormatDeg(std::asin(std::min(1.0, std::abs(Dot(a, n))))) +
