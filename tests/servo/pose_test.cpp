@@ -562,35 +562,22 @@ TEST(EstimatePose, PlaneAnglesMatchYawAndPitchForSmallTilts) {
   }
 }
 
-// The pose step alone (identification + intersections + vpPose), lines built outside the loop.
-TEST(EstimatePose, TimePerFrame) {
+// The pose step (identification + intersections + vpPose) over 50 views at 0.4-0.9 m,
+// tilted 20 deg and rolled all round. Its speed is measured by bench/bench_pose (PoseStep,
+// Identification), not here: tests check behaviour.
+TEST(EstimatePose, IdentifiesAndPosesFiftyVariedViews) {
   const RenderOptions render = SmallRender(false);
   const SceneRenderer renderer(FourLineTarget(), render);
   const PoseOptions options = OptionsFor(render);
   const LineTarget target = FourLineTarget();
   std::mt19937 rng(12);
-  std::vector<std::vector<DetectedLine>> inputs;
   for (int i = 0; i < 50; ++i) {
-    inputs.push_back(SyntheticLines(renderer.Truth(PoseAt(0.4 + 0.01 * i, 7.0 * i, 20.0, 3.0 * i)),
-                                    {0, 1, 2, 3}, render.camera, &rng));
+    const std::vector<DetectedLine> lines =
+        SyntheticLines(renderer.Truth(PoseAt(0.4 + 0.01 * i, 7.0 * i, 20.0, 3.0 * i)), {0, 1, 2, 3},
+                       render.camera, &rng);
+    ASSERT_EQ(IdentifyTargetLines(lines, target, options).status, PoseStatus::kOk) << "view " << i;
+    ASSERT_EQ(EstimatePose(lines, target, options).status, PoseStatus::kOk) << "view " << i;
   }
-  std::vector<double> identify_us, estimate_us;
-  for (int pass = 0; pass < 5; ++pass) {
-    for (const auto& lines : inputs) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const PoseResult identified = IdentifyTargetLines(lines, target, options);
-      const auto t1 = std::chrono::steady_clock::now();
-      const PoseResult posed = EstimatePose(lines, target, options);
-      const auto t2 = std::chrono::steady_clock::now();
-      ASSERT_EQ(identified.status, PoseStatus::kOk);
-      ASSERT_EQ(posed.status, PoseStatus::kOk);
-      identify_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-      estimate_us.push_back(std::chrono::duration<double, std::micro>(t2 - t1).count());
-    }
-  }
-  std::cout << "IdentifyTargetLines median " << Median(identify_us) << " us, EstimatePose median "
-            << Median(estimate_us) << " us\n";
-  EXPECT_LT(Median(estimate_us), 2000.0);  // loose: only a gross regression fails here
 }
 
 }  // namespace
