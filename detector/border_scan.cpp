@@ -88,6 +88,18 @@ void ReverseCopy(const std::uint8_t* first, const std::uint8_t* last, std::uint8
   std::reverse_copy(first, last, out);
 }
 
+// Copies the rect's top and bottom rows into their places in its loop `out` (the top row
+// first, left to right; the bottom row after the right column, right to left).
+void CopyRows(const GrayImageView& image, const BorderRect& rect, std::uint8_t* out) {
+  const int width = rect.Width(), inner_rows = rect.Height() - 2;
+  const std::uint8_t* top = image.data + rect.v0 * image.stride;
+  const std::uint8_t* bottom = image.data + rect.v1 * image.stride;
+  std::memcpy(out, top + rect.u0, static_cast<std::size_t>(width));
+  out += width + inner_rows;
+  *out++ = bottom[rect.u1];  // the bottom-right corner
+  ReverseCopy(bottom + rect.u0, bottom + rect.u1, out);
+}
+
 }  // namespace
 
 void GatherBorder(const GrayImageView& image, const BorderRect& rect,
@@ -95,22 +107,19 @@ void GatherBorder(const GrayImageView& image, const BorderRect& rect,
   const int perimeter = rect.Perimeter();
   samples->resize(static_cast<std::size_t>(perimeter));
   std::uint8_t* out = samples->data();
-  const std::uint8_t* top = image.data + rect.v0 * image.stride;
-  std::memcpy(out, top + rect.u0, static_cast<std::size_t>(rect.Width()));
-  // Both columns in one pass over the rows: the right column fills the loop downwards after
-  // the top row, the left column fills it upwards from the end. (Locals, because the byte
-  // stores could alias rect and image and would force reloads.)
+  CopyRows(image, rect, out);
+  // Both columns in one pass over the inner rows: the right column fills the loop downwards
+  // after the top row, the left column fills it upwards from the end. (Locals, because the
+  // byte stores could alias rect and image and would force reloads.)
   const int u0 = rect.u0, u1 = rect.u1, inner_rows = rect.Height() - 2;
   const std::ptrdiff_t stride = image.stride;
   std::uint8_t* right = out + rect.Width();
   std::uint8_t* left = out + perimeter - 1;
-  const std::uint8_t* row = top + stride;
+  const std::uint8_t* row = image.data + (rect.v0 + 1) * stride;
   for (int k = 0; k < inner_rows; ++k, row += stride) {
     *right++ = row[u1];
     *left-- = row[u0];
   }
-  *right++ = row[u1];  // the bottom-right corner, row v1
-  ReverseCopy(row + u0, row + u1, right);
 }
 
 void BorderLoops::Prepare(int width, int height, int first_px, int step_px) {
@@ -165,16 +174,8 @@ void BorderLoops::Read(const GrayImageView& image) {
 }
 
 const std::vector<std::uint8_t>& BorderLoops::Gather(const GrayImageView& image, int k) {
-  const BorderRect rect = Rect(k);
   std::vector<std::uint8_t>& loop = loops_[static_cast<std::size_t>(k)];
-  const int width = rect.Width(), inner_rows = rect.Height() - 2;
-  std::uint8_t* out = loop.data();
-  const std::uint8_t* top = image.data + rect.v0 * image.stride;
-  const std::uint8_t* bottom = image.data + rect.v1 * image.stride;
-  std::memcpy(out, top + rect.u0, static_cast<std::size_t>(width));
-  out += width + inner_rows;
-  *out++ = bottom[rect.u1];
-  ReverseCopy(bottom + rect.u0, bottom + rect.u1, out);
+  CopyRows(image, Rect(k), loop.data());
   return loop;
 }
 
