@@ -29,6 +29,24 @@ LineParams LineThrough(const Point2d& a, const Point2d& b) {
   return Normalized(rho, theta);
 }
 
+LineParams FitLine(const std::vector<Point2d>& points) {
+  double mu = 0.0, mv = 0.0;
+  for (const Point2d& p : points) {
+    mu += p.u;
+    mv += p.v;
+  }
+  mu /= static_cast<double>(points.size());
+  mv /= static_cast<double>(points.size());
+  double suu = 0.0, svv = 0.0, suv = 0.0;
+  for (const Point2d& p : points) {
+    suu += (p.u - mu) * (p.u - mu);
+    svv += (p.v - mv) * (p.v - mv);
+    suv += (p.u - mu) * (p.v - mv);
+  }
+  const double theta = 0.5 * std::atan2(2.0 * suv, suu - svv) + kPi / 2.0;
+  return Normalized(mu * std::cos(theta) + mv * std::sin(theta), theta);
+}
+
 double AngleBetween(const LineParams& a, const LineParams& b) {
   double d = std::fabs(a.theta_rad - b.theta_rad);
   d = std::fmod(d, kPi);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
 
 namespace oal {
 
@@ -35,6 +36,10 @@ LineParams Normalized(double rho_px, double theta_rad);
 
 /// The line through two distinct points, normalised to theta in [0, pi).
 LineParams LineThrough(const Point2d& a, const Point2d& b);
+
+/// The total-least-squares line through `points` (at least two distinct ones): through
+/// their centroid, along the direction of their largest spread.
+LineParams FitLine(const std::vector<Point2d>& points);
 
 /// Absolute angle between two lines, in [0, pi/2] (lines are undirected).
 double AngleBetween(const LineParams& a, const LineParams& b);

@@ -72,25 +72,6 @@ Point2d IdealPixel(const vpCameraParameters& camera, const Vec3& p) {
           camera.get_v0() + camera.get_py() * p.y / p.z};
 }
 
-// Total least squares line through `points` (at least two distinct ones).
-LineParams FitLine(const std::vector<Point2d>& points) {
-  double mu = 0.0, mv = 0.0;
-  for (const Point2d& p : points) {
-    mu += p.u;
-    mv += p.v;
-  }
-  mu /= static_cast<double>(points.size());
-  mv /= static_cast<double>(points.size());
-  double suu = 0.0, svv = 0.0, suv = 0.0;
-  for (const Point2d& p : points) {
-    suu += (p.u - mu) * (p.u - mu);
-    svv += (p.v - mv) * (p.v - mv);
-    suv += (p.u - mu) * (p.v - mv);
-  }
-  const double theta = 0.5 * std::atan2(2.0 * suv, suu - svv) + kPi / 2.0;
-  return Normalized(mu * std::cos(theta) + mv * std::sin(theta), theta);
-}
-
 // Distorted normalised radius r with r (1 + k r^2) = rho (Newton; monotone convergence from
 // r = rho since the cubic is convex for k > 0 and concave for k < 0). NaN when unreachable.
 double DistortedRadius(double k, double rho) {

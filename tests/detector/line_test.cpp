@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 namespace oal {
 namespace {
 
@@ -72,6 +75,31 @@ TEST(Line, NormalizedTinyNegativeAngleKeepsRho) {
   const LineParams line = Normalized(5.0, -1e-17);
   EXPECT_EQ(line.theta_rad, 0.0);
   EXPECT_EQ(line.rho_px, 5.0);
+}
+
+TEST(Line, FitLineThroughSymmetricScatterIsItsAxis) {
+  // Points spread along a line of normal angle 0.4 rad, offset by +-0.5 px on each side in
+  // equal numbers: the total-least-squares fit is that line (an ordinary regression on v
+  // or u would tilt it).
+  const LineParams truth{12.0, 0.4};
+  const double c = std::cos(truth.theta_rad), s = std::sin(truth.theta_rad);
+  std::vector<Point2d> points;
+  for (int i = -10; i <= 10; ++i) {
+    for (const double offset : {-0.5, 0.5}) {
+      const double along = 3.0 * i, across = truth.rho_px + offset;
+      points.push_back({across * c - along * s, across * s + along * c});
+    }
+  }
+  const LineParams fit = FitLine(points);
+  EXPECT_NEAR(fit.theta_rad, truth.theta_rad, kTol);
+  EXPECT_NEAR(fit.rho_px, truth.rho_px, kTol);
+}
+
+TEST(Line, FitLineOfTwoPointsIsLineThrough) {
+  const LineParams fit = FitLine({{3.0, 4.0}, {20.0, -9.0}});
+  const LineParams through = LineThrough({3.0, 4.0}, {20.0, -9.0});
+  EXPECT_NEAR(AngleBetween(fit, through), 0.0, kTol);
+  EXPECT_NEAR(RhoAlignedTo(fit, through), fit.rho_px, kTol);
 }
 
 }  // namespace

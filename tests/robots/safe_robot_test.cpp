@@ -16,17 +16,6 @@ namespace {
 
 constexpr double kTol = 1e-12;
 
-vpColVector Twist(double vx, double vy, double vz, double wx, double wy, double wz) {
-  vpColVector v(6);
-  v[0] = vx;
-  v[1] = vy;
-  v[2] = vz;
-  v[3] = wx;
-  v[4] = wy;
-  v[5] = wz;
-  return v;
-}
-
 bool SamePose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double tol = kTol) {
   const PoseDistance d = Distance(a, b);
   return d.translation_m <= tol && d.rotation_rad <= tol;
@@ -62,7 +51,7 @@ struct Rig {
 
 TEST(SafeRobot, SaturationScalesTheTwistKeepingItsDirection) {
   Rig rig;
-  const vpColVector request = Twist(0.1, -0.4, 0.05, 0.2, 0.0, 0.25);  // vy twice its limit
+  const vpColVector request({0.1, -0.4, 0.05, 0.2, 0.0, 0.25});  // vy twice its limit
   const vpHomogeneousMatrix before = rig.camera->wMc();
   const CycleReport report = rig.robot->SetVelocity(RobotFrame::kCamera, request);
   ASSERT_TRUE(report.result.ok()) << report.result.message;
@@ -75,7 +64,7 @@ TEST(SafeRobot, SaturationScalesTheTwistKeepingItsDirection) {
 
 TEST(SafeRobot, TwistWithinLimitsIsSentUnchanged) {
   Rig rig;
-  const vpColVector request = Twist(0.1, -0.2, 0.05, 0.5, 0.0, -0.25);
+  const vpColVector request({0.1, -0.2, 0.05, 0.5, 0.0, -0.25});
   const CycleReport report = rig.robot->SetVelocity(RobotFrame::kCamera, request);
   ASSERT_TRUE(report.result.ok());
   EXPECT_FALSE(report.saturated);
@@ -91,7 +80,7 @@ TEST(SafeRobot, VelocityLeavingTheWorkspaceIsRefusedAndTheRobotStaysPutAndStoppe
   const vpHomogeneousMatrix before = rig.camera->wMc();
   // Camera z is world z here: -0.2 m/s for 0.1 s would reach z = 0.19 m.
   const CycleReport report =
-      rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, -0.2, 0, 0, 0));
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, -0.2, 0, 0, 0}));
   EXPECT_EQ(report.result.status, RobotStatus::kWorkspace);
   EXPECT_NE(report.result.message.find("z = 0.19"), std::string::npos) << report.result.message;
   EXPECT_NE(report.result.message.find("[0.2, 1]"), std::string::npos) << report.result.message;
@@ -99,7 +88,8 @@ TEST(SafeRobot, VelocityLeavingTheWorkspaceIsRefusedAndTheRobotStaysPutAndStoppe
   EXPECT_EQ(rig.robot->state(), SafeRobotState::kStopped);
   EXPECT_EQ(rig.robot->stop_reason().status, RobotStatus::kWorkspace);
   // Even a harmless command is now refused, with the reason.
-  const CycleReport next = rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0));
+  const CycleReport next =
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0}));
   EXPECT_EQ(next.result.status, RobotStatus::kStopped);
   EXPECT_NE(next.result.message.find("workspace box"), std::string::npos) << next.result.message;
   EXPECT_TRUE(SamePose(rig.camera->wMc(), before, 0));
@@ -120,13 +110,14 @@ TEST(SafeRobot, MoveTargetOutsideTheWorkspaceIsRefused) {
 TEST(SafeRobot, InjectedErrorStopsTheRobotUntilReEnabled) {
   Rig rig;
   rig.camera->InjectFault(RobotStatus::kError, "controller error 317 BAD CARTESIAN POINT");
-  const CycleReport failed = rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0));
+  const CycleReport failed =
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0}));
   EXPECT_EQ(failed.result.status, RobotStatus::kError);
   EXPECT_EQ(rig.robot->state(), SafeRobotState::kStopped);
   const vpHomogeneousMatrix stopped_at = rig.camera->wMc();
   for (int k = 0; k < 3; ++k) {
     const CycleReport refused =
-        rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0));
+        rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0}));
     EXPECT_EQ(refused.result.status, RobotStatus::kStopped);
     EXPECT_NE(refused.result.message.find("317 BAD CARTESIAN POINT"), std::string::npos)
         << refused.result.message;
@@ -137,7 +128,8 @@ TEST(SafeRobot, InjectedErrorStopsTheRobotUntilReEnabled) {
   EXPECT_TRUE(SamePose(rig.camera->wMc(), stopped_at, 0));
   ASSERT_TRUE(rig.robot->Enable().ok());
   EXPECT_TRUE(rig.robot->stop_reason().ok());
-  EXPECT_TRUE(rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).result.ok());
+  EXPECT_TRUE(
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).result.ok());
   EXPECT_FALSE(SamePose(rig.camera->wMc(), stopped_at, 0));
 }
 
@@ -186,11 +178,13 @@ TEST(SafeRobot, StopIsIdempotentAndSafeInAnyState) {
 
 TEST(SafeRobot, EmergencyFlagStopsTheNextCycle) {
   Rig rig;
-  ASSERT_TRUE(rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).result.ok());
+  ASSERT_TRUE(
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).result.ok());
   rig.robot->RequestEmergencyStop();  // what a SIGINT handler does
   rig.robot->RequestEmergencyStop();
   const vpHomogeneousMatrix before = rig.camera->wMc();
-  const CycleReport report = rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0));
+  const CycleReport report =
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0}));
   EXPECT_EQ(report.result.status, RobotStatus::kStopped);
   EXPECT_NE(report.result.message.find("emergency stop"), std::string::npos)
       << report.result.message;
@@ -198,7 +192,8 @@ TEST(SafeRobot, EmergencyFlagStopsTheNextCycle) {
   EXPECT_EQ(rig.robot->state(), SafeRobotState::kStopped);
   ASSERT_TRUE(rig.robot->Enable().ok());
   EXPECT_FALSE(rig.robot->EmergencyStopRequested());
-  EXPECT_TRUE(rig.robot->SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).result.ok());
+  EXPECT_TRUE(
+      rig.robot->SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).result.ok());
 }
 
 TEST(SafeRobot, PositionMoveReachesTheTarget) {
@@ -260,7 +255,7 @@ TEST(SafeRobot, MoveThatTimesOutStops) {
 TEST(SafeRobot, CommandsBeforeEnableAreRefused) {
   SimulatedCamera camera;
   SafeRobot robot(camera, SafetyOptions());
-  EXPECT_EQ(robot.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).result.status,
+  EXPECT_EQ(robot.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).result.status,
             RobotStatus::kNotReady);
   ASSERT_TRUE(robot.Connect().ok());
   EXPECT_EQ(robot.MovePosition(RobotFrame::kCamera, vpHomogeneousMatrix()).result.status,

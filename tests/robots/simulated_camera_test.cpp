@@ -15,17 +15,6 @@ namespace {
 constexpr double kPoseTolM = 1e-12;
 constexpr double kPoseTolRad = 1e-12;
 
-vpColVector Twist(double vx, double vy, double vz, double wx, double wy, double wz) {
-  vpColVector v(6);
-  v[0] = vx;
-  v[1] = vy;
-  v[2] = vz;
-  v[3] = wx;
-  v[4] = wy;
-  v[5] = wz;
-  return v;
-}
-
 void ExpectPoseNear(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double tol_m,
                     double tol_rad) {
   const PoseDistance d = Distance(a, b);
@@ -51,7 +40,7 @@ TEST(SimulatedCamera, VelocityIntegrationMatchesExponentialMap) {
   vpHomogeneousMatrix expected = options.wMc;
   constexpr int kSteps = 50;
   for (int k = 0; k < kSteps; ++k) {
-    const vpColVector v = Twist(uv(rng), uv(rng), uv(rng), uw(rng), uw(rng), uw(rng));
+    const vpColVector v({uv(rng), uv(rng), uv(rng), uw(rng), uw(rng), uw(rng)});
     ASSERT_TRUE(camera.SetVelocity(RobotFrame::kCamera, v).ok());
     expected = expected * vpExponentialMap::direct(v, options.sampling_time_s);
   }
@@ -64,7 +53,7 @@ TEST(SimulatedCamera, EndEffectorTwistGoesThroughTheHandEye) {
   options.eMc = vpHomogeneousMatrix(0.0, 0.05, 0.1, 0.0, vpMath::rad(90), 0.0);
   SimulatedCamera camera = ReadyCamera(options);
   const vpHomogeneousMatrix wMe0 = camera.GetPosition(RobotFrame::kEndEffector).pose;
-  const vpColVector v_e = Twist(0.1, 0.0, 0.05, 0.0, 0.0, 0.5);
+  const vpColVector v_e({0.1, 0.0, 0.05, 0.0, 0.0, 0.5});
   ASSERT_TRUE(camera.SetVelocity(RobotFrame::kEndEffector, v_e).ok());
   const vpHomogeneousMatrix expected_wMe =
       wMe0 * vpExponentialMap::direct(v_e, options.sampling_time_s);
@@ -78,7 +67,7 @@ TEST(SimulatedCamera, TwistAboveHardwareLimitIsRefusedNotClamped) {
   options.max_translation_mps = 0.5;
   SimulatedCamera camera = ReadyCamera(options);
   const vpHomogeneousMatrix before = camera.wMc();
-  const RobotResult r = camera.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.6, 0, 0, 0));
+  const RobotResult r = camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.6, 0, 0, 0}));
   EXPECT_EQ(r.status, RobotStatus::kLimit);
   EXPECT_NE(r.message.find("vz"), std::string::npos) << r.message;
   ExpectPoseNear(camera.wMc(), before, 0, 0);
@@ -86,16 +75,16 @@ TEST(SimulatedCamera, TwistAboveHardwareLimitIsRefusedNotClamped) {
 
 TEST(SimulatedCamera, RefusesMotionUntilConnectedAndEnabled) {
   SimulatedCamera camera;
-  EXPECT_EQ(camera.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).status,
+  EXPECT_EQ(camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).status,
             RobotStatus::kNotReady);
   EXPECT_EQ(camera.GetPosition(RobotFrame::kCamera).result.status, RobotStatus::kNotReady);
   ASSERT_TRUE(camera.Connect().ok());
   EXPECT_EQ(camera.StartMove(RobotFrame::kCamera, vpHomogeneousMatrix()).status,
             RobotStatus::kNotReady);
   ASSERT_TRUE(camera.Enable().ok());
-  EXPECT_TRUE(camera.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).ok());
+  EXPECT_TRUE(camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).ok());
   EXPECT_TRUE(camera.Disable().ok());
-  EXPECT_EQ(camera.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).status,
+  EXPECT_EQ(camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).status,
             RobotStatus::kNotReady);
 }
 
@@ -145,10 +134,10 @@ TEST(SimulatedCamera, IntegratedMoveIsLengthenedToRespectTheLimits) {
 TEST(SimulatedCamera, InjectedFaultFailsTheNextCommandOnly) {
   SimulatedCamera camera = ReadyCamera(SimulatedCameraOptions());
   camera.InjectFault(RobotStatus::kError, "encoder lost");
-  const RobotResult r = camera.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0));
+  const RobotResult r = camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0}));
   EXPECT_EQ(r.status, RobotStatus::kError);
   EXPECT_EQ(r.message, "encoder lost");
-  EXPECT_TRUE(camera.SetVelocity(RobotFrame::kCamera, Twist(0, 0, 0.1, 0, 0, 0)).ok());
+  EXPECT_TRUE(camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).ok());
 }
 
 TEST(SimulatedCamera, OptionsCheckNamesTheField) {

@@ -142,25 +142,6 @@ class MeLineWithParams : public vpMeLine {
   }
 };
 
-// Total-least-squares line through points (the test's own, to play vpMeLine's edge fit).
-LineParams FitLine(const std::vector<Point2d>& points) {
-  double mu = 0.0, mv = 0.0;
-  for (const Point2d& p : points) {
-    mu += p.u;
-    mv += p.v;
-  }
-  mu /= points.size();
-  mv /= points.size();
-  double suu = 0.0, svv = 0.0, suv = 0.0;
-  for (const Point2d& p : points) {
-    suu += (p.u - mu) * (p.u - mu);
-    svv += (p.v - mv) * (p.v - mv);
-    suv += (p.u - mu) * (p.v - mv);
-  }
-  const double theta = 0.5 * std::atan2(2.0 * suv, suu - svv) + kPi / 2.0;
-  return Normalized(mu * std::cos(theta) + mv * std::sin(theta), theta);
-}
-
 Point2d ProjectOnto(const LineParams& line, const Point2d& p) {
   const double d = line.SignedDistance(p.u, p.v);
   return Point2d{p.u - d * std::cos(line.theta_rad), p.v - d * std::sin(line.theta_rad)};
