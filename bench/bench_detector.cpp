@@ -10,6 +10,7 @@
 #include <tuple>
 #include <vector>
 
+#include "detector/border_scan.h"
 #include "detector/detector.h"
 #include "scene/scene.h"
 
@@ -100,6 +101,35 @@ void OalBorderStep(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(found);
 }
 
+// Step 1 alone on the four-line 640x480 frame, as Detect() runs it at the default (paper)
+// parameters: every border read, its Otsu threshold and its feature points; no pairs, no
+// votes. Shows what the pixels cost before any voting.
+void OalBordersOnly(benchmark::State& state) {
+  const RenderedFrame& frame = Frame("four-line", 640, 480);
+  const GrayImageView view = ViewOf(frame.image);
+  const DetectorOptions options;
+  BorderLoops loops;
+  loops.Prepare(view.width, view.height, options.start_px, options.step_px);
+  std::vector<BorderPoint> points;
+  points.reserve(static_cast<std::size_t>(options.max_points_per_border));
+  int found = 0;
+  for (auto _ : state) {
+    found = 0;
+    loops.Read(view);
+    for (int k = 0; k < loops.count(); ++k) {
+      const std::vector<std::uint8_t>& samples = loops.Gather(view, k);
+      int contrast = 0;
+      const int threshold = OtsuThreshold(samples, &contrast);
+      points.clear();
+      if (contrast >= options.min_contrast) {
+        found += FindBorderPoints(samples, loops.Rect(k), threshold, options, &points);
+      }
+    }
+    benchmark::ClobberMemory();
+  }
+  state.counters["points"] = found;
+}
+
 void OalPaper(benchmark::State& state) {
   const RenderedFrame& frame = Frame("four-line", 640, 480);
   OalDetector detector(DetectorOptions::Paper());
@@ -181,6 +211,7 @@ BENCHMARK_CAPTURE(Oal, four_line_no_undistortion, std::string("four-line"), fals
     ->Args({640, 480})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalBorderStep)->Arg(5)->Arg(10)->Unit(benchmark::kMicrosecond);
+BENCHMARK(OalBordersOnly)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalPaper)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OalLineCount)->Arg(1)->Arg(2)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK(CvThresholdCannyHough)->Unit(benchmark::kMicrosecond);
