@@ -705,6 +705,40 @@ void CopyInto(const cv::Mat& gray, vpImage<unsigned char>* image) {
   }
 }
 
+// Frame numbers as sorted ranges, "0-2, 5, 7-9", at most `max_ranges` of them then "...".
+std::string FrameRanges(std::vector<int> frames, std::size_t max_ranges = 8) {
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  std::string out;
+  std::size_t ranges = 0;
+  for (std::size_t i = 0; i < frames.size();) {
+    std::size_t j = i;
+    while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+    if (ranges++ == max_ranges) return out + ", ...";
+    out += (out.empty() ? "" : ", ") + std::to_string(frames[i]);
+    if (j > i) out += "-" + std::to_string(frames[j]);
+    i = j + 1;
+  }
+  return out.empty() ? "none" : out;
+}
+
+// The frames on which a method threw an OpenCV error (it then finds no line there).
+struct MethodFailure {
+  int frames = 0;
+  std::string first;  // the first such frame and the error
+
+  void Add(int index, const Frame& frame, const cv::Exception& error) {
+    if (frames++ > 0) return;
+    first = "frame " + std::to_string(index) + " '" + frame.source + "', " +
+            std::to_string(frame.gray.cols) + "x" + std::to_string(frame.gray.rows) +
+            " px: OpenCV: " + error.err;
+  }
+  std::string Warning(const std::string& method) const {
+    return method + " could not run on " + std::to_string(frames) + " frame" +
+           (frames == 1 ? "" : "s") + " (first: " + first + "); scored as finding no line there";
+  }
+};
+
 std::string Fixed(double value, int digits) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(digits) << value;
@@ -829,6 +863,10 @@ CompareReport RunComparison(const CompareOptions& options,
           "makes our lines undistorted; drop one of them");
     }
     csv = LoadTruthCsv(options.truth);
+    if (csv.empty()) {
+      throw std::runtime_error("truth " + options.truth +
+                               " has no line row (frame,line,rho,theta): it matches no frame");
+    }
     report.truth_source = "csv";
   } else if (!options.truth.empty()) {
     if (!fs::is_directory(options.truth)) {
@@ -845,6 +883,12 @@ CompareReport RunComparison(const CompareOptions& options,
   if (!source->Next(&frame)) throw std::runtime_error(source->Name() + " holds no frame");
   report.width = frame.gray.cols;
   report.height = frame.gray.rows;
+  if (camera) {
+    if (auto warning =
+            CameraSizeMismatch(*camera, frame.gray.cols, frame.gray.rows, frame.source)) {
+      report.warnings.push_back(*warning);
+    }
+  }
 
   auto json_path = [&](const Frame& f) {
     const fs::path image(f.source);
@@ -915,11 +959,18 @@ CompareReport RunComparison(const CompareOptions& options,
   const std::size_t untruthed_targets =
       options.lines > 0 ? static_cast<std::size_t>(options.lines) : 4;
   std::vector<std::vector<TargetLineTruth>> truth_per_frame;
+  std::vector<int> csv_frames_seen, csv_frames_without_truth;  // frame numbers (CSV truth)
+  std::vector<MethodFailure> method_failures(methods.size());
   vpImage<unsigned char> image;
   std::vector<LineParams> lines;
   int index = 0;
   do {
     if (index > 0) truth = truth_of(frame, index);
+    if (report.truth_source == "csv") {
+      const int number = FrameNumber(frame.source, index);
+      csv_frames_seen.push_back(number);
+      if (csv.count(number) == 0) csv_frames_without_truth.push_back(number);
+    }
     CopyInto(frame.gray, &image);
     std::vector<TargetLineTruth> targets = truth;
     for (std::size_t m = 0; m < methods.size(); ++m) {
@@ -927,7 +978,12 @@ CompareReport RunComparison(const CompareOptions& options,
       MethodResult& result = report.methods[m];
       if (index == 0 && m > 0) method.Start(image, targets, has_truth);
       const auto start = std::chrono::steady_clock::now();
-      method.Process(image, &lines);
+      try {
+        method.Process(image, &lines);
+      } catch (const cv::Exception& error) {  // e.g. an image too small for the method
+        lines.clear();
+        method_failures[m].Add(index, frame, error);
+      }
       const auto stop = std::chrono::steady_clock::now();
       const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
       if (m == 0 && !has_truth) {
@@ -959,6 +1015,26 @@ CompareReport RunComparison(const CompareOptions& options,
   for (std::size_t m = 0; m < methods.size(); ++m) {
     report.methods[m].failures = methods[m]->failures();
     report.methods[m].reinitialisations = methods[m]->reinitialisations();
+    if (method_failures[m].frames > 0) {
+      report.warnings.push_back(method_failures[m].Warning(report.methods[m].name));
+    }
+  }
+  if (report.truth_source == "csv") {
+    std::vector<int> truth_frames;
+    for (const auto& [number, rows] : csv) truth_frames.push_back(number);
+    const std::size_t without = csv_frames_without_truth.size();
+    if (without == csv_frames_seen.size()) {
+      throw std::runtime_error("truth " + options.truth + " matches no frame of " + options.input +
+                               ": its rows are for frames " + FrameRanges(truth_frames) +
+                               ", the input's frames are " + FrameRanges(csv_frames_seen) +
+                               " (frame = the last number in the file name)");
+    }
+    if (without > 0) {
+      report.warnings.push_back(
+          std::to_string(without) + " of " + std::to_string(csv_frames_seen.size()) +
+          " frames have no row in truth " + options.truth + " (frames " +
+          FrameRanges(csv_frames_without_truth) + "): scored as frames without target lines");
+    }
   }
   if (options.out_dir.empty()) return report;
 

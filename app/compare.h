@@ -40,12 +40,18 @@
 //              position in INPUT for a name without digits (app/edge_reference.h's format)
 //       line   an identifier of the line (integer >= 0), the same line across frames
 //       rho    pixels, theta radians: u·cosθ + v·sinθ = ρ, u = column, v = row, pixel centres
-//              at integers (detector/line.h); image (distorted) coordinates; theta any value
-//              (normalised to [0, pi))
+//              at integers (detector/line.h); image (distorted) coordinates; theta in
+//              [-2 pi, 2 pi] (normalised to [0, pi)); a larger |theta| is an error FILE:LINE
 //     An optional header row starting with "frame", blank lines and lines starting with '#'
 //     are skipped, and so are pose rows (app/truth_file.h, `oalservo evaluate`'s format). A frame
-//     without rows has no truth line. The visible chord of a CSV line is its clip to the image
-//     rectangle. CSV lines are edges or centre lines as the target is.
+//     without rows has no truth line (a warning lists such frames); a CSV without line rows,
+//     or whose rows name none of the input's frames, is an error naming both sets of frame
+//     numbers. The visible chord of a CSV line is its clip to the image rectangle. CSV lines
+//     are edges or centre lines as the target is.
+//
+// A method that throws an OpenCV error on a frame (e.g. an image too small for it) finds no
+// line there; a warning names the method, the first such frame and its size. A --camera
+// calibrated for another image size than the first frame's gives a warning (as `detect`).
 //
 // Metrics per method (scored on the first K lines of the method, K = --lines if given, else
 // the frame's truth line count + 2):

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -148,44 +149,6 @@ int PolaritySign(EdgePolarity polarity) {
   return polarity == EdgePolarity::kBrighterPositive   ? 1
          : polarity == EdgePolarity::kBrighterNegative ? -1
                                                        : 0;
-}
-
-std::string FormatFrame(const std::string& pattern, int frame) {
-  // Exactly one %d conversion, optionally zero-padded (%04d); no other '%' but "%%".
-  std::string out;
-  bool converted = false;
-  for (std::size_t k = 0; k < pattern.size(); ++k) {
-    if (pattern[k] != '%') {
-      out += pattern[k];
-      continue;
-    }
-    if (k + 1 < pattern.size() && pattern[k + 1] == '%') {
-      out += '%';
-      ++k;
-      continue;
-    }
-    std::size_t j = k + 1;
-    const bool zero = j < pattern.size() && pattern[j] == '0';
-    if (zero) ++j;
-    int width = 0;
-    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j])) != 0) {
-      width = width * 10 + (pattern[j] - '0');
-      ++j;
-    }
-    if (converted || j >= pattern.size() || pattern[j] != 'd' || width > 20) {
-      throw std::invalid_argument("image pattern \"" + pattern +
-                                  "\": expected exactly one %d conversion (e.g. %04d)");
-    }
-    std::ostringstream number;
-    number << std::setw(width) << std::setfill(zero ? '0' : ' ') << frame;
-    out += number.str();
-    converted = true;
-    k = j;
-  }
-  if (!converted) {
-    throw std::invalid_argument("image pattern \"" + pattern + "\": no %d conversion");
-  }
-  return out;
 }
 
 }  // namespace
@@ -344,14 +307,79 @@ EdgeReference FitEdgeReference(const vpImage<unsigned char>& image,
   return result;
 }
 
+std::string SequenceFramePath(const std::string& pattern, int frame) {
+  // Exactly one %d conversion, optionally zero-padded (%04d); no other '%' but "%%".
+  std::string out;
+  bool converted = false;
+  for (std::size_t k = 0; k < pattern.size(); ++k) {
+    if (pattern[k] != '%') {
+      out += pattern[k];
+      continue;
+    }
+    if (k + 1 < pattern.size() && pattern[k + 1] == '%') {
+      out += '%';
+      ++k;
+      continue;
+    }
+    std::size_t j = k + 1;
+    const bool zero = j < pattern.size() && pattern[j] == '0';
+    if (zero) ++j;
+    int width = 0;
+    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j])) != 0) {
+      width = width * 10 + (pattern[j] - '0');
+      ++j;
+    }
+    if (converted || j >= pattern.size() || pattern[j] != 'd' || width > 20) {
+      throw std::invalid_argument("image pattern \"" + pattern +
+                                  "\": expected exactly one %d conversion (e.g. %04d)");
+    }
+    std::ostringstream number;
+    number << std::setw(width) << std::setfill(zero ? '0' : ' ') << frame;
+    out += number.str();
+    converted = true;
+    k = j;
+  }
+  if (!converted) {
+    throw std::invalid_argument("image pattern \"" + pattern +
+                                "\": no %d conversion; edge-reference follows an edge through "
+                                "numbered frames, e.g. line/image.%04d.pgm (a single image or "
+                                "a directory is not a sequence)");
+  }
+  return out;
+}
+
+int LastSequenceFrame(const std::string& pattern, int first) {
+  if (first < 0) {
+    throw std::invalid_argument("first frame " + std::to_string(first) +
+                                ". Violated constraint: first >= 0");
+  }
+  const std::string first_path = SequenceFramePath(pattern, first);
+  if (!std::filesystem::is_regular_file(first_path)) {
+    throw std::runtime_error("image pattern \"" + pattern + "\": frame " + std::to_string(first) +
+                             " (" + first_path + ") does not exist");
+  }
+  // Each frame number names another file (one %d conversion), so this ends.
+  int last = first;
+  while (last < std::numeric_limits<int>::max() &&
+         std::filesystem::is_regular_file(SequenceFramePath(pattern, last + 1))) {
+    ++last;
+  }
+  return last;
+}
+
 std::vector<FrameReference> FitEdgeSequence(const std::string& pattern, int first, int last,
                                             const EdgeReferenceOptions& options) {
   options.Check();
+  SequenceFramePath(pattern, first);  // a bad pattern fails before any range error
+  if (first < 0 || first > last) {
+    throw std::invalid_argument("frames " + std::to_string(first) + " to " + std::to_string(last) +
+                                ". Violated constraint: 0 <= first <= last");
+  }
   std::vector<FrameReference> references;
   std::optional<LineParams> prior;
   EdgeReferenceOptions frame_options = options;
   for (int frame = first; frame <= last; ++frame) {
-    const std::string path = FormatFrame(pattern, frame);
+    const std::string path = SequenceFramePath(pattern, frame);
     vpImage<unsigned char> image;
     try {
       vpImageIo::read(image, path);
@@ -360,7 +388,11 @@ std::vector<FrameReference> FitEdgeSequence(const std::string& pattern, int firs
     }
     FrameReference reference;
     reference.frame = frame;
-    reference.reference = FitEdgeReference(image, frame_options, prior);
+    try {
+      reference.reference = FitEdgeReference(image, frame_options, prior);
+    } catch (const std::invalid_argument& e) {  // options were checked: the image size
+      throw std::runtime_error(path + ": " + e.what());
+    }
     if (reference.reference.status == EdgeReferenceStatus::kFound) {
       prior = reference.reference.line;
       // Keep the edge's polarity, relative to the prior's (this frame's line's) normal.

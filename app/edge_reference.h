@@ -101,9 +101,21 @@ struct FrameReference {
   EdgeReference reference;
 };
 
-/// Follows one edge through the files `pattern` (printf style, e.g. ".../image.%04d.pgm")
-/// numbered first..last, as the file comment says. Throws std::runtime_error if a file
-/// cannot be read.
+/// The file name of frame `frame` of `pattern`: a printf pattern with exactly one %d
+/// conversion (optionally zero-padded with a width, "%04d"; "%%" for a '%'). Throws
+/// std::invalid_argument naming the pattern when it has no such conversion (a single image or
+/// a directory is not a sequence) or more than one.
+std::string SequenceFramePath(const std::string& pattern, int frame);
+
+/// The last frame of the run of consecutive existing files of `pattern` that starts at
+/// frame `first` (>= 0). Throws std::invalid_argument for a bad pattern or `first` < 0, and
+/// std::runtime_error naming the file when frame `first` does not exist.
+int LastSequenceFrame(const std::string& pattern, int first);
+
+/// Follows one edge through the files `pattern` (SequenceFramePath) numbered first..last, as
+/// the file comment says. Throws std::invalid_argument for a bad pattern or range (first < 0
+/// or first > last), and std::runtime_error naming the file if one cannot be read or is
+/// smaller than FitEdgeReference accepts.
 std::vector<FrameReference> FitEdgeSequence(const std::string& pattern, int first, int last,
                                             const EdgeReferenceOptions& options);
 

@@ -1,11 +1,12 @@
 #include "app/edge_reference_command.h"
 
 #include <CLI/CLI.hpp>
-#include <cstdio>
-#include <fstream>
+#include <filesystem>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 
+#include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/edge_reference.h"
 
@@ -23,37 +24,63 @@ int RunEdgeReference(int argc, char** argv) {
   cli.add_option("PATTERN", pattern, "printf pattern of the frames, e.g. line/image.%04d.pgm")
       ->required();
   cli.add_option("--first", first, "first frame number")->capture_default_str();
-  cli.add_option("--last", last, "last frame number (0: up to the last file that exists)")
+  cli.add_option("--last", last,
+                 "last frame number (0: up to the last consecutive file that exists)")
       ->capture_default_str();
   cli.add_option("--out", out_path, "the truth CSV to write")->required();
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
-  if (last == 0) {
-    // The last consecutive frame that exists.
-    for (last = first;; ++last) {
-      char name[4096];
-      std::snprintf(name, sizeof(name), pattern.c_str(), last + 1);
-      if (!std::ifstream(name)) break;
+  // The frames: a pattern with one %d (not a single image, not a directory), a valid range.
+  SequenceFramePath(pattern, first);
+  if (first < 0) {
+    throw std::invalid_argument("--first " + std::to_string(first) + ": must be >= 0");
+  }
+  if (last < 0 || (last != 0 && first > last)) {
+    throw std::invalid_argument("--first " + std::to_string(first) + " is after --last " +
+                                std::to_string(last) +
+                                " (--last 0: up to the last consecutive file)");
+  }
+  if (last == 0) last = LastSequenceFrame(pattern, first);
+
+  // The output before the work: a bad --out fails now, and the file appears only whole.
+  const std::filesystem::path out(out_path);
+  if (out.has_parent_path()) {
+    std::error_code error;
+    std::filesystem::create_directories(out.parent_path(), error);
+    if (error) {
+      throw std::runtime_error("--out " + out_path + ": cannot create directory " +
+                               out.parent_path().string() + ": " + error.message());
     }
   }
+  CheckOutputFile(out);
+  AtomicFile file(out);  // throws naming the file when it cannot be written
+
   const std::vector<FrameReference> references =
       FitEdgeSequence(pattern, first, last, EdgeReferenceOptions());
-  int found = 0;
+  std::vector<int> missing;
   for (const FrameReference& frame : references) {
     if (frame.reference.status != EdgeReferenceStatus::kFound) {
       Warn("edge-reference",
            "frame " + std::to_string(frame.frame) + ": " + frame.reference.message);
+      missing.push_back(frame.frame);
       continue;
     }
-    ++found;
     std::cout << "frame " << frame.frame << ": rho " << frame.reference.line.rho_px << " px, theta "
               << frame.reference.line.theta_rad << " rad, rms " << frame.reference.rms_residual_px
               << " px over " << frame.reference.points << " edge points\n";
   }
-  WriteTruthCsv(references, out_path);
-  std::cout << found << " of " << references.size() << " frames have a reference; wrote "
-            << out_path << '\n';
-  return found == static_cast<int>(references.size()) ? kExitOk : kExitError;
+  if (!missing.empty()) {
+    std::string frames;
+    for (int frame : missing) frames += (frames.empty() ? "" : ", ") + std::to_string(frame);
+    throw std::runtime_error(
+        std::to_string(missing.size()) + " of " + std::to_string(references.size()) +
+        " frames have no reference (frames " + frames + "); nothing written to " + out_path);
+  }
+  WriteTruthCsv(references, file.stream());
+  file.Commit();
+  std::cout << references.size() << " of " << references.size()
+            << " frames have a reference; wrote " << out_path << '\n';
+  return kExitOk;
 }
 
 }  // namespace oal

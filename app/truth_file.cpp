@@ -88,8 +88,15 @@ TruthCsv LoadTruthCsvWithPoses(const std::string& path) {
     const int frame = row.Index(0, "frame");
     TargetLineTruth target;
     target.id = row.Index(1, "line");
-    target.image_line = target.ideal_line =
-        Normalized(row.Number(2, "rho"), row.Number(3, "theta"));
+    const double rho = row.Number(2, "rho"), theta = row.Number(3, "theta");
+    if (std::fabs(theta) > 2.0 * kPi) {
+      std::ostringstream message;
+      message << "field theta = " << theta
+              << " is outside [-2 pi, 2 pi]: theta is the angle of the line's normal in radians "
+                 "(degrees given?)";
+      Fail(path, number, message.str());
+    }
+    target.image_line = target.ideal_line = Normalized(rho, theta);
     std::vector<TargetLineTruth>& lines = truth.lines[frame];
     for (const TargetLineTruth& other : lines) {
       if (other.id == target.id) {

@@ -14,7 +14,9 @@
 //   line   an integer >= 0 identifying the line across frames (the target line's index for
 //          the four-line target: 0-3 are lines 1-4)
 //   rho, theta   pixels and radians, u·cosθ + v·sinθ = ρ (detector/line.h), image
-//          (distorted) coordinates; theta any value (normalised to [0, pi))
+//          (distorted) coordinates; theta in [-2 pi, 2 pi] (normalised to [0, pi): our
+//          [0, pi), atan2's (-pi, pi] and ViSP's [0, 2 pi) all work; a larger value is
+//          rejected, most likely degrees)
 //
 // A header row starting with "frame", blank lines and lines starting with '#' are skipped.
 #pragma once
@@ -37,7 +39,8 @@ struct TruthCsv {
 
 /// Reads a truth CSV with line and pose rows (file comment). Throws std::runtime_error
 /// "FILE:LINE: ..." for a missing file or a malformed row (wrong field count, a field that is
-/// not a number, a negative or fractional frame or line, a line or pose given twice).
+/// not a number, a negative or fractional frame or line, theta outside [-2 pi, 2 pi], a line
+/// or pose given twice).
 TruthCsv LoadTruthCsvWithPoses(const std::string& path);
 
 /// The pose cMo of a frame_NNNN.json truth file (oalservo render); nothing if it has none.

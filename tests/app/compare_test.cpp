@@ -3,13 +3,18 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "app/camera_file.h"
 #include "app/render_command.h"
+#include "app/truth_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
@@ -190,6 +195,123 @@ TEST(Compare, WithoutTruthOnlyTimes) {
   EXPECT_EQ(report.frames, 3);
   EXPECT_THAT(CompareMarkdown(report), HasSubstr("| vpMeLine |"));
   EXPECT_GE(report.methods[1].lines[0].size(), 1u);  // trackers started on our detections
+}
+
+// Writes `count` images of `width`x`height` into `dir` (frame_0000.png, ...): a dark left
+// half, a bright right half (one vertical edge), so the methods have something to see.
+std::string WriteEdgeImages(const fs::path& dir, int count, int width, int height) {
+  fs::create_directories(dir);
+  for (int f = 0; f < count; ++f) {
+    cv::Mat image(height, width, CV_8UC1, cv::Scalar(40));
+    image.colRange(width / 2, width).setTo(cv::Scalar(200));
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%04d.png", f);
+    EXPECT_TRUE(cv::imwrite((dir / name).string(), image));
+  }
+  return dir.string();
+}
+
+bool AnyContains(const std::vector<std::string>& texts, const std::string& part) {
+  return std::any_of(texts.begin(), texts.end(),
+                     [&](const std::string& text) { return text.find(part) != std::string::npos; });
+}
+
+TEST(Compare, CsvTruthMatchingNoFrameIsAnError) {
+  test::TestDir dir;
+  CompareOptions options;
+  options.input = WriteEdgeImages(dir / "images", 3, 64, 48);
+  options.out_dir = dir / "out";
+
+  // No line row at all.
+  test::WriteText(dir / "empty.csv", "frame,line,rho,theta\n");
+  options.truth = dir / "empty.csv";
+  std::string error = CompareError(options);
+  EXPECT_THAT(error, HasSubstr("empty.csv"));
+  EXPECT_THAT(error, HasSubstr("no line row"));
+
+  // Rows, but for a frame the input does not have: both sets of frame numbers are named.
+  test::WriteText(dir / "elsewhere.csv", "frame,line,rho,theta\n999,0,31.5,0\n");
+  options.truth = dir / "elsewhere.csv";
+  error = CompareError(options);
+  EXPECT_THAT(error, HasSubstr("elsewhere.csv matches no frame"));
+  EXPECT_THAT(error, HasSubstr("rows are for frames 999"));
+  EXPECT_THAT(error, HasSubstr("the input's frames are 0-2"));
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+TEST(Compare, FramesWithoutCsvTruthAreWarnedAbout) {
+  test::TestDir dir;
+  CompareOptions options;
+  options.input = WriteEdgeImages(dir / "images", 4, 64, 48);
+  options.out_dir = dir / "out";
+  options.target_kind = TargetKind::kEdges;
+  test::WriteText(dir / "truth.csv", "frame,line,rho,theta\n0,0,31.5,0\n2,0,31.5,0\n");
+  options.truth = dir / "truth.csv";
+  const CompareReport report = RunComparison(options);
+  EXPECT_EQ(report.frames, 4);
+  EXPECT_EQ(report.methods[0].truth_lines, 2);
+  const std::string expected = "2 of 4 frames have no row in truth " + options.truth;
+  EXPECT_TRUE(AnyContains(report.warnings, expected)) << ::testing::PrintToString(report.warnings);
+  EXPECT_TRUE(AnyContains(report.warnings, "(frames 1, 3)"));
+  const json parsed = json::parse(test::ReadText(fs::path(options.out_dir) / "compare.json"));
+  EXPECT_TRUE(AnyContains(parsed.at("warnings").get<std::vector<std::string>>(), expected));
+}
+
+TEST(Compare, CsvThetaOutsideTwoPiNamesFileAndLine) {
+  test::TestDir dir;
+  test::WriteText(dir / "theta.csv", "frame,line,rho,theta\n0,0,10,-3.0\n1,0,10,6.0\n2,0,10,7.5\n");
+  const std::string error = test::ErrorMessageOf([&] { LoadTruthCsv(dir / "theta.csv"); });
+  EXPECT_THAT(error, HasSubstr("theta.csv:4"));
+  EXPECT_THAT(error, HasSubstr("theta = 7.5"));
+  EXPECT_THAT(error, HasSubstr("[-2 pi, 2 pi]"));
+  // Within [-2 pi, 2 pi] any value is accepted and normalised to [0, pi).
+  test::WriteText(dir / "ok.csv", "0,0,10,-3.0\n1,0,10,6.0\n");
+  const auto truth = LoadTruthCsv(dir / "ok.csv");
+  ASSERT_EQ(truth.size(), 2u);
+  for (const auto& [frame, lines] : truth) {
+    ASSERT_EQ(lines.size(), 1u);
+    EXPECT_GE(lines[0].image_line.theta_rad, 0.0) << frame;
+    EXPECT_LT(lines[0].image_line.theta_rad, kPi) << frame;
+  }
+  // The same through LoadTruthCsvWithPoses (oalservo evaluate's reader).
+  EXPECT_THAT(test::ErrorMessageOf([&] { LoadTruthCsvWithPoses(dir / "theta.csv"); }),
+              HasSubstr("theta.csv:4"));
+}
+
+TEST(Compare, TinyImagesGiveAWarningNamingFrameAndSize) {
+  for (const auto& [width, height] : {std::pair{5, 5}, std::pair{640, 3}}) {
+    test::TestDir dir;
+    CompareOptions options;
+    options.input = WriteEdgeImages(dir / "images", 2, width, height);
+    options.out_dir = dir / "out";
+    const std::string size = std::to_string(width) + "x" + std::to_string(height) + " px";
+    CompareReport report;
+    ASSERT_NO_THROW(report = RunComparison(options)) << size;
+    EXPECT_EQ(report.frames, 2);
+    // Some OpenCV method cannot run on such an image: a warning, no raw assertion.
+    EXPECT_TRUE(AnyContains(report.warnings, "could not run on 2 frames (first: frame 0 '"))
+        << ::testing::PrintToString(report.warnings);
+    EXPECT_TRUE(AnyContains(report.warnings, size)) << size;
+    EXPECT_TRUE(fs::is_regular_file(fs::path(options.out_dir) / "compare.json"));
+  }
+}
+
+TEST(Compare, CameraForAnotherImageSizeIsWarnedAbout) {
+  test::TestDir dir;
+  vpCameraParameters camera;
+  camera.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  SaveCameraFile(dir / "camera.xml", camera, "cam", 640, 480);
+  CompareOptions options;
+  options.input = WriteEdgeImages(dir / "images", 2, 64, 48);
+  options.camera_path = dir / "camera.xml";
+  const CompareReport report = RunComparison(options);
+  EXPECT_TRUE(AnyContains(report.warnings, "calibrated for 640x480"))
+      << ::testing::PrintToString(report.warnings);
+  EXPECT_TRUE(AnyContains(report.warnings, "is 64x48"));
+
+  // The right size: no such warning.
+  SaveCameraFile(dir / "camera.xml", camera, "cam", 64, 48);
+  EXPECT_FALSE(AnyContains(RunComparison(options).warnings, "calibrated for"));
 }
 
 }  // namespace
