@@ -325,6 +325,10 @@ TEST(EdgeReferenceCommand, AnUnwritableOutFailsBeforeTheWork) {
   test::WriteText(dir / "file", "not a directory\n");
   EXPECT_THAT(EdgeReferenceError({pattern, "--out", dir / "file/x.csv"}),
               HasSubstr("--out " + dir / "file/x.csv" + ": cannot create directory"));
+  // Checked before the frames are read: frames the fit rejects are not reached.
+  const std::string tiny = WriteEdgeFrames(dir.path() / "tiny", 1, 1, true, 5);
+  EXPECT_THAT(EdgeReferenceError({tiny, "--out", dir / "file/x.csv"}),
+              HasSubstr("cannot create directory"));
   fs::create_directories(dir / "taken.csv");
   EXPECT_THAT(EdgeReferenceError({pattern, "--out", dir / "taken.csv"}),
               HasSubstr("is a directory"));
