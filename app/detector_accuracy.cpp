@@ -98,13 +98,12 @@ struct OalMethod {
 }  // namespace
 
 void AccuracyOptions::Check() const {
-  auto require = [](bool ok, const std::string& message) {
-    if (!ok) throw std::invalid_argument("AccuracyOptions::" + message);
-  };
-  require(frames >= 1 && frames <= 1000000, "frames must be in [1, 1000000]");
-  require(width >= 16 && height >= 16, "width and height must be >= 16");
-  require(focal_px > 0.0, "focal_px must be > 0");
-  require(max_angle_deg > 0.0 && max_offset_px > 0.0, "error bounds must be > 0");
+  RenderedFrameOptions::Check();
+  if (!(max_angle_deg > 0.0 && max_offset_px > 0.0)) {
+    throw std::invalid_argument("--max-angle-deg and --max-offset-px must be > 0 (got " +
+                                std::to_string(max_angle_deg) + " and " +
+                                std::to_string(max_offset_px) + ")");
+  }
   detector.Check();
 }
 

@@ -80,12 +80,22 @@ int RunDetectAccuracy(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--max-offset-px", options.max_offset_px, "failure bound on offset")
       ->capture_default_str();
-  cli.add_option("--config", config_path, "YAML config (detector section) for our detector")
+  cli.add_option("--config", config_path,
+                 "YAML config for our detector: its 'detector:' section, the only one read "
+                 "(another section is an error)")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
-  if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
+  // Everything that can fail before the evaluation's minutes of work.
+  if (!config_path.empty()) {
+    options.detector = LoadAccuracyConfig(config_path, "detect-accuracy", {"detector"},
+                                          "the target is chosen with --target")
+                           .detector;
+  }
+  options.Check();
+  TargetByName(options.target);  // throws for an unknown name
+  CheckReportFile(out_path);
   const AccuracyReport report = EvaluateDetectorAccuracy(options, TerminalFrameProgress());
   PrintAccuracyReport(Table(report), ToJson(report), out_path);
   return kExitOk;

@@ -25,16 +25,24 @@ double RollDeg(const vpHomogeneousMatrix& cMo) {
   return vpMath::deg(vpRzyxVector(cRo)[0]);
 }
 
+// options.pose with what the evaluation sets: the rendered camera, the detector's
+// undistortion and the image size.
+PoseOptions PoseOptionsFor(const PoseAccuracyOptions& options, const RenderOptions& render,
+                           bool lines_undistorted) {
+  PoseOptions pose = options.pose;
+  pose.camera = render.camera;
+  pose.lines_undistorted = lines_undistorted;
+  pose.image_width = options.width;
+  pose.image_height = options.height;
+  return pose;
+}
+
 }  // namespace
 
 void PoseAccuracyOptions::Check() const {
-  if (frames < 1 || frames > 1000000) {
-    throw std::invalid_argument("PoseAccuracyOptions::frames must be in [1, 1000000]");
-  }
-  if (width < 16 || height < 16 || focal_px <= 0.0) {
-    throw std::invalid_argument("PoseAccuracyOptions: image size >= 16 and focal_px > 0");
-  }
+  RenderedFrameOptions::Check();
   detector.Check();
+  PoseOptionsFor(*this, MakeRenderOptions(*this), true).Check();
 }
 
 PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
@@ -44,11 +52,7 @@ PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
   const SceneRenderer renderer(FourLineTarget(), render);
 
   OalDetector detector(options.detector, render.camera);
-  PoseOptions pose_options;
-  pose_options.camera = render.camera;
-  pose_options.lines_undistorted = detector.Undistorts();
-  pose_options.image_width = options.width;
-  pose_options.image_height = options.height;
+  const PoseOptions pose_options = PoseOptionsFor(options, render, detector.Undistorts());
 
   PoseAccuracyReport report;
   report.options = options;

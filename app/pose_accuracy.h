@@ -11,6 +11,7 @@
 #include "app/accuracy_frames.h"
 #include "detector/options.h"
 #include "scene/scene.h"
+#include "servo/pose.h"
 
 namespace oal {
 
@@ -18,6 +19,9 @@ namespace oal {
 struct PoseAccuracyOptions : RenderedFrameOptions {
   PoseSampling sampling = DefaultSampling();
   DetectorOptions detector;
+  /// EstimatePose's tunables (a config's `pose:`); its camera, lines_undistorted and image
+  /// size are ignored: the evaluation sets them from the rendered frames and the detector.
+  PoseOptions pose;
 
   /// Distance 0.3-1.0 m, tilt up to 40 deg, any roll, every line crossing 150 px of image.
   static PoseSampling DefaultSampling() {
@@ -28,13 +32,14 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
     sampling.min_visible_length_px = 150.0;
     return sampling;
   }
+  /// RenderedFrameOptions::Check(), the detector's and the pose's options (with the camera).
   void Check() const;
 };
 
 struct PoseAccuracyReport {
   PoseAccuracyOptions options;
   int frames = 0;
-  std::array<int, 4> status_counts{};         ///< by PoseStatus
+  std::array<int, 4> status_counts{};         ///< by PoseStatus (its numeric value)
   std::vector<double> translation_error_pct;  ///< |t - t_true| / |t_true|, frames with a pose
   std::vector<double> rotation_error_deg;     ///< angle of R R_true^T
   std::vector<double> roll_error_deg;         ///< |roll - roll_true| wrapped to [0, 180]

@@ -43,21 +43,34 @@ std::string Table(const PoseAccuracyReport& r) {
   return out.str();
 }
 
-nlohmann::json ToJson(const PoseAccuracyReport& r) {
+// {"ok": 20, "not-enough-lines": 0, ...}: the frames of each PoseStatus, by its name.
+nlohmann::json StatusCountsJson(const PoseAccuracyReport& r) {
+  nlohmann::json counts = nlohmann::json::object();
+  for (PoseStatus status : {PoseStatus::kOk, PoseStatus::kNotEnoughLines,
+                            PoseStatus::kNotIdentifiable, PoseStatus::kDegenerate}) {
+    counts[ToString(status)] = r.status_counts[static_cast<std::size_t>(status)];
+  }
+  return counts;
+}
+
+nlohmann::json ToJson(const PoseAccuracyReport& r, const std::string& config_path) {
   const PoseAccuracyOptions& o = r.options;
   nlohmann::json options = RenderedFrameJson(o);
   options["min_distance_m"] = o.sampling.min_distance_m;
   options["max_distance_m"] = o.sampling.max_distance_m;
   options["max_tilt_deg"] = o.sampling.max_tilt_deg;
   options["min_visible_length_px"] = o.sampling.min_visible_length_px;
+  options["max_residual_px"] = o.pose.max_residual_px;
+  if (!config_path.empty()) options["config"] = config_path;
   return {{"options", std::move(options)},
           {"frames", r.frames},
           {"posed", r.posed()},
-          {"status_counts", r.status_counts},
+          {"status_counts", StatusCountsJson(r)},
           {"translation_error_pct_median", Quantile(r.translation_error_pct, 0.5)},
           {"translation_error_pct_p95", Quantile(r.translation_error_pct, 0.95)},
           {"rotation_error_deg_median", Quantile(r.rotation_error_deg, 0.5)},
           {"rotation_error_deg_p95", Quantile(r.rotation_error_deg, 0.95)},
+          {"roll_error_deg_median", Quantile(r.roll_error_deg, 0.5)},
           {"roll_error_deg_max", Quantile(r.roll_error_deg, 1.0)},
           {"roll_flips", r.roll_flips},
           {"pose_time_us_median", Quantile(r.pose_time_us, 0.5)},
@@ -82,14 +95,25 @@ int RunPoseAccuracy(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--max-tilt-deg", options.sampling.max_tilt_deg, "camera tilt bound")
       ->capture_default_str();
-  cli.add_option("--config", config_path, "YAML config (detector section)")
+  cli.add_option("--config", config_path,
+                 "YAML config: its 'detector:' and 'pose:' sections (config/detector.yaml, "
+                 "config/pose.yaml); another section is an error")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
-  if (!config_path.empty()) options.detector = LoadConfig(config_path).detector;
+  // Everything that can fail before the evaluation's minutes of work.
+  if (!config_path.empty()) {
+    const AppConfig config = LoadAccuracyConfig(
+        config_path, "pose-accuracy", {"detector", "pose"},
+        "it renders the built-in four-line target with the camera of its command-line options");
+    options.detector = config.detector;
+    options.pose = config.pose;
+  }
+  options.Check();
+  CheckReportFile(out_path);
   const PoseAccuracyReport report = EvaluatePoseAccuracy(options, TerminalFrameProgress());
-  PrintAccuracyReport(Table(report), ToJson(report), out_path);
+  PrintAccuracyReport(Table(report), ToJson(report, config_path), out_path);
   return kExitOk;
 }
 

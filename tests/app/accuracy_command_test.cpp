@@ -1,0 +1,161 @@
+// `oalservo detect-accuracy` and `oalservo pose-accuracy` (and `demo`'s stdout): what they read
+// from --config, when they check --out, their report, and a failed stdout. A few small
+// evaluations through the real binary; the measures themselves are the benchmarks' business.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "app/command_line.h"
+#include "app/detector_accuracy_command.h"
+#include "app/pose_accuracy.h"
+#include "app/pose_accuracy_command.h"
+#include "tests/app/command_test_util.h"
+#include "tests/app/test_util.h"
+
+namespace oal {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+// Runs `oalservo <args>` through the shell; stdout goes to `stdout_to` (a file of the test's
+// directory when empty).
+Result RunOalservo(const test::TestDir& dir, const std::string& args,
+                   const std::string& stdout_to = "") {
+  const std::string out = stdout_to.empty() ? dir / "stdout.txt" : stdout_to;
+  const std::string err = dir / "stderr.txt";
+  const std::string command =
+      std::string("'") + OAL_OALSERVO_PATH + "' " + args + " >'" + out + "' 2>'" + err + "'";
+  const int status = std::system(command.c_str());
+  Result result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (stdout_to.empty()) result.out = test::ReadText(out);
+  result.err = test::ReadText(err);
+  return result;
+}
+
+// Few small frames: each evaluation takes well under a second.
+const std::string kFewFrames = " --frames 3 --seed 2";
+
+// pose: is applied: a residual bound no pose can meet leaves every frame without a pose.
+TEST(PoseAccuracy, ConfigPoseSectionIsApplied) {
+  test::TestDir dir;
+  PoseAccuracyOptions options;
+  options.frames = 3;
+  EXPECT_EQ(EvaluatePoseAccuracy(options).posed(), 3);
+  options.pose.max_residual_px = 1e-4;
+  EXPECT_EQ(EvaluatePoseAccuracy(options).posed(), 0);
+
+  test::WriteText(dir / "strict.yaml",
+                  "detector:\n  step_px: 5\npose:\n  max_residual_px: 0.0001\n");
+  const Result strict =
+      RunOalservo(dir, "pose-accuracy" + kFewFrames + " --config '" + dir / "strict.yaml" +
+                           "' --out '" + dir / "strict.json" + "'");
+  ASSERT_EQ(strict.exit_code, 0) << strict.err;
+  const json report = json::parse(test::ReadText(dir / "strict.json"));
+  EXPECT_EQ(report.at("posed"), 0);
+  EXPECT_EQ(report.at("options").at("max_residual_px"), 1e-4);
+  EXPECT_EQ(report.at("options").at("config"), dir / "strict.yaml");
+}
+
+// The report: status_counts keyed by status name, and the roll median the table shows.
+TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
+  test::TestDir dir;
+  const Result run =
+      RunOalservo(dir, "pose-accuracy" + kFewFrames + " --out '" + dir / "report.json" + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json report = json::parse(test::ReadText(dir / "report.json"));
+  EXPECT_EQ(report.at("status_counts"),
+            json({{"ok", 3}, {"not-enough-lines", 0}, {"not-identifiable", 0}, {"degenerate", 0}}));
+  EXPECT_EQ(report.at("posed"), 3);
+  ASSERT_TRUE(report.contains("roll_error_deg_median"));
+  EXPECT_LE(report.at("roll_error_deg_median").get<double>(),
+            report.at("roll_error_deg_max").get<double>());
+  EXPECT_THAT(run.out, HasSubstr("| roll error median / max (deg) |"));
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// A section the command would ignore is an error naming the file, the line and the section.
+TEST(AccuracyCommands, ConfigSectionsTheyDoNotReadAreRejected) {
+  test::TestDir dir;
+  const std::string config = dir / "with-target.yaml";
+  test::WriteText(config, "detector:\n  step_px: 5\ntarget: {name: two-line}\n");
+  const Result pose = RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'");
+  EXPECT_EQ(pose.exit_code, 1);
+  EXPECT_THAT(pose.err,
+              HasSubstr(config + ":3: section 'target' is not used by oalservo pose-accuracy "
+                                 "(it reads: detector, pose)"));
+  EXPECT_TRUE(pose.out.empty());
+  const Result detect = RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'");
+  EXPECT_EQ(detect.exit_code, 1);
+  EXPECT_THAT(detect.err,
+              HasSubstr(config + ":3: section 'target' is not used by oalservo "
+                                 "detect-accuracy (it reads: detector); the target is chosen "
+                                 "with --target"));
+  test::WriteText(config, "pose:\n  max_residual_px: 1.0\n");
+  EXPECT_THAT(RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'").err,
+              HasSubstr(":1: section 'pose' is not used by oalservo detect-accuracy"));
+  // A section they read is still checked by the config reader.
+  test::WriteText(config, "pose:\n  max_residual: 1.0\n");
+  EXPECT_THAT(RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'").err,
+              HasSubstr(config + ":2:"));
+}
+
+// --out is checked before the evaluation: an error, and no table printed (it used to come
+// after the whole evaluation, with the table already on stdout).
+TEST(AccuracyCommands, OutputIsCheckedBeforeTheWork) {
+  test::TestDir dir;
+  for (const std::string command : {"pose-accuracy", "detect-accuracy"}) {
+    for (const std::string& out :
+         {dir / "missing/report.json", dir.path().string(), std::string("/proc/report.json")}) {
+      const Result run = RunOalservo(dir, command + " --frames 1 --out '" + out + "'");
+      EXPECT_EQ(run.exit_code, 1) << command << " " << out;
+      EXPECT_THAT(run.err, HasSubstr("cannot write --out '" + out + "'")) << command;
+      EXPECT_TRUE(run.out.empty()) << command << " " << out << ": " << run.out;
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir / "missing"));
+}
+
+// The same ranges as `oalservo render`: -1 < kdu < 1; and a seed is never negative.
+TEST(AccuracyCommands, OptionRanges) {
+  for (auto run : {&RunPoseAccuracy, &RunDetectAccuracy}) {
+    EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>([&] {
+                  test::RunWithArgs(run, {"x", "--frames", "1", "--kdu", "1.5"});
+                }),
+                HasSubstr("--kdu = 1.5 is out of range: -1 < --kdu < 1"));
+    EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>([&] {
+                  test::RunWithArgs(run, {"x", "--frames", "1", "--noise", "200"});
+                }),
+                HasSubstr("--noise = 200"));
+    EXPECT_THROW(test::RunWithArgs(run, {"x", "--frames", "1", "--seed", "-1"}), UsageError);
+  }
+}
+
+// stdout on a full disk: exit 1 with a message, as `detect` and `pose` do.
+TEST(AccuracyCommands, AFullStdoutIsAnError) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  test::TestDir dir;
+  for (const std::string& command :
+       {std::string("pose-accuracy --frames 1"), std::string("detect-accuracy --frames 1"),
+        "demo --out '" + dir / "demo" + "'"}) {
+    const Result run = RunOalservo(dir, command, "/dev/full");
+    EXPECT_EQ(run.exit_code, 1) << command;
+    EXPECT_THAT(run.err, HasSubstr("cannot write the output")) << command;
+  }
+}
+
+}  // namespace
+}  // namespace oal
