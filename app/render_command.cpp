@@ -1,13 +1,17 @@
 #include "app/render_command.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
+#include "app/accuracy_frames.h"  // AddSeedOption
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
 #include "app/command_line.h"
@@ -23,12 +27,12 @@ namespace fs = std::filesystem;
 
 constexpr const char* kCameraName = "oal-render";
 
+// Names the command-line option (`option`, e.g. "--fx"), its value and the constraint.
 template <typename T>
-void Require(bool ok, const char* field, const T& value, const char* constraint) {
+void Require(bool ok, const char* option, const T& value, const char* constraint) {
   if (ok) return;
   std::ostringstream message;
-  message << "RenderCommandOptions::" << field << " = " << value
-          << ". Violated constraint: " << constraint;
+  message << option << " = " << value << " is out of range: " << constraint;
   throw std::invalid_argument(message.str());
 }
 
@@ -58,6 +62,135 @@ PoseSampling ToPoseSampling(const RenderCommandOptions& options) {
   sampling.min_visible_length_px = options.min_visible_px;
   return sampling;
 }
+
+// A renderer file in a data set's folder: frame_NNNN.png, frame_NNNN.json, camera.xml or
+// sequence.json (what RenderDataset writes and --overwrite replaces).
+bool IsRendererFile(const fs::directory_entry& entry) {
+  if (!entry.is_regular_file()) return false;
+  const std::string name = entry.path().filename().string();
+  if (name == "camera.xml" || name == "sequence.json") return true;
+  const std::string stem = entry.path().stem().string();
+  const std::string extension = entry.path().extension().string();
+  return (extension == ".png" || extension == ".json") && stem.size() > 6 &&
+         stem.compare(0, 6, "frame_") == 0 &&
+         stem.find_first_not_of("0123456789", 6) == std::string::npos;
+}
+
+std::vector<fs::path> RendererFilesIn(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    if (IsRendererFile(entry)) files.push_back(entry.path());
+  }
+  return files;
+}
+
+// "20 frames, camera.xml" for the renderer files `files`; empty for none.
+std::string DescribeRendererFiles(const std::vector<fs::path>& files) {
+  int frames = 0;
+  std::string others;
+  for (const fs::path& file : files) {
+    const std::string name = file.filename().string();
+    if (file.extension() == ".png") {
+      ++frames;
+    } else if (file.extension() != ".json" || name == "sequence.json") {
+      others += ", " + name;
+    }
+  }
+  if (frames == 0 && others.empty() && !files.empty()) return "frame_NNNN.json files";
+  if (frames == 0) return others.empty() ? "" : others.substr(2);
+  return std::to_string(frames) + (frames == 1 ? " frame" : " frames") + others;
+}
+
+// The data set's folder, written all or nothing: the frames go to a temporary sibling folder
+// `<DIR>.tmp-<pid>`, which Commit() moves into place (one rename when DIR does not exist;
+// else the renderer files already in DIR are removed and the new ones moved in, other files
+// kept). Without Commit() (an error), the temporary folder and any parent folders created
+// for it are removed: nothing is left behind.
+class StagedDataset {
+ public:
+  // Throws std::invalid_argument when DIR is not a folder, or holds renderer files and
+  // `overwrite` is false; std::runtime_error when the temporary folder cannot be made.
+  StagedDataset(const std::string& out_dir, bool overwrite) : name_(out_dir) {
+    target_ = fs::absolute(out_dir).lexically_normal();
+    if (!target_.has_filename()) target_ = target_.parent_path();  // "data/", "."
+    if (fs::exists(target_) && !fs::is_directory(target_)) {
+      throw std::invalid_argument("--out '" + name_ + "' exists and is not a folder");
+    }
+    if (fs::is_directory(target_) && !overwrite) {
+      const std::string held = DescribeRendererFiles(RendererFilesIn(target_));
+      if (!held.empty()) {
+        throw std::invalid_argument("--out '" + name_ + "' already holds a rendered data set (" +
+                                    held +
+                                    "); pass --overwrite to replace it (other files in the "
+                                    "folder are kept), or choose another folder");
+      }
+    }
+    const fs::path parent = target_.parent_path();
+    for (fs::path p = parent; !p.empty() && !fs::exists(p); p = p.parent_path()) created_ = p;
+    std::error_code error;
+    fs::create_directories(parent, error);
+    temp_ = TempPathFor(target_);
+    if (!error) fs::remove_all(temp_, error);  // a stale one of an earlier process of this pid
+    if (!error) fs::create_directory(temp_, error);
+    if (error) {
+      RemoveCreatedParents();
+      throw std::runtime_error("cannot create the folder '" + temp_.string() + "' for --out '" +
+                               name_ + "': " + error.message());
+    }
+  }
+
+  ~StagedDataset() {
+    if (committed_) return;
+    std::error_code ignored;
+    fs::remove_all(temp_, ignored);
+    RemoveCreatedParents();
+  }
+
+  StagedDataset(const StagedDataset&) = delete;
+  StagedDataset& operator=(const StagedDataset&) = delete;
+
+  /// Where the files are written until Commit().
+  const fs::path& dir() const { return temp_; }
+
+  void Commit() {
+    if (!fs::exists(target_)) {
+      fs::rename(temp_, target_);
+    } else {
+      for (const fs::path& old : RendererFilesIn(target_)) fs::remove(old);
+      // Frames first, then camera.xml, then sequence.json (its presence means complete).
+      std::vector<fs::path> files;
+      for (const fs::directory_entry& entry : fs::directory_iterator(temp_)) {
+        files.push_back(entry.path());
+      }
+      auto rank = [](const fs::path& file) {
+        const std::string name = file.filename().string();
+        return std::make_pair(name == "sequence.json" ? 2 : name == "camera.xml" ? 1 : 0, name);
+      };
+      std::sort(files.begin(), files.end(),
+                [&](const fs::path& a, const fs::path& b) { return rank(a) < rank(b); });
+      for (const fs::path& file : files) fs::rename(file, target_ / file.filename());
+      fs::remove(temp_);
+    }
+    committed_ = true;
+  }
+
+ private:
+  // Removes the parent folders the constructor created, if they are (still) empty.
+  void RemoveCreatedParents() noexcept {
+    if (created_.empty()) return;
+    std::error_code error;
+    for (fs::path p = target_.parent_path(); !error; p = p.parent_path()) {
+      fs::remove(p, error);
+      if (p == created_) break;
+    }
+  }
+
+  std::string name_;  // --out as given, for messages
+  fs::path target_;   // absolute, no trailing separator
+  fs::path temp_;     // <target>.tmp-<pid>
+  fs::path created_;  // the outermost parent folder the constructor created; empty: none
+  bool committed_ = false;
+};
 
 // Noise seed of frame `index`: distinct per frame, a pure function of the data set's seed.
 std::uint64_t NoiseSeed(std::uint64_t seed, int index) {
@@ -110,13 +243,13 @@ LineTarget TargetOf(const RenderCommandOptions& options) {
   return options.config.empty() ? TargetByName(options.target) : LoadConfig(options.config).target;
 }
 
-int RenderSequenceDataset(const RenderCommandOptions& options, const LineTarget& target) {
+// Renders the sequence's frames, camera.xml and sequence.json into `dir`.
+void RenderSequenceDataset(const RenderCommandOptions& options, const LineTarget& target,
+                           const fs::path& dir) {
   const Sequence sequence =
       MakeSequence(SequenceKindFromString(options.sequence), options.count, options.seed, target);
   const SceneRenderer renderer(sequence.target, sequence.options);
   const RenderOptions& render = renderer.options();
-  const fs::path dir(options.out_dir);
-  fs::create_directories(dir);
   SaveCameraFile((dir / "camera.xml").string(), render.camera, kCameraName,
                  static_cast<unsigned int>(render.width), static_cast<unsigned int>(render.height));
   for (int i = 0; i < options.count; ++i) {
@@ -144,56 +277,14 @@ int RenderSequenceDataset(const RenderCommandOptions& options, const LineTarget&
       {"gradient_angle_rad", render.gradient_angle_rad},
       {"frames", FrameName(0, ".png") + " ... " + FrameName(options.count - 1, ".png")}};
   WriteFileAtomically(dir / "sequence.json", summary.dump(2) + "\n");
-  return options.count;
 }
 
-}  // namespace
-
-void RenderCommandOptions::Check() const {
-  if (!sequence.empty()) {
-    try {
-      SequenceKindFromString(sequence);
-    } catch (const std::invalid_argument&) {
-      Require(false, "sequence", sequence, ("sequence is one of: " + SequenceKindNames()).c_str());
-    }
-  }
-  Require(!config.empty() || target == "two-line" || target == "four-line", "target", target,
-          "target is two-line or four-line");
-  Require(count >= 1 && count <= 100000, "count", count, "1 <= count <= 100000");
-  Require(!out_dir.empty(), "out_dir", "''", "an output directory is given");
-  Require(width >= 16 && width <= 8192, "width", width, "16 <= width <= 8192");
-  Require(height >= 16 && height <= 8192, "height", height, "16 <= height <= 8192");
-  Require(fx_px > 0.0 && fx_px <= 1e5, "fx_px", fx_px, "0 < fx_px <= 1e5");
-  Require(kdu > -1.0 && kdu < 1.0, "kdu", kdu, "-1 < kdu < 1");
-  Require(noise_sigma >= 0.0 && noise_sigma <= 100.0, "noise_sigma", noise_sigma,
-          "0 <= noise_sigma <= 100");
-  Require(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0, "blur_sigma_px", blur_sigma_px,
-          "0 <= blur_sigma_px <= 20");
-  Require(gradient >= 0.0 && gradient <= 0.9, "gradient", gradient, "0 <= gradient <= 0.9");
-  Require(min_distance_m > 0.0, "min_distance_m", min_distance_m, "min_distance_m > 0");
-  Require(max_distance_m >= min_distance_m, "max_distance_m", max_distance_m,
-          "max_distance_m >= min_distance_m");
-  Require(max_tilt_deg >= 0.0 && max_tilt_deg <= 80.0, "max_tilt_deg", max_tilt_deg,
-          "0 <= max_tilt_deg <= 80");
-  Require(min_visible_px >= 0.0, "min_visible_px", min_visible_px, "min_visible_px >= 0");
-  if (!background_image.empty() && !fs::is_regular_file(background_image)) {
-    throw std::invalid_argument("background image '" + background_image + "' does not exist");
-  }
-}
-
-vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu) {
-  return CameraWithKdu(fx_px, fx_px, 0.5 * (width - 1), 0.5 * (height - 1), kdu, width, height);
-}
-
-int RenderDataset(const RenderCommandOptions& options) {
-  options.Check();
-  const LineTarget target = TargetOf(options);
-  if (!options.sequence.empty()) return RenderSequenceDataset(options, target);
+// Renders independent random poses, their truth and camera.xml into `dir`.
+void RenderRandomDataset(const RenderCommandOptions& options, const LineTarget& target,
+                         const fs::path& dir) {
   const SceneRenderer renderer(target, ToRenderOptions(options));
   const PoseSampling sampling = ToPoseSampling(options);
   const vpCameraParameters& camera = renderer.options().camera;
-  const fs::path dir(options.out_dir);
-  fs::create_directories(dir);
   SaveCameraFile((dir / "camera.xml").string(), camera, kCameraName,
                  static_cast<unsigned int>(options.width),
                  static_cast<unsigned int>(options.height));
@@ -206,6 +297,56 @@ int RenderDataset(const RenderCommandOptions& options) {
                TruthJson(target.name, options.seed, frame, i, noise_seed, camera, options.width,
                          options.height));
   }
+}
+
+}  // namespace
+
+void RenderCommandOptions::Check() const {
+  if (!sequence.empty()) {
+    try {
+      SequenceKindFromString(sequence);
+    } catch (const std::invalid_argument&) {
+      Require(false, "--sequence", sequence, ("it is one of: " + SequenceKindNames()).c_str());
+    }
+  }
+  Require(!config.empty() || target == "two-line" || target == "four-line", "--target", target,
+          "it is two-line or four-line");
+  Require(count >= 1 && count <= 100000, "--count", count, "1 <= --count <= 100000");
+  if (out_dir.empty()) throw std::invalid_argument("no output folder given (--out DIR)");
+  Require(width >= 16 && width <= 8192, "--width", width, "16 <= --width <= 8192");
+  Require(height >= 16 && height <= 8192, "--height", height, "16 <= --height <= 8192");
+  Require(fx_px > 0.0 && fx_px <= 1e5, "--fx", fx_px, "0 < --fx <= 100000");
+  Require(kdu > -1.0 && kdu < 1.0, "--kdu", kdu, "-1 < --kdu < 1");
+  Require(noise_sigma >= 0.0 && noise_sigma <= 100.0, "--noise", noise_sigma,
+          "0 <= --noise <= 100");
+  Require(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0, "--blur", blur_sigma_px,
+          "0 <= --blur <= 20");
+  Require(gradient >= 0.0 && gradient <= 0.9, "--gradient", gradient, "0 <= --gradient <= 0.9");
+  Require(min_distance_m > 0.0, "--min-distance", min_distance_m, "--min-distance > 0");
+  Require(max_distance_m >= min_distance_m, "--max-distance", max_distance_m,
+          "--max-distance >= --min-distance");
+  Require(max_tilt_deg >= 0.0 && max_tilt_deg <= 80.0, "--max-tilt-deg", max_tilt_deg,
+          "0 <= --max-tilt-deg <= 80");
+  Require(min_visible_px >= 0.0, "--min-visible-px", min_visible_px, "--min-visible-px >= 0");
+  if (!background_image.empty() && !fs::is_regular_file(background_image)) {
+    throw std::invalid_argument("--background image '" + background_image + "' does not exist");
+  }
+}
+
+vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu) {
+  return CameraWithKdu(fx_px, fx_px, 0.5 * (width - 1), 0.5 * (height - 1), kdu, width, height);
+}
+
+int RenderDataset(const RenderCommandOptions& options) {
+  options.Check();
+  const LineTarget target = TargetOf(options);
+  StagedDataset staged(options.out_dir, options.overwrite);
+  if (options.sequence.empty()) {
+    RenderRandomDataset(options, target, staged.dir());
+  } else {
+    RenderSequenceDataset(options, target, staged.dir());
+  }
+  staged.Commit();
   return options.count;
 }
 
@@ -228,8 +369,14 @@ int RunRender(int argc, char** argv) {
                                       "number of frames (default with --sequence: " +
                                           std::to_string(kDefaultSequenceFrames) + ")")
                            ->capture_default_str();
-  cli.add_option("--seed", options.seed, "seed of the poses and the noise")->capture_default_str();
-  cli.add_option("--out", options.out_dir, "output directory (created if missing)")->required();
+  AddSeedOption(cli, &options.seed, "seed of the poses and the noise, >= 0");
+  cli.add_option("--out", options.out_dir,
+                 "output folder (created if missing); a folder that already holds a data set "
+                 "is refused unless --overwrite")
+      ->required();
+  cli.add_flag("--overwrite", options.overwrite,
+               "replace the data set already in --out: its frame_NNNN.png/json, camera.xml and "
+               "sequence.json are removed; other files in the folder are kept");
   // Options that a sequence sets itself.
   const std::vector<CLI::Option*> random_pose_options = {
       cli.add_option("--width", options.width, "image width, pixels")->capture_default_str(),
@@ -259,9 +406,13 @@ int RunRender(int argc, char** argv) {
           ->capture_default_str()};
   for (CLI::Option* option : random_pose_options) sequence->excludes(option);
   cli.footer(
+      "All or nothing: the frames are rendered into a temporary folder next to --out "
+      "(DIR.tmp-PID) and moved into --out only when all are written; on an error nothing is "
+      "left behind, and a data set already in --out is untouched.\n\n"
       "Examples:\n  oalservo render --count 20 --kdu 0.33 --noise 4 --out data/\n"
       "  oalservo detect data/ --camera data/camera.xml --out data/lines.jsonl\n"
-      "  oalservo render --sequence fast --count 60 --seed 1 --out fast/");
+      "  oalservo render --sequence fast --count 60 --seed 1 --out fast/\n"
+      "  oalservo render --count 5 --out data/ --overwrite   # replaces the 20 frames above");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   if (!options.sequence.empty() && count->count() == 0) options.count = kDefaultSequenceFrames;
   const int frames = RenderDataset(options);

@@ -10,6 +10,13 @@
 // written: each frame's JSON gains "sequence", "effects" (gain, offset, occluders) and a
 // per-line "occluded_fraction", and DIR/sequence.json (kind, seed, count, target, description,
 // render settings) is written last, so its presence means the sequence is complete.
+//
+// All or nothing: the files are written into a temporary folder next to DIR (DIR.tmp-<pid>)
+// and moved into DIR only when every frame is written; an error leaves nothing behind (no
+// temporary folder, no parent folder created for it) and a data set already in DIR untouched.
+// A DIR that already holds renderer files (frame_NNNN.png/json, camera.xml, sequence.json) is
+// refused unless `overwrite`: then those files are replaced by the new data set and any other
+// file in DIR is kept (so stale frames of a longer earlier run never sit beside a new camera).
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
@@ -28,9 +35,11 @@ struct RenderCommandOptions {
   /// YAML file whose `target:` section gives the target instead of `target` (app/config.h);
   /// empty: use `target`. The data set's JSON then names the config's target.
   std::string config;
-  int count = 10;                ///< frames, [1, 100000]
-  std::uint64_t seed = 1;        ///< poses and noise are a function of it
-  std::string out_dir;           ///< created if missing; required
+  int count = 10;          ///< frames, [1, 100000]
+  std::uint64_t seed = 1;  ///< poses and noise are a function of it
+  std::string out_dir;     ///< created if missing; required
+  /// Replace the renderer files already in out_dir; false: such a folder is an error.
+  bool overwrite = false;
   int width = 640;               ///< pixels, [16, 8192]
   int height = 480;              ///< pixels, [16, 8192]
   double fx_px = 600.0;          ///< focal length, pixels (fy = fx), > 0
@@ -44,7 +53,8 @@ struct RenderCommandOptions {
   double max_tilt_deg = 30.0;    ///< optical axis to board normal, degrees, [0, 80]
   double min_visible_px = 0.0;   ///< each line's visible length at least this, pixels
 
-  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  /// Throws std::invalid_argument naming the command-line option (`--fx`), its value and
+  /// the violated constraint.
   void Check() const;
 };
 
@@ -55,8 +65,9 @@ vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu)
 /// Frames of a sequence when `--sequence` is given without `--count`.
 constexpr int kDefaultSequenceFrames = 60;
 
-/// Renders options.count frames into options.out_dir (every file written atomically).
-/// Returns the number of frames written; throws on bad options or I/O errors.
+/// Renders options.count frames into options.out_dir, all or nothing (see above). Returns the
+/// number of frames written; throws on bad options, a folder holding a data set without
+/// `overwrite`, a failed pose sampling or I/O errors, leaving no file behind.
 int RenderDataset(const RenderCommandOptions& options);
 
 /// `oalservo render ...`; argv[0] is "render".

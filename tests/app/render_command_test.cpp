@@ -107,7 +107,7 @@ TEST(Render, BadOptionsNameTheField) {
     RenderDataset(options);
     FAIL() << "no error";
   } catch (const std::invalid_argument& error) {
-    EXPECT_THAT(error.what(), HasSubstr("RenderCommandOptions::count = 0"));
+    EXPECT_THAT(error.what(), HasSubstr("--count = 0 is out of range: 1 <= --count <= 100000"));
   }
   options = SmallRender(dir / "data");
   options.target = "three-line";
@@ -116,6 +116,126 @@ TEST(Render, BadOptionsNameTheField) {
   options.background_image = dir / "missing.png";
   EXPECT_THROW(RenderDataset(options), std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir / "data"));
+}
+
+// Options errors name the command-line option, not the struct's field.
+TEST(Render, BadOptionsNameTheCommandLineOption) {
+  test::TestDir dir;
+  const auto error = [&](auto change) {
+    RenderCommandOptions options = SmallRender(dir / "data");
+    change(&options);
+    return test::ErrorMessageOf<std::invalid_argument>([&] { RenderDataset(options); });
+  };
+  EXPECT_EQ(error([](RenderCommandOptions* o) { o->fx_px = 0.0; }),
+            "--fx = 0 is out of range: 0 < --fx <= 100000");
+  EXPECT_THAT(error([](RenderCommandOptions* o) { o->kdu = 1.5; }),
+              HasSubstr("--kdu = 1.5 is out of range: -1 < --kdu < 1"));
+  EXPECT_THAT(error([](RenderCommandOptions* o) { o->max_tilt_deg = 90.0; }),
+              HasSubstr("--max-tilt-deg = 90"));
+  EXPECT_THAT(error([](RenderCommandOptions* o) { o->min_visible_px = -1.0; }),
+              HasSubstr("--min-visible-px = -1"));
+  EXPECT_FALSE(fs::exists(dir / "data"));
+  // A negative seed is a usage error, not 2^64 - 1.
+  EXPECT_THROW(test::RunWithArgs(RunRender, {"render", "--seed", "-1", "--out", dir / "data"}),
+               UsageError);
+  EXPECT_FALSE(fs::exists(dir / "data"));
+}
+
+// A second render into a folder that holds a data set is refused, and the first data set is
+// untouched: no frames of one camera next to another's camera.xml.
+TEST(Render, ADataSetIsNotOverwrittenWithoutOverwrite) {
+  test::TestDir dir;
+  RenderCommandOptions first = SmallRender(dir / "reuse");
+  first.count = 4;
+  ASSERT_EQ(RenderDataset(first), 4);
+  const std::string camera_before = test::ReadText(dir / "reuse/camera.xml");
+  RenderCommandOptions second = SmallRender(dir / "reuse");
+  second.count = 2;
+  second.kdu = 0.0;
+  const std::string message =
+      test::ErrorMessageOf<std::invalid_argument>([&] { RenderDataset(second); });
+  EXPECT_THAT(message,
+              HasSubstr("--out '" + dir / "reuse" + "' already holds a rendered data set"));
+  EXPECT_THAT(message, HasSubstr("--overwrite"));
+  EXPECT_EQ(test::ReadText(dir / "reuse/camera.xml"), camera_before);
+  EXPECT_TRUE(fs::exists(dir / "reuse/frame_0003.png"));
+  // The same through the command line; exit by exception, as main() maps it to 1.
+  EXPECT_THROW(test::RunWithArgs(RunRender, {"render", "--count", "2", "--width", "160", "--height",
+                                             "120", "--out", dir / "reuse/"}),
+               std::invalid_argument);
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// --overwrite replaces every renderer file (frames of a longer run too) and keeps the rest.
+TEST(Render, OverwriteReplacesTheWholeDataSetAndKeepsOtherFiles) {
+  test::TestDir dir;
+  RenderCommandOptions first = SmallRender(dir / "reuse");
+  first.count = 4;
+  RenderDataset(first);
+  test::WriteText(dir / "reuse/notes.txt", "mine");
+  RenderCommandOptions second = SmallRender(dir / "reuse");
+  second.count = 2;
+  second.kdu = 0.0;
+  second.overwrite = true;
+  ASSERT_EQ(RenderDataset(second), 2);
+  EXPECT_TRUE(fs::exists(dir / "reuse/frame_0001.png"));
+  for (const char* stale : {"frame_0002.png", "frame_0002.json", "frame_0003.png"}) {
+    EXPECT_FALSE(fs::exists(dir / (std::string("reuse/") + stale))) << stale;
+  }
+  EXPECT_EQ(LoadCameraFile(dir / "reuse/camera.xml").camera.get_kdu(), 0.0);
+  EXPECT_EQ(json::parse(test::ReadText(dir / "reuse/frame_0001.json")).at("camera").at("kdu"), 0.0);
+  EXPECT_EQ(test::ReadText(dir / "reuse/notes.txt"), "mine");
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+
+  // A sequence over random frames: sequence.json comes; random frames over a sequence: it goes.
+  RenderCommandOptions sequence = test::SequenceRender(dir / "reuse", "slow", 3, 1);
+  sequence.overwrite = true;
+  RenderDataset(sequence);
+  EXPECT_TRUE(fs::exists(dir / "reuse/sequence.json"));
+  EXPECT_TRUE(fs::exists(dir / "reuse/frame_0002.png"));
+  RenderDataset(second);
+  EXPECT_FALSE(fs::exists(dir / "reuse/sequence.json"));
+  EXPECT_FALSE(fs::exists(dir / "reuse/frame_0002.png"));
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// A folder with files of other tools only is not a data set: rendering into it is allowed.
+TEST(Render, IntoAFolderWithOtherFilesOnly) {
+  test::TestDir dir;
+  fs::create_directories(dir / "mixed");
+  test::WriteText(dir / "mixed/frame_notes.txt", "mine");
+  const RenderCommandOptions options = SmallRender(dir / "mixed");
+  ASSERT_EQ(RenderDataset(options), 3);
+  EXPECT_TRUE(fs::exists(dir / "mixed/frame_0002.json"));
+  EXPECT_EQ(test::ReadText(dir / "mixed/frame_notes.txt"), "mine");
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// A render that fails (no pose meets --min-visible-px) leaves nothing: no
+// camera.xml, no frame, no temporary or parent folder, and an older data set as it was.
+TEST(Render, AFailedRenderLeavesNothingBehind) {
+  test::TestDir dir;
+  RenderCommandOptions impossible = SmallRender(dir / "new/deeper/data");
+  impossible.count = 30;
+  impossible.min_visible_px = 660.0;  // longer than the 160x120 image's diagonal
+  EXPECT_THROW(RenderDataset(impossible), std::runtime_error);
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+
+  RenderCommandOptions old = SmallRender(dir / "data");
+  RenderDataset(old);
+  const std::string frame_before = test::ReadText(dir / "data/frame_0002.json");
+  impossible.out_dir = dir / "data";
+  impossible.overwrite = true;
+  EXPECT_THROW(RenderDataset(impossible), std::runtime_error);
+  EXPECT_EQ(test::ReadText(dir / "data/frame_0002.json"), frame_before);
+  EXPECT_FALSE(fs::exists(dir / "data/frame_0003.png"));
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+  std::vector<std::string> entries;
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    entries.push_back(entry.path().filename().string());
+  }
+  EXPECT_EQ(entries, std::vector<std::string>{"data"});
 }
 
 TEST(RenderSequence, WritesFramesTruthAndSequenceJson) {
@@ -184,7 +304,7 @@ TEST(RenderSequence, UnknownSequenceNamesTheValidOnes) {
     RenderDataset(options);
     FAIL() << "no error";
   } catch (const std::invalid_argument& error) {
-    EXPECT_THAT(error.what(), HasSubstr("RenderCommandOptions::sequence = wobbly"));
+    EXPECT_THAT(error.what(), HasSubstr("--sequence = wobbly"));
     EXPECT_THAT(error.what(), HasSubstr("leave-reenter"));
   }
   EXPECT_FALSE(fs::exists(dir / "data"));
