@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 
+#include "app/accuracy_frames.h"  // AddSeedOption, WriteText
 #include "app/annotate.h"
 #include "app/atomic_file.h"
 #include "app/command_line.h"
@@ -98,7 +100,9 @@ std::vector<DemoMatch> MatchLines(const std::vector<TruthLine>& truth,
 }
 
 Json MatchJson(const DemoMatch& match) {
-  Json json{{"truth_index", match.truth_index}, {"detected_index", match.detected_index}};
+  Json json{{"target_line", match.truth_index + 1},
+            {"truth_index", match.truth_index},
+            {"detected_index", match.detected_index}};
   if (match.detected_index >= 0) {
     json["angle_error_deg"] = match.angle_error_deg;
     json["max_offset_px"] = match.max_offset_px;
@@ -127,19 +131,19 @@ Json DemoJson(const RenderOptions& render, const RenderedFrame& frame,
 void PrintTable(const DemoReport& report, const std::vector<TruthLine>& truth,
                 const std::vector<DetectedLine>& lines, std::ostream& out) {
   char row[160];
-  out << "target  true rho(px) theta(deg)  found  rho(px) theta(deg)  angle err(deg)  max "
+  out << "  line  true rho(px) theta(deg)  found  rho(px) theta(deg)  angle err(deg)  max "
          "offset(px)\n";
   int found = 0;
   for (const DemoMatch& match : report.matches) {
     const LineParams& ideal = truth[static_cast<std::size_t>(match.truth_index)].ideal;
     if (match.detected_index < 0) {
-      std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5s\n", match.truth_index, ideal.rho_px,
-                    ideal.theta_rad * kRadToDeg, "-");
+      std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5s\n", match.truth_index + 1,
+                    ideal.rho_px, ideal.theta_rad * kRadToDeg, "-");
     } else {
       ++found;
       const LineParams& line = lines[static_cast<std::size_t>(match.detected_index)].line;
       std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5d  %7.1f %10.2f  %14.3f  %15.2f\n",
-                    match.truth_index, ideal.rho_px, ideal.theta_rad * kRadToDeg,
+                    match.truth_index + 1, ideal.rho_px, ideal.theta_rad * kRadToDeg,
                     match.detected_index, line.rho_px, line.theta_rad * kRadToDeg,
                     match.angle_error_deg, match.max_offset_px);
     }
@@ -182,12 +186,16 @@ DemoReport RunDemoScene(const DemoCommandOptions& options, std::ostream& out) {
   WritePng(dir / "demo.png", AnnotateLines(image, lines, render.camera));
   WriteFileAtomically(dir / "lines.json", DemoJson(render, frame, lines, report).dump(2) + "\n");
 
-  out << "Cheap camera: 640x480, px = py = 600, kdu = 0.33, noise 8, blur 1 px, light -30 %, "
-         "seed "
-      << options.seed << "\nLines in undistorted pixels (rho from the top-left pixel):\n";
-  PrintTable(report, frame.truth, lines, out);
-  out << "Wrote " << (dir / "frame.png").string() << ", " << (dir / "demo.png").string() << ", "
-      << (dir / "lines.json").string() << '\n';
+  std::ostringstream text;
+  text << "Cheap camera: 640x480, px = py = 600, kdu = 0.33, noise 8, blur 1 px, light -30 %, "
+          "seed "
+       << options.seed
+       << "\nLines in undistorted pixels (rho from the top-left pixel); line: the target's line "
+          "1-4, found: the detected line's label in demo.png:\n";
+  PrintTable(report, frame.truth, lines, text);
+  text << "Wrote " << (dir / "frame.png").string() << ", " << (dir / "demo.png").string() << ", "
+       << (dir / "lines.json").string() << '\n';
+  WriteText(out, text.str());
   return report;
 }
 
@@ -199,7 +207,7 @@ int RunDemo(int argc, char** argv) {
       "oalservo demo");
   cli.add_option("--out", options.out_dir, "output directory (created if missing)")
       ->capture_default_str();
-  cli.add_option("--seed", options.seed, "seed of the pose and the noise")->capture_default_str();
+  AddSeedOption(cli, &options.seed, "seed of the pose and the noise, >= 0");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   RunDemoScene(options, std::cout);
   return kExitOk;

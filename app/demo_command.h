@@ -19,7 +19,7 @@ struct DemoCommandOptions {
 
 /// How well one target line was found.
 struct DemoMatch {
-  int truth_index = 0;      ///< index of the target line
+  int truth_index = 0;      ///< index of the target line (line truth_index + 1 in the docs)
   int detected_index = -1;  ///< index in the detector's output; -1: not found
   double angle_error_deg = 0.0;
   /// Largest distance of the detected line from the true line over the visible chord,
@@ -33,7 +33,8 @@ struct DemoReport {
   std::vector<DemoMatch> matches;  ///< one per visible target line
 };
 
-/// Renders, detects, compares and writes the files; prints the table to `out`.
+/// Renders, detects, compares and writes the files; prints the table to `out` (target lines
+/// numbered 1-4, as in the docs). Throws std::runtime_error if `out` fails (disk full).
 DemoReport RunDemoScene(const DemoCommandOptions& options, std::ostream& out);
 
 /// `oalservo demo ...`; argv[0] is "demo".

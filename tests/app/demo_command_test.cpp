@@ -6,7 +6,12 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
+#include "app/command_line.h"
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
@@ -33,6 +38,44 @@ TEST(Demo, WritesThePicturesTheJsonAndATable) {
   EXPECT_THAT(out.str(), HasSubstr("angle err(deg)"));
   EXPECT_THAT(out.str(), HasSubstr("target lines found"));
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// The table numbers the target's lines 1-4, as the docs and `oalservo target` do.
+TEST(Demo, NumbersTheTargetLinesOneToFour) {
+  test::TestDir dir;
+  DemoCommandOptions options;
+  options.out_dir = dir / "demo";
+  std::ostringstream out;
+  RunDemoScene(options, out);
+  std::istringstream table(out.str());
+  std::vector<int> numbers;
+  for (std::string line; std::getline(table, line);) {
+    std::istringstream words(line);
+    int number = 0;
+    if (line.rfind("     ", 0) == 0 && words >> number) numbers.push_back(number);
+  }
+  EXPECT_EQ(numbers, (std::vector<int>{1, 2, 3, 4})) << out.str();
+  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(json.at("matches")[0].at("target_line"), 1);
+  EXPECT_EQ(json.at("matches")[0].at("truth_index"), 0);
+}
+
+// A failed output stream (stdout on a full disk) is an error, not a silent success.
+TEST(Demo, AFailedOutputIsAnError) {
+  test::TestDir dir;
+  DemoCommandOptions options;
+  options.out_dir = dir / "demo";
+  std::ostringstream out;
+  out.setstate(std::ios::badbit);
+  EXPECT_THAT(test::ErrorMessageOf<std::runtime_error>([&] { RunDemoScene(options, out); }),
+              HasSubstr("cannot write the output"));
+}
+
+TEST(Demo, NegativeSeedIsAUsageError) {
+  test::TestDir dir;
+  EXPECT_THROW(test::RunWithArgs(RunDemo, {"demo", "--seed", "-1", "--out", dir / "demo"}),
+               UsageError);
+  EXPECT_FALSE(fs::exists(dir / "demo"));
 }
 
 }  // namespace
