@@ -2,13 +2,17 @@
 
 #include <libxml/parser.h>
 #include <libxml/tree.h>
+#include <visp3/core/vpException.h>
 #include <visp3/core/vpXmlParserCamera.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "app/atomic_file.h"
 
@@ -37,11 +41,21 @@ class MuteStandardStreams {
   std::streambuf* err_;
 };
 
-// What the file says about one <camera>, enough to ask vpXmlParserCamera for it.
+// One numeric parameter of a <model> (<px>, <u0>, <kdu>...), where it is in the file.
+struct ModelField {
+  std::string name;
+  std::string text;
+  long line = 0;
+};
+
+// What the file says about one <camera>, enough to ask vpXmlParserCamera for it and to check
+// its parameters first (ViSP reads "abc" as 0 and then fails with "Camera parameter px = 0",
+// naming neither the file nor the field).
 struct CameraEntry {
   std::string name;
   unsigned int width = 0, height = 0;
   bool with_distortion = false, without_distortion = false;
+  std::vector<ModelField> with_fields, without_fields;  ///< of the first model of each type
 };
 
 struct XmlDocFree {
@@ -84,14 +98,42 @@ CameraEntry ReadEntry(const xmlNode* camera) {
     if (Named(child, "image_width")) entry.width = ToUnsigned(ChildText(child));
     if (Named(child, "image_height")) entry.height = ToUnsigned(ChildText(child));
     if (!Named(child, "model")) continue;
+    std::string type;
+    std::vector<ModelField> fields;
     for (const xmlNode* field = child->children; field != nullptr; field = field->next) {
-      if (!Named(field, "type")) continue;
-      const std::string type = Trimmed(ChildText(field));
-      entry.with_distortion |= type == kWithDistortion;
-      entry.without_distortion |= type == kWithoutDistortion;
+      if (Named(field, "type")) type = Trimmed(ChildText(field));
+      for (const char* parameter : {"px", "py", "u0", "v0", "kud", "kdu"}) {
+        if (Named(field, parameter)) {
+          fields.push_back({parameter, Trimmed(ChildText(field)), xmlGetLineNo(field)});
+        }
+      }
     }
+    if (type == kWithDistortion && !entry.with_distortion) entry.with_fields = fields;
+    if (type == kWithoutDistortion && !entry.without_distortion) entry.without_fields = fields;
+    entry.with_distortion |= type == kWithDistortion;
+    entry.without_distortion |= type == kWithoutDistortion;
   }
   return entry;
+}
+
+// Each parameter of the model a finite number, px and py > 0; else an error naming the file,
+// the line, the camera, the model and the field.
+void CheckModelFields(const std::vector<ModelField>& fields, const std::string& path,
+                      const std::string& camera_name, const char* model) {
+  for (const ModelField& field : fields) {
+    const std::string where = path + ":" + std::to_string(field.line) + ": camera '" + camera_name +
+                              "', model " + model + ": <" + field.name + ">";
+    char* end = nullptr;
+    const double value = std::strtod(field.text.c_str(), &end);
+    if (field.text.empty() || end != field.text.c_str() + field.text.size() ||
+        !std::isfinite(value)) {
+      throw std::runtime_error(where + " is '" + field.text + "', not a number");
+    }
+    if ((field.name == "px" || field.name == "py") && !(value > 0.0)) {
+      throw std::runtime_error(where + " = " + field.text +
+                               ": a focal length in pixels must be > 0");
+    }
+  }
 }
 
 std::vector<CameraEntry> ListCameras(const std::string& path) {
@@ -140,12 +182,16 @@ CameraFile LoadCameraFile(const std::string& path, const std::string& camera_nam
   }
   const auto model = entry.with_distortion ? vpCameraParameters::perspectiveProjWithDistortion
                                            : vpCameraParameters::perspectiveProjWithoutDistortion;
+  CheckModelFields(entry.with_distortion ? entry.with_fields : entry.without_fields, path,
+                   entry.name, entry.with_distortion ? kWithDistortion : kWithoutDistortion);
   CameraFile result;
   int status = vpXmlParserCamera::SEQUENCE_ERROR;
-  {
+  try {
     MuteStandardStreams mute;
     vpXmlParserCamera parser;
     status = parser.parse(result.camera, path, entry.name, model, entry.width, entry.height);
+  } catch (const vpException& error) {
+    throw std::runtime_error("vpXmlParserCamera cannot read " + label + ": " + error.getMessage());
   }
   if (status != vpXmlParserCamera::SEQUENCE_OK) {
     throw std::runtime_error("vpXmlParserCamera cannot read " + label +

@@ -104,5 +104,33 @@ TEST(CameraFile, UnusableFilesAreNamed) {
               HasSubstr("vpXmlParserCamera cannot read camera 'c'"));
 }
 
+// A parameter that is not a number, or a focal length <= 0, is named with the file, its line,
+// the camera, the model and the field (ViSP alone says "Camera parameter px = 0").
+TEST(CameraFile, BadParametersNameTheFileAndTheField) {
+  test::TestDir dir;
+  const auto camera = [](const std::string& px, const std::string& kdu) {
+    return "<?xml version=\"1.0\"?>\n<root>\n  <camera>\n    <name>c</name>\n    <model>\n"
+           "      <type>perspectiveProjWithDistortion</type>\n      <px>" +
+           px + "</px>\n      <py>600</py> <u0>320</u0> <v0>240</v0>\n      <kud>0</kud> <kdu>" +
+           kdu + "</kdu>\n    </model>\n  </camera>\n</root>\n";
+  };
+  const std::string path = dir / "cam.xml";
+  test::WriteText(path, camera("abc", "0"));
+  EXPECT_EQ(LoadError(path), path +
+                                 ":7: camera 'c', model perspectiveProjWithDistortion: <px> is "
+                                 "'abc', not a number");
+  test::WriteText(path, camera("0", "0"));
+  EXPECT_EQ(LoadError(path), path +
+                                 ":7: camera 'c', model perspectiveProjWithDistortion: <px> = 0: "
+                                 "a focal length in pixels must be > 0");
+  test::WriteText(path, camera("-600", "0"));
+  EXPECT_THAT(LoadError(path), HasSubstr("<px> = -600: a focal length"));
+  test::WriteText(path, camera("600", "0.1x"));
+  EXPECT_THAT(LoadError(path), HasSubstr(":9: camera 'c', model perspectiveProjWithDistortion: "
+                                         "<kdu> is '0.1x', not a number"));
+  test::WriteText(path, camera(" 600 ", "0.1"));  // whitespace around a number is fine
+  EXPECT_EQ(LoadCameraFile(path).camera.get_px(), 600.0);
+}
+
 }  // namespace
 }  // namespace oal
