@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/atomic_file.h"
@@ -74,20 +75,32 @@ bool FitOnSheet(const Sheet& sheet, double need_w, double need_h, TargetDrawing*
   return false;
 }
 
+// The largest board that fits on `sheet` in portrait, with the margins and the footer.
+std::pair<double, double> LargestBoardMm(const Sheet& sheet) {
+  return {sheet.width_mm - 2.0 * kMarginMm,
+          sheet.height_mm - 2.0 * kMarginMm - kFooterGapMm - kFooterHeightMm};
+}
+
 std::string TooLargeWarning(const LineTarget& target, const Sheet& sheet, double need_w,
                             double need_h) {
   const double usable_w = sheet.width_mm - 2.0 * kMarginMm;
   const double usable_h = sheet.height_mm - 2.0 * kMarginMm;
   const int across = static_cast<int>(std::ceil(need_w / usable_w));
   const int down = static_cast<int>(std::ceil(need_h / usable_h));
+  const auto [largest_w, largest_h] = LargestBoardMm(sheet);
   std::ostringstream message;
   message << "target '" << target.name << "' (board " << Mm(1000.0 * target.board_width_m) << " x "
           << Mm(1000.0 * target.board_height_m) << " mm) does not fit on " << sheet.label << " ("
           << Mm(sheet.width_mm) << " x " << Mm(sheet.height_mm) << " mm, " << Mm(kMarginMm)
-          << " mm margins) at true scale; the SVG is written at full size, " << Mm(need_w) << " x "
-          << Mm(need_h) << " mm: print it at 100 % on a plotter or at a print shop, or tile it "
-          << "with a poster tool onto about " << across * down << " " << sheet.label << " sheets ("
-          << across << " x " << down << ")";
+          << " mm margins) at true scale, so the SVG is written at full size, " << Mm(need_w)
+          << " x " << Mm(need_h) << " mm. To print it: at 100 % on a plotter or at a print shop, "
+          << "or tiled with a poster tool onto about " << across * down << " " << sheet.label
+          << " sheets (" << across << " x " << down << ") joined edge to edge. Do not shrink it "
+          << "to one page: the pose takes the target's lengths as printed (a scaled print needs "
+          << "a target config scaled by the same factor). For one " << sheet.label
+          << " sheet, draw a board of at most " << Mm(largest_w) << " x " << Mm(largest_h)
+          << " mm: a config whose target: section has that board_width_m and board_height_m "
+          << "(the stripes are clipped to the board; keep every line and crossing on it)";
   return message.str();
 }
 
@@ -243,7 +256,8 @@ int RunTarget(int argc, char** argv) {
   CLI::App cli(
       "Write a printable, true-scale SVG drawing of the line target (1 unit = 1 mm; stripes "
       "black, line numbers, a 100 mm scale bar). A board larger than the page is written at "
-      "full size with a warning.",
+      "full size with a warning saying how to print it; the built-in two-line and four-line "
+      "targets are 2 m x 2 m boards, so they always are.",
       "oalservo target");
   cli.add_option("--config", options.config,
                  "YAML file whose 'target:' section gives the target (default: the built-in "
@@ -252,9 +266,14 @@ int RunTarget(int argc, char** argv) {
   cli.add_option("--page", options.page, "sheet: a4, a3, letter, or auto (A4, else A3)")
       ->check(CLI::IsMember({"a4", "a3", "letter", "auto"}))
       ->capture_default_str();
+  const auto [a3_w, a3_h] = LargestBoardMm(SheetByName("a3"));
   cli.footer(
-      "Examples:\n  oalservo target --config config/two-line-target.yaml --out two-line.svg\n"
-      "  oalservo target --config my-board.yaml --page a3 --out board.svg");
+      "Examples:\n"
+      "  oalservo target --out four-line.svg\n"
+      "      the built-in 2 m x 2 m board at full size, for a plotter or a print shop (or tiles)\n"
+      "  oalservo target --config my-board.yaml --page a3 --out board.svg\n"
+      "      a board of your own (its target: section) up to " +
+      Mm(a3_w) + " x " + Mm(a3_h) + " mm, on one A3 sheet");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   const TargetDrawing drawing = WriteTargetSvg(options);
   if (!drawing.fits) Warn("target", drawing.warning);

@@ -14,7 +14,8 @@
 // Pages: the drawing is centred on the chosen sheet (A4, A3 or US letter, portrait or
 // landscape, whichever holds it; `auto`: A4, else A3). A board too large for the sheet is not
 // tiled or shrunk: the SVG is written at full size (page = drawing plus margins) and a warning
-// says so, with the number of sheets a poster tool would tile it onto. The built-in four-line
+// says so and how to print it: on a plotter, tiled by a poster tool onto N sheets, or as a
+// smaller board of the largest size the sheet holds (given in the warning). The built-in four-line
 // target's board is 2 m x 2 m, so it always takes this path; a print shop or plotter prints it
 // at 100 %.
 #pragma once

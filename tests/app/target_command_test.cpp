@@ -201,6 +201,34 @@ TEST(TargetSvg, FourLineBoardTooLargeIsFullSizeWithAWarning) {
   EXPECT_THAT(DrawTargetSvg(target, "auto").warning, HasSubstr("does not fit on A3"));
 }
 
+// The built-in boards are 2 m x 2 m (scene/scene.cpp, config/*-target.yaml), so every page
+// warns; the warning says how to print it, and the largest board it names for one sheet fits.
+TEST(TargetSvg, TooLargeWarningSaysHowToPrintAndWhichBoardFits) {
+  for (const LineTarget& target : {FourLineTarget(), TwoLineTarget()}) {
+    EXPECT_EQ(target.board_width_m, 2.0) << target.name;
+    EXPECT_EQ(target.board_height_m, 2.0) << target.name;
+  }
+  const std::string warning = DrawTargetSvg(FourLineTarget(), "a4").warning;
+  EXPECT_THAT(warning, HasSubstr("plotter"));
+  EXPECT_THAT(warning, HasSubstr("tiled with a poster tool onto about"));
+  EXPECT_THAT(warning, HasSubstr("scaled by the same factor"));
+  EXPECT_THAT(warning, HasSubstr("For one A4 sheet, draw a board of at most 190 x 241 mm"));
+  EXPECT_THAT(DrawTargetSvg(FourLineTarget(), "a3").warning,
+              HasSubstr("For one A3 sheet, draw a board of at most 277 x 364 mm"));
+  // Just under those sizes a board fits; just over (in height) it does not.
+  LineTarget board = SmallTarget();
+  board.board_width_m = 0.1899;
+  board.board_height_m = 0.2409;
+  EXPECT_EQ(DrawTargetSvg(board, "a4").page, "A4 portrait");
+  board.board_height_m = 0.2411;
+  EXPECT_FALSE(DrawTargetSvg(board, "a4").fits);
+  board.board_width_m = 0.2769;
+  board.board_height_m = 0.3639;
+  EXPECT_EQ(DrawTargetSvg(board, "a3").page, "A3 portrait");
+  board.board_height_m = 0.3641;
+  EXPECT_FALSE(DrawTargetSvg(board, "a3").fits);
+}
+
 TEST(TargetSvg, NameIsEscapedAndBadTargetsAreRejected) {
   LineTarget target = SmallTarget();
   target.name = "a<b&\"c\"";
@@ -289,6 +317,16 @@ TEST(TargetCommand, BinaryWarnsAboutALargeBoard) {
   EXPECT_THAT(err, HasSubstr("oalservo target: warning: target 'four-line'"));
   EXPECT_THAT(err, HasSubstr("does not fit on A4"));
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "four.svg"));
+  // The help's examples: the built-in board without a page it cannot fit, and a board of
+  // one's own of a size that fits the page it names.
+  const std::string help =
+      std::string("'") + OAL_OALSERVO_PATH + "' target --help >'" + (dir / "help.txt") + "'";
+  ASSERT_EQ(std::system(help.c_str()), 0);
+  const std::string help_text = test::ReadText(dir / "help.txt");
+  EXPECT_THAT(help_text, HasSubstr("oalservo target --out four-line.svg\n"));
+  EXPECT_THAT(help_text, HasSubstr("--page a3 --out board.svg"));
+  EXPECT_THAT(help_text, HasSubstr("up to 277 x 364 mm, on one A3 sheet"));
+  EXPECT_THAT(help_text, ::testing::Not(HasSubstr("two-line-target.yaml")));
   const std::string bad = std::string("'") + OAL_OALSERVO_PATH + "' target --out '" +
                           (dir / "x.svg") + "' --page a5 2>/dev/null";
   const int bad_status = std::system(bad.c_str());
