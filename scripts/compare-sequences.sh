@@ -12,7 +12,7 @@ mkdir -p "$out"
 summary="$out/summary.md"
 : > "$summary.tmp"
 for kind in slow fast occlusion illumination leave-reenter distortion; do
-  "$oal" render --sequence "$kind" --count "$frames" --seed "$seed" --out "$out/$kind/frames" > /dev/null
+  "$oal" render --sequence "$kind" --count "$frames" --seed "$seed" --out "$out/$kind/frames" --overwrite > /dev/null
   camera=()
   [ "$kind" = distortion ] && camera=(--camera "$out/$kind/frames/camera.xml")
   "$oal" compare "$out/$kind/frames" "${camera[@]}" --out "$out/$kind" > /dev/null
