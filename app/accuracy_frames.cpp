@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "app/atomic_file.h"
+#include "app/json_io.h"
 
 namespace oal {
 namespace {
@@ -114,12 +115,6 @@ void CheckReportFile(const std::string& out_path) {
   } catch (const std::exception& error) {
     throw std::runtime_error("cannot write --out '" + out_path + "': " + error.what());
   }
-}
-
-void WriteText(std::ostream& out, const std::string& text) {
-  out << text;
-  out.flush();
-  if (!out) throw std::runtime_error("cannot write the output");
 }
 
 void PrintAccuracyReport(const std::string& table, const nlohmann::json& json,

@@ -61,12 +61,8 @@ AppConfig LoadAccuracyConfig(const std::string& path, const std::string& command
 /// empty. Throws std::runtime_error naming --out.
 void CheckReportFile(const std::string& out_path);
 
-/// Writes `text` to `out` and flushes; throws std::runtime_error if the stream failed (disk
-/// full, closed pipe), as WriteJsonLine (app/json_io.h) does for JSON Lines.
-void WriteText(std::ostream& out, const std::string& text);
-
 /// Writes `json` (indented) atomically to out_path, if set; then prints `table` on stdout with
-/// WriteText (a failed stdout is an error, reported after the file is safe).
+/// WriteText of app/json_io.h (a failed stdout is an error, reported after the file is safe).
 void PrintAccuracyReport(const std::string& table, const nlohmann::json& json,
                          const std::string& out_path);
 

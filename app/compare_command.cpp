@@ -6,6 +6,7 @@
 
 #include "app/command_line.h"
 #include "app/compare.h"
+#include "app/json_io.h"
 
 namespace oal {
 
@@ -63,7 +64,7 @@ int RunCompare(int argc, char** argv) {
     report = RunComparison(options);
   }
   for (const std::string& warning : report.warnings) Warn("compare", warning);
-  std::cout << CompareMarkdown(report);
+  WriteText(std::cout, CompareMarkdown(report));
   if (!options.out_dir.empty()) {
     std::cerr << "oalservo compare: " << report.frames << " frames; table, JSON and "
               << report.figures.size() << " figures written to " << options.out_dir << '\n';

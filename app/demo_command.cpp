@@ -10,7 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/accuracy_frames.h"  // AddSeedOption, WriteText
+#include "app/accuracy_frames.h"  // AddSeedOption
 #include "app/annotate.h"
 #include "app/atomic_file.h"
 #include "app/command_line.h"

@@ -67,4 +67,10 @@ void WriteJsonLine(std::ostream& sink, const Json& record, bool flush) {
   if (!sink) throw std::runtime_error("cannot write the output");
 }
 
+void WriteText(std::ostream& sink, const std::string& text) {
+  sink << text;
+  sink.flush();
+  if (!sink) throw std::runtime_error("cannot write the output");
+}
+
 }  // namespace oal

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <string>
 
 #include "detector/detector.h"
 #include "scene/scene.h"
@@ -32,5 +33,9 @@ Json CameraJson(const vpCameraParameters& camera, int width, int height);
 /// Writes `record` as one line of JSON Lines; flushes when asked; throws
 /// std::runtime_error if the stream failed (disk full, closed pipe).
 void WriteJsonLine(std::ostream& sink, const Json& record, bool flush);
+
+/// Writes `text` and flushes; throws std::runtime_error if the stream failed, as
+/// WriteJsonLine does. For tables and reports printed on stdout.
+void WriteText(std::ostream& sink, const std::string& text);
 
 }  // namespace oal

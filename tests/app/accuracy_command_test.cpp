@@ -25,27 +25,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-// Runs `oalservo <args>` through the shell; stdout goes to `stdout_to` (a file of the test's
-// directory when empty).
-Result RunOalservo(const test::TestDir& dir, const std::string& args,
-                   const std::string& stdout_to = "") {
-  const std::string out = stdout_to.empty() ? dir / "stdout.txt" : stdout_to;
-  const std::string err = dir / "stderr.txt";
-  const std::string command =
-      std::string("'") + OAL_OALSERVO_PATH + "' " + args + " >'" + out + "' 2>'" + err + "'";
-  const int status = std::system(command.c_str());
-  Result result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (stdout_to.empty()) result.out = test::ReadText(out);
-  result.err = test::ReadText(err);
-  return result;
-}
-
 // Few small frames: each evaluation takes well under a second.
 const std::string kFewFrames = " --frames 3 --seed 2";
 
@@ -60,9 +39,9 @@ TEST(PoseAccuracy, ConfigPoseSectionIsApplied) {
 
   test::WriteText(dir / "strict.yaml",
                   "detector:\n  step_px: 5\npose:\n  max_residual_px: 0.0001\n");
-  const Result strict =
-      RunOalservo(dir, "pose-accuracy" + kFewFrames + " --config '" + dir / "strict.yaml" +
-                           "' --out '" + dir / "strict.json" + "'");
+  const test::OalservoRun strict =
+      test::RunOalservo(dir, "pose-accuracy" + kFewFrames + " --config '" + dir / "strict.yaml" +
+                                 "' --out '" + dir / "strict.json" + "'");
   ASSERT_EQ(strict.exit_code, 0) << strict.err;
   const json report = json::parse(test::ReadText(dir / "strict.json"));
   EXPECT_EQ(report.at("posed"), 0);
@@ -73,8 +52,8 @@ TEST(PoseAccuracy, ConfigPoseSectionIsApplied) {
 // The report: status_counts keyed by status name, and the roll median the table shows.
 TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
   test::TestDir dir;
-  const Result run =
-      RunOalservo(dir, "pose-accuracy" + kFewFrames + " --out '" + dir / "report.json" + "'");
+  const test::OalservoRun run =
+      test::RunOalservo(dir, "pose-accuracy" + kFewFrames + " --out '" + dir / "report.json" + "'");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const json report = json::parse(test::ReadText(dir / "report.json"));
   EXPECT_EQ(report.at("status_counts"),
@@ -92,24 +71,26 @@ TEST(AccuracyCommands, ConfigSectionsTheyDoNotReadAreRejected) {
   test::TestDir dir;
   const std::string config = dir / "with-target.yaml";
   test::WriteText(config, "detector:\n  step_px: 5\ntarget: {name: two-line}\n");
-  const Result pose = RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'");
+  const test::OalservoRun pose =
+      test::RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'");
   EXPECT_EQ(pose.exit_code, 1);
   EXPECT_THAT(pose.err,
               HasSubstr(config + ":3: section 'target' is not used by oalservo pose-accuracy "
                                  "(it reads: detector, pose)"));
   EXPECT_TRUE(pose.out.empty());
-  const Result detect = RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'");
+  const test::OalservoRun detect =
+      test::RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'");
   EXPECT_EQ(detect.exit_code, 1);
   EXPECT_THAT(detect.err,
               HasSubstr(config + ":3: section 'target' is not used by oalservo "
                                  "detect-accuracy (it reads: detector); the target is chosen "
                                  "with --target"));
   test::WriteText(config, "pose:\n  max_residual_px: 1.0\n");
-  EXPECT_THAT(RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'").err,
+  EXPECT_THAT(test::RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'").err,
               HasSubstr(":1: section 'pose' is not used by oalservo detect-accuracy"));
   // A section they read is still checked by the config reader.
   test::WriteText(config, "pose:\n  max_residual: 1.0\n");
-  EXPECT_THAT(RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'").err,
+  EXPECT_THAT(test::RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'").err,
               HasSubstr(config + ":2:"));
 }
 
@@ -120,7 +101,8 @@ TEST(AccuracyCommands, OutputIsCheckedBeforeTheWork) {
   for (const std::string command : {"pose-accuracy", "detect-accuracy"}) {
     for (const std::string& out :
          {dir / "missing/report.json", dir.path().string(), std::string("/proc/report.json")}) {
-      const Result run = RunOalservo(dir, command + " --frames 1 --out '" + out + "'");
+      const test::OalservoRun run =
+          test::RunOalservo(dir, command + " --frames 1 --out '" + out + "'");
       EXPECT_EQ(run.exit_code, 1) << command << " " << out;
       EXPECT_THAT(run.err, HasSubstr("cannot write --out '" + out + "'")) << command;
       EXPECT_TRUE(run.out.empty()) << command << " " << out << ": " << run.out;
@@ -144,14 +126,16 @@ TEST(AccuracyCommands, OptionRanges) {
   }
 }
 
-// stdout on a full disk: exit 1 with a message, as `detect` and `pose` do.
+// stdout on a full disk: exit 1 with a message, as `detect` and `pose` do (`compare` too).
 TEST(AccuracyCommands, AFullStdoutIsAnError) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   test::TestDir dir;
+  const std::string frames = dir / "frames";
+  test::RenderChecked(test::ScaledRender(frames, 1, 3, 320, 240));
   for (const std::string& command :
        {std::string("pose-accuracy --frames 1"), std::string("detect-accuracy --frames 1"),
-        "demo --out '" + dir / "demo" + "'"}) {
-    const Result run = RunOalservo(dir, command, "/dev/full");
+        "demo --out '" + dir / "demo" + "'", "compare '" + frames + "'"}) {
+    const test::OalservoRun run = test::RunOalservo(dir, command, "/dev/full");
     EXPECT_EQ(run.exit_code, 1) << command;
     EXPECT_THAT(run.err, HasSubstr("cannot write the output")) << command;
   }

@@ -1,10 +1,13 @@
 // Helpers shared by the app command tests: small rendered data sets, the message a call
-// throws with, and running a `Run*(argc, argv)` command on a list of arguments.
+// throws with, running a `Run*(argc, argv)` command on a list of arguments, and running the
+// real `oalservo` binary.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -12,6 +15,7 @@
 
 #include "app/config.h"
 #include "app/render_command.h"
+#include "tests/app/test_util.h"
 
 namespace oal::test {
 
@@ -68,6 +72,28 @@ int RunWithArgs(Run&& run, std::vector<std::string> args) {
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   return run(static_cast<int>(argv.size()), argv.data());
+}
+
+/// What the real `oalservo` binary did.
+struct OalservoRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+/// Runs `oalservo <args>` through the shell (args as written there); stdout goes to
+/// `stdout_to` (e.g. /dev/full), or to a file of `dir` whose text is returned when empty.
+inline OalservoRun RunOalservo(const TestDir& dir, const std::string& args,
+                               const std::string& stdout_to = "") {
+  const std::string out = stdout_to.empty() ? dir / "stdout.txt" : stdout_to;
+  const std::string err = dir / "stderr.txt";
+  const std::string command =
+      std::string("'") + OAL_OALSERVO_PATH + "' " + args + " >'" + out + "' 2>'" + err + "'";
+  const int status = std::system(command.c_str());
+  OalservoRun run;
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (stdout_to.empty()) run.out = ReadText(out);
+  run.err = ReadText(err);
+  return run;
 }
 
 }  // namespace oal::test

@@ -9,30 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
 namespace oal {
 namespace {
 
 using ::testing::HasSubstr;
-
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-// Runs `oalservo <args>` (args are passed through the shell as written).
-Result RunOalservo(const test::TestDir& dir, const std::string& args) {
-  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command =
-      std::string("'") + OAL_OALSERVO_PATH + "' " + args + " >'" + out + "' 2>'" + err + "'";
-  const int status = std::system(command.c_str());
-  Result result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.out = test::ReadText(out);
-  result.err = test::ReadText(err);
-  return result;
-}
 
 // The command names listed by `oalservo --help`, so new commands are covered automatically.
 std::vector<std::string> ListedCommands(const std::string& help) {
@@ -51,12 +34,12 @@ std::vector<std::string> ListedCommands(const std::string& help) {
 
 TEST(Oalservo, HelpListsTheCommandsAndEachHasItsOwnHelp) {
   test::TestDir dir;
-  const Result help = RunOalservo(dir, "--help");
+  const test::OalservoRun help = test::RunOalservo(dir, "--help");
   ASSERT_EQ(help.exit_code, 0) << help.err;
   const std::vector<std::string> commands = ListedCommands(help.out);
   EXPECT_THAT(commands, ::testing::IsSupersetOf({"detect", "render", "demo"}));
   for (const std::string& command : commands) {
-    const Result sub = RunOalservo(dir, command + " --help");
+    const test::OalservoRun sub = test::RunOalservo(dir, command + " --help");
     EXPECT_EQ(sub.exit_code, 0) << command << ": " << sub.err;
     EXPECT_THAT(sub.out, HasSubstr("oalservo " + command)) << command;
     EXPECT_THAT(sub.out, HasSubstr("--help")) << command;
@@ -65,29 +48,29 @@ TEST(Oalservo, HelpListsTheCommandsAndEachHasItsOwnHelp) {
 
 TEST(Oalservo, Version) {
   test::TestDir dir;
-  const Result version = RunOalservo(dir, "--version");
+  const test::OalservoRun version = test::RunOalservo(dir, "--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_THAT(version.out, HasSubstr("oalservo "));
 }
 
 TEST(Oalservo, UsageErrorsExitWithTwo) {
   test::TestDir dir;
-  EXPECT_EQ(RunOalservo(dir, "").exit_code, 2);
-  const Result unknown = RunOalservo(dir, "frobnicate");
+  EXPECT_EQ(test::RunOalservo(dir, "").exit_code, 2);
+  const test::OalservoRun unknown = test::RunOalservo(dir, "frobnicate");
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_THAT(unknown.err, HasSubstr("unknown command 'frobnicate'"));
-  const Result missing = RunOalservo(dir, "detect");
+  const test::OalservoRun missing = test::RunOalservo(dir, "detect");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_THAT(missing.err, HasSubstr("oalservo detect: error: "));
-  const Result bad_option = RunOalservo(dir, "render --out x --count many");
+  const test::OalservoRun bad_option = test::RunOalservo(dir, "render --out x --count many");
   EXPECT_EQ(bad_option.exit_code, 2);
   EXPECT_THAT(bad_option.err, HasSubstr("oalservo render: error: "));
 }
 
 TEST(Oalservo, BadInputExitsWithOneAndSaysWhy) {
   test::TestDir dir;
-  const Result result =
-      RunOalservo(dir, "detect '" + dir / "missing.png" + "' --out '" + dir / "lines.jsonl" + "'");
+  const test::OalservoRun result = test::RunOalservo(
+      dir, "detect '" + dir / "missing.png" + "' --out '" + dir / "lines.jsonl" + "'");
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: no such file or directory '"));
   EXPECT_TRUE(result.out.empty());
@@ -97,13 +80,14 @@ TEST(Oalservo, BadInputExitsWithOneAndSaysWhy) {
 TEST(Oalservo, RenderThenDetectWithTheRenderedCamera) {
   test::TestDir dir;
   const std::string data = dir / "data";
-  const Result render = RunOalservo(dir,
-                                    "render --count 2 --width 160 --height 120 --fx 150 --kdu 0.2 "
-                                    "--min-visible-px 30 --out '" +
-                                        data + "'");
+  const test::OalservoRun render =
+      test::RunOalservo(dir,
+                        "render --count 2 --width 160 --height 120 --fx 150 --kdu 0.2 "
+                        "--min-visible-px 30 --out '" +
+                            data + "'");
   ASSERT_EQ(render.exit_code, 0) << render.err;
-  const Result detect =
-      RunOalservo(dir, "detect '" + data + "' --camera '" + data + "/camera.xml'");
+  const test::OalservoRun detect =
+      test::RunOalservo(dir, "detect '" + data + "' --camera '" + data + "/camera.xml'");
   ASSERT_EQ(detect.exit_code, 0) << detect.err;
   std::istringstream lines(detect.out);
   int count = 0;
