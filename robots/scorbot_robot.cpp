@@ -117,8 +117,9 @@ RobotResult ScorbotRobot::FromReply(const AclReply& reply, const std::string& wh
       connected_ = false;
       enabled_ = false;
       move_active_ = false;
-      return RobotResult::Fail(RobotStatus::kError,
-                               "scorbot: " + what + ": " + reply.message + " (Connect() again)");
+      link_lost_ = reply.message;
+      return RobotResult::Fail(RobotStatus::kError, "scorbot: " + what + ": " + reply.message +
+                                                        " (the link to the controller is lost)");
     case AclStatus::kControllerError:
       break;
   }
@@ -183,6 +184,7 @@ RobotResult ScorbotRobot::Connect() {
   point_known_ = false;
   pose_fresh_ = false;
   move_active_ = false;
+  link_lost_.clear();
   return RobotResult::Ok();
 }
 
@@ -220,8 +222,16 @@ RobotResult ScorbotRobot::Disable() noexcept {
 RobotResult ScorbotRobot::Stop() noexcept {
   move_active_ = false;
   pose_fresh_ = false;
-  if (!connected_ || !client_) return RobotResult::Ok();
+  // Never connected (or disconnected cleanly): nothing can be moving.
+  if (link_lost_.empty() && (!connected_ || !client_)) return RobotResult::Ok();
   try {
+    if (!client_) {
+      return RobotResult::Fail(RobotStatus::kError,
+                               "scorbot: no stop could be sent: the link to the controller is "
+                               "lost (" +
+                                   link_lost_ + ")");
+    }
+    // After a link failure the abort is still tried: the link may be back.
     const AclReply reply = client_->Abort();
     point_known_ = false;
     if (reply.status == AclStatus::kTimeout || reply.status == AclStatus::kLinkError) {

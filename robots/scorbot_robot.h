@@ -28,7 +28,9 @@
 // the result, with the controller's text in the message: IMPACT PROTECTION, HOME FAILURE ->
 // kError; OUT OF RANGE -> kLimit; 317 BAD CARTESIAN POINT, 312 BAD POINT COORDINATE ->
 // kUnreachable; CONTROL DISABLED -> kNotReady; no prompt within reply_timeout_s -> kTimeout; a
-// closed or failed link -> kError, and the robot counts as disconnected (Connect() again).
+// closed or failed link -> kError, and the robot counts as disconnected (Connect() again);
+// until a Connect() succeeds, Stop() still tries the abort but, if it cannot be sent, fails
+// (the arm may still be moving: nothing confirmed it stopped).
 #pragma once
 
 #include <visp3/core/vpMatrix.h>
@@ -139,6 +141,8 @@ class ScorbotRobot final : public Robot {
   AclStats stats_before_;  // of clients before the current one
   bool connected_ = false;
   bool enabled_ = false;
+  // Why the link failed since the last successful Connect() ("" while it works).
+  std::string link_lost_;
   // What the controller holds for the target point (valid when point_known_).
   bool point_known_ = false;
   AclPose point_values_;

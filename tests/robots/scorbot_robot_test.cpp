@@ -309,7 +309,14 @@ TEST(ScorbotRobot, PortClosedDuringAMoveAndReconnection) {
   EXPECT_NE(p.result.message.find("closed"), std::string::npos) << p.result.message;
   EXPECT_FALSE(rig.robot->connected());
   EXPECT_EQ(rig.robot->GetPosition(RobotFrame::kCamera).result.status, RobotStatus::kNotReady);
-  EXPECT_TRUE(rig.robot->Stop().ok());  // nothing to stop on a dead link: still safe
+  // The controller may still be running its queued move: a stop that cannot be sent is not ok,
+  // and says why (the driver contract: "returns an error status, but still tries").
+  const RobotResult stop = rig.robot->Stop();
+  EXPECT_EQ(stop.status, RobotStatus::kError);
+  EXPECT_NE(stop.message.find("the link to the controller is lost"), std::string::npos)
+      << stop.message;
+  EXPECT_FALSE(rig.robot->Stop().ok());  // still nothing confirmed it: idempotent
+  EXPECT_EQ(p.result.message.find("Connect()"), std::string::npos) << p.result.message;
   // The controller comes back (a new pty behind the same link): Connect() again.
   rig.sim.Start();
   const RobotResult c = rig.robot->Connect();
