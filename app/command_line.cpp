@@ -151,31 +151,56 @@ std::string MarkupEscaped(const std::string& text) {
 
 namespace {
 
-// The handler can reach only globals; both are lock-free atomics (async-signal-safe).
-std::atomic<bool> g_sigint{false};
-std::atomic<void (*)()> g_sigint_also{nullptr};
+// The handler can reach only globals; all are lock-free atomics (async-signal-safe).
+std::atomic<bool> g_stop_signal{false};
+std::atomic<int> g_stop_signal_number{0};
+std::atomic<void (*)()> g_stop_signal_also{nullptr};
 static_assert(std::atomic<void (*)()>::is_always_lock_free, "the callback must be lock-free");
+static_assert(std::atomic<int>::is_always_lock_free, "the signal number must be lock-free");
 
-extern "C" void OnSigint(int /*signal*/) {
-  g_sigint.store(true);
-  if (void (*also)() = g_sigint_also.load()) also();
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+extern "C" void OnStopSignal(int signal_number) {
+  int none = 0;
+  g_stop_signal_number.compare_exchange_strong(none, signal_number);  // the first one wins
+  g_stop_signal.store(true);
+  if (void (*also)() = g_stop_signal_also.load()) also();
 }
 
 }  // namespace
 
-SigintScope::SigintScope(void (*also)()) {
-  g_sigint.store(false);
-  g_sigint_also.store(also);
-  previous_ = std::signal(SIGINT, &OnSigint);
+StopSignalScope::StopSignalScope(void (*also)()) {
+  static_assert(sizeof(kStopSignals) / sizeof(kStopSignals[0]) == kSignals);
+  g_stop_signal.store(false);
+  g_stop_signal_number.store(0);
+  g_stop_signal_also.store(also);
+  for (int i = 0; i < kSignals; ++i) previous_[i] = std::signal(kStopSignals[i], &OnStopSignal);
 }
 
-SigintScope::~SigintScope() {
-  std::signal(SIGINT, previous_);
-  g_sigint_also.store(nullptr);
+StopSignalScope::~StopSignalScope() {
+  for (int i = 0; i < kSignals; ++i) std::signal(kStopSignals[i], previous_[i]);
+  g_stop_signal_also.store(nullptr);
 }
 
-const std::atomic<bool>* SigintScope::interrupted() const {
-  return &g_sigint;
+const std::atomic<bool>* StopSignalScope::interrupted() const {
+  return &g_stop_signal;
+}
+
+int StopSignalScope::signal_number() const {
+  return g_stop_signal_number.load();
+}
+
+std::string StopSignalName(int signal_number) {
+  switch (signal_number) {
+    case SIGINT:
+      return "Ctrl-C (SIGINT)";
+    case SIGTERM:
+      return "SIGTERM (a request to terminate)";
+    case SIGHUP:
+      return "SIGHUP (the terminal or session was closed)";
+    default:
+      return "signal " + std::to_string(signal_number);
+  }
 }
 
 }  // namespace oal

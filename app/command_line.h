@@ -55,22 +55,34 @@ std::function<void(int done, int total)> FrameProgress(const std::string& label,
 void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
                        int max_frames, const std::string& out_path);
 
-/// While one lives, Ctrl-C (SIGINT) sets interrupted() instead of ending the process, and
-/// then calls `also` if given (which must be async-signal-safe: store to lock-free atomics
-/// only); the previous handler comes back after. One at a time: the flag is process-wide.
-class SigintScope {
+/// While one lives, the signals that ask a program to stop — SIGINT (Ctrl-C), SIGTERM (kill,
+/// `systemctl stop`, `timeout`) and SIGHUP (the terminal or the SSH session closed) — set
+/// interrupted() instead of ending the process, and then call `also` if given (which must be
+/// async-signal-safe: store to lock-free atomics only); the previous handlers come back after.
+/// signal_number() says which signal came first. One at a time: the flag is process-wide.
+class StopSignalScope {
  public:
-  explicit SigintScope(void (*also)() = nullptr);
-  ~SigintScope();
-  SigintScope(const SigintScope&) = delete;
-  SigintScope& operator=(const SigintScope&) = delete;
+  explicit StopSignalScope(void (*also)() = nullptr);
+  ~StopSignalScope();
+  StopSignalScope(const StopSignalScope&) = delete;
+  StopSignalScope& operator=(const StopSignalScope&) = delete;
 
-  /// Set by Ctrl-C; false when the scope begins.
+  /// Set by any of the stop signals; false when the scope begins.
   const std::atomic<bool>* interrupted() const;
+  /// The first stop signal received since the scope began (SIGINT, SIGTERM, SIGHUP); 0: none.
+  int signal_number() const;
 
  private:
-  void (*previous_)(int);
+  static constexpr int kSignals = 3;
+  void (*previous_[kSignals])(int);
 };
+
+/// The scope's former name, when it handled Ctrl-C only.
+using SigintScope = StopSignalScope;
+
+/// A stop signal for the user: "Ctrl-C (SIGINT)", "SIGTERM (a request to terminate)",
+/// "SIGHUP (the terminal or session was closed)"; "signal N" for another.
+std::string StopSignalName(int signal_number);
 
 /// A warning for the user on stderr: "oalservo <command>: warning: <message>". Libraries
 /// never print; commands report through this.

@@ -4,6 +4,7 @@
 #include <visp3/core/vpRxyzVector.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -137,10 +138,24 @@ void ReadFields(const YAML::Node& section, const std::string& file, const std::s
   }
 }
 
-// Check() names the field as "DetectorOptions::<field> = ..."; point at the line that set it.
+// The keys a Check() message names: "a" for "a", "a" and "b" for "a/b [x]" (a constraint
+// between two keys, on one axis).
+std::vector<std::string> FieldKeys(std::string field) {
+  field = field.substr(0, field.find(" ["));
+  std::vector<std::string> keys;
+  for (std::size_t begin = 0; begin <= field.size();) {
+    const std::size_t end = std::min(field.find('/', begin), field.size());
+    keys.push_back(field.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return keys;
+}
+
+// Check() names the field as "DetectorOptions::<field> = ..."; point at the line that set it
+// (else at the section's line, when given).
 template <typename Options>
 void CheckAt(const Options& options, const std::string& file, const std::string& name,
-             const Lines& lines) {
+             const Lines& lines, int section_line = 0) {
   try {
     options.Check();
   } catch (const std::invalid_argument& error) {
@@ -154,14 +169,16 @@ void CheckAt(const Options& options, const std::string& file, const std::string&
       skip = 1;
     }
     if (begin != std::string::npos && end != std::string::npos && begin < end) {
-      const std::string field = message.substr(begin + skip, end - begin - skip);
-      const auto line = lines.find(field);
-      if (line != lines.end()) {
-        throw std::runtime_error(file + ":" + std::to_string(line->second) + ": '" + name + "." +
-                                 field + "' is invalid: " + message);
+      for (const std::string& field : FieldKeys(message.substr(begin + skip, end - begin - skip))) {
+        const auto line = lines.find(field);
+        if (line != lines.end()) {
+          throw std::runtime_error(file + ":" + std::to_string(line->second) + ": '" + name + "." +
+                                   field + "' is invalid: " + message);
+        }
       }
     }
-    throw std::runtime_error(file + ": section '" + name + "' is invalid: " + message);
+    const std::string at = section_line > 0 ? ":" + std::to_string(section_line) : "";
+    throw std::runtime_error(file + at + ": section '" + name + "' is invalid: " + message);
   }
 }
 
@@ -172,7 +189,7 @@ void ReadCheckedSection(const YAML::Node& section, const std::string& file, cons
                         const std::vector<Field<Options>>& fields, Options* options) {
   Lines lines;
   ReadFields(section, file, name, fields, "", options, &lines);
-  CheckAt(*options, file, name, lines);
+  CheckAt(*options, file, name, lines, section.Mark().line + 1);
 }
 
 const std::vector<Field<DetectorOptions>>& DetectorFields() {
@@ -441,7 +458,8 @@ std::array<double, 3> ReadVector3(const Value& value, const char* unit) {
   return v;
 }
 
-// {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]}, R = Rx·Ry·Rz; both keys optional (0).
+// {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]}, R = Rx·Ry·Rz; both keys required (one
+// missing, silently read as zeros, would put the robot or the goal somewhere else).
 vpHomogeneousMatrix ReadPose(const Value& value) {
   if (!value.node.IsMap()) {
     value.Fail("'" + value.key +
@@ -460,6 +478,13 @@ vpHomogeneousMatrix ReadPose(const Value& value) {
   Parts parts;
   Lines lines;
   ReadFields(value.node, value.file, value.key, fields, "", &parts, &lines);
+  for (const char* key : {"translation_m", "rxyz_deg"}) {
+    if (lines.count(key) == 0) {
+      value.Fail("'" + value.key + "' has no '" + key +
+                 "' (a pose needs translation_m: [x, y, z] and rxyz_deg: [rx, ry, rz]; give "
+                 "[0, 0, 0] for none)");
+    }
+  }
   const std::array<double, 3>& t = parts.t;
   const std::array<double, 3>& r = parts.r;
   const vpRxyzVector rxyz(vpMath::rad(r[0]), vpMath::rad(r[1]), vpMath::rad(r[2]));
@@ -804,6 +829,43 @@ void ReadSection(const std::string& name, const YAML::Node& key, const YAML::Nod
                            "' is unknown (known: " + SectionNames() + ")");
 }
 
+// Records where every key of `node` (a map, recursively) is set, as "FILE:LINE" by full key.
+void RecordOrigins(const YAML::Node& node, const std::string& prefix, const std::string& file,
+                   std::map<std::string, std::string>* origins) {
+  if (!node.IsMap()) return;
+  for (const auto& entry : node) {
+    const std::string key = (prefix.empty() ? "" : prefix + ".") + entry.first.Scalar();
+    (*origins)[key] = At(file, entry.first);
+    RecordOrigins(entry.second, key, file, origins);
+  }
+}
+
+// A configured start pose (the simulated robot's, or the Scorbot simulator's) outside the
+// workspace box: the run would begin where no move is allowed.
+void CheckStartInWorkspace(const AppConfig& config, const std::string& file) {
+  const RobotConfig& robot = config.robot;
+  if (robot.type != "simulated" && robot.scorbot.port != "simulator") return;  // a real arm
+  const vpHomogeneousMatrix wMx = robot.safety.workspace_frame == RobotFrame::kCamera
+                                      ? robot.start_wMc
+                                      : robot.start_wMc * config.camera.eMc.inverse();
+  const std::string why = OutsideWorkspace(robot.safety, wMx.getTranslationVector());
+  if (why.empty()) return;
+  // Lead with a line of this file: the start's if it set it, else the box's.
+  const auto in_file = [&](const std::string& origin) { return origin.rfind(file + ":", 0) == 0; };
+  const std::string start_at = config.Origin("robot.start");
+  std::string at = in_file(start_at) ? start_at : "";
+  for (const char* key : {"robot.workspace_min_m", "robot.workspace_max_m",
+                          "robot.workspace_enabled", "robot.scorbot.port", "robot.type"}) {
+    if (at.empty() && in_file(config.Origin(key))) at = config.Origin(key);
+  }
+  throw std::runtime_error((at.empty() ? file : at) + ": 'robot.start'" +
+                           (start_at.empty() || start_at == at ? "" : " (" + start_at + ")") +
+                           " puts the " + ToString(robot.safety.workspace_frame) +
+                           " outside the workspace box: " + why +
+                           " (robot.workspace_min_m / workspace_max_m); move the start into the "
+                           "box or widen the box");
+}
+
 AppConfig ReadConfig(const YAML::Node& root, const std::string& file, AppConfig config) {
   if (root.IsNull()) return config;  // an empty file changes nothing
   if (!root.IsMap()) {
@@ -821,6 +883,8 @@ AppConfig ReadConfig(const YAML::Node& root, const std::string& file, AppConfig 
     }
     ReadSection(name, entry.first, entry.second, file, &config);
   }
+  RecordOrigins(root, "", file, &config.origins);
+  CheckStartInWorkspace(config, file);
   return config;
 }
 
@@ -849,6 +913,25 @@ std::string Num(double value) {
 }
 
 }  // namespace
+
+std::string AppConfig::Origin(const std::string& key) const {
+  const auto origin = origins.find(key);
+  return origin == origins.end() ? "" : origin->second;
+}
+
+std::string OutsideWorkspace(const SafetyOptions& safety, const vpTranslationVector& p) {
+  if (!safety.workspace_enabled) return "";
+  constexpr const char* kAxis[3] = {"x", "y", "z"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double lo = safety.workspace_min_m[i], hi = safety.workspace_max_m[i];
+    const double value = p[static_cast<unsigned>(i)];
+    if (!(value >= lo && value <= hi)) {
+      return std::string(kAxis[i]) + " = " + Num(value) + " m is outside [" + Num(lo) + ", " +
+             Num(hi) + "] m";
+    }
+  }
+  return "";
+}
 
 vpCameraParameters CameraConfig::Camera() const {
   vpCameraParameters camera;

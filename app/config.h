@@ -34,7 +34,10 @@
 //   output:   directory, display (auto/on/off), save_frames               (OutputConfig)
 //
 // A pose is a map {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]} with the rotation
-// R = Rx(rx)·Ry(ry)·Rz(rz) (vpRxyzVector).
+// R = Rx(rx)·Ry(ry)·Rz(rz) (vpRxyzVector); both keys are required.
+//
+// A configured robot.start (simulated robot, or the Scorbot's controller simulator) must lie
+// inside the workspace box (robot.workspace_min_m / workspace_max_m) when the box is enabled.
 //
 // The section reserved for later versions (render) is rejected with a message saying so,
 // rather than silently ignored.
@@ -43,6 +46,7 @@
 #include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
+#include <map>
 #include <string>
 
 #include "detector/options.h"
@@ -154,7 +158,19 @@ struct AppConfig {
   OutputConfig output;            ///< `output:`
   /// `target_pose: POSE`: wMo, the target in the world frame.
   vpHomogeneousMatrix target_wMo;
+  /// Where each key was last set: "FILE:LINE" by full key ("robot.start", "source.path",
+  /// "robot.scorbot.port"), for messages about values used after loading; a key no file
+  /// set is absent.
+  std::map<std::string, std::string> origins;
+
+  /// origins[key], or "" when no file set it.
+  std::string Origin(const std::string& key) const;
 };
+
+/// Why the point `p` (the origin of safety.workspace_frame in the world frame, m) lies outside
+/// the workspace box of `safety`, e.g. "z = 1.2 m is outside [0.1, 1] m"; "" when it is inside
+/// or the box is disabled.
+std::string OutsideWorkspace(const SafetyOptions& safety, const vpTranslationVector& p);
 
 /// The servo command reads the same file: all sections live in AppConfig.
 using ServoAppConfig = AppConfig;

@@ -4,6 +4,7 @@
 #include <visp3/core/vpRxyzVector.h>
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 #include "app/detector_accuracy.h"  // Quantile
 #include "app/servo_accuracy.h"
 #include "app/servo_command.h"
+#include "app/servo_output.h"
 
 namespace oal {
 namespace {
@@ -118,7 +120,12 @@ int RunServoAccuracy(int argc, char** argv) {
       "Example:\n"
       "  oalservo servo-accuracy --starts 100 --out out/servo-accuracy.json");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
-  if (!out_path.empty()) CheckOutputFile(out_path);
+  if (!out_path.empty()) {
+    // Before the runs, not after them: a directory that cannot take the file fails now.
+    const std::filesystem::path parent = std::filesystem::path(out_path).parent_path();
+    CheckWritableDirectory(parent.empty() ? "." : parent, "directory of --out");
+    CheckOutputFile(out_path);
+  }
   if (!laws.empty()) {
     options.modes.clear();
     for (const std::string& law : laws) options.modes.push_back(ServoModeFromString(law));

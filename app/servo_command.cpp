@@ -17,16 +17,27 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Ctrl-C also stops the robot at once (SigintScope: only lock-free atomics, which a signal
-// handler may touch; RequestEmergencyStop stores to one).
+// A stop signal also stops the robot at once (StopSignalScope: only lock-free atomics, which
+// a signal handler may touch; RequestEmergencyStop stores to one).
 std::atomic<SafeRobot*> g_robot{nullptr};
 static_assert(std::atomic<SafeRobot*>::is_always_lock_free, "the robot pointer must be lock-free");
 
-void StopRobotOnSigint() {
+}  // namespace
+
+void StopRobotOnSignal() {
   if (SafeRobot* robot = g_robot.load()) robot->RequestEmergencyStop();
 }
 
-}  // namespace
+ServoRunHooks StopSignalHooks(const StopSignalScope& signals) {
+  ServoRunHooks hooks;
+  hooks.interrupt = signals.interrupted();
+  hooks.interrupt_reason = [&signals] {
+    const int number = signals.signal_number();
+    return number != 0 ? StopSignalName(number) : std::string("a click in the window");
+  };
+  hooks.on_robot = [](SafeRobot* robot) { g_robot.store(robot); };
+  return hooks;
+}
 
 ServoAppConfig DefaultServoConfig() {
   return ParseConfig(kDefaultServoConfigYaml, kDefaultServoConfigName);
@@ -49,21 +60,42 @@ namespace {
 // The window or the annotated frames, fed by the loop's on_frame hook.
 class FrameOutput {
  public:
-  FrameOutput(const OutputConfig& output, const fs::path& frames_dir) : frames_dir_(frames_dir) {
-    const bool window =
-        output.display == "on" || (output.display == "auto" && CanOpenServoWindow());
-    if (window) {
-      window_ = std::make_unique<ServoWindow>();
-    } else if (output.save_frames && !frames_dir.empty()) {
-      fs::create_directories(frames_dir);
-      // The directory shows this run only: an earlier, longer run's frames would mislead.
-      for (const fs::directory_entry& entry : fs::directory_iterator(frames_dir)) {
-        const std::string name = entry.path().filename().string();
-        if (name.rfind("iter_", 0) == 0 && entry.path().extension() == ".png") {
-          RemoveQuietly(entry.path());
-        }
+  // Opens the window now (display on: a window or an error; auto: a window if one opens, else
+  // a warning and none), before the robot is touched; checks the frames directory writable.
+  FrameOutput(const ServoAppConfig& config, const fs::path& frames_dir) : frames_dir_(frames_dir) {
+    const OutputConfig& output = config.output;
+    const int width = config.camera.width, height = config.camera.height;
+    if (output.display == "on") {
+      try {
+        window_ = std::make_unique<ServoWindow>(width, height);
+      } catch (const std::runtime_error& error) {
+        if (!CanOpenServoWindow()) throw;  // the message says output.display already
+        throw std::runtime_error("output.display is on but " + std::string(error.what()) +
+                                 "; use output.display auto or off (--display)");
       }
+    } else if (output.display == "auto" && CanOpenServoWindow()) {
+      try {
+        window_ = std::make_unique<ServoWindow>(width, height);
+      } catch (const std::runtime_error& error) {
+        Warn("servo", std::string(error.what()) + "; going on without a window (output.display " +
+                          "auto; off to skip this, on to make it an error)");
+      }
+    }
+    if (window_ == nullptr && output.save_frames && !frames_dir.empty()) {
+      CheckWritableDirectory(frames_dir, "frames directory");
       save_ = true;
+    }
+  }
+
+  // The run has begun: the directory shows this run only (an earlier, longer run's frames
+  // would mislead).
+  void Prepare() {
+    if (!save_) return;
+    for (const fs::directory_entry& entry : fs::directory_iterator(frames_dir_)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("iter_", 0) == 0 && entry.path().extension() == ".png") {
+        RemoveQuietly(entry.path());
+      }
     }
   }
 
@@ -97,18 +129,25 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
   const ServoAppConfig config = LoadServoConfig(options);
   const fs::path dir = config.output.directory;
   const fs::path csv = dir / "servo.csv", plot = dir / "servo-error.png";
+  // Everything the outputs need is checked before the source and the robot are opened; what
+  // an earlier run wrote is replaced only once this one has begun.
   if (!dir.empty()) {
-    fs::create_directories(dir);
+    CheckWritableDirectory(dir, options.out_dir.empty() ? "output directory (output.directory)"
+                                                        : "output directory (--out)");
     CheckOutputFile(csv);
     CheckOutputFile(plot);
   }
-  FrameOutput frames(config.output, dir.empty() ? fs::path() : dir / "frames");
+  FrameOutput frames(config, dir.empty() ? fs::path() : dir / "frames");
   out << "oalservo servo: "
       << (options.config_path.empty() ? kDefaultServoConfigName : options.config_path) << ", "
       << ToString(config.servo.law.mode) << " law"
       << (frames.HasWindow() ? ", live window (click to stop)" : "") << '\n';
 
   ServoRunHooks run_hooks = hooks;
+  run_hooks.on_started = [&] {
+    frames.Prepare();
+    if (hooks.on_started) hooks.on_started();
+  };
   SafeRobot* robot = nullptr;
   run_hooks.on_robot = [&](SafeRobot* running) {
     robot = running;
@@ -123,7 +162,10 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
   const ServoRunReport report = RunServo(config, out, run_hooks);
   out << "oalservo servo: " << ToString(report.status) << ": " << report.message << '\n';
   if (!report.link_summary.empty()) out << "oalservo servo: " << report.link_summary << '\n';
-  if (!dir.empty()) {
+  if (!dir.empty() && !report.started) {
+    out << "oalservo servo: nothing written: the run did not begin (" << dir.string()
+        << " keeps what an earlier run wrote)\n";
+  } else if (!dir.empty()) {
     AtomicFile file(csv);
     WriteServoCsv(report, file.stream());
     file.Commit();
@@ -168,11 +210,8 @@ int RunServoMain(int argc, char** argv) {
       "  oalservo servo --config config/table3-sim.yaml --out out/table3\n"
       "  oalservo servo --config config/table3-sim.yaml --mode point-and-go --display off");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
-  const SigintScope sigint(&StopRobotOnSigint);
-  ServoRunHooks hooks;
-  hooks.interrupt = sigint.interrupted();
-  hooks.on_robot = [](SafeRobot* robot) { g_robot.store(robot); };
-  const ServoRunReport report = RunServoCommand(options, std::cout, hooks);
+  const StopSignalScope signals(&StopRobotOnSignal);
+  const ServoRunReport report = RunServoCommand(options, std::cout, StopSignalHooks(signals));
   const bool ok =
       report.status == ServoRunStatus::kConverged || report.status == ServoRunStatus::kEndOfInput;
   return ok ? kExitOk : kExitError;

@@ -6,8 +6,13 @@
 // error mm, rotation error deg, status), then the outcome, and writes into the output
 // directory (config output.directory, or --out) servo.csv, servo-error.png and, without a
 // window, the annotated frames (app/servo_output.h), each atomically. A vpDisplayX window
-// shows the frames when a display exists (output.display). Ctrl-C, or a click in the window,
-// stops the robot (SafeRobot::RequestEmergencyStop) and ends the run with status interrupted.
+// shows the frames when a display exists (output.display; with auto, an X display that cannot
+// be reached gives a warning and no window). Ctrl-C, SIGTERM, SIGHUP, or a click in the
+// window, stops the robot (SafeRobot::RequestEmergencyStop) and ends the run with status
+// interrupted, the outputs written as for any other end.
+// Before the source and the robot are opened the output directory is checked writable and a
+// window opened; an earlier run's outputs are replaced only once the robot is connected (a run
+// that cannot connect writes nothing).
 // Exit status: 0 converged (or a replay played to its end), 1 any other outcome or an error,
 // 2 a bad command line.
 #pragma once
@@ -15,6 +20,7 @@
 #include <iosfwd>
 #include <string>
 
+#include "app/command_line.h"
 #include "app/config.h"
 #include "app/servo_loop.h"
 
@@ -35,6 +41,14 @@ ServoAppConfig DefaultServoConfig();
 /// then the command line's overrides. Throws std::runtime_error / std::invalid_argument for a
 /// bad file or override.
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options);
+
+/// Requests the emergency stop of the robot registered by StopSignalHooks()' on_robot (the
+/// StopSignalScope's callback: async-signal-safe).
+void StopRobotOnSignal();
+/// The hooks `oalservo servo` runs with: `signals`' flag interrupts the loop and its signal
+/// names the reason; the robot is registered for StopRobotOnSignal(). `signals` must outlive
+/// the run.
+ServoRunHooks StopSignalHooks(const StopSignalScope& signals);
 
 /// Loads the configuration, runs the loop (rows to `out`) and writes the outputs.
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,

@@ -4,6 +4,7 @@
 #include <visp3/core/vpRotationMatrix.h>
 #include <visp3/core/vpThetaUVector.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -40,15 +41,22 @@ class StopGuard {
     if (hooks_.on_robot) hooks_.on_robot(&robot_);
   }
   ~StopGuard() {
-    if (hooks_.on_robot) hooks_.on_robot(nullptr);
-    robot_.Stop();
+    if (!stopped_) Stop();
   }
   StopGuard(const StopGuard&) = delete;
   StopGuard& operator=(const StopGuard&) = delete;
 
+  // Unregisters the robot and stops it; the destructor then has nothing left to do.
+  RobotResult Stop() {
+    stopped_ = true;
+    if (hooks_.on_robot) hooks_.on_robot(nullptr);
+    return robot_.Stop();
+  }
+
  private:
   SafeRobot& robot_;
   const ServoRunHooks& hooks_;
+  bool stopped_ = false;
 };
 
 std::string Fixed(double value, int digits) {
@@ -57,12 +65,19 @@ std::string Fixed(double value, int digits) {
   return text.str();
 }
 
-void LogRow(const ServoIteration& row, std::ostream& log) {
+// The table's header and rows; `yaw`: with the yaw column (not for the 5-axis Scorbot).
+void LogHeader(bool yaw, std::ostream& log) {
+  log << "iter     X mm     Y mm     Z mm    pitch     roll" << (yaw ? "      yaw" : "")
+      << "   err mm   err deg  status\n";
+}
+
+void LogRow(const ServoIteration& row, bool yaw, std::ostream& log) {
   log << std::setw(4) << row.iteration << std::fixed << std::setprecision(1) << std::setw(9)
       << row.x_mm << std::setw(9) << row.y_mm << std::setw(9) << row.z_mm << std::setprecision(2)
-      << std::setw(9) << row.pitch_deg << std::setw(9) << row.roll_deg << std::setprecision(3)
-      << std::setw(11) << row.translation_error_mm << std::setw(10) << row.rotation_error_deg
-      << "  " << row.status << '\n'
+      << std::setw(9) << row.pitch_deg << std::setw(9) << row.roll_deg;
+  if (yaw) log << std::setw(9) << row.yaw_deg;
+  log << std::setprecision(3) << std::setw(11) << row.translation_error_mm << std::setw(10)
+      << row.rotation_error_deg << "  " << row.status << '\n'
       << std::defaultfloat;
 }
 
@@ -111,6 +126,9 @@ class LoopCamera {
   /// the source; false at the end of a recording. Throws std::runtime_error when a frame cannot
   /// be read.
   virtual bool Grab(const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) = 0;
+  /// True when a recording has no frame left (the next Grab() would return false); a camera
+  /// never ends.
+  virtual bool AtEnd() { return false; }
   virtual std::string Name() const = 0;
 };
 
@@ -150,15 +168,31 @@ class SourceCamera : public LoopCamera {
   explicit SourceCamera(std::unique_ptr<ImageSource> source) : source_(std::move(source)) {}
 
   bool Grab(const vpHomogeneousMatrix& /*true_cMo*/, int /*iteration*/, cv::Mat* gray) override {
-    if (!source_->Next(&frame_)) return false;
+    const bool have_frame = peeked_ ? peeked_frame_ : source_->Next(&frame_);
+    peeked_ = false;
+    if (!have_frame) return false;
     *gray = frame_.gray;
     return true;
+  }
+  // Reads the next frame ahead (Grab() then hands it out); an unreadable one is not the end.
+  bool AtEnd() override {
+    if (!peeked_) {
+      try {
+        peeked_frame_ = source_->Next(&frame_);
+      } catch (const std::exception&) {
+        return false;  // Grab() reads on past it and reports it
+      }
+      peeked_ = true;
+    }
+    return !peeked_frame_;
   }
   std::string Name() const override { return source_->Name(); }
 
  private:
   std::unique_ptr<ImageSource> source_;
   Frame frame_;
+  bool peeked_ = false;        // frame_ holds the next frame already (AtEnd())
+  bool peeked_frame_ = false;  // ... and there was one
 };
 
 // The robot the configuration names. For the Scorbot with port "simulator", the Controller-A
@@ -245,17 +279,30 @@ std::string LinkSummary(const Robot& driver, int baud, int moves) {
   return summary;
 }
 
+// "FILE:LINE: key" where the configuration set `key`, or "key" when no file set it.
+std::string KeyAt(const ServoAppConfig& config, const std::string& key) {
+  const std::string origin = config.Origin(key);
+  return origin.empty() ? key : origin + ": " + key;
+}
+
 std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
   const SourceConfig& source = config.source;
   if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
-  if (source.type == "v4l2") {
-    V4l2Settings settings;
-    settings.width = config.camera.width;
-    settings.height = config.camera.height;
-    settings.fps = source.fps;
-    return std::make_unique<SourceCamera>(OpenV4l2Source(source.device, settings));
+  const bool v4l2 = source.type == "v4l2";
+  const std::string key = v4l2 ? "source.device" : "source.path";
+  try {
+    if (v4l2) {
+      V4l2Settings settings;
+      settings.width = config.camera.width;
+      settings.height = config.camera.height;
+      settings.fps = source.fps;
+      return std::make_unique<SourceCamera>(OpenV4l2Source(source.device, settings));
+    }
+    return std::make_unique<SourceCamera>(OpenImageSource(source.path));
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(KeyAt(config, key) + " '" + (v4l2 ? source.device : source.path) +
+                             "' cannot be opened: " + error.what());
   }
-  return std::make_unique<SourceCamera>(OpenImageSource(source.path));
 }
 
 // Why the loop ends, for the report.
@@ -279,25 +326,38 @@ void CheckServoConfig(const ServoAppConfig& config) {
   }
 }
 
-// Step 1: the operator's stop, the time and the iteration limits.
+// Who asked for a stop, for "interrupted by ...".
+std::string InterruptedBy(const ServoRunHooks& hooks) {
+  return hooks.interrupt_reason ? hooks.interrupt_reason() : "Ctrl-C or a stop from the window";
+}
+
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// Step 1 (after the operator's stop): the time and the iteration limits. A recording that
+// ends where the iteration limit does was played to its end: end-of-input.
 std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int iteration,
-                                 std::chrono::steady_clock::time_point start, bool interrupted) {
-  if (interrupted) {
-    return Stop{ServoRunStatus::kInterrupted,
-                "interrupted (Ctrl-C or a stop from the window) after " +
-                    std::to_string(iteration) + " iterations; robot stopped"};
-  }
+                                 std::chrono::steady_clock::time_point start, LoopCamera& frames) {
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (elapsed_s > loop.max_time_s) {
     return Stop{ServoRunStatus::kTimeLimit,
-                "time limit: " + Fixed(elapsed_s, 2) + " s > servo.max_time_s = " +
-                    Fixed(loop.max_time_s, 2) + " s without converging"};
+                "time limit reached: servo.max_time_s = " + Number(loop.max_time_s) + " s (" +
+                    Fixed(elapsed_s, 3) + " s elapsed) without converging"};
   }
   if (iteration >= loop.max_iterations) {
+    if (frames.AtEnd()) {
+      return Stop{ServoRunStatus::kEndOfInput,
+                  "end of " + frames.Name() + " after " + std::to_string(iteration) +
+                      " frames (servo.max_iterations = " + std::to_string(loop.max_iterations) +
+                      ")"};
+    }
     return Stop{ServoRunStatus::kIterationLimit,
-                "iteration limit: servo.max_iterations = " + std::to_string(loop.max_iterations) +
-                    " frames without converging"};
+                "iteration limit reached: servo.max_iterations = " +
+                    std::to_string(loop.max_iterations) + " frames without converging"};
   }
   return std::nullopt;
 }
@@ -310,19 +370,17 @@ std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
     have_frame = frames.Grab(true_cMo, iteration, gray);
   } catch (const std::exception& error) {
     return Stop{ServoRunStatus::kError, "cannot read the next frame at iteration " +
-                                            std::to_string(iteration) + ": " + error.what() +
-                                            "; robot stopped"};
+                                            std::to_string(iteration) + ": " + error.what()};
   }
   if (!have_frame) {
     return Stop{ServoRunStatus::kEndOfInput,
                 "end of " + frames.Name() + " after " + std::to_string(iteration) + " frames"};
   }
   if (gray->cols != camera.width || gray->rows != camera.height) {
-    return Stop{ServoRunStatus::kError, frames.Name() + " gives " + std::to_string(gray->cols) +
-                                            "x" + std::to_string(gray->rows) +
-                                            " frames but camera.width x camera.height is " +
-                                            std::to_string(camera.width) + "x" +
-                                            std::to_string(camera.height) + "; robot stopped"};
+    return Stop{ServoRunStatus::kError,
+                frames.Name() + " gives " + std::to_string(gray->cols) + "x" +
+                    std::to_string(gray->rows) + " frames but camera.width x camera.height is " +
+                    std::to_string(camera.width) + "x" + std::to_string(camera.height)};
   }
   return std::nullopt;
 }
@@ -341,8 +399,10 @@ ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomoge
     row.z_mm = acl.z / 10.0;
     row.pitch_deg = acl.p / 10.0;
     row.roll_deg = acl.r / 10.0;
+    row.yaw_deg = kNaN;  // 5 axes: the tool's yaw follows the base
   } else {
-    Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg);
+    Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg,
+                  &row.yaw_deg);
   }
   row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
   if (config.source.type == "simulated") {
@@ -363,7 +423,7 @@ std::optional<Stop> PoseStop(const PoseResult& pose,
     return Stop{ServoRunStatus::kTargetLost,
                 "target lost at iteration " + std::to_string(iteration) + ": " +
                     ToString(pose.status) +
-                    (pose.message.empty() ? "" : " (" + pose.message + ")") + "; robot stopped"};
+                    (pose.message.empty() ? "" : " (" + pose.message + ")")};
   }
   if (!predicted_cMo) return std::nullopt;
   const PoseDistance jump = Distance(*predicted_cMo, pose.cMo);
@@ -377,18 +437,43 @@ std::optional<Stop> PoseStop(const PoseResult& pose,
                   Fixed(vpMath::deg(jump.rotation_rad), 2) +
                   " deg from the previous one moved by the robot (limits " +
                   Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " +
-                  Fixed(loop.max_pose_jump_deg, 2) + " deg); robot stopped"};
+                  Fixed(loop.max_pose_jump_deg, 2) + " deg)"};
 }
 
 // A motion the SafeRobot refused.
-Stop RefusalStop(const RobotResult& moved, const SafeRobot& robot, int iteration) {
+Stop RefusalStop(const RobotResult& moved, const SafeRobot& robot, int iteration,
+                 const ServoRunHooks& hooks) {
   const ServoRunStatus status = StatusOfRefusal(moved, robot);
   if (status == ServoRunStatus::kInterrupted) {
-    return {status, "interrupted (Ctrl-C or a stop from the window) during the move of iteration " +
-                        std::to_string(iteration) + "; robot stopped"};
+    return {status, "interrupted by " + InterruptedBy(hooks) + " during the move of iteration " +
+                        std::to_string(iteration)};
   }
-  return {status, ToString(status) + " at iteration " + std::to_string(iteration) + ": " +
-                      moved.message + "; robot stopped"};
+  return {status,
+          ToString(status) + " at iteration " + std::to_string(iteration) + ": " + moved.message};
+}
+
+// What the end of the run did to the robot, appended to the stop message.
+std::string StopOutcome(const RobotResult& stopped, ServoRunStatus status, bool connected) {
+  if (!stopped.ok()) {
+    return "; STOP COULD NOT BE SENT: " + stopped.message + " — check the arm";
+  }
+  const bool says_so =
+      status != ServoRunStatus::kConverged && status != ServoRunStatus::kEndOfInput && connected;
+  return says_so ? "; robot stopped" : "";
+}
+
+// A robot that starts outside the workspace box (a real arm stands where it stands): a
+// warning, since every move is still checked against the box.
+void WarnIfOutsideWorkspace(SafeRobot& robot, std::ostream& log) {
+  const SafetyOptions& safety = robot.options();
+  const RobotPose at = robot.GetPosition(safety.workspace_frame);
+  if (!at.result.ok()) return;  // the loop's first read reports it
+  const std::string why = OutsideWorkspace(safety, at.pose.getTranslationVector());
+  if (why.empty()) return;
+  log << "warning: the robot starts outside the workspace box: the "
+      << ToString(safety.workspace_frame) << "'s " << why
+      << " (robot.workspace_min_m / workspace_max_m); every move is still checked against the "
+         "box and may be refused: bring the arm into the box or widen it\n";
 }
 
 }  // namespace
@@ -418,25 +503,27 @@ std::string ToString(ServoRunStatus status) {
 }
 
 void Table3Columns(const vpHomogeneousMatrix& wMc, double* x_mm, double* y_mm, double* z_mm,
-                   double* pitch_deg, double* roll_deg) {
-  // wRc = Rx(π)·Rx(pitch)·Rz(roll)  =>  M = Rx(-π)·wRc = Rx(pitch)·Rz(roll).
+                   double* pitch_deg, double* roll_deg, double* yaw_deg) {
+  // wRc = Rx(π)·Rx(pitch)·Ry(yaw)·Rz(roll)  =>  M = Rx(-π)·wRc = Rx(pitch)·Ry(yaw)·Rz(roll),
+  // whose x-y-z Euler angles these are (the config's rxyz_deg with 180 taken off rx).
   const vpRotationMatrix M =
       vpRotationMatrix(vpThetaUVector(-M_PI, 0, 0)) * wMc.getRotationMatrix();
   *x_mm = wMc[0][3] * 1e3;
   *y_mm = wMc[1][3] * 1e3;
   *z_mm = wMc[2][3] * 1e3;
   *pitch_deg = vpMath::deg(std::atan2(-M[1][2], M[2][2]));
+  *yaw_deg = vpMath::deg(std::asin(std::clamp(M[0][2], -1.0, 1.0)));
   *roll_deg = vpMath::deg(std::atan2(-M[0][1], M[0][0]));
 }
 
 void WriteServoCsv(const ServoRunReport& report, std::ostream& out) {
-  out << "iteration,x_mm,y_mm,z_mm,pitch_deg,roll_deg,translation_error_mm,rotation_error_deg,"
-         "true_translation_error_mm,true_rotation_error_deg,status\n";
+  out << "iteration,x_mm,y_mm,z_mm,pitch_deg,roll_deg,yaw_deg,translation_error_mm,"
+         "rotation_error_deg,true_translation_error_mm,true_rotation_error_deg,status\n";
   for (const ServoIteration& row : report.iterations) {
     out << row.iteration << ',' << Fixed(row.x_mm, 4) << ',' << Fixed(row.y_mm, 4) << ','
         << Fixed(row.z_mm, 4) << ',' << Fixed(row.pitch_deg, 5) << ',' << Fixed(row.roll_deg, 5)
-        << ',' << Fixed(row.translation_error_mm, 5) << ',' << Fixed(row.rotation_error_deg, 6)
-        << ',' << Fixed(row.true_translation_error_mm, 5) << ','
+        << ',' << Fixed(row.yaw_deg, 5) << ',' << Fixed(row.translation_error_mm, 5) << ','
+        << Fixed(row.rotation_error_deg, 6) << ',' << Fixed(row.true_translation_error_mm, 5) << ','
         << Fixed(row.true_rotation_error_deg, 6) << ',' << row.status << '\n';
   }
 }
@@ -492,26 +579,51 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   if (!moves_robot) {
     log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
   }
+  const bool yaw_column = config.robot.type != "scorbot";
+  std::optional<StopGuard> guard;  // from Connect() on
+  bool moved_since_row = false;    // a motion was commanded after it
   auto finish = [&](Stop stop) {
     report.status = stop.status;
-    report.message = std::move(stop.message);
-    robot.Stop();
-    report.robot_stopped = robot.state() == SafeRobotState::kStopped;
-    if (const RobotPose where = robot.GetPosition(RobotFrame::kCamera); where.result.ok()) {
-      report.final_wMc = where.pose;
-    }
-    report.link_summary = LinkSummary(*rig.driver, config.robot.scorbot.baud, report.moves);
+    const RobotResult stopped = guard ? guard->Stop() : robot.Stop();
+    report.robot_stopped = stopped.ok();
+    report.message = std::move(stop.message) + StopOutcome(stopped, stop.status, guard.has_value());
     if (!report.iterations.empty()) report.iterations.back().status = ToString(stop.status);
+    if (guard) {
+      // Where the robot stopped: after a move since the last frame, one more row says so.
+      const RobotPose where = robot.GetPosition(RobotFrame::kCamera);
+      if (where.result.ok()) {
+        report.final_wMc = where.pose;
+        if (moved_since_row && !report.iterations.empty()) {
+          ServoIteration row = RowAt(config, report.iterations.back().iteration + 1, where.pose,
+                                     where.pose.inverse() * config.target_wMo, report.cdMo);
+          row.status = "stopped";
+          LogRow(row, yaw_column, log);
+          report.iterations.push_back(row);
+        }
+      } else if (moved_since_row) {
+        report.message += "; position after the stop unknown: " + where.result.message;
+      }
+    }
+    if (guard)
+      report.link_summary = LinkSummary(*rig.driver, config.robot.scorbot.baud, report.moves);
     return report;
   };
 
   if (RobotResult r = robot.Connect(); !r.ok()) {
-    return finish({ServoRunStatus::kError, "cannot connect the robot: " + r.message});
+    std::string message = "cannot connect the robot: " + r.message;
+    if (config.robot.type == "scorbot" && config.robot.scorbot.port != "simulator") {
+      message += " (check " + KeyAt(config, "robot.scorbot.port") + " = '" +
+                 config.robot.scorbot.port + "')";
+    }
+    return finish({ServoRunStatus::kError, message});
   }
-  StopGuard guard(robot, hooks);
+  guard.emplace(robot, hooks);
   if (RobotResult r = robot.Enable(); !r.ok()) {
     return finish({ServoRunStatus::kError, "cannot enable the robot: " + r.message});
   }
+  WarnIfOutsideWorkspace(robot, log);
+  report.started = true;
+  if (hooks.on_started) hooks.on_started();
 
   const ServoLoopOptions& loop = config.servo;
   const auto start = std::chrono::steady_clock::now();
@@ -519,12 +631,17 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   vpHomogeneousMatrix previous_wMc;
   cv::Mat gray;
   std::vector<LineSeed> seeds;
-  log << "iter     X mm     Y mm     Z mm    pitch     roll   err mm   err deg  status\n";
+  LogHeader(yaw_column, log);
   for (int iteration = 0;; ++iteration) {
     const bool interrupted =
         (hooks.interrupt != nullptr && hooks.interrupt->load()) || robot.EmergencyStopRequested();
-    if (interrupted) robot.RequestEmergencyStop();
-    if (std::optional<Stop> stop = LimitReached(loop, iteration, start, interrupted)) {
+    if (interrupted) {
+      robot.RequestEmergencyStop();
+      return finish({ServoRunStatus::kInterrupted, "interrupted by " + InterruptedBy(hooks) +
+                                                       " after " + std::to_string(iteration) +
+                                                       " iterations"});
+    }
+    if (std::optional<Stop> stop = LimitReached(loop, iteration, start, *frames)) {
       return finish(*stop);
     }
 
@@ -540,6 +657,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     if (hooks.on_grab) hooks.on_grab(iteration, &gray);
     report.iterations.push_back(RowAt(config, iteration, wMc, true_cMo, report.cdMo));
+    moved_since_row = false;
     ServoIteration& current = report.iterations.back();
 
     // Where the robot's motion since the last estimate puts the target.
@@ -562,7 +680,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     std::optional<Stop> stop = PoseStop(pose, predicted_cMo, loop, iteration);
     if (stop) current.status = ToString(stop->status);
-    LogRow(current, log);
+    LogRow(current, yaw_column, log);
     if (stop) return finish(*stop);
     previous_cMo = pose.cMo;
     previous_wMc = wMc;
@@ -574,11 +692,12 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     if (!moves_robot) continue;
 
+    moved_since_row = true;
     const RobotResult moved =
         velocity_law ? robot.SetVelocity(RobotFrame::kCamera, step->twist).result
                      : robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew).result;
     ++report.moves;
-    if (!moved.ok()) return finish(RefusalStop(moved, robot, iteration));
+    if (!moved.ok()) return finish(RefusalStop(moved, robot, iteration, hooks));
   }
 }
 

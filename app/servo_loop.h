@@ -23,7 +23,8 @@
 //      SafeRobot::SetVelocity(camera, twist) for one sampling period. A refusal ends the run:
 //      a workspace, velocity or reach limit (limit), the emergency stop (interrupted), any
 //      other failure (error);
-//   7. after servo.max_iterations frames without convergence: iteration-limit.
+//   7. after servo.max_iterations frames without convergence: iteration-limit (a recording
+//      that ends exactly there ends the run with end-of-input instead).
 //
 // Frame sources (config `source:`): "simulated" renders the frame from the true cMo (above);
 // "v4l2" grabs from a camera carried by the robot (closed loop; not with the simulated robot,
@@ -36,7 +37,15 @@
 // A taught goal (config `goal.image`) is read before the robot moves: the pose estimated in
 // that image becomes cdMo (TeachGoal).
 // Whatever the outcome, the robot is stopped when RunServo returns (a guard stops it also on
-// an exception).
+// an exception), and the message says whether the stop could be sent ("robot stopped", or
+// "STOP COULD NOT BE SENT: why"). After the stop the robot's position is read once: when the
+// robot moved since the last frame's row (a limit, an interrupt, an error during a move), one
+// more row with status "stopped" records where it stopped.
+//
+// Before the first frame: the source is opened (a missing recording names source.path and
+// where it was set), the robot connected (a bad port names robot.scorbot.port) and enabled; a
+// robot that starts outside the workspace box is reported by a warning in the log (every
+// move is still checked against the box). Hooks::on_started then says the run has begun.
 #pragma once
 
 #include <atomic>
@@ -70,19 +79,23 @@ enum class ServoRunStatus {
 std::string ToString(ServoRunStatus status);
 
 /// One iteration (one frame): where the camera was when the frame was taken and what the law
-/// saw. Table 3's columns: X, Y, Z of the camera in the base frame and pitch, roll with
-/// wRc = Rx(π)·Rx(pitch)·Rz(roll) (the camera looks down at pitch = roll = 0); for the
-/// Scorbot, the controller's own X, Y, Z of the tool centre point and P (the tool axis' angle
-/// above the horizontal), R (robots/scorbot_kinematics.h).
+/// saw. Table 3's columns: X, Y, Z of the camera in the base frame and pitch, roll, and yaw
+/// with wRc = Rx(π)·Rx(pitch)·Ry(yaw)·Rz(roll) (the camera looks down at 0, 0, 0; the config's
+/// pose form rxyz_deg [180 + pitch, yaw, roll]): pitch turns about the camera's x axis, yaw
+/// about its y axis, roll about its optical axis; the paper's arm has no yaw. For the Scorbot,
+/// the controller's own X, Y, Z of the tool centre point and P (the tool axis' angle above the
+/// horizontal), R (robots/scorbot_kinematics.h); yaw NaN (5 axes: no independent yaw).
 struct ServoIteration {
   int iteration = 0;
   double x_mm = 0, y_mm = 0, z_mm = 0;
-  double pitch_deg = 0, roll_deg = 0;
+  double pitch_deg = 0, roll_deg = 0, yaw_deg = 0;
   /// Error to the goal from the estimated pose (NaN when there is no pose).
   double translation_error_mm = 0, rotation_error_deg = 0;
   /// Error to the goal from the true pose (simulation ground truth).
   double true_translation_error_mm = 0, true_rotation_error_deg = 0;
-  std::string status;  ///< "running", "converged", or the stop status
+  /// "running", "converged", the stop status, or "stopped" for the row after the stop
+  /// (where the robot stopped; no frame).
+  std::string status;
 };
 
 struct ServoRunReport {
@@ -90,10 +103,16 @@ struct ServoRunReport {
   vpHomogeneousMatrix cdMo;  ///< the goal used (configured or taught)
   std::string message;       ///< why the run ended, one line for the user
   std::vector<ServoIteration> iterations;
-  vpHomogeneousMatrix final_wMc;  ///< the camera where the run left it
-  bool robot_stopped = false;     ///< the robot was stopped at the end (always true)
-  int moves = 0;                  ///< motion commands sent
-  /// For a robot on a serial link (the Scorbot): what the run cost on it, one line; else empty.
+  vpHomogeneousMatrix final_wMc;  ///< the camera where the run left it (read after the stop)
+  /// The stop was sent and confirmed at the end (or there was nothing to stop); false when it
+  /// could not be sent (the link to the arm lost): the message says so.
+  bool robot_stopped = false;
+  /// The source and the robot were opened and the loop began (Hooks::on_started was called);
+  /// false when the run ended before (the robot could not be connected or enabled).
+  bool started = false;
+  int moves = 0;  ///< motion commands sent
+  /// For a robot on a serial link (the Scorbot) once connected: what the run cost on it, one
+  /// line; else empty.
   std::string link_summary;
 };
 
@@ -114,7 +133,14 @@ struct ServoFrame {
 
 struct ServoRunHooks {
   const std::atomic<bool>* interrupt = nullptr;
+  /// Who asked for the stop, for the message "interrupted by ...", called when the loop sees
+  /// an interrupt (e.g. "SIGTERM (a request to terminate)"); unset: "Ctrl-C or a stop from the
+  /// window".
+  std::function<std::string()> interrupt_reason;
   std::function<void(SafeRobot*)> on_robot;
+  /// Called once the frame source is open and the robot connected and enabled, before the
+  /// first frame: from here on the run has begun and its outputs describe it.
+  std::function<void()> on_started;
   /// Called once per frame, after the pose and the law, before the robot moves.
   std::function<void(const ServoFrame&)> on_frame;
   /// Called with each frame before detection; may change it (tests inject occlusions and a
@@ -133,9 +159,10 @@ vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config);
 ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
                         const ServoRunHooks& hooks = ServoRunHooks());
 
-/// The Table 3 columns of a camera pose wMc: X, Y, Z (mm), pitch, roll (deg).
+/// The Table 3 columns of a camera pose wMc: X, Y, Z (mm), pitch, roll and yaw (deg) with
+/// wRc = Rx(π)·Rx(pitch)·Ry(yaw)·Rz(roll) (ServoIteration).
 void Table3Columns(const vpHomogeneousMatrix& wMc, double* x_mm, double* y_mm, double* z_mm,
-                   double* pitch_deg, double* roll_deg);
+                   double* pitch_deg, double* roll_deg, double* yaw_deg);
 
 /// The report as CSV: a header and one row per iteration.
 void WriteServoCsv(const ServoRunReport& report, std::ostream& out);

@@ -2,6 +2,7 @@
 
 #include <visp3/core/vpConfig.h>
 #include <visp3/core/vpDisplay.h>
+#include <visp3/core/vpException.h>
 #include <visp3/core/vpImage.h>
 #include <visp3/core/vpImageConvert.h>
 #include <visp3/core/vpRGBa.h>
@@ -9,13 +10,17 @@
 #include <visp3/gui/vpDisplayX.h>
 #endif
 
+#include <fcntl.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iomanip>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -145,6 +150,23 @@ cv::Mat AnnotateServoFrame(const ServoFrame& frame) {
   return image;
 }
 
+void CheckWritableDirectory(const std::filesystem::path& dir, const std::string& what) {
+  const std::string where = what + " '" + dir.string() + "'";
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw std::runtime_error("cannot create the " + where + ": " + error.message());
+  if (!std::filesystem::is_directory(dir, error)) {
+    throw std::runtime_error("the " + where + " is not a directory");
+  }
+  const std::filesystem::path probe = TempPathFor(dir / ".oalservo-write-check");
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    throw std::runtime_error("cannot write into the " + where + ": " + std::strerror(errno));
+  }
+  ::close(fd);
+  RemoveQuietly(probe);
+}
+
 bool CanOpenServoWindow() {
 #ifdef VISP_HAVE_X11
   const char* display = std::getenv("DISPLAY");
@@ -161,26 +183,45 @@ struct ServoWindow::Impl {
 #endif
   bool open = false;
   bool clicked = false;
+
+  // Opens the window on `image` (its size); throws std::runtime_error saying why it cannot.
+  void Open() {
+#ifdef VISP_HAVE_X11
+    try {
+      display.init(image, 0, 0, "oalservo servo (click to stop)");
+    } catch (const vpException& error) {
+      const char* name = std::getenv("DISPLAY");
+      throw std::runtime_error(
+          "cannot open a window on the X display '" + std::string(name != nullptr ? name : "") +
+          "' ($DISPLAY): " + error.getMessage() + " (is the X server running and reachable?)");
+    }
+    open = true;
+#endif
+  }
 };
 
-ServoWindow::ServoWindow() {
+ServoWindow::ServoWindow(int width, int height) {
   if (!CanOpenServoWindow()) {
     throw std::runtime_error(
         "output.display is on but no window can be opened (no X11 display: $DISPLAY is unset "
         "or this ViSP has no X11); use output.display: auto or off");
   }
   impl_ = std::make_unique<Impl>();
+  impl_->image.init(static_cast<unsigned>(height), static_cast<unsigned>(width), vpRGBa(0));
+  impl_->Open();
 }
 
 ServoWindow::~ServoWindow() = default;
 
 void ServoWindow::Show(const cv::Mat& bgr) {
 #ifdef VISP_HAVE_X11
-  vpImageConvert::convert(bgr, impl_->image);
-  if (!impl_->open) {
-    impl_->display.init(impl_->image, 0, 0, "oalservo servo (click to stop)");
-    impl_->open = true;
+  if (impl_->open && (static_cast<int>(impl_->image.getWidth()) != bgr.cols ||
+                      static_cast<int>(impl_->image.getHeight()) != bgr.rows)) {
+    vpDisplay::close(impl_->image);  // reopened below at the frame's size
+    impl_->open = false;
   }
+  vpImageConvert::convert(bgr, impl_->image);
+  if (!impl_->open) impl_->Open();
   vpDisplay::display(impl_->image);
   vpDisplay::flush(impl_->image);
 #else

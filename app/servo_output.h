@@ -6,8 +6,11 @@
 //                          and (simulation) true, against the tolerances, drawn by gnuplot
 //   DIR/frames/iter_NNNN.png  each iteration's frame with the identified lines 1-4, the
 //                          target frame and the errors (no window, output.save_frames); a
-//                          run first removes the iter_*.png an earlier run left there
-// Every file is written atomically.
+//                          run, once its source and robot are open, first removes the
+//                          iter_*.png an earlier run left there
+// Every file is written atomically. The directory is checked writable before the robot is
+// touched (CheckWritableDirectory); an earlier run's files are replaced only by a run that
+// began (the robot connected).
 #pragma once
 
 #include <atomic>
@@ -33,19 +36,27 @@ void WriteServoPlot(const ServoRunReport& report, const ServoOptions& law,
 /// (AnnotatePose) and a caption with the iteration, the errors and the status.
 cv::Mat AnnotateServoFrame(const ServoFrame& frame);
 
-/// True when a window can be opened: this ViSP has X11 and $DISPLAY is set.
+/// Makes sure `dir` can take output files before any work: creates it (and its parents) if
+/// missing, then creates and removes a file in it. Throws std::runtime_error naming `what`
+/// (e.g. "output directory (--out)"), the directory and the reason.
+void CheckWritableDirectory(const std::filesystem::path& dir, const std::string& what);
+
+/// True when a window may be tried: this ViSP has X11 and $DISPLAY is set (the X server may
+/// still be unreachable: ServoWindow's constructor says so).
 bool CanOpenServoWindow();
 
 /// A vpDisplayX window that shows annotated frames; a click in it asks the loop to stop.
 class ServoWindow {
  public:
-  /// Throws std::runtime_error when no window can be opened (CanOpenServoWindow()).
-  ServoWindow();
+  /// Opens the window now, blank, `width` x `height` (the frames' size), so that a missing or
+  /// unreachable X display is found before the robot is touched. Throws std::runtime_error
+  /// saying why when it cannot be opened.
+  ServoWindow(int width, int height);
   ~ServoWindow();
   ServoWindow(const ServoWindow&) = delete;
   ServoWindow& operator=(const ServoWindow&) = delete;
 
-  /// Shows a BGR frame (the window opens on the first one, at its size).
+  /// Shows a BGR frame (the window takes its size).
   void Show(const cv::Mat& bgr);
   /// True once the user has clicked in the window.
   bool StopClicked();

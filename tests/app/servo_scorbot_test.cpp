@@ -2,12 +2,16 @@
 // against the Controller-A simulator started by the loop (config/scorbot-sim.yaml; issue 6).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <visp3/core/vpMath.h>
 
+#include <cmath>
 #include <sstream>
 #include <string>
 
 #include "app/config.h"
 #include "app/servo_loop.h"
+#include "robots/scorbot_controller_sim.h"
+#include "robots/scorbot_kinematics.h"
 #include "servo_test_util.h"
 
 namespace oal {
@@ -47,6 +51,81 @@ TEST(ServoScorbot, Table3ThroughTheDriverAndTheControllerSimulatorConverges) {
   }
 }
 
+// A Controller-A simulator the test holds (to pull its cable, to make it hit something), with
+// the arm at the configured start; the loop connects to it as to a real arm.
+class HeldController {
+ public:
+  explicit HeldController(ServoAppConfig* config) : sim_(Options(*config)) {
+    sim_.Start();
+    config->robot.scorbot.port = sim_.DevicePath();
+    config->robot.scorbot.reply_timeout_s = 0.5;
+  }
+  ScorbotControllerSim& sim() { return sim_; }
+
+ private:
+  static ScorbotSimOptions Options(const ServoAppConfig& config) {
+    ScorbotSimOptions options = config.robot.simulator;
+    options.geometry = config.robot.scorbot.geometry;
+    const ScorbotReach start =
+        NearestReachable(options.geometry, config.robot.start_wMc, config.camera.eMc);
+    EXPECT_TRUE(start.ok) << start.why;
+    for (std::size_t i = 0; i < 5; ++i) options.start_deg[i] = vpMath::deg(start.q[i]);
+    return options;
+  }
+
+  ScorbotControllerSim sim_;
+};
+
+// The cable pulled during the run: the stop cannot be sent, and the run must not say
+// "robot stopped" (the controller may still be running its queued move).
+TEST(ServoScorbot, AStopThatCannotBeSentIsReportedAsSuch) {
+  ServoAppConfig config = FastScorbot();
+  HeldController controller(&config);
+  ServoRunHooks hooks;
+  hooks.on_grab = [&](int iteration, cv::Mat*) {
+    if (iteration == 1) controller.sim().Stop();  // before the move of iteration 1
+  };
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log, hooks);
+  EXPECT_EQ(report.status, ServoRunStatus::kError) << report.message;
+  EXPECT_FALSE(report.robot_stopped);
+  EXPECT_THAT(report.message, HasSubstr("; STOP COULD NOT BE SENT: scorbot: "));
+  EXPECT_THAT(report.message, HasSubstr("the link to the controller is lost"));
+  EXPECT_THAT(report.message, HasSubstr(" — check the arm"));
+  EXPECT_THAT(report.message, ::testing::Not(HasSubstr("robot stopped")));
+  EXPECT_THAT(report.message, ::testing::Not(HasSubstr("Connect()")));  // no API talk
+}
+
+// The arm stopped mid-move (an impact): the last row is where it stopped, read after the stop,
+// not where the iteration began.
+TEST(ServoScorbot, TheLastRowIsWhereTheArmStopped) {
+  ServoAppConfig config = FastScorbot();
+  HeldController controller(&config);
+  ServoRunHooks hooks;
+  hooks.on_frame = [&](const ServoFrame& frame) {
+    if (frame.row.iteration == 0) controller.sim().InjectImpact(2);  // halfway through move 0
+  };
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log, hooks);
+  EXPECT_EQ(report.status, ServoRunStatus::kError) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("IMPACT"));
+  EXPECT_THAT(report.message, HasSubstr("; robot stopped"));
+  EXPECT_TRUE(report.robot_stopped);
+  ASSERT_EQ(report.iterations.size(), 2u) << log.str();
+  const ServoIteration& began = report.iterations[0];
+  const ServoIteration& stopped = report.iterations[1];
+  EXPECT_EQ(began.status, "error");
+  EXPECT_EQ(stopped.status, "stopped");
+  // Where the controller's arm is (the simulator's joints), in the table's ACL units.
+  const AclPose arm = AclPoseOfJoints(config.robot.scorbot.geometry, controller.sim().joints());
+  EXPECT_NEAR(stopped.x_mm, arm.x / 10.0, 0.2);
+  EXPECT_NEAR(stopped.y_mm, arm.y / 10.0, 0.2);
+  EXPECT_NEAR(stopped.z_mm, arm.z / 10.0, 0.2);
+  const double moved_mm =
+      std::hypot(stopped.x_mm - began.x_mm, stopped.y_mm - began.y_mm, stopped.z_mm - began.z_mm);
+  EXPECT_GT(moved_mm, 5.0) << log.str();
+}
+
 TEST(ServoScorbot, VelocityLawIsRefusedBeforeTheArmMoves) {
   ServoAppConfig config = FastScorbot();
   config.servo.law.mode = ServoMode::kVelocity;
@@ -75,7 +154,9 @@ TEST(ServoScorbot, AStartOutOfReachOrAMissingPortFailsClearly) {
   EXPECT_EQ(report.status, ServoRunStatus::kError);
   EXPECT_THAT(report.message, HasSubstr("cannot connect the robot"));
   EXPECT_THAT(report.message, HasSubstr("/dev/ttyOAL-missing"));
+  EXPECT_THAT(report.message, HasSubstr("robot.scorbot.port = '/dev/ttyOAL-missing')"));
   EXPECT_TRUE(report.iterations.empty());
+  EXPECT_FALSE(report.started);
 }
 
 TEST(ServoScorbot, ConfigErrorsNameTheNestedKeyAndLine) {

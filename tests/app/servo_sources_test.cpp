@@ -8,11 +8,13 @@
 #include <cstdlib>
 #include <functional>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "app/config.h"
 #include "app/servo_accuracy.h"
+#include "app/servo_accuracy_command.h"
 #include "app/servo_command.h"
 #include "app/servo_loop.h"
 #include "app/servo_output.h"
@@ -74,10 +76,11 @@ TEST(ServoConfigSections, SourceOutputAndGoalImageAreReadAndChecked) {
   EXPECT_THAT(ErrorOf("source: {type: v4l2, fps: 30}\n"),
               HasSubstr("'source.fps' is invalid: SourceConfig::fps = 30"));
   EXPECT_THAT(ErrorOf("source: {type: replay}\n"),
-              HasSubstr("section 'source' is invalid: SourceConfig::path"));
+              HasSubstr("dir/servo.yaml:1: section 'source' is invalid: SourceConfig::path"));
   EXPECT_THAT(ErrorOf("output:\n  display: maybe\n"),
               HasSubstr("dir/servo.yaml:2: 'output.display' is invalid"));
-  EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.5]}\n  image: g.png\n"),
+  EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.5], rxyz_deg: [0, 0, 0]}\n"
+                      "  image: g.png\n"),
               HasSubstr("dir/servo.yaml:3: 'goal.image' and 'goal.cdMo' (line 2) both set"));
   EXPECT_THAT(ErrorOf("goal: {image: ''}\n"), HasSubstr("'goal.image' must not be empty"));
 }
@@ -106,6 +109,50 @@ TEST(ServoSources, ReplayRunsOpenLoopToTheEndWithoutMovingTheRobot) {
     EXPECT_TRUE(std::isnan(row.true_translation_error_mm));
   }
   EXPECT_TRUE(report.robot_stopped);
+}
+
+// A recording exactly servo.max_iterations frames long was played to its end: end-of-input
+// (exit 0), as a longer one would be cut by the limit and a shorter one end on its own.
+TEST(ServoSources, ReplayAsLongAsTheIterationLimitEndsWithEndOfInput) {
+  const test::TestDir dir;
+  ServoAppConfig config = Small(DefaultServoConfig());
+  const vpHomogeneousMatrix start_cMo = config.robot.start_wMc.inverse() * config.target_wMo;
+  for (int i = 0; i < 4; ++i) {
+    WriteView(config, start_cMo, 7 + i, dir / ("frame_000" + std::to_string(i) + ".png"));
+  }
+  config.source.type = "replay";
+  config.source.path = dir / "frame_%04d.png";
+  config.servo.max_iterations = 4;
+  std::ostringstream log;
+  ServoRunReport report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kEndOfInput) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("after 4 frames (servo.max_iterations = 4)"));
+  EXPECT_EQ(report.iterations.size(), 4u);
+  EXPECT_EQ(report.iterations.back().status, "end-of-input");
+
+  config.servo.max_iterations = 3;  // a frame left: the limit
+  report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kIterationLimit) << report.message;
+  EXPECT_EQ(report.iterations.size(), 3u);
+
+  config.servo.max_iterations = 5;  // shorter than the limit
+  report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kEndOfInput) << report.message;
+  EXPECT_EQ(report.iterations.size(), 4u);
+}
+
+TEST(ServoSources, AMissingRecordingNamesSourcePathAndWhereItWasSet) {
+  const test::TestDir dir;
+  test::WriteText(dir / "replay.yaml",
+                  "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n"
+                  "source:\n  type: replay\n  path: missing.avi\n");
+  ServoCommandOptions options;
+  options.config_path = dir / "replay.yaml";
+  std::ostringstream log;
+  const std::string error =
+      test::ErrorMessageOf<std::runtime_error>([&] { RunServo(LoadServoConfig(options), log); });
+  EXPECT_THAT(error, HasSubstr(options.config_path + ":4: source.path '" +
+                               (dir.path() / "missing.avi").string() + "' cannot be opened: "));
 }
 
 TEST(ServoSources, ReplayOfAWrongSizeOrMissingRecordingFailsClearly) {
@@ -234,6 +281,119 @@ TEST(ServoOutput, CommandWritesCsvPlotAndAnnotatedFrames) {
   for (const auto& entry : fs::directory_iterator(dir.path() / "out")) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
   }
+}
+
+// $DISPLAY as in an SSH session whose X forwarding is gone: set, but no server answers.
+class UnreachableDisplay {
+ public:
+  UnreachableDisplay() {
+    if (const char* saved = std::getenv("DISPLAY")) saved_ = saved;
+    ::setenv("DISPLAY", ":987", 1);
+  }
+  ~UnreachableDisplay() {
+    if (saved_) {
+      ::setenv("DISPLAY", saved_->c_str(), 1);
+    } else {
+      ::unsetenv("DISPLAY");
+    }
+  }
+
+ private:
+  std::optional<std::string> saved_;
+};
+
+TEST(ServoOutput, AnUnreachableDisplayFallsBackToFramesInAutoAndFailsBeforeMovingInOn) {
+  const test::TestDir dir;
+  const std::string config_path = dir / "small.yaml";
+  test::WriteText(config_path,
+                  "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n");
+  const UnreachableDisplay display;
+  if (!CanOpenServoWindow()) GTEST_SKIP() << "this ViSP has no X11";
+  ServoCommandOptions options;
+  options.config_path = config_path;
+  options.out_dir = dir / "auto";
+  options.display = "auto";
+  options.mode = "point-and-go";
+  std::ostringstream out;
+  const ServoRunReport report = RunServoCommand(options, out);
+  EXPECT_EQ(report.status, ServoRunStatus::kConverged) << out.str();
+  EXPECT_THAT(out.str(), ::testing::Not(HasSubstr("live window")));
+  EXPECT_TRUE(fs::exists(dir.path() / "auto" / "frames" / "iter_0000.png"));  // frames instead
+
+  options.out_dir = dir / "on";
+  options.display = "on";
+  int robots = 0;
+  ServoRunHooks hooks;
+  hooks.on_robot = [&](SafeRobot* robot) { robots += robot != nullptr; };
+  const std::string error =
+      test::ErrorMessageOf<std::runtime_error>([&] { RunServoCommand(options, out, hooks); });
+  EXPECT_THAT(error, HasSubstr("output.display is on but cannot open a window on the X display "
+                               "':987'"));
+  EXPECT_EQ(robots, 0);  // before the robot was connected
+  EXPECT_FALSE(fs::exists(dir.path() / "on" / "servo.csv"));
+}
+
+// A run that cannot begin (bad port, missing recording) leaves an earlier run's results as
+// they were; a directory that cannot take the results fails before the robot is touched.
+TEST(ServoOutput, ARunThatCannotBeginKeepsTheEarlierResults) {
+  const test::TestDir dir;
+  const fs::path out = dir.path() / "out";
+  fs::create_directories(out / "frames");
+  test::WriteText(out / "servo.csv", "earlier run");
+  test::WriteText(out / "servo-error.png", "earlier plot");
+  test::WriteText(out / "frames" / "iter_0000.png", "earlier frame");
+  const std::string small =
+      "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n"
+      "output: {display: off}\n";
+  test::WriteText(dir / "port.yaml", small +
+                                         "robot:\n  type: scorbot\n  scorbot:\n"
+                                         "    port: /dev/ttyOAL-missing\n");
+  test::WriteText(dir / "replay.yaml", small + "source: {type: replay, path: missing.avi}\n");
+  ServoCommandOptions options;
+  options.out_dir = out;
+  options.config_path = dir / "port.yaml";
+  std::ostringstream log;
+  const ServoRunReport report = RunServoCommand(options, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kError);
+  EXPECT_FALSE(report.started);
+  EXPECT_THAT(report.message, HasSubstr("cannot connect the robot: scorbot: "));
+  EXPECT_THAT(report.message, HasSubstr("(check " + options.config_path +
+                                        ":6: robot.scorbot.port = '/dev/ttyOAL-missing')"));
+  EXPECT_THAT(log.str(), HasSubstr("nothing written"));
+
+  options.config_path = dir / "replay.yaml";
+  EXPECT_THAT(test::ErrorMessageOf<std::runtime_error>([&] { RunServoCommand(options, log); }),
+              HasSubstr("source.path"));
+
+  EXPECT_EQ(test::ReadText(out / "servo.csv"), "earlier run");
+  EXPECT_EQ(test::ReadText(out / "servo-error.png"), "earlier plot");
+  EXPECT_EQ(test::ReadText(out / "frames" / "iter_0000.png"), "earlier frame");
+}
+
+TEST(ServoOutput, AnOutputDirectoryThatCannotBeWrittenFailsBeforeTheRobotMoves) {
+  const test::TestDir dir;
+  test::WriteText(dir / "file", "a file, not a directory");
+  ServoCommandOptions options;
+  options.out_dir = (dir.path() / "file" / "out").string();
+  options.display = "off";
+  int robots = 0;
+  ServoRunHooks hooks;
+  hooks.on_robot = [&](SafeRobot* robot) { robots += robot != nullptr; };
+  std::ostringstream log;
+  const std::string error =
+      test::ErrorMessageOf<std::runtime_error>([&] { RunServoCommand(options, log, hooks); });
+  EXPECT_THAT(error,
+              HasSubstr("cannot create the output directory (--out) '" + options.out_dir + "'"));
+  EXPECT_EQ(robots, 0);
+
+  // servo-accuracy --out: checked before the first run (whose recording is missing here).
+  if (!fs::is_directory("/proc")) GTEST_SKIP() << "no /proc: a directory nobody may write";
+  test::WriteText(dir / "replay.yaml", "source: {type: replay, path: missing.avi}\n");
+  const std::string accuracy = test::ErrorMessageOf<std::runtime_error>([&] {
+    test::RunWithArgs(RunServoAccuracy, {"servo-accuracy", "--config", dir / "replay.yaml",
+                                         "--starts", "1", "--out", "/proc/oal-accuracy.json"});
+  });
+  EXPECT_THAT(accuracy, HasSubstr("cannot write into the directory of --out '/proc'"));
 }
 
 TEST(ServoOutput, DisplayOnWithoutAnXServerIsAClearErrorBeforeMoving) {

@@ -3,12 +3,17 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "app/command_line.h"
 #include "app/config.h"
 #include "app/servo_command.h"
 #include "app/servo_default_config.h"
@@ -61,20 +66,40 @@ TEST(ServoConfig, BuiltInDefaultIsConfigServoSimYaml) {
 
 TEST(ServoConfig, ShippedTable3UsesThePaperConvention) {
   const ServoAppConfig config = ShippedServoConfig("table3-sim.yaml");
-  double x, y, z, pitch, roll;
-  Table3Columns(config.robot.start_wMc, &x, &y, &z, &pitch, &roll);
+  double x, y, z, pitch, roll, yaw;
+  Table3Columns(config.robot.start_wMc, &x, &y, &z, &pitch, &roll, &yaw);
   EXPECT_NEAR(x, 490, 1e-9);
   EXPECT_NEAR(y, 15, 1e-9);
   EXPECT_NEAR(z, 610, 1e-9);
   EXPECT_NEAR(pitch, -5, 1e-9);
   EXPECT_NEAR(roll, 0, 1e-9);
+  EXPECT_NEAR(yaw, 0, 1e-9);
   const vpHomogeneousMatrix wMcd = config.target_wMo * config.goal_cdMo.inverse();
-  Table3Columns(wMcd, &x, &y, &z, &pitch, &roll);
+  Table3Columns(wMcd, &x, &y, &z, &pitch, &roll, &yaw);
   EXPECT_NEAR(x, 550, 1e-9);
   EXPECT_NEAR(y, -35, 1e-9);
   EXPECT_NEAR(z, 550, 1e-9);
   EXPECT_NEAR(pitch, 0, 1e-9);
   EXPECT_NEAR(roll, 0, 1e-9);
+  EXPECT_NEAR(yaw, 0, 1e-9);
+}
+
+// The columns are the config's rxyz_deg [180 + pitch, yaw, roll]: the default start, turned
+// 10 deg about the camera's y axis, shows yaw -10 (it printed as pitch -0.00 with no yaw).
+TEST(ServoConfig, Table3ColumnsReadBackTheConfigsAngles) {
+  const ServoAppConfig config = DefaultServoConfig();  // start rxyz_deg [180, -10, 5]
+  double x, y, z, pitch, roll, yaw;
+  Table3Columns(config.robot.start_wMc, &x, &y, &z, &pitch, &roll, &yaw);
+  EXPECT_NEAR(pitch, 0, 1e-9);
+  EXPECT_NEAR(yaw, -10, 1e-9);
+  EXPECT_NEAR(roll, 5, 1e-9);
+  const ServoAppConfig tilted =
+      ParseConfig("robot:\n  start: {translation_m: [0.5, 0, 0.6], rxyz_deg: [172, 7, -20]}\n",
+                  "t.yaml", config);
+  Table3Columns(tilted.robot.start_wMc, &x, &y, &z, &pitch, &roll, &yaw);
+  EXPECT_NEAR(pitch, -8, 1e-9);
+  EXPECT_NEAR(yaw, 7, 1e-9);
+  EXPECT_NEAR(roll, -20, 1e-9);
 }
 
 TEST(ServoConfig, ErrorsNameFileLineAndKey) {
@@ -99,10 +124,70 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
   EXPECT_THAT(
       ErrorOf("goal:\n  taught_from_pose: x.png\n"),
       HasSubstr("servo.yaml:2: key 'goal.taught_from_pose' is unknown (known: cdMo, image)"));
-  EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5]}\n"),
+  EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5], rxyz_deg: [0, 0, 0]}\n"),
               HasSubstr("servo.yaml:2: 'goal.cdMo' puts the target at z = -0.5"));
   EXPECT_THAT(ErrorOf("target_pose: {translation_m: [0, 0, 0], rxyz: [0, 0, 0]}\n"),
               HasSubstr("servo.yaml:1: key 'target_pose.rxyz' is unknown"));
+}
+
+// Half a pose was read as zeros for the other half: the robot would start (or servo to)
+// somewhere else than the user wrote.
+TEST(ServoConfig, APoseWithOnlyOneOfItsKeysIsAnErrorNamingTheMissingKey) {
+  EXPECT_THAT(ErrorOf("robot:\n  start: {translation_m: [0.5, 0, 0.6]}\n"),
+              HasSubstr("servo.yaml:2: 'robot.start' has no 'rxyz_deg'"));
+  EXPECT_THAT(ErrorOf("goal:\n  cdMo:\n    rxyz_deg: [0, 0, 10]\n"),
+              HasSubstr("servo.yaml:3: 'goal.cdMo' has no 'translation_m'"));
+  EXPECT_THAT(ErrorOf("target_pose: {rxyz_deg: [180, 0, 0]}\n"),
+              HasSubstr("servo.yaml:1: 'target_pose' has no 'translation_m'"));
+  EXPECT_THAT(ErrorOf("camera:\n  eMc: {rxyz_deg: [0, 0, 90]}\n"),
+              HasSubstr("servo.yaml:2: 'camera.eMc' has no 'translation_m'"));
+  EXPECT_EQ(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.4], rxyz_deg: [0, 0, 0]}\n"), "");
+}
+
+TEST(ServoConfig, AWorkspaceBoxWithMinAboveMaxNamesTheKeyAndLine) {
+  EXPECT_THAT(ErrorOf("robot:\n  workspace_enabled: true\n  workspace_min_m: [1, -1, -1]\n"
+                      "  workspace_max_m: [0, 1, 1]\n"),
+              HasSubstr("servo.yaml:3: 'robot.workspace_min_m' is invalid: "
+                        "SafetyOptions::workspace_min_m/workspace_max_m [x] = 1 / 0"));
+  // Only the max in this file: its line.
+  EXPECT_THAT(ErrorOf("robot:\n  workspace_max_m: [1, 1, -2]\n"),
+              HasSubstr("servo.yaml:2: 'robot.workspace_max_m' is invalid"));
+}
+
+// A configured start outside the box would begin where no move is allowed.
+TEST(ServoConfig, AStartOutsideTheWorkspaceIsAnErrorNamingTheKey) {
+  const ServoAppConfig base = DefaultServoConfig();  // box [0, 1] x [-0.5, 0.5] x [0.1, 1] m
+  const std::string error = test::ErrorMessageOf<std::runtime_error>([&] {
+    ParseConfig("robot:\n  start: {translation_m: [0.5, 0, 1.5], rxyz_deg: [180, 0, 0]}\n",
+                "start.yaml", base);
+  });
+  EXPECT_THAT(error, HasSubstr("start.yaml:2: 'robot.start' puts the camera outside the "
+                               "workspace box: z = 1.5 m is outside [0.1, 1] m"));
+  // The box moved away from the built-in start: this file's line of the box, and where the
+  // start was set.
+  const std::string moved = test::ErrorMessageOf<std::runtime_error>(
+      [&] { ParseConfig("robot:\n  workspace_min_m: [0.7, -0.5, 0.1]\n", "box.yaml", base); });
+  EXPECT_THAT(moved, HasSubstr("box.yaml:2: 'robot.start' (config/servo-sim.yaml (built in):"));
+  EXPECT_THAT(moved, HasSubstr("x = 0.6 m is outside [0.7, 1] m"));
+  // No box, no check; a real arm starts where it stands.
+  EXPECT_EQ(test::ErrorMessageOf<std::runtime_error>([&] {
+              ParseConfig(
+                  "robot:\n  workspace_enabled: false\n  start: {translation_m: [0.5, 0, "
+                  "1.5], rxyz_deg: [180, 0, 0]}\n",
+                  "off.yaml", base);
+            }),
+            "");
+  EXPECT_EQ(test::ErrorMessageOf<std::runtime_error>([&] {
+              ParseConfig(
+                  "robot:\n  type: scorbot\n  scorbot: {port: /dev/ttyS0}\n  start: "
+                  "{translation_m: [0.5, 0, 1.5], rxyz_deg: [180, 0, 0]}\n",
+                  "arm.yaml", base);
+            }),
+            "");
+  // Where each key was set is kept for later messages.
+  const ServoAppConfig config = ParseConfig("source:\n  type: replay\n  path: v.avi\n", "s.yaml");
+  EXPECT_EQ(config.Origin("source.path"), "s.yaml:3");
+  EXPECT_EQ(config.Origin("robot.start"), "");
 }
 
 TEST(ServoLoop, DefaultConfigConvergesWithTheImageInTheLoop) {
@@ -217,14 +302,54 @@ TEST(ServoLoop, PoseJumpBeyondTheBoundStops) {
   EXPECT_EQ(report.moves, 1);
 }
 
-TEST(ServoLoop, IterationLimitStopsTheRobot) {
+TEST(ServoLoop, IterationLimitStopsTheRobotAndRecordsWhereItStopped) {
   ServoAppConfig config = Small(DefaultServoConfig());
   config.servo.max_iterations = 2;
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   EXPECT_EQ(report.status, ServoRunStatus::kIterationLimit) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("iteration limit reached: servo.max_iterations = 2"));
+  EXPECT_THAT(report.message, HasSubstr("; robot stopped"));
   EXPECT_EQ(report.moves, 2);
   EXPECT_TRUE(report.robot_stopped);
+  // Two frames, then the row of where the second move left the camera.
+  ASSERT_EQ(report.iterations.size(), 3u);
+  EXPECT_EQ(report.iterations[1].status, "iteration-limit");
+  const ServoIteration& stopped = report.iterations[2];
+  EXPECT_EQ(stopped.status, "stopped");
+  EXPECT_EQ(stopped.iteration, 2);
+  double x, y, z, pitch, roll, yaw;
+  Table3Columns(report.final_wMc, &x, &y, &z, &pitch, &roll, &yaw);
+  EXPECT_DOUBLE_EQ(stopped.x_mm, x);
+  EXPECT_DOUBLE_EQ(stopped.z_mm, z);
+  EXPECT_GT(std::abs(stopped.x_mm - report.iterations[1].x_mm), 1.0);  // it moved
+  EXPECT_TRUE(std::isnan(stopped.translation_error_mm));               // no frame there
+  EXPECT_LT(stopped.true_translation_error_mm, report.iterations[1].true_translation_error_mm);
+  EXPECT_THAT(log.str(), HasSubstr("  stopped\n"));
+}
+
+TEST(ServoLoop, TimeLimitSaysItWasReached) {
+  ServoAppConfig config = Small(DefaultServoConfig());
+  config.servo.max_time_s = 1e-6;  // over before the second frame
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kTimeLimit) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("time limit reached: servo.max_time_s = 1e-06 s ("));
+  EXPECT_THAT(report.message, HasSubstr(" s elapsed) without converging; robot stopped"));
+}
+
+// A robot standing outside the box (a real arm stands where it stands): a warning at the start.
+TEST(ServoLoop, ARobotStartingOutsideTheWorkspaceIsWarnedAbout) {
+  ServoAppConfig config = Small(DefaultServoConfig());
+  config.robot.start_wMc[2][3] = 1.02;  // above the box's z <= 1 m
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_THAT(log.str(), HasSubstr("warning: the robot starts outside the workspace box: the "
+                                   "camera's z = 1.02 m is outside [0.1, 1] m"));
+  EXPECT_TRUE(report.robot_stopped);
+  std::ostringstream inside;
+  RunServo(Small(DefaultServoConfig()), inside);
+  EXPECT_THAT(inside.str(), ::testing::Not(HasSubstr("warning")));
 }
 
 TEST(ServoLoop, InterruptFlagStopsBeforeMoving) {
@@ -241,10 +366,73 @@ TEST(ServoLoop, InterruptFlagStopsBeforeMoving) {
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log, hooks);
   EXPECT_EQ(report.status, ServoRunStatus::kInterrupted);
+  EXPECT_THAT(report.message, HasSubstr("interrupted by Ctrl-C or a stop from the window after 0 "
+                                        "iterations; robot stopped"));
   EXPECT_TRUE(report.robot_stopped);
   EXPECT_EQ(report.moves, 0);
   EXPECT_NE(seen, nullptr);
   EXPECT_EQ(calls, 2);  // registered, then unregistered
+}
+
+std::atomic<int> g_stop_signal_callbacks{0};
+
+TEST(StopSignalScope, EveryStopSignalSetsTheFlagCallsBackAndTheHandlersComeBack) {
+  for (const int number : {SIGINT, SIGTERM, SIGHUP}) {
+    const auto previous = std::signal(number, SIG_IGN);
+    g_stop_signal_callbacks = 0;
+    {
+      const StopSignalScope signals([] { g_stop_signal_callbacks.fetch_add(1); });
+      EXPECT_FALSE(signals.interrupted()->load());
+      EXPECT_EQ(signals.signal_number(), 0);
+      std::raise(number);  // handled: the test process goes on
+      EXPECT_TRUE(signals.interrupted()->load());
+      EXPECT_EQ(signals.signal_number(), number);
+      std::raise(SIGINT);  // a second signal does not change which came first
+      EXPECT_EQ(signals.signal_number(), number);
+      EXPECT_EQ(g_stop_signal_callbacks.load(), 2);
+    }
+    EXPECT_EQ(std::signal(number, previous), SIG_IGN) << number;  // put back
+  }
+  EXPECT_EQ(StopSignalName(SIGTERM), "SIGTERM (a request to terminate)");
+  EXPECT_EQ(StopSignalName(SIGINT), "Ctrl-C (SIGINT)");
+}
+
+// SIGTERM (systemd, timeout) and SIGHUP (SSH hang-up) end a run exactly as Ctrl-C does: the
+// robot stopped at once, the outputs written, the signal named as the reason.
+TEST(ServoCommand, SigtermAndSighupStopTheRobotAndWriteTheOutputsLikeCtrlC) {
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "oal_servo_signal_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string config_path = (dir / "small.yaml").string();
+  {
+    std::ofstream out(config_path);
+    out << "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n"
+        << "output: {display: off, save_frames: false}\n";
+  }
+  std::vector<std::string> csvs;
+  for (const int number : {SIGINT, SIGTERM, SIGHUP}) {
+    ServoCommandOptions options;
+    options.config_path = config_path;
+    options.out_dir = (dir / std::to_string(number)).string();
+    const StopSignalScope signals(&StopRobotOnSignal);
+    ServoRunHooks hooks = StopSignalHooks(signals);
+    hooks.on_grab = [number](int iteration, cv::Mat*) {
+      if (iteration == 1) std::raise(number);  // while the robot is running
+    };
+    std::ostringstream out;
+    const ServoRunReport report = RunServoCommand(options, out, hooks);
+    EXPECT_EQ(report.status, ServoRunStatus::kInterrupted) << out.str();
+    EXPECT_THAT(report.message, HasSubstr("interrupted by " + StopSignalName(number) +
+                                          " during the move of iteration 1; robot stopped"));
+    EXPECT_TRUE(report.robot_stopped);
+    EXPECT_EQ(report.moves, 2);  // the move of iteration 1 was refused
+    csvs.push_back(ReadText(options.out_dir + "/servo.csv"));
+    EXPECT_THAT(csvs.back(), HasSubstr(",interrupted\n")) << number;
+  }
+  EXPECT_EQ(csvs[1], csvs[0]);  // SIGTERM: the same outputs as Ctrl-C
+  EXPECT_EQ(csvs[2], csvs[0]);  // SIGHUP too
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ServoCommand, WritesTheCsvAtomically) {
