@@ -206,6 +206,7 @@ void DecodeFrames(ImageSource* source, int max_frames, BoundedQueue<DecodedFrame
     item.index = index;
     bool more = true;
     const Clock::time_point start = Clock::now();
+    frame.source.clear();  // a failing list of images names its file here
     try {
       more = source->Next(&frame);
     } catch (const std::exception& error) {
@@ -219,7 +220,8 @@ void DecodeFrames(ImageSource* source, int max_frames, BoundedQueue<DecodedFrame
       item.source = frame.source;
       consecutive_errors = 0;
     } else {
-      item.source = source->Name() + " frame " + std::to_string(index);
+      item.source =
+          frame.source.empty() ? source->Name() + " frame " + std::to_string(index) : frame.source;
       if (++consecutive_errors > kMaxConsecutiveUnreadable) {
         stats->stop_reason = "gave up after " + std::to_string(kMaxConsecutiveUnreadable) +
                              " consecutive unreadable frames";
@@ -1281,6 +1283,22 @@ Json ReadJsonOrNull(const fs::path& path) {
   }
 }
 
+// Why a plan has no input: the directories given and what they hold.
+std::string NoInputsMessage(const std::vector<std::string>& inputs, const InputPlan& plan) {
+  std::string names;
+  for (const std::string& input : inputs) names += (names.empty() ? "'" : ", '") + input + "'";
+  std::string message = "no inputs found in " + names +
+                        " (expected videos, image sequences, or directories of these)";
+  constexpr std::size_t kListed = 5;
+  for (std::size_t k = 0; k < plan.skipped.size() && k < kListed; ++k) {
+    message += "; " + plan.skipped[k];
+  }
+  if (plan.skipped.size() > kListed) {
+    message += "; and " + std::to_string(plan.skipped.size() - kListed) + " more";
+  }
+  return message;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -1339,14 +1357,18 @@ InputPlan PlanInputs(const std::vector<std::string>& inputs) {
       entries.push_back(entry.path());
     }
     std::sort(entries.begin(), entries.end());
+    const std::size_t before = specs.size();
     for (const fs::path& entry : entries) {
       if (fs::is_regular_file(entry) && HasVideoExtension(entry.string())) {
         specs.push_back(entry.string());
       } else if (fs::is_directory(entry) && HoldsImages(entry)) {
         specs.push_back(entry.string());
-      } else {
+      } else if (!(fs::is_regular_file(entry) && IsCompanionFile(entry.string()))) {
         plan.skipped.push_back(entry.string() + ": not a video or a directory of images");
       }
+    }
+    if (specs.size() == before) {
+      plan.skipped.push_back(input + ": holds no video and no directory of images");
     }
   }
   std::set<std::string> used;
@@ -1375,6 +1397,7 @@ EvaluateResult Evaluate(const EvaluateOptions& options,
     check.Check();
   }
   const InputPlan plan = PlanInputs(options.inputs);
+  if (plan.inputs.empty()) throw std::runtime_error(NoInputsMessage(options.inputs, plan));
   if (!options.truth_path.empty() && plan.inputs.size() != 1) {
     throw std::invalid_argument("--truth applies to one input, but there are " +
                                 std::to_string(plan.inputs.size()) +

@@ -5,8 +5,10 @@
 // printf pattern, app/image_source.h), a single image, or a directory of these: a directory
 // holding at least one image is one image sequence; any other directory stands for its
 // entries, sorted by name: each video file and each subdirectory holding images is one
-// input, every other entry is skipped and listed in the report. The inputs, in that order,
-// are numbered 0, 1, ...; `--shard I/N` keeps those whose number is I modulo N.
+// input, every other entry is skipped and listed in the report (but the companion files,
+// IsCompanionFile in app/image_source.h: camera.xml, truth JSON and CSV). No input at all is
+// an error. The inputs, in that order, are numbered 0, 1, ...; `--shard I/N` keeps those
+// whose number is I modulo N.
 //
 // Outputs, in --out DIR, one directory per input (named after the input, "-2", "-3" ... for
 // repeated names; the names depend on the whole input list, not on the shard):
@@ -95,7 +97,9 @@ struct PlannedInput {
 
 struct InputPlan {
   std::vector<PlannedInput> inputs;  ///< every input, before sharding
-  std::vector<std::string> skipped;  ///< entries of input directories that are no input
+  /// Entries of input directories that are no input (companion files left out), and input
+  /// directories holding no input.
+  std::vector<std::string> skipped;
 };
 
 /// Expands `inputs` (file comment) and names them. Inputs that do not exist stay in the
@@ -122,8 +126,8 @@ struct EvaluateResult {
 /// cannot be read fails alone: the others go on. `progress(done, total)` is called with the
 /// frames done over the shard's inputs (total: the frames the inputs announce; 0 unknown),
 /// from one thread at a time. Throws std::invalid_argument for bad options and
-/// std::runtime_error for a bad configuration or camera file, a missing Chart.js (report.h)
-/// or an output that cannot be written.
+/// std::runtime_error for no input at all (before anything is written), a bad configuration
+/// or camera file, a missing Chart.js (report.h) or an output that cannot be written.
 EvaluateResult Evaluate(const EvaluateOptions& options,
                         const std::function<void(int done, int total)>& progress = {});
 

@@ -19,8 +19,9 @@ int RunEvaluate(int argc, char** argv) {
       "an index (docs/EVALUATE.md).",
       "oalservo evaluate");
   cli.add_option("INPUT", options.inputs,
-                 "video, directory of images, printf pattern (frames/img%04d.png), or a "
-                 "directory of videos and image directories")
+                 "video, directory of images, printf pattern (frames/img%04d.png: up to the "
+                 "first missing file, with a warning if files follow the gap), or a directory "
+                 "of videos and image directories")
       ->required();
   cli.add_option("--out", options.out_dir, "output directory (created if missing)")->required();
   cli.add_option("--config", options.config_path,

@@ -24,8 +24,9 @@ std::filesystem::path AnnotationPath(const FrameCommandOptions& options, const s
 
 void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options) {
   cli.add_option("INPUT", options->inputs,
-                 "image, directory of images, printf pattern (frames/img%04d.png), video file, "
-                 "or V4L2 device /dev/videoN")
+                 "image, directory of images, printf pattern (frames/img%04d.png: from index "
+                 "0 or 1 up to the first missing file, with a warning if files follow the gap), "
+                 "video file, or V4L2 device /dev/videoN")
       ->required();
 }
 

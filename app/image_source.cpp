@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -37,9 +39,90 @@ bool OneOf(const std::string& value, std::initializer_list<const char*> choices)
                      [&value](const char* choice) { return value == choice; });
 }
 
+bool StartsWith(const std::vector<unsigned char>& bytes,
+                std::initializer_list<unsigned char> prefix) {
+  return bytes.size() >= prefix.size() && std::equal(prefix.begin(), prefix.end(), bytes.begin());
+}
+
+std::uint32_t BigEndian(const std::vector<unsigned char>& bytes, std::size_t at, int size) {
+  std::uint32_t value = 0;
+  for (int k = 0; k < size; ++k) value = (value << 8) | bytes[at + static_cast<std::size_t>(k)];
+  return value;
+}
+
+// Why a JPEG stream is cut short, or "": the header segments up to the first scan must be
+// whole, and an end-of-image marker (0xFFD9) must follow the scan. Entropy-coded data never
+// holds 0xFF 0xD9 (a data 0xFF is followed by 0x00), so that marker anywhere after the first
+// scan's header is the image's end, whatever trails it (zero padding, camera trailers).
+// libjpeg itself only warns ("Premature end of JPEG file") and returns grey rows.
+std::string JpegTruncation(const std::vector<unsigned char>& bytes) {
+  std::size_t at = 2;  // after SOI
+  while (at + 1 < bytes.size()) {
+    if (bytes[at] != 0xFF) return "";  // not a marker: let the decoder judge
+    const unsigned char marker = bytes[at + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++at;
+      continue;
+    }
+    if (marker == 0xD9) return "";                               // EOI before any scan
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // no length
+      at += 2;
+      continue;
+    }
+    if (at + 3 >= bytes.size()) break;
+    const std::size_t end = at + 2 + BigEndian(bytes, at + 2, 2);
+    if (end > bytes.size()) break;
+    if (marker == 0xDA) {  // start of scan: the rest is data up to EOI
+      for (std::size_t k = end; k + 1 < bytes.size(); ++k) {
+        if (bytes[k] == 0xFF && bytes[k + 1] == 0xD9) return "";
+      }
+      return "truncated JPEG (no end-of-image marker after the image data)";
+    }
+    at = end;
+  }
+  return "truncated JPEG (the file ends inside its header)";
+}
+
+// Why a PNG stream is cut short, or "": its chunks must be whole up to IEND.
+std::string PngTruncation(const std::vector<unsigned char>& bytes) {
+  std::size_t at = 8;  // after the signature
+  while (at + 8 <= bytes.size()) {
+    const std::uint64_t length = BigEndian(bytes, at, 4);
+    if (length > 0x7FFFFFFFu) return "";  // corrupt, not short: let the decoder judge
+    const bool iend = BigEndian(bytes, at + 4, 4) == 0x49454E44u;  // "IEND"
+    at += 12 + static_cast<std::size_t>(length);                   // length, type, data, CRC
+    if (at > bytes.size()) break;
+    if (iend) return "";
+  }
+  return "truncated PNG (the file ends before its IEND chunk)";
+}
+
+// Why the image file `bytes` is cut short, or "" (also for formats not checked here: their
+// decoders fail on a short file by themselves).
+std::string Truncation(const std::vector<unsigned char>& bytes) {
+  if (StartsWith(bytes, {0xFF, 0xD8, 0xFF})) return JpegTruncation(bytes);
+  if (StartsWith(bytes, {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'})) return PngTruncation(bytes);
+  return "";
+}
+
+std::vector<unsigned char> ReadBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in ? static_cast<std::streamoff>(in.tellg()) : -1;
+  std::vector<unsigned char> bytes(size > 0 ? static_cast<std::size_t>(size) : 0);
+  if (size < 0 || !in.seekg(0) ||
+      !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()))) {
+    throw std::runtime_error("cannot read " + Quoted(path));
+  }
+  return bytes;
+}
+
 cv::Mat DecodeGray(const fs::path& path) {
   if (!fs::exists(path)) throw std::runtime_error("no such file " + Quoted(path));
-  cv::Mat gray = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  const std::vector<unsigned char> bytes = ReadBytes(path);
+  if (const std::string truncation = Truncation(bytes); !truncation.empty()) {
+    throw std::runtime_error("cannot decode image " + Quoted(path) + ": " + truncation);
+  }
+  cv::Mat gray = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
   if (gray.empty()) {
     throw std::runtime_error("cannot decode image " + Quoted(path) +
                              " (not an image, truncated, or a format OpenCV cannot read)");
@@ -56,8 +139,8 @@ class ImageListSource : public ImageSource {
   bool Next(Frame* frame) override {
     if (next_ >= paths_.size()) return false;
     const fs::path& path = paths_[next_++];  // past it even if it does not decode
+    frame->source = path.string();           // also when it does not decode
     frame->gray = (next_ == 1 && !first_.empty()) ? first_ : DecodeGray(path);
-    frame->source = path.string();
     return true;
   }
   std::string Name() const override { return name_; }
@@ -95,7 +178,7 @@ std::unique_ptr<ImageSource> OpenDirectory(const fs::path& directory,
   for (const fs::directory_entry& entry : fs::directory_iterator(directory)) {
     if (entry.is_regular_file() && HasImageExtension(entry.path().string())) {
       images.push_back(entry.path());
-    } else {
+    } else if (!(entry.is_regular_file() && IsCompanionFile(entry.path().string()))) {
       skipped.push_back(entry.path().filename().string());
     }
   }
@@ -109,7 +192,29 @@ std::unique_ptr<ImageSource> OpenDirectory(const fs::path& directory,
   return std::make_unique<ImageListSource>("directory " + Quoted(directory), std::move(images));
 }
 
-std::unique_ptr<ImageSource> OpenPattern(const std::string& pattern) {
+// After the file `missing` that ends a pattern's sequence at `index`: if any of the next
+// kGapLookahead indices exists, a warning naming the gap and the files found after it.
+constexpr int kGapLookahead = 100;
+
+std::optional<std::string> GapWarning(const std::string& pattern, int index) {
+  int after = 0, first = -1, last = -1;
+  for (int k = index + 1; k <= (last < 0 ? index : last) + kGapLookahead; ++k) {
+    if (!fs::exists(ExpandPattern(pattern, k))) continue;
+    ++after;
+    if (first < 0) first = k;
+    last = k;
+  }
+  if (after == 0) return std::nullopt;
+  const bool one = after == 1;
+  return "pattern '" + pattern + "': the sequence ends at the missing file " +
+         Quoted(ExpandPattern(pattern, index)) + "; " + std::to_string(after) +
+         (one ? " file" : " files") + " after the gap (" + Quoted(ExpandPattern(pattern, first)) +
+         (one ? "" : " ... " + Quoted(ExpandPattern(pattern, last))) + (one ? ") is" : ") are") +
+         " not read";
+}
+
+std::unique_ptr<ImageSource> OpenPattern(const std::string& pattern,
+                                         std::vector<std::string>* warnings) {
   int index = 0;
   if (!fs::exists(ExpandPattern(pattern, 0))) index = 1;
   if (!fs::exists(ExpandPattern(pattern, index))) {
@@ -120,6 +225,9 @@ std::unique_ptr<ImageSource> OpenPattern(const std::string& pattern) {
   std::vector<fs::path> paths;
   for (; fs::exists(ExpandPattern(pattern, index)); ++index) {
     paths.emplace_back(ExpandPattern(pattern, index));
+  }
+  if (warnings != nullptr) {
+    if (auto gap = GapWarning(pattern, index)) warnings->push_back(*gap);
   }
   return std::make_unique<ImageListSource>("pattern '" + pattern + "'", std::move(paths));
 }
@@ -186,6 +294,7 @@ class V4l2Source : public ImageSource {
   }
 
   bool Next(Frame* frame) override {
+    frame->source = device_ + "#" + std::to_string(index_++);
     try {
       grabber_.acquire(image_);
     } catch (const vpException& error) {
@@ -195,7 +304,6 @@ class V4l2Source : public ImageSource {
     // A header over ViSP's buffer: no copy, valid until the next acquire.
     frame->gray = cv::Mat(static_cast<int>(image_.getHeight()), static_cast<int>(image_.getWidth()),
                           CV_8UC1, image_.bitmap);
-    frame->source = device_ + "#" + std::to_string(index_++);
     return true;
   }
   std::string Name() const override { return "V4L2 device '" + device_ + "'"; }
@@ -262,6 +370,16 @@ bool HasImageExtension(const std::string& path) {
                 ".dib", ".tif", ".tiff", ".webp", ".jp2", ".sr",  ".ras", ".exr",  ".hdr", ".pic"});
 }
 
+bool IsCompanionFile(const std::string& path) {
+  const fs::path file(path);
+  const std::string name = file.filename().string();
+  const auto ends_with = [&name](const std::string& end) {
+    return name.size() >= end.size() &&
+           name.compare(name.size() - end.size(), end.size(), end) == 0;
+  };
+  return name == "camera.xml" || LowerExtension(path) == ".json" || ends_with(".truth.csv");
+}
+
 bool HasVideoExtension(const std::string& path) {
   return OneOf(LowerExtension(path),
                {".avi", ".mp4", ".mkv", ".mov", ".webm", ".mpg", ".mpeg", ".m4v", ".wmv", ".flv",
@@ -293,7 +411,7 @@ std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
                                              std::vector<std::string>* warnings) {
   if (spec.empty()) throw std::runtime_error("empty input name");
   if (IsDevicePath(spec)) return OpenV4l2Source(spec);
-  if (spec.find('%') != std::string::npos && !fs::exists(spec)) return OpenPattern(spec);
+  if (spec.find('%') != std::string::npos && !fs::exists(spec)) return OpenPattern(spec, warnings);
   if (!fs::exists(spec)) throw std::runtime_error("no such file or directory '" + spec + "'");
   if (fs::is_directory(spec)) return OpenDirectory(spec, warnings);
   if (HasVideoExtension(spec)) return std::make_unique<VideoSource>(spec);

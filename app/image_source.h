@@ -2,9 +2,12 @@
 //
 //   x.png                 one image (any format OpenCV decodes)
 //   frames/               the images of a directory, sorted by file name; other files are
-//                         skipped with a warning
+//                         skipped with a warning, but for the known companion files
+//                         (IsCompanionFile: camera.xml, truth JSON and CSV)
 //   frames/img%04d.png    a printf pattern: indices from 0 (or 1 if there is no 0) until the
-//                         first missing file; only one %d conversion (with optional 0 and width)
+//                         first missing file (a warning names the gap when files exist in
+//                         the 100 indices after it); only one %d conversion (with optional 0
+//                         and width)
 //   x.avi, x.mp4, ...     a video (cv::VideoCapture)
 //   /dev/videoN           a V4L2 camera (vpV4l2Grabber), until stopped
 //
@@ -36,8 +39,10 @@ class ImageSource {
  public:
   virtual ~ImageSource() = default;
   /// Reads the next frame into `frame`; false at the end of the source. Throws
-  /// std::runtime_error naming the file when a frame cannot be read or decoded; a list of
-  /// images has then moved past that file, so a caller may skip it and call Next() again.
+  /// std::runtime_error naming the file when a frame cannot be read or decoded (a JPEG or
+  /// PNG cut short included); frame->source then names that file (a list of images) or is
+  /// left as it was (a caller clears it first to tell). A list of images has then moved
+  /// past that file, so a caller may skip it and call Next() again.
   virtual bool Next(Frame* frame) = 0;
   /// Frames the source announces (files listed, the container's frame count); -1: unknown
   /// (a camera, a video without a count).
@@ -49,7 +54,8 @@ class ImageSource {
 /// Opens the source named by `spec` (see the file comment). Throws std::runtime_error with
 /// the reason for a missing file, an undecodable image ("cannot decode image 'x.png'"), a
 /// video without frames, a missing device and an unsupported input. Files skipped in a
-/// directory are reported in `warnings` (if given).
+/// directory, and files after the gap that ends a printf pattern, are reported in
+/// `warnings` (if given).
 std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
                                              std::vector<std::string>* warnings = nullptr);
 
@@ -67,6 +73,10 @@ std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
 
 /// True if `path` has the extension of an image format OpenCV reads (case-insensitive).
 bool HasImageExtension(const std::string& path);
+/// True if `path` names a file expected next to images or videos that is no frame: a
+/// camera.xml, a JSON file (`oalservo render`'s frame truth and sequence.json) or a
+/// <video>.truth.csv. Directories skip these without a warning.
+bool IsCompanionFile(const std::string& path);
 /// True if `path` has the extension of a video container.
 bool HasVideoExtension(const std::string& path);
 

@@ -208,14 +208,31 @@ TEST(Evaluate, ParsesShardsAndPlansNamesThatDoNotCollide) {
   test::WriteText(dir / "a/clip.avi", "x");
   test::WriteText(dir / "a/clip.mp4", "x");
   test::WriteText(dir / "a/notes.txt", "x");
+  test::WriteText(dir / "a/camera.xml", "x");  // companions: not listed as skipped
+  test::WriteText(dir / "a/clip.truth.csv", "x");
   test::WriteText(dir / "b/a/f.png", "x");
-  const InputPlan plan = PlanInputs({dir / "a", dir / "b"});
+  fs::create_directories(dir / "c");
+  const InputPlan plan = PlanInputs({dir / "a", dir / "b", dir / "c"});
   ASSERT_EQ(plan.inputs.size(), 3u);
   EXPECT_EQ(plan.inputs[0].name, "clip");
   EXPECT_EQ(plan.inputs[1].name, "clip-2");
   EXPECT_EQ(plan.inputs[2].name, "a");
-  ASSERT_EQ(plan.skipped.size(), 1u);
+  ASSERT_EQ(plan.skipped.size(), 2u);
   EXPECT_THAT(plan.skipped[0], HasSubstr("notes.txt"));
+  EXPECT_EQ(plan.skipped[1], dir / "c" + ": holds no video and no directory of images");
+}
+
+TEST(Evaluate, NoInputFoundIsAnErrorAndWritesNothing) {
+  test::TestDir dir;
+  fs::create_directories(dir / "empty");
+  EvaluateOptions options = Options({dir / "empty"}, dir / "out");
+  EXPECT_THAT([&] { Evaluate(options); }, ::testing::ThrowsMessage<std::runtime_error>(HasSubstr(
+                                              "no inputs found in '" + dir / "empty" + "'")));
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  test::WriteText(dir / "empty/notes.txt", "x");
+  EXPECT_THAT([&] { Evaluate(options); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("notes.txt: not a video")));
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(Evaluate, VideoWithTruthCsvReportsTheKnownErrors) {
@@ -275,6 +292,9 @@ TEST(Evaluate, SmoothSequenceHasNoPoseJump) {
   EXPECT_GE(pose.at("frames_ok").get<int>(), 10);
   EXPECT_EQ(pose.at("jumps"), 0);
   EXPECT_TRUE(pose.at("jump_frames").empty());
+  // The renderer's camera.xml, sequence.json and frame JSON are no "skipped" files.
+  const json warnings = ReadJson(dir / "out/slow/summary.json").at("warnings");
+  EXPECT_THAT(warnings.dump(), ::testing::Not(HasSubstr("skipped"))) << warnings;
 }
 
 TEST(Evaluate, FullSizeMjpgVideoOnRequest) {
@@ -322,7 +342,7 @@ TEST(Evaluate, TruncatedVideoAndNonVideoFilesAreListedNotFatal) {
   EvaluateOptions options = Options({videos}, dir / "out");
   options.write_video = false;
   const EvaluateResult result = Evaluate(options);
-  ASSERT_EQ(result.inputs.size(), 3u);  // garbage, good, truncated (camera.xml, notes skipped)
+  ASSERT_EQ(result.inputs.size(), 3u);  // garbage, good, truncated (notes skipped)
   EXPECT_EQ(result.inputs[0].name, "garbage");
   EXPECT_EQ(result.inputs[0].status, "failed");
   EXPECT_THAT(result.inputs[0].error, HasSubstr("garbage.avi"));
@@ -333,8 +353,8 @@ TEST(Evaluate, TruncatedVideoAndNonVideoFilesAreListedNotFatal) {
   EXPECT_LT(truncated.at("frames_readable").get<int>(), kFrames);
   EXPECT_GT(truncated.at("frames_unreadable").get<int>(), 0);
   EXPECT_THAT(truncated.at("warnings").dump(), HasSubstr("truncated"));
-  ASSERT_EQ(result.skipped.size(), 2u);
-  EXPECT_THAT(result.skipped[1], HasSubstr("notes.txt"));
+  ASSERT_EQ(result.skipped.size(), 1u);  // not camera.xml, a known companion file
+  EXPECT_THAT(result.skipped[0], HasSubstr("notes.txt"));
   // The index lists the failure and the skipped files; the truncated report its frames.
   const std::string index = test::ReadText(dir / "out/index.html");
   EXPECT_THAT(index, HasSubstr("garbage.avi"));
@@ -345,19 +365,34 @@ TEST(Evaluate, TruncatedVideoAndNonVideoFilesAreListedNotFatal) {
 TEST(Evaluate, UndecodableImageIsSkippedCountedAndListed) {
   test::TestDir dir;
   const std::string frames = RenderFrames(dir, "frames", 4);
-  test::WriteText(frames + "/" + FrameName(2, ".png"), "\x89PNG truncated");
+  const std::string png2 = frames + "/" + FrameName(2, ".png");
+  test::WriteText(png2, "\x89PNG truncated");
+  // Frame 1 as the first half of a JPEG: libjpeg alone would decode it with a warning.
+  const std::string png1 = frames + "/" + FrameName(1, ".png"), jpg1 = frames + "/frame_0001.jpg";
+  ASSERT_TRUE(cv::imwrite(jpg1, cv::imread(png1)));
+  const std::string jpeg = test::ReadText(jpg1);
+  test::WriteText(jpg1, jpeg.substr(0, jpeg.size() / 2));
+  fs::remove(png1);
   EvaluateOptions options = Options({frames}, dir / "out");
   options.write_video = false;
   const EvaluateResult result = Evaluate(options);
   ASSERT_EQ(result.inputs.at(0).status, "complete") << result.inputs[0].error;
   const json& summary = result.inputs[0].summary;
   EXPECT_EQ(summary.at("frames"), 4);
-  EXPECT_EQ(summary.at("frames_unreadable"), 1);
-  EXPECT_EQ(summary.at("unreadable").at(0).at("frame"), 2);
+  EXPECT_EQ(summary.at("frames_unreadable"), 2);
+  EXPECT_EQ(summary.at("unreadable").at(0).at("frame"), 1);
+  EXPECT_EQ(summary.at("unreadable").at(0).at("source"), jpg1);
+  EXPECT_EQ(summary.at("unreadable").at(1).at("frame"), 2);
+  EXPECT_EQ(summary.at("unreadable").at(1).at("source"), png2);
   const auto records = test::ParseJsonLines(test::ReadText(dir / "out/frames/frames.jsonl"));
   ASSERT_EQ(records.size(), 4u);
+  EXPECT_EQ(records[1].at("status"), "unreadable");
+  EXPECT_EQ(records[1].at("source"), jpg1);  // the file, as for a readable frame
+  EXPECT_THAT(records[1].at("error").get<std::string>(), HasSubstr("truncated JPEG"));
   EXPECT_EQ(records[2].at("status"), "unreadable");
+  EXPECT_EQ(records[2].at("source"), png2);
   EXPECT_EQ(records[3].at("status"), "pose");
+  EXPECT_EQ(records[3].at("source"), frames + "/" + FrameName(3, ".png"));
   EXPECT_THAT(test::ReadText(dir / "out/frames/report.html"), HasSubstr("cannot decode image"));
 }
 

@@ -94,14 +94,45 @@ TEST(ImageSource, DirectoryIsSortedByNameAndSkipsOtherFiles) {
   EXPECT_THAT(warnings[0], HasSubstr("notes.txt"));
 }
 
+TEST(ImageSource, CompanionFilesOfTheRendererAreSkippedWithoutAWarning) {
+  test::TestDir dir;
+  WriteImage(dir / "frame_0000.png", 1);
+  test::WriteText(dir / "frame_0000.json", "{}");
+  test::WriteText(dir / "sequence.json", "{}");
+  test::WriteText(dir / "camera.xml", "<root/>");
+  test::WriteText(dir / "clip.truth.csv", "frame,line,rho,theta\n");
+  std::vector<std::string> warnings;
+  EXPECT_EQ(ReadAll(*OpenImageSource(dir.path().string(), &warnings)).size(), 1u);
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  test::WriteText(dir / "notes.txt", "not an image");  // still unexpected
+  test::WriteText(dir / "other.xml", "<root/>");
+  OpenImageSource(dir.path().string(), &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_THAT(warnings[0], HasSubstr("skipped 2 non-image entries"));
+  EXPECT_THAT(warnings[0], HasSubstr("notes.txt, other.xml"));
+  EXPECT_TRUE(IsCompanionFile("a/b/camera.xml"));
+  EXPECT_TRUE(IsCompanionFile("frame_0007.JSON"));
+  EXPECT_FALSE(IsCompanionFile("camera.xml.bak"));
+  EXPECT_FALSE(IsCompanionFile("truth.csv"));
+}
+
 TEST(ImageSource, PatternStartsAtZeroOrOneAndStopsAtTheFirstGap) {
   test::TestDir dir;
   for (int i = 1; i <= 3; ++i) WriteImage(dir / ("f" + std::to_string(i) + ".png"), i);
-  WriteImage(dir / "f5.png", 5);  // after the gap: not read
-  auto source = OpenImageSource(dir / "f%d.png");
+  std::vector<std::string> warnings;
+  EXPECT_EQ(ReadAll(*OpenImageSource(dir / "f%d.png", &warnings)).size(), 3u);
+  EXPECT_TRUE(warnings.empty());  // nothing after the end
+  WriteImage(dir / "f5.png", 5);  // after the gap: not read, but warned about
+  WriteImage(dir / "f7.png", 7);
+  auto source = OpenImageSource(dir / "f%d.png", &warnings);
   const std::vector<Frame> frames = ReadAll(*source);
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_EQ(frames[2].source, dir / "f3.png");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "pattern '" + dir / "f%d.png" +
+                             "': the sequence ends at the missing file '" + dir / "f4.png" +
+                             "'; 2 files after the gap ('" + dir / "f5.png" + "' ... '" +
+                             dir / "f7.png" + "') are not read");
   WriteImage(dir / "f0.png", 0);
   EXPECT_EQ(ReadAll(*OpenImageSource(dir / "f%d.png")).size(), 4u);
   EXPECT_THAT(OpenError(dir / "g%03d.png"), HasSubstr("no file matches the pattern"));
@@ -138,7 +169,11 @@ TEST(ImageSource, BadInputsFailWithTheReason) {
   WriteImage(dir / "whole.png", 50);
   const std::string png = test::ReadText(dir / "whole.png");
   test::WriteText(dir / "truncated.png", png.substr(0, png.size() / 2));
-  EXPECT_THAT(OpenError(dir / "truncated.png"), HasSubstr("cannot decode image"));
+  EXPECT_EQ(OpenError(dir / "truncated.png"),
+            "cannot decode image '" + dir / "truncated.png" +
+                "': truncated PNG (the file ends before its IEND chunk)");
+  test::WriteText(dir / "no_iend.png", png.substr(0, png.size() - 12));
+  EXPECT_THAT(OpenError(dir / "no_iend.png"), HasSubstr("truncated PNG"));
 
   test::WriteText(dir / "garbage.avi", std::string(4096, '\x5a'));
   EXPECT_THAT(OpenError(dir / "garbage.avi"), HasSubstr("video '" + dir / "garbage.avi'"));
@@ -178,6 +213,53 @@ TEST(ImageSource, BadImageInADirectoryFailsWhenReached) {
   } catch (const std::runtime_error& error) {
     EXPECT_THAT(error.what(), HasSubstr("cannot decode image '" + dir / "b.png'"));
   }
+}
+
+// libjpeg decodes a JPEG cut short with a warning only ("Premature end of JPEG file"),
+// filling the missing rows with grey: such a file must fail like a truncated PNG.
+TEST(ImageSource, TruncatedJpegIsRejectedNamingTheFile) {
+  test::TestDir dir;
+  WriteImage(dir / "whole.jpg", 50);
+  const std::string jpeg = test::ReadText(dir / "whole.jpg");
+  ASSERT_GT(jpeg.size(), 1000u);
+  const std::string expected = "cannot decode image '" + dir / "half.jpg" +
+                               "': truncated JPEG (no end-of-image marker after the image data)";
+  test::WriteText(dir / "half.jpg", jpeg.substr(0, jpeg.size() / 2));
+  EXPECT_EQ(OpenError(dir / "half.jpg"), expected);
+  test::WriteText(dir / "head.jpg", jpeg.substr(0, 500));  // `head -c 500`
+  EXPECT_THAT(OpenError(dir / "head.jpg"), HasSubstr("'" + dir / "head.jpg" + "': truncated JPEG"));
+  test::WriteText(dir / "header.jpg", jpeg.substr(0, 40));  // inside the header segments
+  EXPECT_THAT(OpenError(dir / "header.jpg"), HasSubstr("truncated JPEG (the file ends inside"));
+  test::WriteText(dir / "no_eoi.jpg", jpeg.substr(0, jpeg.size() - 2));
+  EXPECT_THAT(OpenError(dir / "no_eoi.jpg"), HasSubstr("truncated JPEG"));
+
+  // Whole files with something after the end-of-image marker still decode.
+  test::WriteText(dir / "padded.jpg", jpeg + std::string(64, '\0'));
+  test::WriteText(dir / "trailer.jpg", jpeg + "camera maker trailer");
+  for (const char* name : {"whole.jpg", "padded.jpg", "trailer.jpg"}) {
+    EXPECT_EQ(OpenError(dir / name), "") << name;
+    Frame frame;
+    ASSERT_TRUE(OpenImageSource(dir / name)->Next(&frame));
+    EXPECT_EQ(frame.gray.cols, 160) << name;
+  }
+
+  // In a directory, the truncated frame fails when reached, naming its file.
+  fs::create_directory(dir.path() / "seq");
+  fs::copy_file(dir / "whole.jpg", dir / "seq/a.jpg");
+  fs::copy_file(dir / "half.jpg", dir / "seq/b.jpg");
+  fs::copy_file(dir / "whole.jpg", dir / "seq/c.jpg");
+  auto source = OpenImageSource(dir / "seq");
+  Frame frame;
+  ASSERT_TRUE(source->Next(&frame));
+  try {
+    source->Next(&frame);
+    FAIL() << "no error for b.jpg";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("'" + dir / "seq/b.jpg" + "': truncated JPEG"));
+  }
+  EXPECT_EQ(frame.source, dir / "seq/b.jpg");  // the failing file, for the caller's record
+  ASSERT_TRUE(source->Next(&frame));
+  EXPECT_EQ(frame.source, dir / "seq/c.jpg");
 }
 
 }  // namespace

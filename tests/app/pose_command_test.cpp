@@ -192,6 +192,21 @@ TEST(Pose, WithoutACameraFailsClearlyAndLeavesNoOutput) {
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
 
+TEST(Pose, TruncatedJpegFailsNamingTheFileAndLeavesNoOutput) {
+  test::TestDir dir;
+  const std::string data = RenderSmall(dir, "data", 1, 0.0);
+  const std::string jpg = data + "/frame_0001.jpg";
+  ASSERT_TRUE(cv::imwrite(jpg, cv::imread(FrameFile(data, 0, ".png"))));
+  const std::string jpeg = test::ReadText(jpg);
+  test::WriteText(jpg, jpeg.substr(0, jpeg.size() / 2));
+  PoseCommandOptions options;
+  options.inputs = {data};
+  options.out_path = dir / "out.jsonl";
+  EXPECT_THAT(PoseError(options), HasSubstr("cannot decode image '" + jpg + "': truncated JPEG"));
+  EXPECT_FALSE(fs::exists(options.out_path));
+  EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
 TEST(Pose, BadPoseConfigNamesFileAndLineAndLeavesNoOutput) {
   test::TestDir dir;
   const std::string data = RenderSmall(dir, "data", 1, 0.0);
