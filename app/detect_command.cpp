@@ -94,6 +94,10 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
 
 void DetectCommandOptions::Check() const {
   CheckFrameCommand("DetectCommandOptions", inputs, max_frames, out_path);
+  if (!camera_name.empty() && camera_path.empty()) {
+    throw std::invalid_argument("DetectCommandOptions::camera_name '" + camera_name +
+                                "' needs camera_path (the camera file to read it from)");
+  }
 }
 
 DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& out) {
@@ -113,16 +117,21 @@ int RunDetect(int argc, char** argv) {
   DetectCommandOptions options;
   CLI::App cli(
       "Detect lines with the OAL detector. Prints one JSON object per frame (JSON "
-      "Lines) to stdout, or writes them to --out.",
+      "Lines) to stdout, or writes them to --out. Each object's \"frame\" is the frame's "
+      "position in this run, from 0 over all inputs; \"source\" is its file (or "
+      "video#index). `compare` and `edge-reference` number frames by the number in the file "
+      "name instead (image.0001.pgm is frame 1); match them by \"source\".",
       "oalservo detect");
   AddInputsArgument(cli, &options);
   cli.add_option("--config", options.config_path, "YAML configuration (see config/detector.yaml)");
   cli.add_flag("--paper", options.paper,
                "start from the paper's algorithm (every remedy off); --config still overrides");
-  cli.add_option("--camera", options.camera_path,
-                 "ViSP camera XML; with distortion (kdu), lines are in undistorted pixels");
+  CLI::Option* camera =
+      cli.add_option("--camera", options.camera_path,
+                     "ViSP camera XML; with distortion (kdu), lines are in undistorted pixels");
   cli.add_option("--camera-name", options.camera_name,
-                 "camera to read from --camera (default: the first in the file)");
+                 "camera to read from --camera (default: the first in the file)")
+      ->needs(camera);
   AddOutputOptions(cli, &options,
                    "directory for one PNG per frame with the lines drawn (created if missing)");
   cli.footer(

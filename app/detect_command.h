@@ -5,8 +5,11 @@
 //    "coordinates":"image","lines":[{"rho":..,"theta":..,"votes":..,"count":..,"borders":..,
 //    "support":..,"width":..,"end_a":[u,v],"end_b":[u,v]}, ...]}
 //
-// `coordinates` is "undistorted" when a camera with distortion (kdu != 0) was given: the
-// lines are then those an ideal pinhole camera would see (detector.h).
+// `frame` is the frame's position in the run, from 0, counted over all inputs in order (not
+// the number in the file name, which `compare` and `edge-reference` use: match by `source`,
+// the image path or "<video>#<index>"). `coordinates` is "undistorted" when a camera with
+// distortion (kdu != 0) was given: the lines are then those an ideal pinhole camera would see
+// (detector.h).
 #pragma once
 
 #include <iosfwd>
@@ -24,7 +27,8 @@ struct DetectCommandOptions : FrameCommandOptions {
   std::string config_path;
   /// Start from DetectorOptions::Paper() instead of the defaults; the config still overrides.
   bool paper = false;
-  /// ViSP camera XML; empty: no camera (lines in image coordinates).
+  /// ViSP camera XML; empty: no camera (lines in image coordinates), and camera_name must be
+  /// empty too.
   std::string camera_path;
 
   /// Throws std::invalid_argument naming the field and the violated constraint.

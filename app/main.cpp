@@ -2,6 +2,7 @@
 // the command table, --help and --version; each command lives in app/<name>_command.cpp,
 // whose Run* function parses its arguments and calls a plain function that tests call
 // directly. To add a command: include its header and add one row to kCommands.
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <iomanip>
@@ -89,8 +90,14 @@ int RunCommand(const oal::Command& command, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // OpenCV's own warnings ("imread_(...): can't open/read file") would repeat our errors.
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  // OpenCV's own log ("imread_(...): can't open/read file", the GStreamer and CAP_IMAGES
+  // backends' errors when a video will not open) would repeat our errors, less clearly:
+  // every failure it logs reaches the user as our own message.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  // Likewise FFmpeg's ("moov atom not found"), which OpenCV's FFmpeg backend lets through at
+  // its error level unless OPENCV_FFMPEG_LOGLEVEL says otherwise (left to the user if set:
+  // e.g. 24 for FFmpeg's warnings). -8 is AV_LOG_QUIET.
+  ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", /*overwrite=*/0);
   if (argc < 2) {
     PrintUsage(std::cerr);
     return oal::kExitUsage;

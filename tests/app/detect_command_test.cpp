@@ -255,6 +255,9 @@ TEST(Detect, OptionsAreChecked) {
   options.max_frames = 0;
   options.out_path = dir / "no/such/dir/lines.jsonl";
   EXPECT_THAT(DetectError(options), HasSubstr("does not exist"));
+  options.out_path.clear();
+  options.camera_name = "left";  // without a camera file it would be ignored
+  EXPECT_THAT(DetectError(options), HasSubstr("camera_name 'left' needs camera_path"));
 }
 
 }  // namespace

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -75,6 +78,49 @@ TEST(Oalservo, BadInputExitsWithOneAndSaysWhy) {
   EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: no such file or directory '"));
   EXPECT_TRUE(result.out.empty());
   EXPECT_FALSE(std::filesystem::exists(dir / "lines.jsonl"));
+}
+
+TEST(Oalservo, CameraNameWithoutCameraIsAUsageError) {
+  test::TestDir dir;
+  const Result result = RunOalservo(dir, "detect x.png --camera-name left");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: --camera-name requires --camera"));
+}
+
+// Each bad input gives our one-line error, without OpenCV's or libpng's own messages.
+TEST(Oalservo, BadFramesGiveOneClearLineOnStderr) {
+  test::TestDir dir;
+  test::WriteText(dir / "empty.avi", "");
+  test::WriteText(dir / "empty.mp4", "");
+  const Result render = RunOalservo(dir,
+                                    "render --count 1 --width 160 --height 120 --fx 150 "
+                                    "--min-visible-px 30 --out '" +
+                                        dir / "data" + "'");
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const std::string png = test::ReadText(dir / "data/frame_0000.png");
+  test::WriteText(dir / "truncated.png", png.substr(0, png.size() / 2));
+  ASSERT_TRUE(cv::imwrite(dir / "whole.jpg", cv::imread(dir / "data/frame_0000.png")));
+  const std::string jpeg = test::ReadText(dir / "whole.jpg");
+  test::WriteText(dir / "truncated.jpg", jpeg.substr(0, jpeg.size() / 2));
+  for (const char* name : {"empty.avi", "empty.mp4", "truncated.png", "truncated.jpg"}) {
+    const Result result = RunOalservo(dir, "detect '" + dir / name + "'");
+    EXPECT_EQ(result.exit_code, 1) << name;
+    EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: ")) << name;
+    EXPECT_THAT(result.err, HasSubstr(name)) << name;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_TRUE(result.out.empty()) << name;
+  }
+}
+
+TEST(Oalservo, EvaluateWithoutInputsFailsAndWritesNothing) {
+  test::TestDir dir;
+  std::filesystem::create_directory(dir / "empty");
+  const Result result =
+      RunOalservo(dir, "evaluate '" + dir / "empty" + "' --out '" + dir / "out" + "'");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.err,
+              HasSubstr("oalservo evaluate: error: no inputs found in '" + dir / "empty" + "'"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
 TEST(Oalservo, RenderThenDetectWithTheRenderedCamera) {
