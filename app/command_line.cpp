@@ -37,7 +37,7 @@ namespace {
 
 // The progress printer: `terminal` redraws one line, else one line per `every_s` seconds.
 std::function<void(int, int)> ProgressPrinter(const std::string& label, bool terminal,
-                                              double every_s) {
+                                              double every_s, const std::string& unit = "frames") {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
   auto last = std::make_shared<Clock::time_point>(start);
@@ -49,8 +49,8 @@ std::function<void(int, int)> ProgressPrinter(const std::string& label, bool ter
     const double elapsed_s = std::chrono::duration<double>(now - start).count();
     const double rate = elapsed_s > 0.0 ? done / elapsed_s : 0.0;
     char text[160];
-    int length = std::snprintf(text, sizeof text, "%s %d / %d, %.1f frames/s", label.c_str(), done,
-                               total, rate);
+    int length = std::snprintf(text, sizeof text, "%s %d / %d, %.1f %s/s", label.c_str(), done,
+                               total, rate, unit.c_str());
     if (total > 0 && rate > 0.0 && length > 0 && length < static_cast<int>(sizeof text)) {
       const long left_s = std::lround(std::max(0, total - done) / rate);
       std::snprintf(text + length, sizeof text - static_cast<std::size_t>(length),
@@ -71,9 +71,10 @@ std::function<void(int, int)> TerminalFrameProgress() {
   return ProgressPrinter("frame", true, 0.2);
 }
 
-std::function<void(int, int)> FrameProgress(const std::string& label, double plain_every_s) {
+std::function<void(int, int)> FrameProgress(const std::string& label, double plain_every_s,
+                                            const std::string& unit) {
   const bool terminal = isatty(fileno(stderr));
-  return ProgressPrinter(label, terminal, terminal ? 0.2 : plain_every_s);
+  return ProgressPrinter(label, terminal, terminal ? 0.2 : plain_every_s, unit);
 }
 
 void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,

@@ -45,10 +45,11 @@ std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv);
 std::function<void(int done, int total)> TerminalFrameProgress();
 
 /// As TerminalFrameProgress, with `label` instead of "frame"; when stderr is not a terminal,
-/// a plain line "label N / total, R frames/s, ETA m:ss" every `plain_every_s` seconds and at
+/// a plain line "label N / total, R <unit>/s, ETA m:ss" every `plain_every_s` seconds and at
 /// the end. total <= 0: unknown (no ETA). Not thread-safe: callers serialise the calls.
 std::function<void(int done, int total)> FrameProgress(const std::string& label,
-                                                       double plain_every_s = 10.0);
+                                                       double plain_every_s = 10.0,
+                                                       const std::string& unit = "frames");
 
 /// The checks every command over image sources shares: at least one input, max_frames >= 0
 /// and a writable --out. Throws std::invalid_argument naming `options_name`'s field.

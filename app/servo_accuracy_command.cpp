@@ -134,7 +134,7 @@ int RunServoAccuracy(int argc, char** argv) {
   servo.config_path = config_path;
   const ServoAppConfig config = LoadServoConfig(servo);
   const ServoAccuracyReport report =
-      EvaluateServoAccuracy(config, options, FrameProgress("servo run", 30.0));
+      EvaluateServoAccuracy(config, options, FrameProgress("servo run", 30.0, "runs"));
   std::cout << Table(report);
   if (!out_path.empty()) WriteFileAtomically(out_path, ToJson(report).dump(2) + '\n');
   return kExitOk;

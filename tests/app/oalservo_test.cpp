@@ -82,7 +82,7 @@ TEST(Oalservo, BadInputExitsWithOneAndSaysWhy) {
 
 TEST(Oalservo, CameraNameWithoutCameraIsAUsageError) {
   test::TestDir dir;
-  const Result result = RunOalservo(dir, "detect x.png --camera-name left");
+  const test::OalservoRun result = test::RunOalservo(dir, "detect x.png --camera-name left");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: --camera-name requires --camera"));
 }
@@ -92,10 +92,11 @@ TEST(Oalservo, BadFramesGiveOneClearLineOnStderr) {
   test::TestDir dir;
   test::WriteText(dir / "empty.avi", "");
   test::WriteText(dir / "empty.mp4", "");
-  const Result render = RunOalservo(dir,
-                                    "render --count 1 --width 160 --height 120 --fx 150 "
-                                    "--min-visible-px 30 --out '" +
-                                        dir / "data" + "'");
+  const test::OalservoRun render =
+      test::RunOalservo(dir,
+                        "render --count 1 --width 160 --height 120 --fx 150 "
+                        "--min-visible-px 30 --out '" +
+                            dir / "data" + "'");
   ASSERT_EQ(render.exit_code, 0) << render.err;
   const std::string png = test::ReadText(dir / "data/frame_0000.png");
   test::WriteText(dir / "truncated.png", png.substr(0, png.size() / 2));
@@ -103,7 +104,7 @@ TEST(Oalservo, BadFramesGiveOneClearLineOnStderr) {
   const std::string jpeg = test::ReadText(dir / "whole.jpg");
   test::WriteText(dir / "truncated.jpg", jpeg.substr(0, jpeg.size() / 2));
   for (const char* name : {"empty.avi", "empty.mp4", "truncated.png", "truncated.jpg"}) {
-    const Result result = RunOalservo(dir, "detect '" + dir / name + "'");
+    const test::OalservoRun result = test::RunOalservo(dir, "detect '" + dir / name + "'");
     EXPECT_EQ(result.exit_code, 1) << name;
     EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: ")) << name;
     EXPECT_THAT(result.err, HasSubstr(name)) << name;
@@ -115,8 +116,8 @@ TEST(Oalservo, BadFramesGiveOneClearLineOnStderr) {
 TEST(Oalservo, EvaluateWithoutInputsFailsAndWritesNothing) {
   test::TestDir dir;
   std::filesystem::create_directory(dir / "empty");
-  const Result result =
-      RunOalservo(dir, "evaluate '" + dir / "empty" + "' --out '" + dir / "out" + "'");
+  const test::OalservoRun result =
+      test::RunOalservo(dir, "evaluate '" + dir / "empty" + "' --out '" + dir / "out" + "'");
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.err,
               HasSubstr("oalservo evaluate: error: no inputs found in '" + dir / "empty" + "'"));
