@@ -1,6 +1,6 @@
 #include "app/edge_reference.h"
 
-#include <visp3/io/vpImageIo.h>
+#include <visp3/core/vpImageConvert.h>
 
 #include <algorithm>
 #include <cctype>
@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "app/atomic_file.h"
+#include "app/image_source.h"
 
 namespace oal {
 namespace {
@@ -308,44 +309,14 @@ EdgeReference FitEdgeReference(const vpImage<unsigned char>& image,
 }
 
 std::string SequenceFramePath(const std::string& pattern, int frame) {
-  // Exactly one %d conversion, optionally zero-padded (%04d); no other '%' but "%%".
-  std::string out;
-  bool converted = false;
-  for (std::size_t k = 0; k < pattern.size(); ++k) {
-    if (pattern[k] != '%') {
-      out += pattern[k];
-      continue;
-    }
-    if (k + 1 < pattern.size() && pattern[k + 1] == '%') {
-      out += '%';
-      ++k;
-      continue;
-    }
-    std::size_t j = k + 1;
-    const bool zero = j < pattern.size() && pattern[j] == '0';
-    if (zero) ++j;
-    int width = 0;
-    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j])) != 0) {
-      width = width * 10 + (pattern[j] - '0');
-      ++j;
-    }
-    if (converted || j >= pattern.size() || pattern[j] != 'd' || width > 20) {
-      throw std::invalid_argument("image pattern \"" + pattern +
-                                  "\": expected exactly one %d conversion (e.g. %04d)");
-    }
-    std::ostringstream number;
-    number << std::setw(width) << std::setfill(zero ? '0' : ' ') << frame;
-    out += number.str();
-    converted = true;
-    k = j;
+  try {
+    return ExpandPattern(pattern, frame);
+  } catch (const std::runtime_error& error) {
+    throw std::invalid_argument(std::string(error.what()) +
+                                "; edge-reference follows an edge through numbered frames, e.g. "
+                                "line/image.%04d.pgm (a single image or a directory is not a "
+                                "sequence)");
   }
-  if (!converted) {
-    throw std::invalid_argument("image pattern \"" + pattern +
-                                "\": no %d conversion; edge-reference follows an edge through "
-                                "numbered frames, e.g. line/image.%04d.pgm (a single image or "
-                                "a directory is not a sequence)");
-  }
-  return out;
 }
 
 int LastSequenceFrame(const std::string& pattern, int first) {
@@ -380,12 +351,11 @@ std::vector<FrameReference> FitEdgeSequence(const std::string& pattern, int firs
   EdgeReferenceOptions frame_options = options;
   for (int frame = first; frame <= last; ++frame) {
     const std::string path = SequenceFramePath(pattern, frame);
+    // Through the commands' image reading, which rejects files cut short (JPEG, PNG).
+    Frame decoded;
+    if (!OpenImageSource(path)->Next(&decoded)) throw std::runtime_error("cannot read " + path);
     vpImage<unsigned char> image;
-    try {
-      vpImageIo::read(image, path);
-    } catch (const std::exception& e) {
-      throw std::runtime_error("cannot read " + path + ": " + e.what());
-    }
+    vpImageConvert::convert(decoded.gray, image);
     FrameReference reference;
     reference.frame = frame;
     try {

@@ -275,7 +275,7 @@ TEST(EdgeReferenceCommand, ASingleImageOrADirectoryIsNotASequence) {
   fs::create_directories(dir / "empty");
   for (const std::string& input : {image, dir / "empty", dir / "seq"}) {
     const std::string error = EdgeReferenceError({input, "--out", dir / "x.csv"});
-    EXPECT_THAT(error, HasSubstr("\"" + input + "\": no %d conversion")) << input;
+    EXPECT_THAT(error, HasSubstr("pattern '" + input + "' has no %d conversion")) << input;
     EXPECT_THAT(error, HasSubstr("not a sequence")) << input;
     EXPECT_THROW(LastSequenceFrame(input, 1), std::invalid_argument) << input;
   }
@@ -284,6 +284,18 @@ TEST(EdgeReferenceCommand, ASingleImageOrADirectoryIsNotASequence) {
   EXPECT_THAT(EdgeReferenceError({dir / "seq/e%d.pgm", "--first", "4", "--out", dir / "x.csv"}),
               HasSubstr("frame 4 (" + dir / "seq/e4.pgm" + ") does not exist"));
   EXPECT_EQ(LastSequenceFrame(dir / "seq/e%d.pgm", 1), 1);
+}
+
+// Frames are read as every command reads images: a file cut short is an error naming it,
+// not a frame decoded from half its data.
+TEST(EdgeReferenceCommand, AFrameCutShortIsAnError) {
+  test::TestDir dir;
+  const std::string pattern = WriteEdgeFrames(dir.path() / "seq", 1, 3, false);
+  const fs::path cut = dir.path() / "seq/e2.pgm";
+  fs::resize_file(cut, fs::file_size(cut) / 2);
+  const std::string error = EdgeReferenceError({pattern, "--out", dir / "x.csv"});
+  EXPECT_THAT(error, HasSubstr(cut.string()));
+  EXPECT_FALSE(fs::exists(dir / "x.csv"));
 }
 
 TEST(EdgeReferenceCommand, FirstAfterLastIsRejected) {
