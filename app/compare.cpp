@@ -877,8 +877,9 @@ CompareReport RunComparison(const CompareOptions& options,
     report.truth_source = "json";
   }
 
-  // Files skipped in a directory (the truth JSON, camera.xml) are expected: no warning.
-  std::unique_ptr<ImageSource> source = OpenImageSource(options.input);
+  // Unexpected files skipped in a directory, and files after a pattern's gap, are warned
+  // about (the truth JSON and camera.xml are expected there: no warning).
+  std::unique_ptr<ImageSource> source = OpenImageSource(options.input, &report.warnings);
   Frame frame;
   if (!source->Next(&frame)) throw std::runtime_error(source->Name() + " holds no frame");
   report.width = frame.gray.cols;

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include "app/image_source.h"
 #include "detector/detector.h"
@@ -285,7 +286,9 @@ std::string KeyAt(const ServoAppConfig& config, const std::string& key) {
   return origin.empty() ? key : origin + ": " + key;
 }
 
-std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
+// Files after a printf pattern's gap are reported in `warnings`.
+std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config,
+                                           std::vector<std::string>* warnings) {
   const SourceConfig& source = config.source;
   if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
   const bool v4l2 = source.type == "v4l2";
@@ -298,7 +301,7 @@ std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config) {
       settings.fps = source.fps;
       return std::make_unique<SourceCamera>(OpenV4l2Source(source.device, settings));
     }
-    return std::make_unique<SourceCamera>(OpenImageSource(source.path));
+    return std::make_unique<SourceCamera>(OpenImageSource(source.path, warnings));
   } catch (const std::runtime_error& error) {
     throw std::runtime_error(KeyAt(config, key) + " '" + (v4l2 ? source.device : source.path) +
                              "' cannot be opened: " + error.what());
@@ -558,7 +561,9 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   const LoopModel model(config);
   OalDetector detector(config.detector, model.camera);
   const PoseOptions pose_options = model.PoseOptionsFor(detector);
-  const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config);
+  std::vector<std::string> source_warnings;
+  const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &source_warnings);
+  for (const std::string& warning : source_warnings) log << "warning: " << warning << '\n';
   const bool moves_robot = config.source.type != "replay";
 
   const RobotRig rig = OpenRobot(config);

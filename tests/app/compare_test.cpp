@@ -296,6 +296,18 @@ TEST(Compare, TinyImagesGiveAWarningNamingFrameAndSize) {
   }
 }
 
+TEST(Compare, APatternWithAGapIsWarnedAbout) {
+  test::TestDir dir;
+  const std::string images = WriteEdgeImages(dir / "images", 4, 64, 48);
+  fs::remove(fs::path(images) / "frame_0002.png");
+  CompareOptions options;
+  options.input = images + "/frame_%04d.png";
+  const CompareReport report = RunComparison(options);
+  EXPECT_EQ(report.frames, 2);
+  EXPECT_TRUE(AnyContains(report.warnings, "the sequence ends at the missing file"))
+      << ::testing::PrintToString(report.warnings);
+}
+
 TEST(Compare, CameraForAnotherImageSizeIsWarnedAbout) {
   test::TestDir dir;
   vpCameraParameters camera;

@@ -109,6 +109,13 @@ TEST(ServoSources, ReplayRunsOpenLoopToTheEndWithoutMovingTheRobot) {
     EXPECT_TRUE(std::isnan(row.true_translation_error_mm));
   }
   EXPECT_TRUE(report.robot_stopped);
+
+  // A frame missing in the middle of the recording ends the replay there, with a warning.
+  fs::rename(dir / "frame_0001.png", dir / "moved.png");
+  std::ostringstream gap_log;
+  EXPECT_EQ(RunServo(config, gap_log).iterations.size(), 1u);
+  EXPECT_THAT(gap_log.str(), HasSubstr("warning: pattern '" + config.source.path +
+                                       "': the sequence ends at the missing file"));
 }
 
 // A recording exactly servo.max_iterations frames long was played to its end: end-of-input
