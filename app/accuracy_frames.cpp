@@ -11,33 +11,24 @@
 
 #include "app/atomic_file.h"
 #include "app/json_io.h"
+#include "detector/options.h"  // RequireOption
 
 namespace oal {
-namespace {
-
-template <typename T>
-void Require(bool ok, const char* option, const T& value, const char* constraint) {
-  if (ok) return;
-  std::ostringstream message;
-  message << option << " = " << value << " is out of range: " << constraint;
-  throw std::invalid_argument(message.str());
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void RenderedFrameOptions::Check() const {
-  Require(frames >= 1 && frames <= 1000000, "--frames", frames, "1 <= --frames <= 1000000");
-  Require(kdu > -1.0 && kdu < 1.0, "--kdu", kdu, "-1 < --kdu < 1");
-  Require(noise_sigma >= 0.0 && noise_sigma <= 100.0, "--noise", noise_sigma,
-          "0 <= --noise <= 100");
-  Require(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0, "--blur", blur_sigma_px,
-          "0 <= --blur <= 20");
-  Require(illumination_gradient >= 0.0 && illumination_gradient <= 0.9, "--gradient",
-          illumination_gradient, "0 <= --gradient <= 0.9");
-  Require(width >= 16 && height >= 16, "RenderedFrameOptions::width, height",
-          std::to_string(width) + "x" + std::to_string(height), "both >= 16");
-  Require(focal_px > 0.0 && std::isfinite(focal_px), "RenderedFrameOptions::focal_px", focal_px,
-          "focal_px > 0");
+  RequireOption(frames >= 1 && frames <= 1000000, "--frames", frames, "1 <= --frames <= 1000000");
+  RequireOption(kdu > -1.0 && kdu < 1.0, "--kdu", kdu, "-1 < --kdu < 1");
+  RequireOption(noise_sigma >= 0.0 && noise_sigma <= 100.0, "--noise", noise_sigma,
+                "0 <= --noise <= 100");
+  RequireOption(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0, "--blur", blur_sigma_px,
+                "0 <= --blur <= 20");
+  RequireOption(illumination_gradient >= 0.0 && illumination_gradient <= 0.9, "--gradient",
+                illumination_gradient, "0 <= --gradient <= 0.9");
+  RequireOption(width >= 16 && height >= 16, "RenderedFrameOptions::width, height",
+                std::to_string(width) + "x" + std::to_string(height), "both >= 16");
+  RequireOption(focal_px > 0.0 && std::isfinite(focal_px), "RenderedFrameOptions::focal_px",
+                focal_px, "focal_px > 0");
 }
 
 RenderOptions MakeRenderOptions(const RenderedFrameOptions& options) {

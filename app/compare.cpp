@@ -27,6 +27,7 @@
 #include "app/truth_file.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
+#include "detector/options.h"  // RequireOption
 #include "detector/tracker.h"
 #include "scene/scene.h"
 
@@ -770,12 +771,7 @@ TargetKind TargetKindFromString(const std::string& text) {
 
 void VpMeLineOptions::Check() const {
   auto require = [](bool ok, const std::string& field, double value, const char* constraint) {
-    if (!ok) {
-      std::ostringstream message;
-      message << "VpMeLineOptions::" << field << " = " << value
-              << ". Violated constraint: " << constraint;
-      throw std::invalid_argument(message.str());
-    }
+    RequireOption(ok, "VpMeLineOptions::" + field, value, constraint);
   };
   require(range_px >= 1 && range_px <= 100, "range_px", range_px, "1 <= range_px <= 100");
   require(threshold > 0.0, "threshold", threshold, "threshold > 0");
@@ -787,12 +783,7 @@ void VpMeLineOptions::Check() const {
 
 void CompareOptions::Check() const {
   auto require = [](bool ok, const std::string& field, double value, const char* constraint) {
-    if (!ok) {
-      std::ostringstream message;
-      message << "CompareOptions::" << field << " = " << value
-              << ". Violated constraint: " << constraint;
-      throw std::invalid_argument(message.str());
-    }
+    RequireOption(ok, "CompareOptions::" + field, value, constraint);
   };
   if (input.empty()) throw std::invalid_argument("CompareOptions::input is empty");
   require(lines >= 0 && lines <= 100, "lines", lines, "0 <= lines <= 100");

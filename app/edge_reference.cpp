@@ -13,6 +13,7 @@
 
 #include "app/atomic_file.h"
 #include "app/image_source.h"
+#include "detector/options.h"  // RequireOption
 
 namespace oal {
 namespace {
@@ -168,10 +169,7 @@ std::string ToString(EdgePolarity polarity) {
 
 void EdgeReferenceOptions::Check() const {
   auto reject = [](const std::string& field, double value, const std::string& constraint) {
-    std::ostringstream message;
-    message << "EdgeReferenceOptions::" << field << " = " << value
-            << ". Violated constraint: " << constraint;
-    throw std::invalid_argument(message.str());
+    RequireOption(false, "EdgeReferenceOptions::" + field, value, constraint);
   };
   if (!(smoothing_sigma_px >= 0.5 && smoothing_sigma_px <= 10.0)) {
     reject("smoothing_sigma_px", smoothing_sigma_px, "0.5 <= smoothing_sigma_px <= 10");

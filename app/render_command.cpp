@@ -17,6 +17,7 @@
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/json_io.h"
+#include "detector/options.h"  // RequireOption
 #include "scene/scene.h"
 #include "scene/sequence.h"
 
@@ -26,15 +27,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kCameraName = "oal-render";
-
-// Names the command-line option (`option`, e.g. "--fx"), its value and the constraint.
-template <typename T>
-void Require(bool ok, const char* option, const T& value, const char* constraint) {
-  if (ok) return;
-  std::ostringstream message;
-  message << option << " = " << value << " is out of range: " << constraint;
-  throw std::invalid_argument(message.str());
-}
 
 std::string FrameName(int index, const char* extension) {
   std::string number = std::to_string(index);
@@ -306,28 +298,30 @@ void RenderCommandOptions::Check() const {
     try {
       SequenceKindFromString(sequence);
     } catch (const std::invalid_argument&) {
-      Require(false, "--sequence", sequence, ("it is one of: " + SequenceKindNames()).c_str());
+      RequireOption(false, "--sequence", sequence,
+                    ("it is one of: " + SequenceKindNames()).c_str());
     }
   }
-  Require(!config.empty() || target == "two-line" || target == "four-line", "--target", target,
-          "it is two-line or four-line");
-  Require(count >= 1 && count <= 100000, "--count", count, "1 <= --count <= 100000");
+  RequireOption(!config.empty() || target == "two-line" || target == "four-line", "--target",
+                target, "it is two-line or four-line");
+  RequireOption(count >= 1 && count <= 100000, "--count", count, "1 <= --count <= 100000");
   if (out_dir.empty()) throw std::invalid_argument("no output folder given (--out DIR)");
-  Require(width >= 16 && width <= 8192, "--width", width, "16 <= --width <= 8192");
-  Require(height >= 16 && height <= 8192, "--height", height, "16 <= --height <= 8192");
-  Require(fx_px > 0.0 && fx_px <= 1e5, "--fx", fx_px, "0 < --fx <= 100000");
-  Require(kdu > -1.0 && kdu < 1.0, "--kdu", kdu, "-1 < --kdu < 1");
-  Require(noise_sigma >= 0.0 && noise_sigma <= 100.0, "--noise", noise_sigma,
-          "0 <= --noise <= 100");
-  Require(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0, "--blur", blur_sigma_px,
-          "0 <= --blur <= 20");
-  Require(gradient >= 0.0 && gradient <= 0.9, "--gradient", gradient, "0 <= --gradient <= 0.9");
-  Require(min_distance_m > 0.0, "--min-distance", min_distance_m, "--min-distance > 0");
-  Require(max_distance_m >= min_distance_m, "--max-distance", max_distance_m,
-          "--max-distance >= --min-distance");
-  Require(max_tilt_deg >= 0.0 && max_tilt_deg <= 80.0, "--max-tilt-deg", max_tilt_deg,
-          "0 <= --max-tilt-deg <= 80");
-  Require(min_visible_px >= 0.0, "--min-visible-px", min_visible_px, "--min-visible-px >= 0");
+  RequireOption(width >= 16 && width <= 8192, "--width", width, "16 <= --width <= 8192");
+  RequireOption(height >= 16 && height <= 8192, "--height", height, "16 <= --height <= 8192");
+  RequireOption(fx_px > 0.0 && fx_px <= 1e5, "--fx", fx_px, "0 < --fx <= 100000");
+  RequireOption(kdu > -1.0 && kdu < 1.0, "--kdu", kdu, "-1 < --kdu < 1");
+  RequireOption(noise_sigma >= 0.0 && noise_sigma <= 100.0, "--noise", noise_sigma,
+                "0 <= --noise <= 100");
+  RequireOption(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0, "--blur", blur_sigma_px,
+                "0 <= --blur <= 20");
+  RequireOption(gradient >= 0.0 && gradient <= 0.9, "--gradient", gradient,
+                "0 <= --gradient <= 0.9");
+  RequireOption(min_distance_m > 0.0, "--min-distance", min_distance_m, "--min-distance > 0");
+  RequireOption(max_distance_m >= min_distance_m, "--max-distance", max_distance_m,
+                "--max-distance >= --min-distance");
+  RequireOption(max_tilt_deg >= 0.0 && max_tilt_deg <= 80.0, "--max-tilt-deg", max_tilt_deg,
+                "0 <= --max-tilt-deg <= 80");
+  RequireOption(min_visible_px >= 0.0, "--min-visible-px", min_visible_px, "--min-visible-px >= 0");
   if (!background_image.empty() && !fs::is_regular_file(background_image)) {
     throw std::invalid_argument("--background image '" + background_image + "' does not exist");
   }

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "detector/options.h"  // RequireOption
 #include "scene/scene.h"
 
 namespace oal {
@@ -17,10 +18,7 @@ int ServoAccuracyLaw::converged() const {
 
 void ServoAccuracyOptions::Check() const {
   const auto fail = [](const std::string& field, double value, const std::string& constraint) {
-    std::ostringstream message;
-    message << "ServoAccuracyOptions::" << field << " = " << value
-            << ". Violated constraint: " << constraint;
-    throw std::invalid_argument(message.str());
+    RequireOption(false, "ServoAccuracyOptions::" + field, value, constraint);
   };
   if (starts < 1) fail("starts", starts, "starts >= 1");
   if (!(min_distance_m > 0.0)) fail("min_distance_m", min_distance_m, "min_distance_m > 0");

@@ -117,7 +117,7 @@ TEST(AccuracyCommands, OptionRanges) {
     EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>([&] {
                   test::RunWithArgs(run, {"x", "--frames", "1", "--kdu", "1.5"});
                 }),
-                HasSubstr("--kdu = 1.5 is out of range: -1 < --kdu < 1"));
+                HasSubstr("--kdu = 1.5. Violated constraint: -1 < --kdu < 1"));
     EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>([&] {
                   test::RunWithArgs(run, {"x", "--frames", "1", "--noise", "200"});
                 }),

@@ -107,7 +107,8 @@ TEST(Render, BadOptionsNameTheField) {
     RenderDataset(options);
     FAIL() << "no error";
   } catch (const std::invalid_argument& error) {
-    EXPECT_THAT(error.what(), HasSubstr("--count = 0 is out of range: 1 <= --count <= 100000"));
+    EXPECT_THAT(error.what(),
+                HasSubstr("--count = 0. Violated constraint: 1 <= --count <= 100000"));
   }
   options = SmallRender(dir / "data");
   options.target = "three-line";
@@ -127,9 +128,9 @@ TEST(Render, BadOptionsNameTheCommandLineOption) {
     return test::ErrorMessageOf<std::invalid_argument>([&] { RenderDataset(options); });
   };
   EXPECT_EQ(error([](RenderCommandOptions* o) { o->fx_px = 0.0; }),
-            "--fx = 0 is out of range: 0 < --fx <= 100000");
+            "--fx = 0. Violated constraint: 0 < --fx <= 100000");
   EXPECT_THAT(error([](RenderCommandOptions* o) { o->kdu = 1.5; }),
-              HasSubstr("--kdu = 1.5 is out of range: -1 < --kdu < 1"));
+              HasSubstr("--kdu = 1.5. Violated constraint: -1 < --kdu < 1"));
   EXPECT_THAT(error([](RenderCommandOptions* o) { o->max_tilt_deg = 90.0; }),
               HasSubstr("--max-tilt-deg = 90"));
   EXPECT_THAT(error([](RenderCommandOptions* o) { o->min_visible_px = -1.0; }),
