@@ -1,5 +1,5 @@
-// The ordered-accumulator-list (OAL) line detector of shared/paper/ordered-list-hough.md,
-// sections 2 and 3, with the remedies of shared/paper/NOTES.md behind switches
+// The ordered-accumulator-list (OAL) line detector of ../shared/paper/ordered-list-hough.md,
+// sections 2 and 3, with the remedies of ../shared/paper/NOTES.md behind switches
 // (DetectorOptions::Paper() turns them all off).
 //
 //   for each border d = start, start + step, ... until the centre:

@@ -84,7 +84,7 @@ struct DetectorOptions {
   /// Range [1, 1000].
   int max_lines = 20;
 
-  // --- Remedies for the weak points in shared/paper/NOTES.md (false = the paper) --------
+  // --- Remedies for the weak points in ../shared/paper/NOTES.md (false = the paper) --------
   /// Increment `count` only on borders the line crosses (NOTES 1).
   bool count_visible_borders_only = true;
   /// Refit each read-off line to the feature points of all borders by least squares (NOTES 3).

@@ -1,4 +1,4 @@
-// Camera pose from the four-line target (shared/paper/ordered-list-hough.md, section 4).
+// Camera pose from the four-line target (../shared/paper/ordered-list-hough.md, section 4).
 //
 //   step 1  identify the detected lines as target lines 1-4          IdentifyTargetLines()
 //   step 2  roll from the orientation of line 1, over 0-360 deg      PoseResult::line1_roll_deg
