@@ -139,7 +139,7 @@ int RunDetect(int argc, char** argv) {
       "  oalservo detect frames/ --out lines.jsonl --annotate annotated/\n"
       "  oalservo detect data/ --camera data/camera.xml\n"
       "  oalservo detect '/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm' "
-      "--config edges.yaml\n"
+      "--config config/visp_line_edges.yaml\n"
       "  oalservo detect /dev/video0 --max-frames 100");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   const DetectSummary summary = DetectImages(options, std::cout);
