@@ -1,5 +1,6 @@
 #include "robots/robot.h"
 
+#include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpThetaUVector.h>
 
 namespace oal {
@@ -36,6 +37,16 @@ std::string ToString(RobotFrame frame) {
       return "end-effector";
   }
   return "unknown";
+}
+
+RobotPose Robot::PoseAlongMove(RobotFrame /*frame*/, const vpHomogeneousMatrix& from,
+                               const vpHomogeneousMatrix& target, double fraction) const {
+  // A constant twist applied for a fraction of the move's time: exactly what
+  // SimulatedCamera's kIntegrate move reaches after that many of its sampling periods.
+  const vpColVector screw = vpExponentialMap::inverse(from.inverse() * target, 1.0);
+  RobotPose p;
+  p.pose = from * vpExponentialMap::direct(screw, fraction);
+  return p;
 }
 
 PoseDistance Distance(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {

@@ -33,6 +33,11 @@
 //     next command (real velocity-driven robots); the runner re-sends it every cycle.
 //   - NearestReachable() maps a requested pose to the nearest pose the arm can reach (a 5-DOF
 //     arm cannot reach every 6-DOF pose); a 6-DOF robot returns the pose unchanged.
+//   - PoseAlongMove() says where a position move passes: the pose of `frame` at a fraction of
+//     the way, as the driver's own interpolation moves it (the default: the screw from start to
+//     target at constant twist, what SimulatedCamera integrates; the Scorbot overrides it with
+//     its joint interpolation). The runner checks the path against the workspace box with it
+//     before anything is sent, so it must not touch the robot.
 //   - No call is thread-safe; the runner's emergency flag is the only cross-context entry.
 #pragma once
 
@@ -137,6 +142,18 @@ class Robot {
   /// The nearest pose of `frame` to `target` that the robot can reach (same frame). A 6-DOF
   /// robot without joint limits returns `target`.
   virtual RobotPose NearestReachable(RobotFrame frame, const vpHomogeneousMatrix& target) = 0;
+
+  /// The pose of `frame` (wMc or wMe) at `fraction` in [0, 1] of the way of a position move of
+  /// `frame` from the world pose `from` (where the robot is) to `target` (from
+  /// NearestReachable()), as this robot executes StartMove(). The path does not depend on the
+  /// speed profile: `fraction` is the progress along it, 0 at `from`, 1 at `target`. Computes
+  /// only (no communication). kUnreachable when the driver cannot say (e.g. no joints for an
+  /// end). Default: the screw motion at constant twist,
+  /// from * exp(fraction * log(from^-1 * target)), as SimulatedCamera integrates a move (the
+  /// same path whichever frame is given: the screw does not depend on a rigidly attached
+  /// frame).
+  virtual RobotPose PoseAlongMove(RobotFrame frame, const vpHomogeneousMatrix& from,
+                                  const vpHomogeneousMatrix& target, double fraction) const;
 
   /// The hand-eye transform: the camera in the end-effector frame.
   virtual vpHomogeneousMatrix eMc() const = 0;

@@ -3,6 +3,7 @@
 #include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpMath.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -91,9 +92,13 @@ RobotResult SafeRobot::Enable() {
   if (state_ == SafeRobotState::kDisconnected) {
     return RobotResult::Fail(RobotStatus::kNotReady, "not connected: call Connect() first");
   }
+  // Cleared before the driver call: a request that arrives during CON survives Enable().
+  const bool requested_before = emergency_.exchange(false, std::memory_order_relaxed);
   RobotResult r = robot_.Enable();
-  if (!r.ok()) return r;
-  emergency_.store(false, std::memory_order_relaxed);
+  if (!r.ok()) {
+    if (requested_before) emergency_.store(true, std::memory_order_relaxed);
+    return r;
+  }
   stop_reason_ = RobotResult::Ok();
   state_ = SafeRobotState::kEnabled;
   return r;
@@ -155,6 +160,55 @@ RobotResult SafeRobot::CheckInBox(const vpHomogeneousMatrix& wMb, const std::str
         << " = " << p << " m, outside the workspace box [" << lo << ", " << hi << "] m";
       return RobotResult::Fail(RobotStatus::kWorkspace, s.str());
     }
+  }
+  return RobotResult::Ok();
+}
+
+RobotResult SafeRobot::CheckPathInBox(RobotFrame frame, const vpHomogeneousMatrix& from,
+                                      const vpHomogeneousMatrix& target) const {
+  if (!options_.workspace_enabled) return RobotResult::Ok();
+  // Sampling: kCoarse equal steps of the fraction, each split further so that two samples are
+  // at most kMaxStepM apart in the box frame's position. A smooth path then leaves the box by
+  // at most about half a step (2.5 mm) between two samples without being seen; the check at
+  // every poll still watches the real motion. fraction 0 is where the robot already is.
+  constexpr int kCoarse = 32;
+  constexpr double kMaxStepM = 0.005;
+  constexpr int kMaxSplit = 10000;  // bounds the work for absurd paths (kilometres)
+  auto origin_at = [&](double fraction, vpHomogeneousMatrix* wMb) {
+    const RobotPose p = robot_.PoseAlongMove(frame, from, target, fraction);
+    if (!p.result.ok()) {
+      return RobotResult::Fail(p.result.status,
+                               "cannot tell the path of the move to check it against the "
+                               "workspace box: " +
+                                   p.result.message);
+    }
+    *wMb = BoxFramePose(frame, p.pose);
+    return RobotResult::Ok();
+  };
+  vpHomogeneousMatrix previous;
+  if (RobotResult r = origin_at(0, &previous); !r.ok()) return r;
+  for (int i = 0; i < kCoarse; ++i) {
+    const double f0 = static_cast<double>(i) / kCoarse;
+    const double f1 = static_cast<double>(i + 1) / kCoarse;
+    vpHomogeneousMatrix end;
+    if (RobotResult r = origin_at(f1, &end); !r.ok()) return r;
+    const double chord =
+        (end.getTranslationVector() - previous.getTranslationVector()).frobeniusNorm();
+    const int split =
+        std::isfinite(chord)
+            ? std::min(kMaxSplit, std::max(1, static_cast<int>(std::ceil(chord / kMaxStepM))))
+            : 1;
+    for (int j = 1; j <= split; ++j) {
+      const double f = j == split ? f1 : f0 + (f1 - f0) * j / split;
+      vpHomogeneousMatrix wMb = end;
+      if (j < split) {
+        if (RobotResult r = origin_at(f, &wMb); !r.ok()) return r;
+      }
+      std::ostringstream what;
+      what << "the move's path, at " << f << " of the way,";
+      if (RobotResult r = CheckInBox(wMb, what.str()); !r.ok()) return r;
+    }
+    previous = end;
   }
   return RobotResult::Ok();
 }
@@ -265,6 +319,13 @@ MoveReport SafeRobot::MovePosition(RobotFrame frame, const vpHomogeneousMatrix& 
   report.target = reach.pose;
   if (RobotResult r = CheckInBox(BoxFramePose(frame, report.target), "the move target"); !r.ok()) {
     return fail(r);
+  }
+  // The path too, as the driver will execute it (a joint-interpolated arm swings out on an
+  // arc), before anything is sent.
+  if (options_.workspace_enabled) {
+    const RobotPose from = robot_.GetPosition(frame);
+    if (!from.result.ok()) return fail(from.result);
+    if (RobotResult r = CheckPathInBox(frame, from.pose, report.target); !r.ok()) return fail(r);
   }
   if (RobotResult r = robot_.StartMove(frame, report.target); !r.ok()) return fail(r);
   const int max_polls = static_cast<int>(std::ceil(options_.move_timeout_s / sampling_time_s_));

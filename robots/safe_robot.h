@@ -9,11 +9,14 @@
 //     |vx|, |vy|, |vz| <= max_translation_mps and |wx|, |wy|, |wz| <= max_rotation_radps (the
 //     direction is kept, as vpRobot::saturateVelocities does, but silently); CycleReport says
 //     by how much (scale < 1, saturated) and which axis limited it.
-//   - Workspace box: before every motion the pose of workspace_frame that the motion leads to
-//     (for a velocity: after one sampling period; for a move: the target) must lie inside the
-//     axis-aligned box [workspace_min_m, workspace_max_m] of the world frame. Otherwise the
-//     motion is refused (kWorkspace, message naming the axis and the bound), the robot is
-//     stopped and stays where it was. During a move the box is checked again at every poll.
+//   - Workspace box: before every motion the poses of workspace_frame that the motion leads to
+//     (for a velocity: after one sampling period; for a move: the target, then its whole path
+//     as the driver executes it, Robot::PoseAlongMove(), sampled at least 32 times and at most
+//     5 mm of travel apart) must lie inside the axis-aligned box [workspace_min_m,
+//     workspace_max_m] of the world frame. Otherwise the motion is refused (kWorkspace, message
+//     naming the axis and the bound, and for a path the fraction of the way), the robot is
+//     stopped and stays where it was: nothing is sent. During a move the box is checked again
+//     at every poll.
 //   - Stop-on-error: any failed driver call during motion, any refused motion, a move that
 //     times out or ends away from its target, stops the driver (Robot::Stop()) and latches
 //     the runner in kStopped; every later motion command fails with kStopped and the reason,
@@ -22,7 +25,9 @@
 //   - Emergency stop: RequestEmergencyStop() only stores to a lock-free atomic flag, so a
 //     signal handler (the servo loop's Ctrl-C) may call it. The next cycle (SetVelocity(),
 //     MovePosition() or a poll inside a move) sees the flag, stops the driver and latches.
-//     Enable() clears the flag.
+//     Enable() clears a flag set before it was called; a request that arrives while Enable()
+//     runs (during CON) is kept, so the next cycle stops and latches as for any request, and
+//     only a later Enable() clears it.
 //   - Timing: every cycle (one velocity command or one move poll, with its checks) is timed
 //     on the steady clock; timing() keeps count, last and max; a cycle longer than
 //     max_cycle_s (if > 0) stops the robot (kTimeout).
@@ -110,7 +115,8 @@ class SafeRobot {
   SafeRobot& operator=(const SafeRobot&) = delete;
 
   RobotResult Connect();
-  /// Allows motion; clears a latched stop and the emergency flag.
+  /// Allows motion; clears a latched stop and an emergency flag set before the call (not one
+  /// requested while it runs: the next cycle acts on that one).
   RobotResult Enable();
   /// Stops and forbids motion until Enable(). Safe in any state, idempotent.
   RobotResult Disable() noexcept;
@@ -149,6 +155,9 @@ class SafeRobot {
   RobotResult CheckMayMove();
   RobotResult Latch(RobotResult why) noexcept;
   RobotResult CheckInBox(const vpHomogeneousMatrix& wMb, const std::string& what) const;
+  /// The path of a move of `frame` from `from` to `target` (Robot::PoseAlongMove()) in the box.
+  RobotResult CheckPathInBox(RobotFrame frame, const vpHomogeneousMatrix& from,
+                             const vpHomogeneousMatrix& target) const;
   /// The box frame's pose in the world given the pose wMx of `frame`.
   vpHomogeneousMatrix BoxFramePose(RobotFrame frame, const vpHomogeneousMatrix& wMx) const;
   void RecordCycle(double seconds);

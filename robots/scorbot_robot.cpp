@@ -330,6 +330,42 @@ RobotPose ScorbotRobot::NearestReachable(RobotFrame frame, const vpHomogeneousMa
   return p;
 }
 
+RobotPose ScorbotRobot::PoseAlongMove(RobotFrame frame, const vpHomogeneousMatrix& from,
+                                      const vpHomogeneousMatrix& target, double fraction) const {
+  RobotPose p;
+  const vpHomogeneousMatrix cMe = options_.eMc.inverse();
+  const vpHomogeneousMatrix wMe_from = frame == RobotFrame::kCamera ? from * cMe : from;
+  const vpHomogeneousMatrix wMe_to = frame == RobotFrame::kCamera ? target * cMe : target;
+  // The start: the joints the arm stands at: those read last if `from` is their pose (the
+  // runner reads it just before), else the inverse kinematics. The end: what StartMove()
+  // sends, rounded to the ACL units; the controller solves it as below. A joint outside its
+  // range still gives joints (StartMove() refuses such a target).
+  const ScorbotIk q0 = [&] {
+    const PoseDistance off_read = Distance(wMe_from, wMe_);
+    if (off_read.translation_m > 1e-9 || off_read.rotation_rad > 1e-9) {
+      return InverseKinematics(options_.geometry, wMe_from, 1e-6);
+    }
+    ScorbotIk read;
+    read.ok = true;
+    read.q = q_;
+    return read;
+  }();
+  const ScorbotIk q1 = InverseKinematics(options_.geometry, FromAclPose(ToAclPose(wMe_to)), 1e-6);
+  for (const ScorbotIk* ik : {&q0, &q1}) {
+    if (!ik->ok && ik->axis == 0) {
+      p.result = RobotResult::Fail(RobotStatus::kUnreachable,
+                                   std::string("scorbot: no joints for the move's ") +
+                                       (ik == &q0 ? "start" : "target") + ": " + ik->why);
+      return p;
+    }
+  }
+  ScorbotJoints q{};
+  for (int i = 0; i < 5; ++i) q[i] = q0.q[i] + fraction * (q1.q[i] - q0.q[i]);
+  const vpHomogeneousMatrix wMe = ForwardKinematics(options_.geometry, q);
+  p.pose = frame == RobotFrame::kCamera ? wMe * options_.eMc : wMe;
+  return p;
+}
+
 RobotResult ScorbotRobot::StartMove(RobotFrame frame, const vpHomogeneousMatrix& target) {
   if (RobotResult r = CheckEnabled(); !r.ok()) return r;
   if (!target.isAnHomogeneousMatrix()) {

@@ -24,6 +24,10 @@
 //                 move_timeout_s.
 //   NearestReachable() the kinematics' projection (scorbot_kinematics.h), rounded to the ACL
 //                 units (0.1 mm, 0.1 deg), checked against the joint ranges.
+//   PoseAlongMove() nothing sent: MOVE is joint-interpolated, so the path is the forward
+//                 kinematics of the joints linear between the inverse kinematics of both ends
+//                 (the target rounded to the ACL units as StartMove() sends it): the tool swings
+//                 on an arc about the base axis, not along the chord.
 // Errors: a controller error anywhere in a reply (or printed asynchronously before it) becomes
 // the result, with the controller's text in the message: IMPACT PROTECTION, HOME FAILURE ->
 // kError; OUT OF RANGE -> kLimit; 317 BAD CARTESIAN POINT, 312 BAD POINT COORDINATE ->
@@ -111,6 +115,9 @@ class ScorbotRobot final : public Robot {
   /// kUnsupported: ACL has no velocity interface. Throws std::invalid_argument if v is not 6.
   RobotResult SetVelocity(RobotFrame frame, const vpColVector& v) override;
   RobotPose NearestReachable(RobotFrame frame, const vpHomogeneousMatrix& target) override;
+  /// The joint-interpolated path of MOVE (see the file comment).
+  RobotPose PoseAlongMove(RobotFrame frame, const vpHomogeneousMatrix& from,
+                          const vpHomogeneousMatrix& target, double fraction) const override;
   vpHomogeneousMatrix eMc() const override { return options_.eMc; }
 
   /// HOME (blocking, up to home_timeout_s). Needs Enable(). Moves the arm!
