@@ -1,6 +1,7 @@
 // ScorbotRobot through SafeRobot against the Controller-A simulator on a real pty: moves that
 // reach their targets, the 5-axis projection, Stop() during a move, controller errors with the
-// controller's text, a silent controller, the port closed during a move, reconnection.
+// controller's text, a silent controller, the port closed during a move, reconnection, a move
+// whose joint-interpolated arc leaves the workspace box.
 #include "robots/scorbot_robot.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <visp3/core/vpMath.h>
 #include <visp3/core/vpRzyxVector.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <thread>
 
@@ -152,6 +154,63 @@ TEST(ScorbotRobot, StartMoveRefusesPosesFiveAxesCannotReach) {
   EXPECT_EQ(far.result.status, RobotStatus::kUnreachable);
   EXPECT_EQ(rig.safe->state(), SafeRobotState::kStopped);
   EXPECT_EQ(rig.sim.stats().moves_started, 0);
+}
+
+// MOVE is joint-interpolated: from (0.79, 0.20) to (0.79, -0.20) m the base swings the tool at
+// a radius of 0.815 m, out of scorbot-sim.yaml's box (x <= 0.80 m) mid-way though both ends
+// are in it. The runner refuses it before anything is sent; with room for the arc it runs.
+TEST(ScorbotRobot, MoveWhoseArcLeavesTheBoxIsRefusedBeforeAnythingIsSent) {
+  const ScorbotGeometry geometry;
+  const AclPose from_acl{7900, 2000, 4500, -100, 0};  // tool 10 deg below the horizontal
+  const AclPose to_acl{7900, -2000, 4500, -100, 0};
+  const ScorbotIk start = InverseKinematics(geometry, FromAclPose(from_acl));
+  ASSERT_TRUE(start.ok) << start.why;
+  ScorbotSimOptions sim_options = FastSim();
+  for (int i = 0; i < 5; ++i) sim_options.start_deg[i] = vpMath::deg(start.q[i]);
+  const vpHomogeneousMatrix eMc(0, 0, 0, 0, 0, vpMath::rad(90));  // as scorbot-sim.yaml
+  for (const double x_max : {0.80, 0.82}) {
+    ScorbotControllerSim sim(sim_options);
+    sim.Start();
+    ScorbotOptions o = RobotOptions(sim.DevicePath());
+    o.eMc = eMc;
+    ScorbotRobot robot(o);
+    SafetyOptions safety = Safety();
+    safety.workspace_min_m = {0.25, -0.30, 0.30};  // scorbot-sim.yaml's box
+    safety.workspace_max_m = {x_max, 0.30, 0.90};
+    safety.reach_tolerance_rad = 0.005;
+    SafeRobot safe(robot, safety);
+    ASSERT_TRUE(safe.Connect().ok());
+    ASSERT_TRUE(safe.Enable().ok());
+    const RobotPose from = safe.GetPosition(RobotFrame::kCamera);
+    ASSERT_TRUE(from.result.ok()) << from.result.message;
+    const vpHomogeneousMatrix target = FromAclPose(to_acl) * eMc;
+    // The straight chord stays at x = 0.79 m; the arc does not.
+    const RobotPose mid = robot.PoseAlongMove(RobotFrame::kCamera, from.pose, target, 0.5);
+    ASSERT_TRUE(mid.result.ok()) << mid.result.message;
+    EXPECT_NEAR(mid.pose[0][3], std::hypot(0.79, 0.20), 1e-3);
+    EXPECT_NEAR(mid.pose[1][3], 0, 2e-4);  // the start is read through the encoders
+    const ScorbotJoints before = sim.joints();
+    const MoveReport report = safe.MovePosition(RobotFrame::kCamera, target);
+    if (x_max < 0.81) {
+      EXPECT_EQ(report.result.status, RobotStatus::kWorkspace);
+      EXPECT_NE(report.result.message.find("the move's path, at 0."), std::string::npos)
+          << report.result.message;
+      EXPECT_NE(report.result.message.find("would take the camera to x = 0.80"), std::string::npos)
+          << report.result.message;
+      EXPECT_NE(report.result.message.find("outside the workspace box [0.25, 0.8] m"),
+                std::string::npos)
+          << report.result.message;
+      EXPECT_EQ(report.polls, 0);
+      EXPECT_EQ(sim.stats().moves_started, 0);
+      EXPECT_FALSE(sim.moving());
+      EXPECT_EQ(sim.joints(), before);
+      EXPECT_EQ(safe.state(), SafeRobotState::kStopped);
+    } else {
+      EXPECT_TRUE(report.result.ok()) << report.result.message;
+      EXPECT_EQ(sim.stats().moves_completed, 1);
+      EXPECT_LE(Distance(report.reached, target).translation_m, 1e-3);
+    }
+  }
 }
 
 TEST(ScorbotRobot, StopAbortsAMove) {
