@@ -14,6 +14,19 @@ namespace {
 constexpr char kXon = 0x11;
 constexpr char kXoff = 0x13;
 constexpr char kCtrlA = 0x01;
+// An unterminated line longer than this is taken as a line.
+constexpr std::size_t kMaxPartialLine = 512;
+// Output without a prompt longer than this fails the command (not a Controller-A?).
+constexpr std::size_t kMaxReply = 65536;
+// While waiting for the resynchronisation: stale output beyond this is dropped, keeping the
+// last kResyncKeep bytes (where its output may have begun).
+constexpr std::size_t kMaxResyncBuffer = 16384;
+constexpr std::size_t kResyncKeep = 1024;
+constexpr std::size_t kMaxAsyncText = 4096;
+constexpr std::size_t kMaxErrors = 16;
+// A read-only command; its echo after two bare prompts marks the resynchronisation's output.
+constexpr char kResyncMarker[] = "LISTPV POSITION";
+constexpr char kResyncWhat[] = "NOECHO, ECHO, LISTPV POSITION";
 
 std::string Trim(const std::string& s) {
   std::size_t b = 0, e = s.size();
@@ -62,6 +75,55 @@ std::size_t FindPrompt(const std::string& s, std::size_t from) {
     if (s[i] == '>' && (i == from || s[i - 1] == '\n' || s[i - 1] == '\r')) return i;
   }
   return std::string::npos;
+}
+
+// Moves the complete lines of `*pending` (up to its last CR or LF) and the prompts that start
+// the rest to `*async`; the rest, an unterminated line, stays (unless it is too long).
+void SplitOffCompleteLines(std::string* pending, std::string* async) {
+  const std::size_t last = pending->find_last_of("\r\n");
+  std::size_t keep_from = last == std::string::npos ? 0 : last + 1;
+  while (keep_from < pending->size() && (*pending)[keep_from] == '>') ++keep_from;
+  if (pending->size() - keep_from > kMaxPartialLine) keep_from = pending->size();
+  async->append(*pending, 0, keep_from);
+  pending->erase(0, keep_from);
+}
+
+// The end (after the last prompt) of the resynchronisation's output in `s`: two prompts with
+// only CR/LF between and after them, the echo of the marker, its reply and prompt and, when
+// `noecho`, the echo of NOECHO and its prompt. npos while not (yet) all there.
+std::size_t FindResyncEnd(const std::string& s, bool noecho) {
+  const std::string echo = std::string(kResyncMarker) + "\r\n";
+  for (std::size_t at = s.find(echo); at != std::string::npos; at = s.find(echo, at + 1)) {
+    std::size_t i = at;
+    int prompts = 0;
+    while (i > 0 && prompts < 2) {
+      const char c = s[i - 1];
+      if (c == '>') {
+        ++prompts;
+      } else if (c != '\r' && c != '\n') {
+        break;
+      }
+      --i;
+    }
+    if (prompts < 2) continue;
+    std::size_t end = FindPrompt(s, at + echo.size());
+    if (end == std::string::npos) return end;
+    ++end;
+    if (noecho) {
+      const std::string noecho_echo = "NOECHO\r\n";
+      const std::size_t n = s.find(noecho_echo, end);
+      if (n == std::string::npos) return n;
+      end = FindPrompt(s, n + noecho_echo.size());
+      if (end == std::string::npos) return end;
+      ++end;
+    }
+    return end;
+  }
+  return std::string::npos;
+}
+
+AclStatus StatusOf(const IoResult& r) {
+  return r.status == IoStatus::kTimeout ? AclStatus::kTimeout : AclStatus::kLinkError;
 }
 
 // Reads a signed integer after `key` (e.g. "X:", "3:") in `s`; spaces allowed after the colon.
@@ -119,6 +181,9 @@ std::vector<AclError> ParseAclErrors(const std::string& text) {
   std::vector<AclError> errors;
   for (const std::string& raw : Lines(StripFlowControl(text))) {
     std::string line = raw;
+    while (!line.empty() && line[0] == '>') line.erase(0, 1);  // a prompt before the message
+    line = Trim(line);
+    const std::string shown = line;
     bool starred = false;
     while (!line.empty() && line[0] == '*') {
       starred = true;
@@ -127,7 +192,7 @@ std::vector<AclError> ParseAclErrors(const std::string& text) {
     line = Trim(line);
     const std::string up = Upper(line);
     AclError e;
-    e.text = Trim(raw);
+    e.text = shown;
     // A numbered error: digits, a space, then an upper-case word.
     std::size_t digits = 0;
     while (digits < up.size() && std::isdigit(static_cast<unsigned char>(up[digits]))) ++digits;
@@ -222,32 +287,110 @@ AclClient::AclClient(ByteLink& link, const AclClientOptions& options)
 }
 
 AclReply AclClient::Finish(AclReply reply, const std::string& async, const std::string& body) {
-  if (!async.empty()) async_text_ += async;
+  if (!async.empty()) {
+    async_text_ += async;
+    if (async_text_.size() > kMaxAsyncText)
+      async_text_.erase(0, async_text_.size() - kMaxAsyncText);
+  }
   std::vector<AclError> errors = ParseAclErrors(async);
   for (const AclError& e : ParseAclErrors(body)) errors.push_back(e);
+  if (errors.size() > kMaxErrors) errors.resize(kMaxErrors);
   reply.lines = Lines(StripFlowControl(body));
   reply.errors = std::move(errors);
-  if (reply.status == AclStatus::kOk && !reply.errors.empty()) {
+  if (reply.errors.empty()) return reply;
+  std::string texts = reply.errors.front().text;
+  for (std::size_t i = 1; i < reply.errors.size(); ++i) texts += "; " + reply.errors[i].text;
+  if (reply.status == AclStatus::kOk) {
     reply.status = AclStatus::kControllerError;
-    reply.message = "controller: " + reply.errors.front().text;
-    for (std::size_t i = 1; i < reply.errors.size(); ++i)
-      reply.message += "; " + reply.errors[i].text;
+    reply.message = "controller: " + texts;
+  } else {
+    reply.message += " (the controller printed: " + texts + ")";
   }
   return reply;
+}
+
+bool AclClient::Resynchronise(const std::string& command, std::string* async, AclReply* reply) {
+  if (sync_ == Sync::kInSync) return true;
+  const double timeout = options_.reply_timeout_s;
+  if (sync_ == Sync::kNeeded) {
+    pending_ += StripFlowControl(link_.DrainInput());
+    resync_noecho_ = !options_.echo;
+    std::string sequence = std::string("NOECHO\rECHO\r") + kResyncMarker + "\r";
+    if (resync_noecho_) sequence += "NOECHO\r";
+    if (IoResult w = link_.Write(sequence, timeout); !w.ok()) {
+      reply->status = StatusOf(w);
+      reply->message = "'" + command + "' not sent: resynchronising after a timeout (" +
+                       kResyncWhat + "): " + w.message;
+      return false;
+    }
+    sync_ = Sync::kSent;
+    ++resyncs_;
+  }
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::microseconds(static_cast<long long>(timeout * 1e6));
+  for (;;) {
+    pending_ = StripFlowControl(pending_);
+    const std::size_t end = FindResyncEnd(pending_, resync_noecho_);
+    if (end != std::string::npos) {
+      // All before answered earlier commands, or is the resynchronisation's own output.
+      async->append(pending_, pending_scanned_, end - pending_scanned_);
+      pending_.erase(0, end);
+      pending_scanned_ = 0;
+      SplitOffCompleteLines(&pending_, async);
+      sync_ = Sync::kInSync;
+      return true;
+    }
+    if (pending_.size() > kMaxResyncBuffer) {
+      const std::size_t cut = pending_.size() - kResyncKeep;
+      if (cut > pending_scanned_) async->append(pending_, pending_scanned_, cut - pending_scanned_);
+      pending_.erase(0, cut);
+      pending_scanned_ = pending_scanned_ > cut ? pending_scanned_ - cut : 0;
+    }
+    const double left_s =
+        std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    const IoResult r =
+        left_s > 0 ? link_.ReadSome(&pending_, left_s) : IoResult{IoStatus::kTimeout, "timeout"};
+    if (r.ok()) continue;
+    // Report the error lines received so far; keep the text (the answer may have begun).
+    const std::size_t last = pending_.find_last_of("\r\n");
+    if (last != std::string::npos && last + 1 > pending_scanned_) {
+      async->append(pending_, pending_scanned_, last + 1 - pending_scanned_);
+      pending_scanned_ = last + 1;
+    }
+    reply->status = StatusOf(r);
+    std::ostringstream s;
+    s << "'" << command << "' not sent: out of step with the controller since an earlier "
+      << "timeout, and ";
+    if (r.status == IoStatus::kTimeout) {
+      s << "no answer to the resynchronisation (" << kResyncWhat << ") within " << timeout
+        << " s (controller silent or busy? if it lost our input, connect again)";
+    } else {
+      s << "waiting for the resynchronisation: " << r.message;
+    }
+    reply->message = s.str();
+    return false;
+  }
 }
 
 AclReply AclClient::Command(const std::string& command, double timeout_s) {
   ++commands_;
   const double timeout = timeout_s > 0 ? timeout_s : options_.reply_timeout_s;
-  std::string async = StripFlowControl(link_.DrainInput());
   AclReply reply;
+  std::string async;
+  if (!Resynchronise(command, &async, &reply)) return Finish(reply, async, "");
+  // What arrived since the last reply is asynchronous; an unterminated line stays pending and
+  // is completed by what follows.
+  pending_ += StripFlowControl(link_.DrainInput());
+  SplitOffCompleteLines(&pending_, &async);
   if (IoResult w = link_.Write(command + "\r", timeout); !w.ok()) {
-    reply.status = w.status == IoStatus::kTimeout ? AclStatus::kTimeout : AclStatus::kLinkError;
+    sync_ = Sync::kNeeded;  // part of the command may have left
+    reply.status = StatusOf(w);
     reply.message = "sending '" + command + "': " + w.message;
     return Finish(reply, async, "");
   }
   const std::string echo = command + "\r\n";
-  std::string in;
+  std::string in = std::move(pending_);
+  pending_.clear();
   std::size_t body_from = 0;
   bool echo_seen = !options_.echo;
   const auto deadline = std::chrono::steady_clock::now() +
@@ -266,15 +409,23 @@ AclReply AclClient::Command(const std::string& command, double timeout_s) {
       const std::size_t prompt = FindPrompt(in, body_from);
       if (prompt != std::string::npos) {
         const std::string body = in.substr(body_from, prompt - body_from);
-        // Anything after the prompt (should be nothing) is kept for the next command.
-        async_text_ += in.substr(prompt + 1);
+        // What came with the prompt: complete lines (an error printed right after it) are
+        // reported now, an unterminated line with the next command.
+        pending_ = in.substr(prompt + 1);
+        SplitOffCompleteLines(&pending_, &async);
         return Finish(reply, async, body);
       }
     }
     const double left_s =
         std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
     IoResult r = left_s > 0 ? link_.ReadSome(&in, left_s) : IoResult{IoStatus::kTimeout, "timeout"};
+    if (r.ok() && in.size() > kMaxReply) {
+      r = {IoStatus::kError, "more than " + std::to_string(kMaxReply) +
+                                 " bytes without a prompt (is this a Controller-A at the "
+                                 "right baud rate?)"};
+    }
     if (!r.ok()) {
+      sync_ = Sync::kNeeded;  // a late answer must not be taken for the next command's
       std::ostringstream s;
       if (r.status == IoStatus::kTimeout) {
         reply.status = AclStatus::kTimeout;
@@ -298,7 +449,7 @@ AclReply AclClient::Abort() {
   // Ctrl-A first, on its own: the controller acts on it as it arrives.
   if (IoResult w = link_.Write(std::string(1, kCtrlA), options_.reply_timeout_s); !w.ok()) {
     AclReply reply;
-    reply.status = w.status == IoStatus::kTimeout ? AclStatus::kTimeout : AclStatus::kLinkError;
+    reply.status = StatusOf(w);
     reply.message = "sending Ctrl-A: " + w.message;
     return reply;
   }
@@ -340,6 +491,7 @@ std::string AclClient::TakeAsyncText() {
 AclStats AclClient::stats() const {
   AclStats s;
   s.commands = commands_;
+  s.resyncs = resyncs_;
   s.link = link_.counters();
   return s;
 }

@@ -3,17 +3,38 @@
 // A command is sent as its text plus CR. The controller echoes what it receives (unless NOECHO),
 // runs the command, prints its reply lines and prompts with '>' at the start of a line.
 // Command():
-//   1. drains bytes that arrived since the last command (asynchronous messages such as
-//      "*** IMPACT PROTECTION axis 2" printed during a move) and keeps them;
-//   2. writes the command and CR;
-//   3. reads until the prompt: with echo on, the prompt must come after the echo of the command
-//      (text before the echo is asynchronous output, parsed for errors like the reply); with
-//      echo off, the first '>' at the start of a line;
-//   4. strips XON/XOFF bytes (0x11, 0x13: they reach us when flow control is off), splits the
+//   1. after a timeout, first resynchronises (below);
+//   2. takes the bytes that arrived since the last reply (asynchronous messages such as
+//      "*** IMPACT PROTECTION axis 2" printed during a move): their complete lines are
+//      asynchronous output, an unterminated line is kept and completed by what follows;
+//   3. writes the command and CR;
+//   4. reads until the prompt: with echo on, the prompt must come after the echo of the command
+//      (text before the echo is asynchronous output); with echo off, the first '>' at the start
+//      of a line;
+//   5. keeps what came after the prompt in the same read: its complete lines are asynchronous
+//      output reported with this reply, an unterminated line waits for the next command;
+//   6. strips XON/XOFF bytes (0x11, 0x13: they reach us when flow control is off), splits the
 //      reply into lines and parses every error line into an AclError.
-// An error anywhere in the drained, skipped or reply text makes the reply a controller error.
-// Abort() is Ctrl-A (0x01, stops all motion immediately) followed by CLRBUF (clears the
-// movement buffer). Not thread-safe.
+// An error anywhere in the asynchronous or reply text makes the reply a controller error, so an
+// error line is reported once, with the reply it arrived with or, if it was cut by a read
+// boundary, with the next one. Buffers are bounded (an unterminated line: 512 bytes; output
+// without a prompt: 64 KiB, then a link error).
+//
+// Resynchronisation. After a command timed out (or its write failed) the controller may still
+// answer it later: with echo off, its late prompt would end the next command's reply. So the
+// next Command() first sends "NOECHO CR ECHO CR LISTPV POSITION CR" (plus "NOECHO CR" when echo
+// is off) and reads until the output of exactly that sequence: two prompts (NOECHO's and
+// ECHO's, CR/LF between allowed), the echo of "LISTPV POSITION", its reply and prompt (then the
+// echo of NOECHO and its prompt). Earlier commands produce no such pattern (their echo, if any,
+// is not preceded by two bare prompts), and the controller runs its input in order, so
+// everything before it answered earlier commands: it is dropped (its error lines are
+// reported). Only then is the command sent. If the sequence is not answered within
+// reply_timeout_s, the command is not sent (kTimeout) and the next Command() waits for the same
+// sequence again: no second one is sent, since its output could not be told from the first's.
+// A controller that lost the sequence (bytes lost on the line) therefore stays out of step
+// until a new client (ScorbotRobot::Connect()).
+// Abort() is Ctrl-A (0x01, stops all motion immediately, sent even when out of step) followed
+// by CLRBUF (clears the movement buffer). Not thread-safe.
 #pragma once
 
 #include <array>
@@ -48,8 +69,8 @@ struct AclError {
   std::string text;  ///< the controller's line, trimmed
 };
 
-/// The error lines of `text` (any line starting with "***", "CONTROL DISABLED", or a number
-/// followed by an upper-case word). Other lines are ignored.
+/// The error lines of `text` (any line starting, after any prompt '>', with "***",
+/// "CONTROL DISABLED", or a number followed by an upper-case word). Other lines are ignored.
 std::vector<AclError> ParseAclErrors(const std::string& text);
 
 /// What LISTPV prints for a position: joint encoder counts and, when it has them, the Cartesian
@@ -99,6 +120,7 @@ struct AclClientOptions {
 /// Counts over the life of a client.
 struct AclStats {
   long commands = 0;
+  long resyncs = 0;   ///< resynchronisation sequences sent after timeouts
   LinkCounters link;  ///< bytes over the link (from the ByteLink)
 };
 
@@ -120,18 +142,29 @@ class AclClient {
   /// LISTPV `position` ("POSITION" for the current one), parsed.
   AclReply ListPosition(const std::string& position, AclPositionValues* values);
 
-  /// Asynchronous output seen so far (drained before commands or skipped before an echo),
-  /// and clears it.
+  /// Asynchronous output seen so far (its last 4096 bytes), and clears it.
   std::string TakeAsyncText();
+  /// False after a timeout until the resynchronisation has been answered.
+  bool in_sync() const { return sync_ == Sync::kInSync; }
   AclStats stats() const;
 
  private:
+  enum class Sync { kInSync, kNeeded, kSent };
   AclReply Finish(AclReply reply, const std::string& async, const std::string& body);
+  // Brings the exchange back in step after a timeout; false (with `*reply` set) if it could not.
+  bool Resynchronise(const std::string& command, std::string* async, AclReply* reply);
 
   ByteLink& link_;
   AclClientOptions options_;
+  // Bytes received after the last prompt not yet consumed: an unterminated line while in step,
+  // everything since the resynchronisation was sent while waiting for it.
+  std::string pending_;
+  std::size_t pending_scanned_ = 0;  // bytes of pending_ already handed over as asynchronous text
   std::string async_text_;
+  Sync sync_ = Sync::kInSync;
+  bool resync_noecho_ = false;  // the resynchronisation sent ends with NOECHO
   long commands_ = 0;
+  long resyncs_ = 0;
 };
 
 }  // namespace oal

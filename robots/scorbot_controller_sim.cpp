@@ -143,6 +143,8 @@ void ScorbotControllerSim::Start() {
     echo_ = true;
     silent_ = false;
     homing_reply_pending_ = false;
+    holding_reply_ = false;
+    held_.clear();
     Emit("SYSTEM READY!\r\n");
     Prompt();
   }
@@ -179,6 +181,20 @@ std::string ScorbotControllerSim::ConnectPath() const {
 void ScorbotControllerSim::InjectImpact(int axis) {
   std::lock_guard<std::mutex> lock(mutex_);
   impact_axis_ = std::max(1, std::min(5, axis));
+}
+
+void ScorbotControllerSim::InjectImpactAfterNextPrompt(int axis) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  impact_after_prompt_axis_ = std::max(1, std::min(5, axis));
+}
+
+void ScorbotControllerSim::InjectLateReply() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  late_reply_armed_ = true;
+}
+
+std::string ScorbotControllerSim::last_command() const {
+  return Snapshot(last_command_);
 }
 
 void ScorbotControllerSim::SetSilent(bool silent) {
@@ -316,6 +332,10 @@ void ScorbotControllerSim::FlushOutput() {
 
 void ScorbotControllerSim::Emit(const std::string& text) {
   if (silent_) return;
+  if (holding_reply_) {
+    held_ += text;
+    return;
+  }
   if (out_.empty()) {
     const double wall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_).count();
@@ -341,6 +361,11 @@ void ScorbotControllerSim::Receive(char c) {
   }
   if (c == kXon || c == kXoff || c == '\n' || c == '\0') return;
   if (c == '\r') {
+    if (holding_reply_) {  // the late answer goes out before this line is executed
+      holding_reply_ = false;
+      Emit(held_);
+      held_.clear();
+    }
     if (echo_) Emit("\r\n");
     const std::string line = line_;
     line_.clear();
@@ -581,6 +606,11 @@ void ScorbotControllerSim::Execute(const std::string& raw) {
   const std::string line = Upper(raw);
   const std::vector<std::string> w = Split(line);
   ++stats_.commands;
+  last_command_ = line;
+  if (late_reply_armed_) {
+    late_reply_armed_ = false;
+    holding_reply_ = true;  // from here on, output is held (the echo already went)
+  }
   if (w.empty()) {
     Prompt();
     return;
@@ -674,6 +704,14 @@ void ScorbotControllerSim::Execute(const std::string& raw) {
     Emit("*** INVALID COMMAND\r\n");
   }
   Prompt();
+  if (impact_after_prompt_axis_ > 0 && motion_.active && !motion_.homing) {
+    joints_ = CurrentJoints();
+    motion_ = Motion();
+    queue_.clear();
+    control_ = false;
+    Emit("\r\n*** IMPACT PROTECTION axis " + std::to_string(impact_after_prompt_axis_) + "\r\n");
+    impact_after_prompt_axis_ = 0;
+  }
 }
 
 }  // namespace oal

@@ -32,9 +32,11 @@
 //     throttle_to_baud, every byte in each direction takes 10 bits at the baud rate (8N1), the
 //     two directions independently (full duplex), so link timing is realistic.
 // FAULT INJECTION (thread-safe, for tests): an impact on axis n halfway through the next move;
-// silence (a hung controller: input discarded, nothing executed, echoed or answered); "317 BAD
-// CARTESIAN POINT" for the next MOVE; a home failure on axis n for the next HOME; XOFF / XON sent
-// to the host.
+// an impact on axis n during the current move right after the next command's prompt (in the
+// same write); silence (a hung controller: input discarded, nothing executed, echoed or
+// answered); a late answer (the next command's reply and prompt held back until the host sends
+// another line); "317 BAD CARTESIAN POINT" for the next MOVE; a home failure on axis n for the
+// next HOME; XOFF / XON sent to the host.
 #pragma once
 
 #include <array>
@@ -107,6 +109,14 @@ class ScorbotControllerSim {
   // --- fault injection ---
   /// The next move stops halfway with "*** IMPACT PROTECTION axis n"; control goes off.
   void InjectImpact(int axis);
+  /// While a move runs, the next command executed is answered as usual and the move then stops
+  /// with "*** IMPACT PROTECTION axis n" written right after that command's prompt, in the same
+  /// write (control goes off). Deterministic, unlike InjectImpact().
+  void InjectImpactAfterNextPrompt(int axis);
+  /// The reply and prompt of the next command (its echo is not held) are held back and sent
+  /// when the host's next CR arrives, before that line is executed: a busy controller that
+  /// answers after the host gave up.
+  void InjectLateReply();
   /// While silent, input is discarded unexecuted and nothing is sent (no echo, no reply, no
   /// prompt, no asynchronous message): a hung controller.
   void SetSilent(bool silent);
@@ -124,6 +134,8 @@ class ScorbotControllerSim {
   bool control_enabled() const;
   bool echo() const;
   int speed_percent() const;
+  /// The last command line executed, upper-cased ("" before the first).
+  std::string last_command() const;
   ScorbotSimStats stats() const;
 
  private:
@@ -194,6 +206,11 @@ class ScorbotControllerSim {
   std::string pending_async_;
   bool silent_ = false;
   int impact_axis_ = 0;
+  int impact_after_prompt_axis_ = 0;
+  bool late_reply_armed_ = false;
+  bool holding_reply_ = false;
+  std::string held_;  // output held back by a late reply
+  std::string last_command_;
   bool bad_cartesian_ = false;
   int home_failure_axis_ = 0;
   bool homing_reply_pending_ = false;

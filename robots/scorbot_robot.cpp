@@ -189,7 +189,14 @@ RobotResult ScorbotRobot::Connect() {
 }
 
 void ScorbotRobot::Disconnect() noexcept {
-  if (connected_) Stop();
+  // The session ends: abort, then control off (COFF) once the controller confirmed the abort,
+  // so that the arm cannot move until someone enables it again.
+  if (connected_ && Stop().ok()) {
+    try {
+      client_->Command("COFF");
+    } catch (...) {
+    }
+  }
   connected_ = false;
   enabled_ = false;
   move_active_ = false;

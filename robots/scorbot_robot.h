@@ -9,6 +9,8 @@
 //   Connect()     waits for the line to go quiet, drains it, sends an empty line (the prompt
 //                 answers), ECHO or NOECHO (options.echo), DEFP P, HERE P, SPEED n. No motion.
 //   Enable()      CON.          Disable()   Ctrl-A, CLRBUF, COFF.
+//   Disconnect() (and the destructor, at the end of a session) Ctrl-A, CLRBUF and, if the
+//                 controller answered them, COFF; then the port is closed.
 //   Stop()        Ctrl-A, CLRBUF (AclClient::Abort). noexcept, safe in any state.
 //   GetPosition() LISTPV POSITION -> encoder counts -> joints -> wMe (forward kinematics);
 //                 wMc = wMe * eMc. The pose read by the last PollMove() is reused once by the
@@ -28,10 +30,12 @@
 //                 kinematics of the joints linear between the inverse kinematics of both ends
 //                 (the target rounded to the ACL units as StartMove() sends it): the tool swings
 //                 on an arc about the base axis, not along the chord.
-// Errors: a controller error anywhere in a reply (or printed asynchronously before it) becomes
-// the result, with the controller's text in the message: IMPACT PROTECTION, HOME FAILURE ->
-// kError; OUT OF RANGE -> kLimit; 317 BAD CARTESIAN POINT, 312 BAD POINT COORDINATE ->
-// kUnreachable; CONTROL DISABLED -> kNotReady; no prompt within reply_timeout_s -> kTimeout; a
+// Errors: a controller error anywhere in a reply (or printed asynchronously before it, or right
+// after its prompt: then at the latest with the next command) becomes the result, with the
+// controller's text in the message, so a poll reports an impact at once: IMPACT PROTECTION,
+// HOME FAILURE -> kError; OUT OF RANGE -> kLimit; 317 BAD CARTESIAN POINT, 312 BAD POINT
+// COORDINATE -> kUnreachable; CONTROL DISABLED -> kNotReady; no prompt within reply_timeout_s
+// -> kTimeout (the next command first resynchronises the exchange: acl_client.h); a
 // closed or failed link -> kError, and the robot counts as disconnected (Connect() again);
 // until a Connect() succeeds, Stop() still tries the abort but, if it cannot be sent, fails
 // (the arm may still be moving: nothing confirmed it stopped).
@@ -98,7 +102,7 @@ class ScorbotRobot final : public Robot {
  public:
   /// Throws std::invalid_argument on bad options. Does not open the port.
   explicit ScorbotRobot(const ScorbotOptions& options);
-  /// Aborts any motion (Ctrl-A, CLRBUF) and closes the port.
+  /// Disconnect(): aborts any motion (Ctrl-A, CLRBUF), control off (COFF), closes the port.
   ~ScorbotRobot() override;
   ScorbotRobot(const ScorbotRobot&) = delete;
   ScorbotRobot& operator=(const ScorbotRobot&) = delete;
@@ -127,7 +131,8 @@ class ScorbotRobot final : public Robot {
   /// The manipulator Jacobian (6 x 5, twist of e in e per joint rate) at the joints read last
   /// (home before any read); see EndEffectorJacobian().
   vpMatrix eJe() const;
-  /// Closes the port (aborting motion first). Connect() opens it again.
+  /// Ends the session: aborts motion (Ctrl-A, CLRBUF) and, once the controller confirmed the
+  /// abort, turns control off (COFF); then closes the port. Connect() opens it again.
   void Disconnect() noexcept;
   bool connected() const { return connected_; }
   bool enabled() const { return enabled_; }

@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -90,7 +92,12 @@ SerialPort::~SerialPort() {
 }
 
 void SerialPort::Close() noexcept {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ >= 0) {
+    // The exclusive flag belongs to the tty, which outlives our descriptor when another one is
+    // open (the simulator keeps its pty slave open): clear it, or we could not open it again.
+    ::ioctl(fd_, TIOCNXCL);
+    ::close(fd_);  // releases the lock
+  }
   fd_ = -1;
 }
 
@@ -99,10 +106,34 @@ IoResult SerialPort::Open(const std::string& path, const SerialPortOptions& opti
   Close();
   path_ = path;
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return {IoStatus::kError, Errno("cannot open " + path)};
+  if (fd < 0) {
+    if (errno == EBUSY) {
+      return {IoStatus::kError,
+              Errno("cannot open " + path) + " (another program has it open exclusively)"};
+    }
+    return {IoStatus::kError, Errno("cannot open " + path)};
+  }
+  // One program at a time talks to the controller: an advisory lock (also among root
+  // processes, and within one process), then the tty's exclusive mode (TIOCEXCL: further
+  // open()s fail with EBUSY, except for root).
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const IoResult r{IoStatus::kError,
+                     errno == EWOULDBLOCK
+                         ? "cannot open " + path +
+                               ": in use by another program (or another port in this one): "
+                               "it holds the lock on the device; close it first"
+                         : Errno("cannot lock " + path)};
+    ::close(fd);
+    return r;
+  }
   termios tio{};
   if (::tcgetattr(fd, &tio) != 0) {
     const IoResult r{IoStatus::kError, Errno(path + " is not a serial port (tcgetattr)")};
+    ::close(fd);
+    return r;
+  }
+  if (::ioctl(fd, TIOCEXCL) != 0) {
+    const IoResult r{IoStatus::kError, Errno("cannot open " + path + " exclusively (TIOCEXCL)")};
     ::close(fd);
     return r;
   }
@@ -120,6 +151,7 @@ IoResult SerialPort::Open(const std::string& path, const SerialPortOptions& opti
   if (::cfsetispeed(&tio, speed) != 0 || ::cfsetospeed(&tio, speed) != 0 ||
       ::tcsetattr(fd, TCSANOW, &tio) != 0) {
     const IoResult r{IoStatus::kError, Errno("cannot configure " + path)};
+    ::ioctl(fd, TIOCNXCL);
     ::close(fd);
     return r;
   }

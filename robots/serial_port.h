@@ -3,7 +3,8 @@
 // ByteLink is the small interface the ACL command layer depends on (shared/STYLE.md: "the
 // serial driver depends on a small transport interface"), so tests can run the command layer
 // against a fault-injecting link as well as against the simulator on a real pseudo-terminal.
-// SerialPort is the POSIX implementation: an RAII file descriptor opened non-blocking, termios
+// SerialPort is the POSIX implementation: an RAII file descriptor opened non-blocking and
+// exclusively (flock + TIOCEXCL: one program at a time talks to the controller), termios
 // raw 8N1 at a configurable baud rate, optional XON/XOFF flow control (IXON | IXOFF: the kernel
 // pauses our output on XOFF from the controller and resumes on XON), writes and reads with
 // timeouts through poll(2), and byte counters for the link budget.
@@ -73,7 +74,10 @@ class SerialPort final : public ByteLink {
   SerialPort(const SerialPort&) = delete;
   SerialPort& operator=(const SerialPort&) = delete;
 
-  /// Opens `path` (a tty or a pty slave) and configures it. Closes a port already open.
+  /// Opens `path` (a tty or a pty slave) exclusively and configures it. Closes a port already
+  /// open. Exclusive: an advisory lock (flock; a second Open() of the same device, in this or
+  /// another process, fails saying it is in use) and the tty's exclusive mode (TIOCEXCL: other
+  /// programs' open() fails with EBUSY unless they run as root); Close() undoes both.
   /// Throws std::invalid_argument on bad options; I/O failures come back as the result.
   IoResult Open(const std::string& path, const SerialPortOptions& options);
   void Close() noexcept;
