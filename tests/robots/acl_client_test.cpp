@@ -1,9 +1,14 @@
 // The ACL command layer: parsing (LISTPV, every error kind) and the command exchange against
 // the Controller-A simulator on a real pty (echo, NOECHO, prompt, errors, silence, XON/XOFF,
-// a closed link), and against a fault-injecting link.
+// a closed link), against a fault-injecting link, and against a raw pty peer sending exact
+// bytes (errors after a prompt or split across writes, late answers and the resynchronisation,
+// the exclusive port).
 #include "robots/acl_client.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
 
 #include <deque>
 #include <thread>
@@ -13,8 +18,36 @@
 namespace oal {
 namespace {
 
+using testing_scorbot::PtyPeer;
 using testing_scorbot::SimLink;
 using testing_scorbot::WaitFor;
+
+// What the simulator prints for LISTPV POSITION at home, and with other values.
+const char kListpvHome[] =
+    "Position POSITION\r\n 1:0 2:0 3:0 4:0 5:0\r\n X:4165 Y:0 Z:2423 P:-900 R:0\r\n";
+const char kListpvOther[] =
+    "Position POSITION\r\n 1:7 2:0 3:0 4:0 5:0\r\n X:4160 Y:30 Z:2423 P:-900 R:0\r\n";
+const char kImpact[] = "\r\n*** IMPACT PROTECTION axis 2\r\n";
+
+// A client without echo on a port opened on `peer`.
+struct PeerLink {
+  explicit PeerLink(PtyPeer& peer, double reply_timeout_s = 1.0) {
+    const IoResult r = port.Open(peer.DevicePath(), SerialPortOptions());
+    EXPECT_TRUE(r.ok()) << r.message;
+    AclClientOptions acl;
+    acl.echo = false;
+    acl.reply_timeout_s = reply_timeout_s;
+    client = std::make_unique<AclClient>(port, acl);
+  }
+  SerialPort port;
+  std::unique_ptr<AclClient> client;
+};
+
+int CountImpacts(const AclReply& reply) {
+  int n = 0;
+  for (const AclError& e : reply.errors) n += e.kind == AclErrorKind::kImpact && e.axis == 2;
+  return n;
+}
 
 TEST(AclParse, ListpvInTheManualsFormat) {
   AclPositionValues v;
@@ -223,7 +256,7 @@ TEST(AclClient, FlowControlBytesAreIgnoredWhenFlowControlIsOff) {
   EXPECT_EQ(r.lines[0], "PAR 2 = 5");
 }
 
-TEST(AclClient, AbortStopsAMoveAndClearsTheBuffer) {
+TEST(AclClient, AbortStopsAMoveAndClearsTheBufferWithClrbuf) {
   SimLink link;
   ASSERT_TRUE(link.client->Command("SPEED 5").ok());
   ASSERT_TRUE(link.client->Command("DEFP P1").ok());
@@ -232,11 +265,33 @@ TEST(AclClient, AbortStopsAMoveAndClearsTheBuffer) {
   ASSERT_TRUE(link.client->Command("MOVE P1").ok());
   ASSERT_TRUE(link.client->Command("MOVE P1").ok());  // queued behind
   ASSERT_TRUE(link.sim.moving());
-  ASSERT_TRUE(link.client->Abort().ok());
+  const long commands = link.sim.stats().commands;
+  const AclReply abort = link.client->Abort();
+  ASSERT_TRUE(abort.ok()) << abort.message;
+  EXPECT_TRUE(abort.lines.empty());
+  // Ctrl-A is not a command; CLRBUF is, and its answer (echo, prompt) ended the abort.
+  EXPECT_EQ(link.sim.stats().commands, commands + 1);
+  EXPECT_EQ(link.sim.last_command(), "CLRBUF");
   EXPECT_FALSE(link.sim.moving());
   const double at = link.sim.joints()[0];
   std::this_thread::sleep_for(std::chrono::milliseconds(30));
   EXPECT_EQ(link.sim.joints()[0], at);
+  EXPECT_TRUE(link.client->Ping().ok());  // the exchange is still in step
+}
+
+TEST(AclClient, AbortWritesCtrlAThenClrbufAndWaitsForClrbufsPrompt) {
+  PtyPeer peer;
+  PeerLink link(peer);
+  peer.Script(">");  // CLRBUF
+  const AclReply abort = link.client->Abort();
+  ASSERT_TRUE(abort.ok()) << abort.message;
+  EXPECT_EQ(peer.received(),
+            "\x01"
+            "CLRBUF\r");
+  // Unanswered, the abort is not confirmed.
+  const AclReply silent = link.client->Abort();
+  EXPECT_EQ(silent.status, AclStatus::kTimeout);
+  EXPECT_NE(silent.message.find("no reply to 'CLRBUF'"), std::string::npos) << silent.message;
 }
 
 // A link that replays scripted input and records what was written.
@@ -244,6 +299,7 @@ class ScriptedLink final : public ByteLink {
  public:
   std::deque<std::string> replies;  // one per Write
   std::string written;
+  bool chunked = false;  // ReadSome returns all pending bytes at once (else one byte)
   IoResult Write(const std::string& bytes, double /*timeout_s*/) override {
     written += bytes;
     if (!replies.empty()) {
@@ -254,6 +310,11 @@ class ScriptedLink final : public ByteLink {
   }
   IoResult ReadSome(std::string* out, double /*timeout_s*/) override {
     if (pending_.empty()) return {IoStatus::kTimeout, "scripted: nothing"};
+    if (chunked) {
+      *out += pending_;
+      pending_.clear();
+      return {};
+    }
     // One byte at a time: the parser must not depend on chunking.
     out->push_back(pending_[0]);
     pending_.erase(0, 1);
@@ -282,6 +343,167 @@ TEST(AclClient, ByteByByteRepliesWithFlowControlBytesAndAsyncText) {
   AclPositionValues parsed;
   ASSERT_TRUE(ParseListpv(r.text(), &parsed, nullptr));
   EXPECT_EQ(parsed.counts, (ScorbotCounts{1, 2, 3, 4, 5}));
+}
+
+TEST(AclClient, ErrorRightAfterThePromptInTheSameReadFailsThatReply) {
+  // A poll's LISTPV answered, and an impact printed right after the prompt, in one read.
+  ScriptedLink link;
+  link.chunked = true;
+  link.replies.push_back(std::string(kListpvHome) + ">" + kImpact);
+  link.replies.push_back(">");
+  AclClientOptions options;
+  options.echo = false;
+  AclClient client(link, options);
+  AclPositionValues v;
+  const AclReply r = client.ListPosition("POSITION", &v);
+  EXPECT_EQ(r.status, AclStatus::kControllerError);
+  EXPECT_EQ(CountImpacts(r), 1);
+  EXPECT_NE(r.message.find("*** IMPACT PROTECTION axis 2"), std::string::npos) << r.message;
+  const AclReply next = client.Ping();  // reported once
+  EXPECT_TRUE(next.ok()) << next.message;
+}
+
+TEST(AclClient, ErrorAfterThePromptOnAPtyIsReportedOnce) {
+  // The same bytes in one write on a real pty: reported with the LISTPV or, if the read was
+  // cut after the prompt, with the next command; never lost, never twice.
+  PtyPeer peer;
+  PeerLink link(peer);
+  peer.Script(std::string(kListpvHome) + ">" + kImpact);
+  peer.Script(">");
+  AclPositionValues v;
+  const AclReply listpv = link.client->ListPosition("POSITION", &v);
+  const AclReply ping = link.client->Ping();
+  EXPECT_EQ(CountImpacts(listpv) + CountImpacts(ping), 1)
+      << listpv.message << " / " << ping.message;
+  EXPECT_EQ(peer.received(), "LISTPV POSITION\r\r");
+}
+
+TEST(AclClient, ErrorLineSplitAcrossTwoWritesIsReported) {
+  PtyPeer peer;
+  PeerLink link(peer);
+  peer.Script(std::string(kListpvHome) + ">\r\n*** IMP");
+  AclPositionValues v;
+  const AclReply listpv = link.client->ListPosition("POSITION", &v);
+  ASSERT_TRUE(listpv.ok()) << listpv.message;  // the line is not complete yet
+  EXPECT_EQ(v.counts, (ScorbotCounts{0, 0, 0, 0, 0}));
+  peer.Write("ACT PROTECTION axis 2\r\n");
+  peer.Script(">");
+  const AclReply ping = link.client->Ping();
+  EXPECT_EQ(ping.status, AclStatus::kControllerError);
+  ASSERT_EQ(CountImpacts(ping), 1) << ping.message;
+  EXPECT_EQ(ping.errors[0].text, "*** IMPACT PROTECTION axis 2");
+  // The same with the second half arriving while the next command waits for its prompt.
+  peer.Script(std::string(kListpvHome) + ">\r\n*** OUT OF RAN");
+  ASSERT_TRUE(link.client->ListPosition("POSITION", &v).ok());
+  peer.Script("GE axis 4\r\n>");
+  const AclReply next = link.client->Ping();
+  ASSERT_EQ(next.errors.size(), 1u) << next.message;
+  EXPECT_EQ(next.errors[0].kind, AclErrorKind::kOutOfRange);
+  EXPECT_EQ(next.errors[0].axis, 4);
+}
+
+TEST(AclClient, LateAnswerAfterATimeoutIsNotTakenForTheNextReply) {
+  // Without echo: LISTPV is answered only after the host gave up; the host then aborts. The
+  // late prompt must not end CLRBUF's wait, nor CLRBUF's prompt the next LISTPV's.
+  PtyPeer peer;
+  PeerLink link(peer, 0.2);
+  peer.Script("");  // LISTPV POSITION: no answer in time
+  AclPositionValues v;
+  const AclReply late = link.client->ListPosition("POSITION", &v);
+  ASSERT_EQ(late.status, AclStatus::kTimeout) << late.message;
+  EXPECT_FALSE(link.client->in_sync());
+  // What a controller without echo answers to the resynchronisation, the late answer first.
+  peer.Script(std::string(kListpvHome) + ">" + ">");                    // NOECHO
+  peer.Script(">");                                                     // ECHO
+  peer.Script(std::string("LISTPV POSITION\r\n") + kListpvHome + ">");  // LISTPV, echoed
+  peer.Script("NOECHO\r\n>");                                           // NOECHO, echoed
+  peer.Script(">");                                                     // CLRBUF
+  const AclReply abort = link.client->Abort();
+  ASSERT_TRUE(abort.ok()) << abort.message;
+  EXPECT_TRUE(abort.lines.empty()) << abort.text();  // not the late LISTPV's lines
+  EXPECT_EQ(peer.received(),
+            "LISTPV POSITION\r"
+            "\x01"
+            "NOECHO\rECHO\rLISTPV POSITION\rNOECHO\r"
+            "CLRBUF\r");
+  EXPECT_TRUE(link.client->in_sync());
+  EXPECT_EQ(link.client->stats().resyncs, 1);
+  peer.Script(std::string(kListpvOther) + ">");
+  const AclReply now = link.client->ListPosition("POSITION", &v);
+  ASSERT_TRUE(now.ok()) << now.message;
+  EXPECT_EQ(v.counts, (ScorbotCounts{7, 0, 0, 0, 0}));
+  EXPECT_EQ(v.cartesian.y, 30);
+}
+
+TEST(AclClient, UnansweredResynchronisationHoldsCommandsBackUntilItIsAnswered) {
+  PtyPeer peer;
+  PeerLink link(peer, 0.2);
+  peer.Script("");  // SPEED 30: no answer
+  ASSERT_EQ(link.client->Command("SPEED 30").status, AclStatus::kTimeout);
+  for (int i = 0; i < 4; ++i) peer.Script("");  // the resynchronisation: no answer either
+  const AclReply held = link.client->Command("SPEED 40");
+  EXPECT_EQ(held.status, AclStatus::kTimeout);
+  EXPECT_NE(held.message.find("'SPEED 40' not sent"), std::string::npos) << held.message;
+  EXPECT_NE(held.message.find("resynchronisation"), std::string::npos) << held.message;
+  // The controller wakes up and answers everything in order, with an impact on the way.
+  peer.Write(std::string(">") + kImpact + ">>LISTPV POSITION\r\n" + kListpvHome + ">NOECHO\r\n>");
+  peer.Script(">");  // SPEED 50
+  const AclReply next = link.client->Command("SPEED 50");
+  EXPECT_EQ(next.status, AclStatus::kControllerError) << next.message;
+  EXPECT_EQ(CountImpacts(next), 1) << next.message;
+  EXPECT_TRUE(link.client->in_sync());
+  EXPECT_EQ(link.client->stats().resyncs, 1);  // one sequence: a second could not be told apart
+  EXPECT_EQ(peer.received(),
+            "SPEED 30\r"
+            "NOECHO\rECHO\rLISTPV POSITION\rNOECHO\r"
+            "SPEED 50\r");
+  peer.Script(">");
+  EXPECT_TRUE(link.client->Command("SPEED 60").ok());
+}
+
+TEST(AclClient, LateAnswerFromTheSimulatorWithAndWithoutEcho) {
+  for (const bool echo : {true, false}) {
+    SCOPED_TRACE(echo ? "echo" : "noecho");
+    SimLink link(testing_scorbot::FastSim(), false, 0.2);
+    ASSERT_TRUE(link.client->SetEcho(echo).ok());
+    link.sim.InjectLateReply();
+    AclPositionValues v;
+    ASSERT_EQ(link.client->ListPosition("POSITION", &v).status, AclStatus::kTimeout);
+    const AclReply speed = link.client->Command("SPEED 30");
+    ASSERT_TRUE(speed.ok()) << speed.message;
+    EXPECT_TRUE(speed.lines.empty()) << speed.text();
+    EXPECT_EQ(link.sim.speed_percent(), 30);
+    EXPECT_EQ(link.sim.echo(), echo);
+    const AclReply now = link.client->ListPosition("POSITION", &v);
+    ASSERT_TRUE(now.ok()) << now.message;
+    EXPECT_EQ(v.name, "POSITION");
+    EXPECT_EQ(link.client->stats().resyncs, 1);
+  }
+}
+
+TEST(SerialPort, SecondOpenOfTheSameDeviceFailsSayingItIsInUse) {
+  PtyPeer peer;
+  SerialPort first;
+  ASSERT_TRUE(first.Open(peer.DevicePath(), SerialPortOptions()).ok());
+  SerialPort second;
+  const IoResult r = second.Open(peer.DevicePath(), SerialPortOptions());
+  EXPECT_EQ(r.status, IoStatus::kError);
+  EXPECT_NE(r.message.find(peer.DevicePath()), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("in use by another program"), std::string::npos) << r.message;
+  EXPECT_FALSE(second.is_open());
+  // The tty is in exclusive mode (other programs' open() fails with EBUSY, root's does not).
+  const int probe = ::open(peer.DevicePath().c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC);
+  ASSERT_GE(probe, 0);
+  int exclusive = 0;
+  ASSERT_EQ(::ioctl(probe, TIOCGEXCL, &exclusive), 0);
+  EXPECT_EQ(exclusive, 1);
+  // Closing undoes both: the port can be opened again.
+  first.Close();
+  ASSERT_EQ(::ioctl(probe, TIOCGEXCL, &exclusive), 0);
+  EXPECT_EQ(exclusive, 0);
+  ::close(probe);
+  const IoResult again = second.Open(peer.DevicePath(), SerialPortOptions());
+  EXPECT_TRUE(again.ok()) << again.message;
 }
 
 }  // namespace
