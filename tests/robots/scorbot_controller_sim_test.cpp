@@ -140,5 +140,44 @@ TEST(ScorbotControllerSim, ThrottledLinkCarriesTheSameBytes) {
   EXPECT_EQ(v.cartesian.p, -900);
 }
 
+TEST(ScorbotControllerSim, ImpactAfterThePromptComesInTheSameOutput) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  SerialPort port;
+  ASSERT_TRUE(port.Open(sim.DevicePath(), SerialPortOptions()).ok());
+  ReadTo(port, ">");
+  for (const char* command : {"SPEED 2", "DEFP P1", "HERE P1", "SETPV P1 1 3000", "MOVE P1"}) {
+    ASSERT_TRUE(port.Write(std::string(command) + "\r", 1.0).ok());
+    ReadTo(port, ">");
+  }
+  ASSERT_TRUE(sim.moving());
+  sim.InjectImpactAfterNextPrompt(4);
+  ASSERT_TRUE(port.Write("SPEED\r", 1.0).ok());
+  EXPECT_EQ(ReadTo(port, "axis 4\r\n"),
+            "SPEED\r\nSPEED 2\r\n>\r\n*** IMPACT PROTECTION axis 4\r\n");
+  EXPECT_FALSE(sim.moving());
+  EXPECT_FALSE(sim.control_enabled());
+  EXPECT_EQ(sim.last_command(), "SPEED");
+}
+
+TEST(ScorbotControllerSim, LateReplyGoesOutWhenTheNextLineArrives) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  SerialPort port;
+  ASSERT_TRUE(port.Open(sim.DevicePath(), SerialPortOptions()).ok());
+  ReadTo(port, ">");
+  ASSERT_TRUE(port.Write("NOECHO\r", 1.0).ok());
+  EXPECT_EQ(ReadTo(port, ">"), "NOECHO\r\n>");
+  sim.InjectLateReply();
+  const long commands = sim.stats().commands;
+  const auto sent = sim.stats().bytes_sent;
+  ASSERT_TRUE(port.Write("SPEED\r", 1.0).ok());
+  ASSERT_TRUE(WaitFor([&] { return sim.stats().commands == commands + 1; }));
+  EXPECT_EQ(sim.stats().bytes_sent, sent);  // executed, answer held back
+  ASSERT_TRUE(port.Write("SPEED 30\r", 1.0).ok());
+  EXPECT_EQ(ReadTo(port, ">>"), "SPEED 50\r\n>>");  // the late answer, then SPEED 30's prompt
+  EXPECT_EQ(sim.speed_percent(), 30);
+}
+
 }  // namespace
 }  // namespace oal

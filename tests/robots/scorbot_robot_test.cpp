@@ -319,7 +319,31 @@ TEST(ScorbotRobot, ControllerErrorsMapToStatuses) {
                std::invalid_argument);
 }
 
-TEST(ScorbotRobot, SilentControllerIsATimeout) {
+// A robot connected and enabled on `sim`, at 2 % speed, and a move of seconds started.
+struct SlowMove {
+  SlowMove(ScorbotControllerSim& sim, bool echo, double reply_timeout_s) {
+    ScorbotOptions o = RobotOptions(sim.DevicePath());
+    o.speed_percent = 2;
+    o.echo = echo;
+    o.reply_timeout_s = reply_timeout_s;
+    robot = std::make_unique<ScorbotRobot>(o);
+    const RobotResult c = robot->Connect();
+    EXPECT_TRUE(c.ok()) << c.message;
+    EXPECT_TRUE(robot->Enable().ok());
+    const RobotPose e = robot->GetPosition(RobotFrame::kEndEffector);
+    EXPECT_TRUE(e.result.ok()) << e.result.message;
+    target = robot->NearestReachable(RobotFrame::kEndEffector,
+                                     vpHomogeneousMatrix(0, 0.15, 0, 0, 0, 0) * e.pose);
+    EXPECT_TRUE(target.result.ok()) << target.result.message;
+    const RobotResult m = robot->StartMove(RobotFrame::kEndEffector, target.pose);
+    EXPECT_TRUE(m.ok()) << m.message;
+    EXPECT_TRUE(sim.moving());
+  }
+  std::unique_ptr<ScorbotRobot> robot;
+  RobotPose target;
+};
+
+TEST(ScorbotRobot, SilentControllerFailsConnectAndStartMoveWithTimeouts) {
   ScorbotControllerSim sim(FastSim());
   sim.Start();
   sim.SetSilent(true);
@@ -332,8 +356,8 @@ TEST(ScorbotRobot, SilentControllerIsATimeout) {
   EXPECT_FALSE(robot.connected());
   sim.SetSilent(false);
   EXPECT_TRUE(robot.Connect().ok());
-  // Silent in the middle of a session: the poll times out, the runner stops.
-  ASSERT_TRUE(robot.Enable().ok());
+  // Silent before a move: the first command of StartMove (a SETPVC) times out; the runner
+  // stops.
   SafeRobot safe(robot, Safety());
   ASSERT_TRUE(safe.Connect().ok());
   ASSERT_TRUE(safe.Enable().ok());
@@ -343,7 +367,100 @@ TEST(ScorbotRobot, SilentControllerIsATimeout) {
   const MoveReport report = safe.MovePosition(RobotFrame::kEndEffector,
                                               vpHomogeneousMatrix(0.01, 0, 0, 0, 0, 0) * e.pose);
   EXPECT_EQ(report.result.status, RobotStatus::kTimeout) << report.result.message;
+  EXPECT_NE(report.result.message.find("no reply to 'SETPVC"), std::string::npos)
+      << report.result.message;
   EXPECT_EQ(safe.state(), SafeRobotState::kStopped);
+  EXPECT_EQ(sim.stats().moves_started, 0);
+}
+
+TEST(ScorbotRobot, SilentControllerDuringAMoveTimesOutThePoll) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  SlowMove move(sim, /*echo=*/true, 0.2);
+  ScorbotRobot& robot = *move.robot;
+  sim.SetSilent(true);  // after MOVE was answered
+  const MoveProgress p = robot.PollMove();
+  EXPECT_EQ(p.result.status, RobotStatus::kTimeout) << p.result.message;
+  EXPECT_NE(p.result.message.find("no reply to 'LISTPV POSITION'"), std::string::npos)
+      << p.result.message;
+  // Nothing confirms the stop while the controller is silent.
+  const RobotResult stop = robot.Stop();
+  EXPECT_EQ(stop.status, RobotStatus::kTimeout) << stop.message;
+  // It lost what we sent meanwhile (the abort, the resynchronisation): connect again, which
+  // aborts the move (Ctrl-A is sent whatever the state of the exchange).
+  sim.SetSilent(false);
+  const RobotResult c = robot.Connect();
+  ASSERT_TRUE(c.ok()) << c.message;
+  EXPECT_FALSE(sim.moving());
+  ASSERT_TRUE(robot.Enable().ok());
+  EXPECT_TRUE(robot.GetPosition(RobotFrame::kEndEffector).result.ok());
+}
+
+TEST(ScorbotRobot, ImpactRightAfterAPollsPromptFailsThePoll) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  SlowMove move(sim, /*echo=*/true, 1.0);
+  ScorbotRobot& robot = *move.robot;
+  sim.InjectImpactAfterNextPrompt(2);
+  // The LISTPV of the poll is answered, then the impact comes in the same write: this poll
+  // reports it (or, if the pty cut the read after the prompt, the next one).
+  MoveProgress p = robot.PollMove();
+  if (p.result.ok() && !p.done) p = robot.PollMove();
+  EXPECT_EQ(p.result.status, RobotStatus::kError) << p.result.message;
+  EXPECT_NE(p.result.message.find("IMPACT PROTECTION axis 2"), std::string::npos)
+      << p.result.message;
+  EXPECT_FALSE(p.done);
+  EXPECT_FALSE(sim.control_enabled());
+  EXPECT_FALSE(sim.moving());
+}
+
+TEST(ScorbotRobot, LateAnswerToAPollIsNotTakenForTheStopsAnswer) {
+  for (const bool echo : {false, true}) {
+    SCOPED_TRACE(echo ? "echo" : "noecho");
+    ScorbotControllerSim sim(FastSim());
+    sim.Start();
+    SlowMove move(sim, echo, 0.2);
+    ScorbotRobot& robot = *move.robot;
+    sim.InjectLateReply();  // the poll's LISTPV is answered after the driver gave up
+    const MoveProgress p = robot.PollMove();
+    EXPECT_EQ(p.result.status, RobotStatus::kTimeout) << p.result.message;
+    const RobotResult stop = robot.Stop();
+    ASSERT_TRUE(stop.ok()) << stop.message;
+    EXPECT_EQ(sim.last_command(), "CLRBUF");  // answered, after the resynchronisation
+    EXPECT_FALSE(sim.moving());
+    EXPECT_EQ(sim.echo(), echo);
+    const RobotPose now = robot.GetPosition(RobotFrame::kEndEffector);
+    ASSERT_TRUE(now.result.ok()) << now.result.message;
+    EXPECT_LE(Distance(now.pose, ForwardKinematics(ScorbotGeometry(), sim.joints())).translation_m,
+              1e-4);  // encoder resolution
+    // Every command ran once, plus NOECHO, ECHO, LISTPV POSITION (and NOECHO) of the resync.
+    EXPECT_EQ(sim.stats().commands, robot.link_stats().commands + (echo ? 3 : 4));
+  }
+}
+
+TEST(ScorbotRobot, SessionEndAbortsAndTurnsControlOff) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  {
+    SlowMove move(sim, /*echo=*/true, 1.0);
+    EXPECT_TRUE(sim.control_enabled());
+  }  // the driver is destroyed with the arm moving
+  EXPECT_FALSE(sim.moving());
+  EXPECT_FALSE(sim.control_enabled());
+  EXPECT_EQ(sim.last_command(), "COFF");
+}
+
+TEST(ScorbotRobot, SecondProgramCannotOpenTheControllersPort) {
+  Rig rig;
+  ScorbotRobot other(RobotOptions(rig.sim.ConnectPath()));
+  const RobotResult r = other.Connect();
+  EXPECT_EQ(r.status, RobotStatus::kError);
+  EXPECT_NE(r.message.find(rig.sim.ConnectPath()), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("in use by another program"), std::string::npos) << r.message;
+  EXPECT_TRUE(rig.robot->GetPosition(RobotFrame::kCamera).result.ok());  // undisturbed
+  rig.robot->Disconnect();
+  const RobotResult again = other.Connect();
+  EXPECT_TRUE(again.ok()) << again.message;
 }
 
 TEST(ScorbotRobot, PortClosedDuringAMoveAndReconnection) {
