@@ -391,6 +391,9 @@ AclReply AclClient::Command(const std::string& command, double timeout_s) {
   const std::string echo = command + "\r\n";
   std::string in = std::move(pending_);
   pending_.clear();
+  // Where what answers this command begins: a line start even after an unterminated line kept
+  // from before (a stray byte must not hide the prompt that follows it).
+  const std::size_t fresh_from = in.size();
   std::size_t body_from = 0;
   bool echo_seen = !options_.echo;
   const auto deadline = std::chrono::steady_clock::now() +
@@ -406,7 +409,11 @@ AclReply AclClient::Command(const std::string& command, double timeout_s) {
       }
     }
     if (echo_seen) {
-      const std::size_t prompt = FindPrompt(in, body_from);
+      std::size_t prompt = FindPrompt(in, body_from);
+      if (fresh_from > body_from && fresh_from < prompt && in.size() > fresh_from &&
+          in[fresh_from] == '>') {
+        prompt = fresh_from;
+      }
       if (prompt != std::string::npos) {
         const std::string body = in.substr(body_from, prompt - body_from);
         // What came with the prompt: complete lines (an error printed right after it) are

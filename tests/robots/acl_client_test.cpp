@@ -402,6 +402,19 @@ TEST(AclClient, ErrorLineSplitAcrossTwoWritesIsReported) {
   EXPECT_EQ(next.errors[0].axis, 4);
 }
 
+TEST(AclClient, StrayByteAfterAPromptDoesNotHideTheNextPrompt) {
+  // Line noise after a prompt is kept as an unterminated line; the next prompt, right after
+  // it, still ends the next command.
+  PtyPeer peer;
+  PeerLink link(peer, 0.5);
+  peer.Script(">~");
+  ASSERT_TRUE(link.client->Ping().ok());
+  peer.Script(">");
+  const AclReply next = link.client->Ping();
+  EXPECT_TRUE(next.ok()) << next.message;
+  EXPECT_TRUE(link.client->in_sync());
+}
+
 TEST(AclClient, LateAnswerAfterATimeoutIsNotTakenForTheNextReply) {
   // Without echo: LISTPV is answered only after the host gave up; the host then aborts. The
   // late prompt must not end CLRBUF's wait, nor CLRBUF's prompt the next LISTPV's.
