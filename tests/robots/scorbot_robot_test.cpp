@@ -356,18 +356,25 @@ TEST(ScorbotRobot, SilentControllerFailsConnectAndStartMoveWithTimeouts) {
   EXPECT_FALSE(robot.connected());
   sim.SetSilent(false);
   EXPECT_TRUE(robot.Connect().ok());
-  // Silent before a move: the first command of StartMove (a SETPVC) times out; the runner
-  // stops.
+  // Silent before a move: the driver's first command of StartMove (a SETPVC) times out.
+  ASSERT_TRUE(robot.Enable().ok());
+  const RobotPose e = robot.GetPosition(RobotFrame::kEndEffector);
+  ASSERT_TRUE(e.result.ok());
+  const vpHomogeneousMatrix target = vpHomogeneousMatrix(0.01, 0, 0, 0, 0, 0) * e.pose;
+  sim.SetSilent(true);
+  const RobotResult start = robot.StartMove(RobotFrame::kEndEffector, target);
+  EXPECT_EQ(start.status, RobotStatus::kTimeout) << start.message;
+  EXPECT_NE(start.message.find("no reply to 'SETPVC"), std::string::npos) << start.message;
+  // Through the runner, the pose read for the path check comes first: it times out, the
+  // runner stops, and no move was started.
+  sim.SetSilent(false);
   SafeRobot safe(robot, Safety());
   ASSERT_TRUE(safe.Connect().ok());
   ASSERT_TRUE(safe.Enable().ok());
-  const RobotPose e = safe.GetPosition(RobotFrame::kEndEffector);
-  ASSERT_TRUE(e.result.ok());
   sim.SetSilent(true);
-  const MoveReport report = safe.MovePosition(RobotFrame::kEndEffector,
-                                              vpHomogeneousMatrix(0.01, 0, 0, 0, 0, 0) * e.pose);
+  const MoveReport report = safe.MovePosition(RobotFrame::kEndEffector, target);
   EXPECT_EQ(report.result.status, RobotStatus::kTimeout) << report.result.message;
-  EXPECT_NE(report.result.message.find("no reply to 'SETPVC"), std::string::npos)
+  EXPECT_NE(report.result.message.find("no reply to '"), std::string::npos)
       << report.result.message;
   EXPECT_EQ(safe.state(), SafeRobotState::kStopped);
   EXPECT_EQ(sim.stats().moves_started, 0);
