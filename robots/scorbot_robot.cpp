@@ -189,9 +189,9 @@ RobotResult ScorbotRobot::Connect() {
 }
 
 void ScorbotRobot::Disconnect() noexcept {
-  // The session ends: abort, then control off (COFF) once the controller confirmed the abort,
-  // so that the arm cannot move until someone enables it again.
-  if (connected_ && Stop().ok()) {
+  // The session ends: abort; then, if asked, control off (COFF) once the controller confirmed
+  // the abort, so that the arm cannot move until someone enables it again.
+  if (connected_ && Stop().ok() && options_.control_off_at_end) {
     try {
       client_->Command("COFF");
     } catch (...) {

@@ -9,8 +9,9 @@
 //   Connect()     waits for the line to go quiet, drains it, sends an empty line (the prompt
 //                 answers), ECHO or NOECHO (options.echo), DEFP P, HERE P, SPEED n. No motion.
 //   Enable()      CON.          Disable()   Ctrl-A, CLRBUF, COFF.
-//   Disconnect() (and the destructor, at the end of a session) Ctrl-A, CLRBUF and, if the
-//                 controller answered them, COFF; then the port is closed.
+//   Disconnect() (and the destructor, at the end of a session) Ctrl-A, CLRBUF and, with
+//                 control_off_at_end and if the controller answered them, COFF; then the port
+//                 is closed.
 //   Stop()        Ctrl-A, CLRBUF (AclClient::Abort). noexcept, safe in any state.
 //   GetPosition() LISTPV POSITION -> encoder counts -> joints -> wMe (forward kinematics);
 //                 wMc = wMe * eMc. The pose read by the last PollMove() is reused once by the
@@ -81,6 +82,11 @@ struct ScorbotOptions {
   double arrive_tolerance_deg = 0.1;
   /// The ACL position variable used for targets: 1-5 letters and digits, starting with a letter.
   std::string point_name = "OALT";
+  /// At the end of a session (Disconnect(), the destructor), after the abort was confirmed:
+  /// false leaves control on, so the servos hold the arm where it stopped; true sends COFF,
+  /// so nothing moves it until the next CON, but an axis its load can back-drive may sag
+  /// (unverified on hardware: docs/SCORBOT.md).
+  bool control_off_at_end = false;
   /// The arm.
   ScorbotGeometry geometry;
   /// Hand-eye: the camera in the TCP frame e.
@@ -102,7 +108,8 @@ class ScorbotRobot final : public Robot {
  public:
   /// Throws std::invalid_argument on bad options. Does not open the port.
   explicit ScorbotRobot(const ScorbotOptions& options);
-  /// Disconnect(): aborts any motion (Ctrl-A, CLRBUF), control off (COFF), closes the port.
+  /// Disconnect(): aborts any motion (Ctrl-A, CLRBUF), COFF if control_off_at_end, closes
+  /// the port.
   ~ScorbotRobot() override;
   ScorbotRobot(const ScorbotRobot&) = delete;
   ScorbotRobot& operator=(const ScorbotRobot&) = delete;
@@ -131,8 +138,9 @@ class ScorbotRobot final : public Robot {
   /// The manipulator Jacobian (6 x 5, twist of e in e per joint rate) at the joints read last
   /// (home before any read); see EndEffectorJacobian().
   vpMatrix eJe() const;
-  /// Ends the session: aborts motion (Ctrl-A, CLRBUF) and, once the controller confirmed the
-  /// abort, turns control off (COFF); then closes the port. Connect() opens it again.
+  /// Ends the session: aborts motion (Ctrl-A, CLRBUF) and, with control_off_at_end once the
+  /// controller confirmed the abort, turns control off (COFF); then closes the port.
+  /// Connect() opens it again.
   void Disconnect() noexcept;
   bool connected() const { return connected_; }
   bool enabled() const { return enabled_; }

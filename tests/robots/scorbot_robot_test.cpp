@@ -321,8 +321,10 @@ TEST(ScorbotRobot, ControllerErrorsMapToStatuses) {
 
 // A robot connected and enabled on `sim`, at 2 % speed, and a move of seconds started.
 struct SlowMove {
-  SlowMove(ScorbotControllerSim& sim, bool echo, double reply_timeout_s) {
+  SlowMove(ScorbotControllerSim& sim, bool echo, double reply_timeout_s,
+           bool control_off_at_end = false) {
     ScorbotOptions o = RobotOptions(sim.DevicePath());
+    o.control_off_at_end = control_off_at_end;
     o.speed_percent = 2;
     o.echo = echo;
     o.reply_timeout_s = reply_timeout_s;
@@ -445,13 +447,27 @@ TEST(ScorbotRobot, LateAnswerToAPollIsNotTakenForTheStopsAnswer) {
   }
 }
 
-TEST(ScorbotRobot, SessionEndAbortsAndTurnsControlOff) {
+// By default the session end aborts and leaves control on, so the servos hold the arm where
+// it stopped (an arm whose axes can be back-driven would sag with control off).
+TEST(ScorbotRobot, SessionEndAbortsAndHoldsThePose) {
   ScorbotControllerSim sim(FastSim());
   sim.Start();
   {
     SlowMove move(sim, /*echo=*/true, 1.0);
     EXPECT_TRUE(sim.control_enabled());
   }  // the driver is destroyed with the arm moving
+  EXPECT_FALSE(sim.moving());
+  EXPECT_TRUE(sim.control_enabled());
+  EXPECT_EQ(sim.last_command(), "CLRBUF");
+}
+
+TEST(ScorbotRobot, SessionEndTurnsControlOffWhenAsked) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  {
+    SlowMove move(sim, /*echo=*/true, 1.0, /*control_off_at_end=*/true);
+    EXPECT_TRUE(sim.control_enabled());
+  }
   EXPECT_FALSE(sim.moving());
   EXPECT_FALSE(sim.control_enabled());
   EXPECT_EQ(sim.last_command(), "COFF");
