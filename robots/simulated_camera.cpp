@@ -184,6 +184,12 @@ MoveProgress SimulatedCamera::PollMove() {
     p.result = r;
     return p;
   }
+  if (move_steps_left_ <= 0) {
+    // Nothing queued (the poll only counted towards an armed fault): nothing to integrate.
+    move_steps_left_ = 0;
+    p.done = true;
+    return p;
+  }
   if (move_jump_) {
     sim_.setPosition(move_target_wMc_);
     time_s_ += options_.sampling_time_s;

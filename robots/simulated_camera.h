@@ -71,7 +71,8 @@ class SimulatedCamera final : public Robot {
   double Time() const { return time_s_; }
   /// A motion command (SetVelocity, StartMove, PollMove) fails with `status` and `message`:
   /// the next one, or the one after `after_commands` more succeed. Fires once. The failing
-  /// command stops the camera where it is.
+  /// command stops the camera where it is. A PollMove() with no move queued counts too, but
+  /// moves nothing and reports the move done.
   void InjectFault(RobotStatus status = RobotStatus::kError, std::string message = "injected fault",
                    int after_commands = 0);
   bool moving() const { return move_steps_left_ > 0; }

@@ -140,6 +140,46 @@ TEST(SimulatedCamera, InjectedFaultFailsTheNextCommandOnly) {
   EXPECT_TRUE(camera.SetVelocity(RobotFrame::kCamera, vpColVector({0, 0, 0.1, 0, 0, 0})).ok());
 }
 
+// A fault armed for a later command while no move is queued: the polls counting towards it
+// moved the camera along the last move's twist, and the move never ended (the queue ran
+// below zero).
+TEST(SimulatedCamera, PollsWithAFaultArmedAndNoMoveQueuedMoveNothingAndAreDone) {
+  SimulatedCameraOptions options;
+  options.move_mode = SimulatedCameraOptions::MoveMode::kIntegrate;
+  options.move_duration_s = 0.2;
+  options.sampling_time_s = 0.04;
+  SimulatedCamera camera = ReadyCamera(options);
+  const vpHomogeneousMatrix target(0.05, 0.0, 0.1, 0, 0, vpMath::rad(20));
+  ASSERT_TRUE(camera.StartMove(RobotFrame::kCamera, target).ok());
+  int polls = 0;
+  while (!camera.PollMove().done && polls < 100) ++polls;
+  ASSERT_EQ(polls + 1, 5);
+  ExpectPoseNear(camera.wMc(), target, kPoseTolM, kPoseTolRad);
+
+  camera.InjectFault(RobotStatus::kError, "encoder lost", 2);
+  for (int i = 0; i < 2; ++i) {  // counted towards the fault, nothing queued
+    const MoveProgress p = camera.PollMove();
+    EXPECT_TRUE(p.result.ok()) << p.result.message;
+    EXPECT_TRUE(p.done) << "poll " << i;
+    EXPECT_FALSE(camera.moving());
+    ExpectPoseNear(camera.wMc(), target, kPoseTolM, kPoseTolRad);
+  }
+  const MoveProgress fault = camera.PollMove();
+  EXPECT_EQ(fault.result.status, RobotStatus::kError);
+  EXPECT_EQ(fault.result.message, "encoder lost");
+  const MoveProgress after = camera.PollMove();
+  EXPECT_TRUE(after.result.ok());
+  EXPECT_TRUE(after.done);
+  ExpectPoseNear(camera.wMc(), target, kPoseTolM, kPoseTolRad);
+
+  // A move after them runs as usual.
+  ASSERT_TRUE(camera.StartMove(RobotFrame::kCamera, options.wMc).ok());
+  polls = 0;
+  while (!camera.PollMove().done && polls < 100) ++polls;
+  EXPECT_EQ(polls + 1, 5);
+  ExpectPoseNear(camera.wMc(), options.wMc, kPoseTolM, kPoseTolRad);
+}
+
 TEST(SimulatedCamera, OptionsCheckNamesTheField) {
   SimulatedCameraOptions options;
   options.sampling_time_s = 0;
