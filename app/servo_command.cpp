@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <thread>
 
 #include "app/atomic_file.h"
 #include "app/command_line.h"
@@ -17,15 +18,37 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A stop signal also stops the robot at once (StopSignalScope: only lock-free atomics, which
-// a signal handler may touch; RequestEmergencyStop stores to one).
+// A stop signal also stops the robot at once, from the signal handler (StopSignalScope's
+// callback). Why globals: a handler is called with the signal number only, so the robot it
+// must stop can be reached only through process-wide state, and of that a handler may touch
+// lock-free atomics only (RequestEmergencyStop() stores to one).
+//   g_robot: the running SafeRobot, registered by the loop's on_robot hook once it runs and
+//     set back to null before it is destroyed (StopGuard in app/servo_loop.cpp, on every path
+//     out of RunServo);
+//   g_stops_in_flight: handlers between their load of g_robot and their last use of it. The
+//     signal may be delivered to another thread (the Controller-A simulator's) while the loop
+//     unregisters the robot: unregistering waits until none is left, so that the SafeRobot is
+//     not destroyed under a handler still using it.
 std::atomic<SafeRobot*> g_robot{nullptr};
+std::atomic<int> g_stops_in_flight{0};
 static_assert(std::atomic<SafeRobot*>::is_always_lock_free, "the robot pointer must be lock-free");
+static_assert(std::atomic<int>::is_always_lock_free, "the handler count must be lock-free");
+
+void RegisterRobot(SafeRobot* robot) {
+  g_robot.store(robot);
+  if (robot != nullptr) return;
+  // A handler that loaded the old pointer before the store is counted (sequentially
+  // consistent: it counted itself before its load); one that runs on this thread meanwhile
+  // loads null and returns.
+  while (g_stops_in_flight.load() != 0) std::this_thread::yield();
+}
 
 }  // namespace
 
 void StopRobotOnSignal() {
+  g_stops_in_flight.fetch_add(1);
   if (SafeRobot* robot = g_robot.load()) robot->RequestEmergencyStop();
+  g_stops_in_flight.fetch_sub(1);
 }
 
 ServoRunHooks StopSignalHooks(const StopSignalScope& signals) {
@@ -35,7 +58,7 @@ ServoRunHooks StopSignalHooks(const StopSignalScope& signals) {
     const int number = signals.signal_number();
     return number != 0 ? StopSignalName(number) : std::string("a click in the window");
   };
-  hooks.on_robot = [](SafeRobot* robot) { g_robot.store(robot); };
+  hooks.on_robot = &RegisterRobot;
   return hooks;
 }
 

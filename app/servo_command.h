@@ -43,10 +43,11 @@ ServoAppConfig DefaultServoConfig();
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options);
 
 /// Requests the emergency stop of the robot registered by StopSignalHooks()' on_robot (the
-/// StopSignalScope's callback: async-signal-safe).
+/// StopSignalScope's callback: async-signal-safe; a no-op when none is registered).
 void StopRobotOnSignal();
 /// The hooks `oalservo servo` runs with: `signals`' flag interrupts the loop and its signal
-/// names the reason; the robot is registered for StopRobotOnSignal(). `signals` must outlive
+/// names the reason; the robot is registered for StopRobotOnSignal() (on_robot(nullptr)
+/// unregisters it and returns once no handler is still using it). `signals` must outlive
 /// the run.
 ServoRunHooks StopSignalHooks(const StopSignalScope& signals);
 
