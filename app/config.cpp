@@ -697,6 +697,8 @@ const std::vector<Field<ServoLoopOptions>>& ServoFields() {
       DoubleField("max_time_s", &O::max_time_s),
       DoubleField("max_pose_jump_m", &O::max_pose_jump_m),
       DoubleField("max_pose_jump_deg", &O::max_pose_jump_deg),
+      DoubleField("max_step_m", &O::max_step_m),
+      DoubleField("max_step_deg", &O::max_step_deg),
   };
   return fields;
 }
@@ -1010,6 +1012,12 @@ void ServoLoopOptions::Check() const {
   if (!(max_pose_jump_deg > 0.0 && max_pose_jump_deg <= 180.0)) {
     Violated("ServoLoopOptions::max_pose_jump_deg", Num(max_pose_jump_deg),
              "0 < max_pose_jump_deg <= 180");
+  }
+  if (!(max_step_m > 0.0) || !std::isfinite(max_step_m)) {
+    Violated("ServoLoopOptions::max_step_m", Num(max_step_m), "max_step_m > 0");
+  }
+  if (!(max_step_deg > 0.0 && max_step_deg <= 180.0)) {
+    Violated("ServoLoopOptions::max_step_deg", Num(max_step_deg), "0 < max_step_deg <= 180");
   }
 }
 

@@ -104,6 +104,10 @@ struct ServoLoopOptions {
   double max_time_s = 60.0;        ///< wall time before time-limit, s, > 0
   double max_pose_jump_m = 0.05;   ///< estimate vs odometry prediction, m, > 0
   double max_pose_jump_deg = 5.0;  ///< ... and degrees, (0, 180]
+  /// The largest position move (point-and-go, exponential) the loop commands: a larger step
+  /// stops the run (limit) before the robot moves. m, > 0.
+  double max_step_m = 0.5;
+  double max_step_deg = 60.0;  ///< ... and degrees, (0, 180]
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;

@@ -35,11 +35,18 @@ namespace {
 constexpr std::uint64_t kNoiseSeed = 20240605;
 
 // Stops the robot however the loop ends (also on an exception) and unregisters it from the
-// command's signal handler first.
+// command's signal handler first. Declared after the SafeRobot, so destroyed before it: the
+// handler never sees a destroyed robot.
 class StopGuard {
  public:
   StopGuard(SafeRobot& robot, const ServoRunHooks& hooks) : robot_(robot), hooks_(hooks) {
-    if (hooks_.on_robot) hooks_.on_robot(&robot_);
+    if (!hooks_.on_robot) return;
+    try {
+      hooks_.on_robot(&robot_);
+    } catch (...) {
+      Unregister();  // a hook that registered the robot and then threw
+      throw;
+    }
   }
   ~StopGuard() {
     if (!stopped_) Stop();
@@ -48,13 +55,21 @@ class StopGuard {
   StopGuard& operator=(const StopGuard&) = delete;
 
   // Unregisters the robot and stops it; the destructor then has nothing left to do.
-  RobotResult Stop() {
+  RobotResult Stop() noexcept {
     stopped_ = true;
-    if (hooks_.on_robot) hooks_.on_robot(nullptr);
+    Unregister();
     return robot_.Stop();
   }
 
  private:
+  void Unregister() noexcept {
+    if (!hooks_.on_robot) return;
+    try {
+      hooks_.on_robot(nullptr);
+    } catch (...) {  // the stop must still be sent; nothing else to do about it
+    }
+  }
+
   SafeRobot& robot_;
   const ServoRunHooks& hooks_;
   bool stopped_ = false;
@@ -219,7 +234,7 @@ ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
   return sim;
 }
 
-RobotRig OpenRobot(const ServoAppConfig& config) {
+RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll) {
   RobotRig rig;
   if (config.robot.type == "scorbot") {
     ScorbotOptions options = config.robot.scorbot;
@@ -234,9 +249,12 @@ RobotRig OpenRobot(const ServoAppConfig& config) {
   }
   SimulatedCameraOptions options;
   options.sampling_time_s = config.robot.sampling_time_s;
-  options.move_mode = SimulatedCameraOptions::MoveMode::kJump;
+  // A move takes time, one sampling period per poll, as on an arm: a stop during it (Ctrl-C,
+  // a limit) leaves the camera on its way.
+  options.move_mode = SimulatedCameraOptions::MoveMode::kIntegrate;
   options.wMc = config.robot.start_wMc;
   options.eMc = config.camera.eMc;
+  options.on_poll = std::move(on_poll);
   rig.driver = std::make_unique<SimulatedCamera>(options);
   return rig;
 }
@@ -418,10 +436,11 @@ ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomoge
   return row;
 }
 
-// Steps 3 and 4: no pose, or a pose that disagrees with the odometry's prediction.
+// Steps 3 and 4: no pose, or a pose that disagrees with the odometry's prediction;
+// `confirming`: the frame that confirms the first pose (the robot has not moved yet).
 std::optional<Stop> PoseStop(const PoseResult& pose,
                              const std::optional<vpHomogeneousMatrix>& predicted_cMo,
-                             const ServoLoopOptions& loop, int iteration) {
+                             const ServoLoopOptions& loop, int iteration, bool confirming) {
   if (pose.status != PoseStatus::kOk) {
     return Stop{ServoRunStatus::kTargetLost,
                 "target lost at iteration " + std::to_string(iteration) + ": " +
@@ -434,6 +453,18 @@ std::optional<Stop> PoseStop(const PoseResult& pose,
       vpMath::deg(jump.rotation_rad) <= loop.max_pose_jump_deg) {
     return std::nullopt;
   }
+  if (confirming) {
+    return Stop{ServoRunStatus::kPoseJump,
+                "pose not confirmed at iteration " + std::to_string(iteration) +
+                    ": estimated on its own, this frame puts the target " +
+                    Fixed(jump.translation_m * 1e3, 1) + " mm and " +
+                    Fixed(vpMath::deg(jump.rotation_rad), 2) +
+                    " deg from where the first frame did, the robot still (limits " +
+                    Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " +
+                    Fixed(loop.max_pose_jump_deg, 2) +
+                    " deg: servo.max_pose_jump_m, max_pose_jump_deg); the pose is ambiguous or "
+                    "wrong, the robot was not moved"};
+  }
   return Stop{ServoRunStatus::kPoseJump,
               "pose jump at iteration " + std::to_string(iteration) + ": the estimate is " +
                   Fixed(jump.translation_m * 1e3, 1) + " mm and " +
@@ -443,16 +474,37 @@ std::optional<Stop> PoseStop(const PoseResult& pose,
                   Fixed(loop.max_pose_jump_deg, 2) + " deg)"};
 }
 
-// A motion the SafeRobot refused.
-Stop RefusalStop(const RobotResult& moved, const SafeRobot& robot, int iteration,
+// A motion that failed: refused before it began (`started` false: the robot did not move),
+// or stopped on its way.
+Stop RefusalStop(const RobotResult& moved, bool started, const SafeRobot& robot, int iteration,
                  const ServoRunHooks& hooks) {
   const ServoRunStatus status = StatusOfRefusal(moved, robot);
+  const std::string move = "the move of iteration " + std::to_string(iteration);
   if (status == ServoRunStatus::kInterrupted) {
-    return {status, "interrupted by " + InterruptedBy(hooks) + " during the move of iteration " +
-                        std::to_string(iteration)};
+    return {status, "interrupted by " + InterruptedBy(hooks) +
+                        (started ? " during " + move : " before " + move + " began (refused)")};
   }
   return {status,
-          ToString(status) + " at iteration " + std::to_string(iteration) + ": " + moved.message};
+          ToString(status) + " at iteration " + std::to_string(iteration) + ": " +
+              (started ? "stopped during the move: " : "move refused, the robot did not move: ") +
+              moved.message};
+}
+
+// A position step larger than servo.max_step_m / max_step_deg: the run stops before it.
+std::optional<Stop> StepTooLarge(const ServoStep& step, const ServoLoopOptions& loop,
+                                 int iteration) {
+  const PoseDistance size = Distance(vpHomogeneousMatrix(), step.c_T_cnew);
+  if (size.translation_m <= loop.max_step_m &&
+      vpMath::deg(size.rotation_rad) <= loop.max_step_deg) {
+    return std::nullopt;
+  }
+  return Stop{ServoRunStatus::kLimit,
+              "limit at iteration " + std::to_string(iteration) + ": the move of " +
+                  Fixed(size.translation_m * 1e3, 1) + " mm and " +
+                  Fixed(vpMath::deg(size.rotation_rad), 2) + " deg exceeds servo.max_step_m = " +
+                  Number(loop.max_step_m) + " m or max_step_deg = " + Number(loop.max_step_deg) +
+                  " deg, the robot did not move (a wrong pose, or a goal farther than one move "
+                  "may go: raise them, or use the exponential law with a smaller servo.delta)"};
 }
 
 // What the end of the run did to the robot, appended to the stop message.
@@ -566,7 +618,10 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   for (const std::string& warning : source_warnings) log << "warning: " << warning << '\n';
   const bool moves_robot = config.source.type != "replay";
 
-  const RobotRig rig = OpenRobot(config);
+  int move_iteration = -1;  // the iteration whose move runs, for Hooks::on_move_poll
+  const RobotRig rig = OpenRobot(config, [&hooks, &move_iteration](int poll) {
+    if (hooks.on_move_poll) hooks.on_move_poll(move_iteration, poll);
+  });
   if (velocity_law && !rig.driver->Capabilities().velocity) {
     throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
                                 rig.driver->Name() +
@@ -634,6 +689,8 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   const auto start = std::chrono::steady_clock::now();
   std::optional<vpHomogeneousMatrix> previous_cMo;
   vpHomogeneousMatrix previous_wMc;
+  // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
+  bool confirmed = !moves_robot;
   cv::Mat gray;
   std::vector<LineSeed> seeds;
   LogHeader(yaw_column, log);
@@ -668,11 +725,19 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     // Where the robot's motion since the last estimate puts the target.
     std::optional<vpHomogeneousMatrix> predicted_cMo;
     if (previous_cMo) predicted_cMo = wMc.inverse() * previous_wMc * *previous_cMo;
+    // The frame that confirms the first pose: the robot has not moved since the first frame.
+    const bool confirming = !confirmed && previous_cMo.has_value();
     // Its lines seed the accumulator list: a line seen at a grazing place (an image corner)
     // keeps its entry instead of being culled before it gathers its votes.
     if (predicted_cMo) seeds = PredictedSeeds(config.target, *predicted_cMo, model.camera);
     const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray), seeds);
-    const PoseResult pose = EstimatePose(lines, config.target, pose_options, previous_cMo);
+    // The prediction seeds the estimate: the lines' identities and the solution of the planar
+    // pose ambiguity carried through the move (after a move that rolled the camera by 60 deg,
+    // the pose before it is nearer a 90-deg-turned assignment of a near-square target's lines
+    // than the right one). The confirming frame is estimated on its own, so that a wrong
+    // first pose cannot seed its own confirmation.
+    const PoseResult pose =
+        EstimatePose(lines, config.target, pose_options, confirming ? std::nullopt : predicted_cMo);
     std::optional<ServoStep> step;
     if (pose.status == PoseStatus::kOk) {
       step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);
@@ -683,7 +748,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (hooks.on_frame) {
       hooks.on_frame(ServoFrame{gray, lines, pose, current, model.camera, detector.Undistorts()});
     }
-    std::optional<Stop> stop = PoseStop(pose, predicted_cMo, loop, iteration);
+    std::optional<Stop> stop = PoseStop(pose, predicted_cMo, loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);
     LogRow(current, yaw_column, log);
     if (stop) return finish(*stop);
@@ -691,18 +756,37 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     previous_wMc = wMc;
     if (step->status == ServoStatus::kConverged) {
       return finish({ServoRunStatus::kConverged,
-                     "converged in " + std::to_string(iteration) + " moves: estimated error " +
+                     "converged in " + std::to_string(report.moves) + " moves: estimated error " +
                          Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
                          Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"});
     }
     if (!moves_robot) continue;
+    if (!confirmed) {
+      if (!confirming) continue;  // the first frame: the next one confirms its pose
+      confirmed = true;
+    }
+    if (!velocity_law) {
+      if (std::optional<Stop> too_large = StepTooLarge(*step, loop, iteration)) {
+        return finish(*too_large);
+      }
+    }
 
+    // Only a motion the robot began counts as a move: a velocity cycle it took, a position
+    // move it was polled in (a refusal before StartMove leaves the robot where it was).
     moved_since_row = true;
-    const RobotResult moved =
-        velocity_law ? robot.SetVelocity(RobotFrame::kCamera, step->twist).result
-                     : robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew).result;
-    ++report.moves;
-    if (!moved.ok()) return finish(RefusalStop(moved, robot, iteration, hooks));
+    move_iteration = iteration;
+    RobotResult moved;
+    bool started = false;
+    if (velocity_law) {
+      moved = robot.SetVelocity(RobotFrame::kCamera, step->twist).result;
+      started = moved.ok();
+    } else {
+      const MoveReport move = robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew);
+      moved = move.result;
+      started = moved.ok() || move.polls > 0;
+    }
+    if (started) ++report.moves;
+    if (!moved.ok()) return finish(RefusalStop(moved, started, robot, iteration, hooks));
   }
 }
 

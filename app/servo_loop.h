@@ -13,18 +13,31 @@
 //   2. render the frame from the true cMo (camera intrinsics, kdu, noise and blur from the
 //      config), detect (OalDetector with the camera: undistorted lines; its accumulator list
 //      seeded with the target's lines projected from the odometry prediction of step 4),
-//      EstimatePose seeded by the previous estimate;
+//      EstimatePose seeded by that prediction (after a move: the previous estimate carried by
+//      the motion, so that a move that rolls the camera far keeps the lines' identities);
 //   3. stop (target-lost) when the pose status is not ok;
 //   4. stop (pose-jump) when the estimate disagrees with the previous estimate carried by the
 //      robot's own motion (odometry: predicted cMo = wMc⁻¹·wMc_prev·cMo_prev) by more than
 //      servo.max_pose_jump_m or max_pose_jump_deg;
 //   5. ComputeServoStep(estimate, cdMo): converged ends the run (converged); otherwise
-//   6. position laws: SafeRobot::MovePosition(camera, wMc·c_T_cnew); velocity law:
-//      SafeRobot::SetVelocity(camera, twist) for one sampling period. A refusal ends the run:
+//   6. position laws: a step larger than servo.max_step_m or max_step_deg ends the run
+//      (limit) before the robot moves; else SafeRobot::MovePosition(camera, wMc·c_T_cnew).
+//      Velocity law: SafeRobot::SetVelocity(camera, twist) for one sampling period (bounded
+//      by the velocity saturation instead). A refusal, or a failure on the way, ends the run:
 //      a workspace, velocity or reach limit (limit), the emergency stop (interrupted), any
-//      other failure (error);
+//      other failure (error); the message says whether the robot had begun to move;
 //   7. after servo.max_iterations frames without convergence: iteration-limit (a recording
 //      that ends exactly there ends the run with end-of-input instead).
+//
+// The first pose is confirmed before anything moves: the planar target's pose has two
+// solutions that fit a frame almost equally (the pose ambiguity), and the first estimate has
+// nothing to be checked against, so a wrong one would send the robot the whole wrong way in
+// one point-and-go move. Frame 0 commands nothing; frame 1, taken with the robot still, is
+// estimated on its own (not seeded by frame 0) and must agree with frame 0 within
+// servo.max_pose_jump_m / max_pose_jump_deg, else the run stops (pose-jump, "pose not
+// confirmed") with the robot where it started. The first move is that of frame 1. (A replay
+// moves nothing and confirms nothing.) servo.max_step_m / max_step_deg bound what a pose that
+// is wrong in both frames can still command.
 //
 // Frame sources (config `source:`): "simulated" renders the frame from the true cMo (above);
 // "v4l2" grabs from a camera carried by the robot (closed loop; not with the simulated robot,
@@ -46,6 +59,9 @@
 // where it was set), the robot connected (a bad port names robot.scorbot.port) and enabled; a
 // robot that starts outside the workspace box is reported by a warning in the log (every
 // move is still checked against the box). Hooks::on_started then says the run has begun.
+// The simulated robot (robot.type simulated) runs a position move along its screw, one
+// sampling period (robot.sampling_time_s) per poll, over 1 s of simulated time (lengthened to
+// its hardware limits; nothing sleeps): a stop during a move leaves the camera on its way.
 #pragma once
 
 #include <atomic>
@@ -110,16 +126,14 @@ struct ServoRunReport {
   /// The source and the robot were opened and the loop began (Hooks::on_started was called);
   /// false when the run ended before (the robot could not be connected or enabled).
   bool started = false;
-  int moves = 0;  ///< motion commands sent
+  /// Motion commands the robot began: position moves it was polled in, velocity cycles it
+  /// took; not those it refused (the message says so).
+  int moves = 0;
   /// For a robot on a serial link (the Scorbot) once connected: what the run cost on it, one
   /// line; else empty.
   std::string link_summary;
 };
 
-/// Hooks for the command: `interrupt` is polled every iteration (and on set, the robot's
-/// emergency stop is requested); `on_robot` is called with the SafeRobot once it is running
-/// and with nullptr before it is destroyed, so a signal handler can reach
-/// SafeRobot::RequestEmergencyStop().
 /// What the loop saw in one iteration, for displays and annotated frames (valid during the
 /// on_frame call only).
 struct ServoFrame {
@@ -131,6 +145,10 @@ struct ServoFrame {
   bool lines_undistorted = false;    ///< the lines are in undistorted pixels
 };
 
+/// Hooks for the command: `interrupt` is polled every iteration (and on set, the robot's
+/// emergency stop is requested); `on_robot` is called with the SafeRobot once it is running
+/// and with nullptr before it is destroyed, on every path out of RunServo (an exception
+/// too), so a signal handler can reach SafeRobot::RequestEmergencyStop() while it lives.
 struct ServoRunHooks {
   const std::atomic<bool>* interrupt = nullptr;
   /// Who asked for the stop, for the message "interrupted by ...", called when the loop sees
@@ -146,6 +164,10 @@ struct ServoRunHooks {
   /// Called with each frame before detection; may change it (tests inject occlusions and a
   /// target leaving the view through it). The frame may be a view of the source's buffer.
   std::function<void(int iteration, cv::Mat* gray)> on_grab;
+  /// Tests: called at every poll of a position move of the simulated robot (robot.type
+  /// simulated, whose moves take one sampling period per poll), with the iteration that
+  /// commanded the move and the poll's number in it (0 first), e.g. to stop it on its way.
+  std::function<void(int iteration, int poll)> on_move_poll;
 };
 
 /// The goal of a taught configuration: the pose of config.target estimated in the image

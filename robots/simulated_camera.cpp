@@ -154,6 +154,7 @@ RobotResult SimulatedCamera::StartMove(RobotFrame frame, const vpHomogeneousMatr
     return RobotResult::Fail(RobotStatus::kUnreachable, "target is not a rigid transform");
   }
   move_target_wMc_ = frame == RobotFrame::kCamera ? target : target * options_.eMc;
+  move_polls_ = 0;
   if (options_.move_mode == SimulatedCameraOptions::MoveMode::kJump) {
     move_jump_ = true;
     move_steps_left_ = 1;
@@ -180,6 +181,7 @@ MoveProgress SimulatedCamera::PollMove() {
     p.done = true;
     return p;
   }
+  if (move_steps_left_ > 0 && options_.on_poll) options_.on_poll(move_polls_++);
   if (RobotResult r = CheckCanMove(); !r.ok()) {
     p.result = r;
     return p;

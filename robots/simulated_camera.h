@@ -18,6 +18,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/robot/vpSimulatorCamera.h>
 
+#include <functional>
 #include <string>
 
 #include "robots/robot.h"
@@ -41,6 +42,9 @@ struct SimulatedCameraOptions {
   vpHomogeneousMatrix wMc;
   /// Hand-eye: the camera in the end-effector frame (identity: e = c, as vpSimulatorCamera).
   vpHomogeneousMatrix eMc;
+  /// Tests: called at the start of every PollMove() of a queued move with the poll's number in
+  /// that move (0 first), e.g. to act while the camera is on its way. Empty: none.
+  std::function<void(int poll)> on_poll;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
@@ -91,6 +95,7 @@ class SimulatedCamera final : public Robot {
   vpHomogeneousMatrix move_target_wMc_;
   vpColVector move_twist_;
   int move_steps_left_ = 0;
+  int move_polls_ = 0;  // polls of the queued move so far
   bool move_jump_ = false;
   // Injected fault.
   bool fault_armed_ = false;

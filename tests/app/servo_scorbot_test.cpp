@@ -83,7 +83,7 @@ TEST(ServoScorbot, AStopThatCannotBeSentIsReportedAsSuch) {
   HeldController controller(&config);
   ServoRunHooks hooks;
   hooks.on_grab = [&](int iteration, cv::Mat*) {
-    if (iteration == 1) controller.sim().Stop();  // before the move of iteration 1
+    if (iteration == 2) controller.sim().Stop();  // before the move of iteration 2
   };
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log, hooks);
@@ -103,7 +103,8 @@ TEST(ServoScorbot, TheLastRowIsWhereTheArmStopped) {
   HeldController controller(&config);
   ServoRunHooks hooks;
   hooks.on_frame = [&](const ServoFrame& frame) {
-    if (frame.row.iteration == 0) controller.sim().InjectImpact(2);  // halfway through move 0
+    // Halfway through the first move (frame 0's pose is confirmed on frame 1, which moves).
+    if (frame.row.iteration == 1) controller.sim().InjectImpact(2);
   };
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log, hooks);
@@ -111,9 +112,10 @@ TEST(ServoScorbot, TheLastRowIsWhereTheArmStopped) {
   EXPECT_THAT(report.message, HasSubstr("IMPACT"));
   EXPECT_THAT(report.message, HasSubstr("; robot stopped"));
   EXPECT_TRUE(report.robot_stopped);
-  ASSERT_EQ(report.iterations.size(), 2u) << log.str();
-  const ServoIteration& began = report.iterations[0];
-  const ServoIteration& stopped = report.iterations[1];
+  ASSERT_EQ(report.iterations.size(), 3u) << log.str();
+  EXPECT_EQ(report.moves, 1);  // begun, then stopped by the impact
+  const ServoIteration& began = report.iterations[1];
+  const ServoIteration& stopped = report.iterations[2];
   EXPECT_EQ(began.status, "error");
   EXPECT_EQ(stopped.status, "stopped");
   // Where the controller's arm is (the simulator's joints), in the table's ACL units.

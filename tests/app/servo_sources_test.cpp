@@ -512,22 +512,22 @@ ServoRunReport RunWithFrameChange(int from_iteration, const std::function<void(c
 
 TEST(ServoFailureInjection, TargetLeavingTheViewStopsTheRobot) {
   const ServoRunReport report =
-      RunWithFrameChange(2, [](cv::Mat* gray) { gray->setTo(cv::Scalar(200)); });
+      RunWithFrameChange(3, [](cv::Mat* gray) { gray->setTo(cv::Scalar(200)); });
   EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 2: not-enough-lines"));
+  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 3: not-enough-lines"));
   EXPECT_THAT(report.message, HasSubstr("robot stopped"));
-  EXPECT_EQ(report.moves, 2);  // no move after the frame without the target
+  EXPECT_EQ(report.moves, 2);  // frames 1 and 2 moved; none after the frame without the target
   EXPECT_TRUE(report.robot_stopped);
   EXPECT_EQ(report.iterations.back().status, "target-lost");
 }
 
 TEST(ServoFailureInjection, OccludedLinesStopTheRobot) {
   // A sheet of paper over the right half of the view hides two of the four lines.
-  const ServoRunReport report = RunWithFrameChange(1, [](cv::Mat* gray) {
+  const ServoRunReport report = RunWithFrameChange(2, [](cv::Mat* gray) {
     (*gray)(cv::Rect(gray->cols / 2, 0, gray->cols / 2, gray->rows)).setTo(cv::Scalar(215));
   });
   EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 1"));
+  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 2"));
   EXPECT_EQ(report.moves, 1);
   EXPECT_TRUE(report.robot_stopped);
 }

@@ -2,14 +2,19 @@
 // configuration sections and the built-in default (app/servo_command.h).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <visp3/core/vpMath.h>
+#include <visp3/core/vpRzyxVector.h>
 
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -18,6 +23,8 @@
 #include "app/servo_command.h"
 #include "app/servo_default_config.h"
 #include "app/servo_loop.h"
+#include "robots/simulated_camera.h"
+#include "scene/scene.h"
 #include "servo_test_util.h"
 
 namespace oal {
@@ -109,6 +116,14 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
               HasSubstr("servo.yaml:3: 'servo.delta' is invalid"));
   EXPECT_THAT(ErrorOf("servo:\n  max_iterations: 0\n"),
               HasSubstr("servo.yaml:2: 'servo.max_iterations' is invalid"));
+  EXPECT_THAT(
+      ErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
+      HasSubstr("servo.yaml:3: 'servo.max_step_m' is invalid: ServoLoopOptions::max_step_m = "
+                "0. Violated constraint: max_step_m > 0"));
+  EXPECT_THAT(ErrorOf("servo:\n  max_step_deg: 200\n"),
+              HasSubstr("servo.yaml:2: 'servo.max_step_deg' is invalid"));
+  EXPECT_THAT(ErrorOf("servo:\n  max_step_m: fast\n"),
+              HasSubstr("servo.yaml:2: 'servo.max_step_m'"));
   EXPECT_THAT(ErrorOf("servo:\n  mode: sideways\n"),
               HasSubstr("servo.yaml:2: 'servo.mode' must be one of point-and-go, exponential"));
   EXPECT_THAT(ErrorOf("camera:\n  px: 600\n  width: 8\n"),
@@ -263,12 +278,18 @@ TEST(ServoLoop, TargetOutOfViewStopsWithTargetLost) {
 TEST(ServoLoop, GoalBeyondTheWorkspaceStopsWithLimit) {
   ServoAppConfig config = Small(DefaultServoConfig());
   config.goal_cdMo = vpHomogeneousMatrix(0.0, 0.0, 3.0, 0.0, 0.0, 0.0);  // 3 m above the table
+  config.servo.max_step_m = 5.0;  // a step the loop allows, a target the workspace does not
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   EXPECT_EQ(report.status, ServoRunStatus::kLimit) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("limit at iteration 0"));
+  // Frame 0 commands nothing (the first pose is confirmed on frame 1).
+  EXPECT_THAT(report.message,
+              HasSubstr("limit at iteration 1: move refused, the robot did not move: the move "
+                        "target"));
+  EXPECT_THAT(report.message, HasSubstr("outside the workspace box"));
   EXPECT_TRUE(report.robot_stopped);
   EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));  // refused, not moved
+  EXPECT_EQ(report.moves, 0);  // a refused command is not a move
 }
 
 TEST(ServoLoop, PointAndGoAndVelocityLawsConvergeToo) {
@@ -289,17 +310,143 @@ TEST(ServoLoop, PointAndGoAndVelocityLawsConvergeToo) {
   }
 }
 
+// The frame after a move disagrees with the odometry: the image slid by 40 px (~65 mm at 0.5 m).
 TEST(ServoLoop, PoseJumpBeyondTheBoundStops) {
+  const ServoAppConfig config = Small(DefaultServoConfig());
+  ServoRunHooks hooks;
+  hooks.on_grab = [](int iteration, cv::Mat* gray) {
+    if (iteration != 2) return;
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 40, 0, 1, 0);
+    cv::Mat moved;
+    cv::warpAffine(*gray, moved, shift, gray->size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    moved.copyTo(*gray);
+  };
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log, hooks);
+  EXPECT_EQ(report.status, ServoRunStatus::kPoseJump) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("pose jump at iteration 2: the estimate is "));
+  EXPECT_THAT(report.message, HasSubstr("robot stopped"));
+  EXPECT_TRUE(report.robot_stopped);
+  EXPECT_EQ(report.moves, 1);
+}
+
+// Any disagreement between two frames (image noise) exceeds this bound: the first pose is
+// never confirmed and the robot never moves.
+TEST(ServoLoop, AnUnconfirmedFirstPoseStopsBeforeTheRobotMoves) {
   ServoAppConfig config = Small(DefaultServoConfig());
-  // Any disagreement between the estimate and the robot's odometry (image noise) exceeds it.
   config.servo.max_pose_jump_m = 1e-7;
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   EXPECT_EQ(report.status, ServoRunStatus::kPoseJump) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("pose jump at iteration 1"));
-  EXPECT_THAT(report.message, HasSubstr("robot stopped"));
+  EXPECT_THAT(report.message, HasSubstr("pose not confirmed at iteration 1: estimated on its own"));
+  EXPECT_THAT(report.message, HasSubstr("the robot was not moved; robot stopped"));
+  EXPECT_EQ(report.moves, 0);
+  ASSERT_EQ(report.iterations.size(), 2u);  // no "stopped" row: nothing moved
+  EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));
+}
+
+// The planar pose ambiguity: frame 0 shows the target as the other solution would (its tilt
+// mirrored about the optical axis, the same image to first order), a pose estimated with
+// status ok. Point-and-go would send the robot the whole wrong way in one move; the second
+// frame, estimated on its own, contradicts it and nothing moves.
+TEST(ServoLoop, AFlippedFirstPoseIsNotConfirmedAndTheRobotDoesNotMove) {
+  ServoAppConfig config = Small(DefaultServoConfig());
+  config.servo.law.mode = ServoMode::kPointAndGo;
+  const vpHomogeneousMatrix true_cMo = config.robot.start_wMc.inverse() * config.target_wMo;
+  // R' = S·R·S, S = diag(1, 1, -1): the same first two rows of the first two columns.
+  vpRotationMatrix S;
+  S[2][2] = -1;
+  const vpHomogeneousMatrix flipped_cMo(true_cMo.getTranslationVector(),
+                                        vpRotationMatrix(S * true_cMo.getRotationMatrix() * S));
+  ASSERT_GT(vpMath::deg(Distance(true_cMo, flipped_cMo).rotation_rad), 15.0);
+  RenderOptions render;
+  render.width = config.camera.width;
+  render.height = config.camera.height;
+  render.camera = config.camera.Camera();
+  render.noise_sigma = config.camera.noise;
+  render.blur_sigma_px = config.camera.blur;
+  const SceneRenderer renderer(config.target, render);
+  const RenderedFrame flipped = renderer.Render(flipped_cMo, 7);
+  ServoRunHooks hooks;
+  hooks.on_grab = [&](int iteration, cv::Mat* gray) {
+    if (iteration != 0) return;
+    const cv::Mat view(static_cast<int>(flipped.image.getHeight()),
+                       static_cast<int>(flipped.image.getWidth()), CV_8UC1, flipped.image.bitmap);
+    view.copyTo(*gray);
+  };
+  std::vector<vpHomogeneousMatrix> estimates;
+  hooks.on_frame = [&](const ServoFrame& frame) { estimates.push_back(frame.pose.cMo); };
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log, hooks);
+  // Frame 0's estimate is the flipped pose (status ok), frame 1's the true one.
+  ASSERT_EQ(estimates.size(), 2u) << log.str() << report.message;
+  EXPECT_LT(vpMath::deg(Distance(estimates[0], flipped_cMo).rotation_rad), 2.0);
+  EXPECT_LT(vpMath::deg(Distance(estimates[1], true_cMo).rotation_rad), 2.0);
+  EXPECT_EQ(report.status, ServoRunStatus::kPoseJump) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("pose not confirmed at iteration 1"));
+  EXPECT_EQ(report.moves, 0);
   EXPECT_TRUE(report.robot_stopped);
-  EXPECT_EQ(report.moves, 1);
+  EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));
+}
+
+// A position step above servo.max_step_m / max_step_deg stops the run before the robot moves.
+TEST(ServoLoop, AStepAboveTheMaximumStopsBeforeTheRobotMoves) {
+  // The default start is 135 mm and 11.2 deg from the goal: point-and-go's one move.
+  struct Limits {
+    double m, deg;
+    const char* text;
+  };
+  for (const Limits& limits :
+       {Limits{0.1, 60.0, "servo.max_step_m = 0.1 m or max_step_deg = 60 deg"},
+        Limits{0.5, 10.0, "servo.max_step_m = 0.5 m or max_step_deg = 10 deg"}}) {
+    ServoAppConfig config = Small(DefaultServoConfig());
+    config.servo.law.mode = ServoMode::kPointAndGo;
+    config.servo.max_step_m = limits.m;
+    config.servo.max_step_deg = limits.deg;
+    std::ostringstream log;
+    const ServoRunReport report = RunServo(config, log);
+    EXPECT_EQ(report.status, ServoRunStatus::kLimit) << report.message;
+    EXPECT_THAT(report.message, HasSubstr("limit at iteration 1: the move of 13"));
+    EXPECT_THAT(report.message,
+                HasSubstr(std::string("exceeds ") + limits.text + ", the robot did not move"));
+    EXPECT_EQ(report.moves, 0);
+    EXPECT_TRUE(report.robot_stopped);
+    EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));
+  }
+  // The shipped limits let it go.
+  ServoAppConfig config = Small(DefaultServoConfig());
+  config.servo.law.mode = ServoMode::kPointAndGo;
+  std::ostringstream log;
+  EXPECT_EQ(RunServo(config, log).status, ServoRunStatus::kConverged) << log.str();
+}
+
+// A move that rolls the camera by more than PoseOptions::previous_max_deg (45 deg): the next
+// frame's estimate must be seeded by the pose predicted from the robot's motion, not by the pose
+// before the move. On a near-square '#' (16 x 16 cm, widths 28, 26, 21, 23 mm: the line
+// assignment turned by 90 deg costs ~20, under max_identification_cost) the pose before a
+// 60-deg roll is closer to that wrong assignment (30 deg) than to the right one (60 deg): it
+// was taken, and the run stopped on a 90-deg pose jump.
+TEST(ServoLoop, ALargeRollInOneMoveConvergesWithoutAPoseJump) {
+  for (const double roll_deg : {60.0, -70.0}) {
+    ServoAppConfig config = Small(DefaultServoConfig());
+    config.target.lines = {
+        TargetLine{-0.08, -1.0, -0.08, 1.0, 0.028}, TargetLine{-1.0, -0.08, 1.0, -0.08, 0.026},
+        TargetLine{0.08, -1.0, 0.08, 1.0, 0.021}, TargetLine{-1.0, 0.08, 1.0, 0.08, 0.023}};
+    config.servo.law.mode = ServoMode::kPointAndGo;
+    config.servo.max_step_deg = 90.0;
+    config.goal_cdMo =
+        vpHomogeneousMatrix(vpTranslationVector(0.0, 0.0, 0.5),
+                            vpRotationMatrix(vpRzyxVector(vpMath::rad(roll_deg), 0, 0)));
+    std::ostringstream log;
+    const ServoRunReport report = RunServo(config, log);
+    EXPECT_EQ(report.status, ServoRunStatus::kConverged) << roll_deg << "\n"
+                                                         << log.str() << report.message;
+    ASSERT_GE(report.iterations.size(), 3u) << log.str();
+    // The first move rolled the camera by more than 45 deg.
+    EXPECT_GT(std::abs(report.iterations[2].roll_deg - report.iterations[1].roll_deg), 50.0);
+    EXPECT_LE(report.moves, 3) << roll_deg;
+    EXPECT_LT(report.iterations.back().true_rotation_error_deg, 0.5) << roll_deg;
+  }
 }
 
 TEST(ServoLoop, IterationLimitStopsTheRobotAndRecordsWhereItStopped) {
@@ -310,9 +457,9 @@ TEST(ServoLoop, IterationLimitStopsTheRobotAndRecordsWhereItStopped) {
   EXPECT_EQ(report.status, ServoRunStatus::kIterationLimit) << report.message;
   EXPECT_THAT(report.message, HasSubstr("iteration limit reached: servo.max_iterations = 2"));
   EXPECT_THAT(report.message, HasSubstr("; robot stopped"));
-  EXPECT_EQ(report.moves, 2);
+  EXPECT_EQ(report.moves, 1);  // frame 0 confirmed on frame 1, which moved
   EXPECT_TRUE(report.robot_stopped);
-  // Two frames, then the row of where the second move left the camera.
+  // Two frames, then the row of where the move of frame 1 left the camera.
   ASSERT_EQ(report.iterations.size(), 3u);
   EXPECT_EQ(report.iterations[1].status, "iteration-limit");
   const ServoIteration& stopped = report.iterations[2];
@@ -398,8 +545,10 @@ TEST(StopSignalScope, EveryStopSignalSetsTheFlagCallsBackAndTheHandlersComeBack)
 }
 
 // SIGTERM (systemd, timeout) and SIGHUP (SSH hang-up) end a run exactly as Ctrl-C does: the
-// robot stopped at once, the outputs written, the signal named as the reason.
-TEST(ServoCommand, SigtermAndSighupStopTheRobotAndWriteTheOutputsLikeCtrlC) {
+// robot stopped at once, mid-move, the outputs written, the signal named as the reason. The
+// signal arrives at the 6th poll of the move of iteration 2 (of 25: the simulated robot's moves
+// take a second at 0.04 s a poll).
+TEST(ServoCommand, SigtermAndSighupStopTheRobotDuringAMoveAndWriteTheOutputsLikeCtrlC) {
   const std::filesystem::path dir =
       std::filesystem::path(::testing::TempDir()) / "oal_servo_signal_test";
   std::filesystem::remove_all(dir);
@@ -410,6 +559,14 @@ TEST(ServoCommand, SigtermAndSighupStopTheRobotAndWriteTheOutputsLikeCtrlC) {
     out << "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n"
         << "output: {display: off, save_frames: false}\n";
   }
+  // Where the move of iteration 2 goes: the row of iteration 3 of a run left alone.
+  ServoCommandOptions plain;
+  plain.config_path = config_path;
+  std::ostringstream plain_log;
+  const ServoRunReport whole = RunServo(LoadServoConfig(plain), plain_log);
+  ASSERT_GE(whole.iterations.size(), 4u) << plain_log.str();
+  const ServoIteration& target = whole.iterations[3];
+
   std::vector<std::string> csvs;
   for (const int number : {SIGINT, SIGTERM, SIGHUP}) {
     ServoCommandOptions options;
@@ -417,22 +574,90 @@ TEST(ServoCommand, SigtermAndSighupStopTheRobotAndWriteTheOutputsLikeCtrlC) {
     options.out_dir = (dir / std::to_string(number)).string();
     const StopSignalScope signals(&StopRobotOnSignal);
     ServoRunHooks hooks = StopSignalHooks(signals);
-    hooks.on_grab = [number](int iteration, cv::Mat*) {
-      if (iteration == 1) std::raise(number);  // while the robot is running
+    bool raised = false;
+    int polls_after = 0;
+    hooks.on_move_poll = [&](int iteration, int poll) {
+      if (raised) ++polls_after;
+      if (iteration == 2 && poll == 5) {
+        std::raise(number);  // the robot is on its way
+        raised = true;
+      }
     };
     std::ostringstream out;
     const ServoRunReport report = RunServoCommand(options, out, hooks);
+    ASSERT_TRUE(raised) << out.str();
     EXPECT_EQ(report.status, ServoRunStatus::kInterrupted) << out.str();
     EXPECT_THAT(report.message, HasSubstr("interrupted by " + StopSignalName(number) +
-                                          " during the move of iteration 1; robot stopped"));
+                                          " during the move of iteration 2; robot stopped"));
     EXPECT_TRUE(report.robot_stopped);
-    EXPECT_EQ(report.moves, 2);  // the move of iteration 1 was refused
+    EXPECT_EQ(polls_after, 0);   // the next cycle stopped it: no poll after the signal
+    EXPECT_EQ(report.moves, 2);  // iteration 1's, and iteration 2's, begun and stopped
+    // The last row is where it stopped: on its way, neither where the move began nor its
+    // target.
+    ASSERT_EQ(report.iterations.size(), 4u) << out.str();
+    const ServoIteration& began = report.iterations[2];
+    const ServoIteration& stopped = report.iterations[3];
+    EXPECT_EQ(began.status, "interrupted");
+    EXPECT_EQ(stopped.status, "stopped");
+    const auto mm_between = [](const ServoIteration& a, const ServoIteration& b) {
+      return std::hypot(a.x_mm - b.x_mm, a.y_mm - b.y_mm, a.z_mm - b.z_mm);
+    };
+    EXPECT_GT(mm_between(stopped, began), 1.0) << out.str();
+    EXPECT_GT(mm_between(stopped, target), 1.0) << out.str();
+    EXPECT_GT(mm_between(began, target), mm_between(stopped, target));  // it was getting there
+    double x, y, z, pitch, roll, yaw;
+    Table3Columns(report.final_wMc, &x, &y, &z, &pitch, &roll, &yaw);
+    EXPECT_DOUBLE_EQ(stopped.x_mm, x);
+    EXPECT_DOUBLE_EQ(stopped.z_mm, z);
     csvs.push_back(ReadText(options.out_dir + "/servo.csv"));
     EXPECT_THAT(csvs.back(), HasSubstr(",interrupted\n")) << number;
+    EXPECT_THAT(csvs.back(), HasSubstr(",stopped\n")) << number;
   }
   EXPECT_EQ(csvs[1], csvs[0]);  // SIGTERM: the same outputs as Ctrl-C
   EXPECT_EQ(csvs[2], csvs[0]);  // SIGHUP too
   std::filesystem::remove_all(dir);
+}
+
+// The signal handler reaches the robot only while it is registered: the loop unregisters it
+// before the SafeRobot is destroyed, on every path out of the run, an exception too.
+TEST(ServoCommand, TheSignalHandlerReachesTheRobotOnlyWhileItIsRegistered) {
+  const StopSignalScope signals(&StopRobotOnSignal);
+  const ServoRunHooks command_hooks = StopSignalHooks(signals);
+  SimulatedCamera driver;
+  SafeRobot robot(driver, SafetyOptions());
+  ASSERT_TRUE(robot.Connect().ok());
+  ASSERT_TRUE(robot.Enable().ok());
+  command_hooks.on_robot(&robot);
+  StopRobotOnSignal();
+  EXPECT_TRUE(robot.EmergencyStopRequested());
+  ASSERT_TRUE(robot.Enable().ok());  // clears the flag
+  command_hooks.on_robot(nullptr);
+  StopRobotOnSignal();
+  EXPECT_FALSE(robot.EmergencyStopRequested());
+
+  // An exception out of the loop: unregistered while the SafeRobot still lives.
+  const ServoAppConfig config = Small(DefaultServoConfig());
+  std::vector<SafeRobot*> calls;
+  bool alive_at_unregister = false;
+  ServoRunHooks hooks;
+  hooks.on_robot = [&](SafeRobot* running) {
+    if (running == nullptr && !calls.empty() && calls.back() != nullptr) {
+      // Still the live robot: stopped by the guard after this returns, state readable.
+      alive_at_unregister = calls.back()->state() != SafeRobotState::kDisconnected;
+    }
+    calls.push_back(running);
+    command_hooks.on_robot(running);
+  };
+  hooks.on_grab = [](int iteration, cv::Mat*) {
+    if (iteration == 1) throw std::runtime_error("frame grabber fell over");
+  };
+  std::ostringstream log;
+  EXPECT_THROW(RunServo(config, log, hooks), std::runtime_error);
+  ASSERT_EQ(calls.size(), 2u);
+  EXPECT_NE(calls[0], nullptr);
+  EXPECT_EQ(calls[1], nullptr);
+  EXPECT_TRUE(alive_at_unregister);
+  StopRobotOnSignal();  // nothing registered: a no-op
 }
 
 TEST(ServoCommand, WritesTheCsvAtomically) {

@@ -8,6 +8,7 @@
 
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 namespace oal {
 namespace {
@@ -178,6 +179,24 @@ TEST(SimulatedCamera, PollsWithAFaultArmedAndNoMoveQueuedMoveNothingAndAreDone) 
   while (!camera.PollMove().done && polls < 100) ++polls;
   EXPECT_EQ(polls + 1, 5);
   ExpectPoseNear(camera.wMc(), options.wMc, kPoseTolM, kPoseTolRad);
+}
+
+TEST(SimulatedCamera, ThePollHookSeesEveryPollOfAMoveNumberedFromZero) {
+  SimulatedCameraOptions options;
+  options.move_mode = SimulatedCameraOptions::MoveMode::kIntegrate;
+  options.move_duration_s = 0.2;
+  options.sampling_time_s = 0.04;
+  std::vector<int> polls;
+  options.on_poll = [&](int poll) { polls.push_back(poll); };
+  SimulatedCamera camera = ReadyCamera(options);
+  for (int move = 0; move < 2; ++move) {
+    ASSERT_TRUE(
+        camera.StartMove(RobotFrame::kCamera, vpHomogeneousMatrix(0, 0, 0.1 * move, 0, 0, 0)).ok());
+    while (!camera.PollMove().done) {
+    }
+  }
+  EXPECT_TRUE(camera.PollMove().done);  // nothing queued: no call
+  EXPECT_EQ(polls, (std::vector<int>{0, 1, 2, 3, 4, 0, 1, 2, 3, 4}));
 }
 
 TEST(SimulatedCamera, OptionsCheckNamesTheField) {
