@@ -623,6 +623,7 @@ const std::vector<Field<RobotConfig>>& ScorbotFields() {
       option("arrive_tolerance_mm", &ScorbotOptions::arrive_tolerance_mm),
       option("arrive_tolerance_deg", &ScorbotOptions::arrive_tolerance_deg),
       option("point_name", &ScorbotOptions::point_name),
+      option("control_off_at_end", &ScorbotOptions::control_off_at_end),
       {"geometry",
        [](const Value& value, O* robot) {
          const Lines lines = ReadNested(value, ScorbotGeometryFields(), &robot->scorbot.geometry);

@@ -175,6 +175,13 @@ TEST(ServoScorbot, ConfigErrorsNameTheNestedKeyAndLine) {
               HasSubstr("arm.yaml:3: key 'robot.scorbot.parity' is unknown"));
   EXPECT_THAT(error("robot:\n  type: puma\n"),
               HasSubstr("arm.yaml:2: 'robot.type' must be one of simulated, scorbot"));
+  EXPECT_THAT(error("robot:\n  scorbot:\n    control_off_at_end: maybe\n"),
+              HasSubstr("arm.yaml:3: 'robot.scorbot.control_off_at_end'"));
+  // Read: off by default, on when asked.
+  EXPECT_FALSE(DefaultServoConfig().robot.scorbot.control_off_at_end);
+  const ServoAppConfig off =
+      ParseConfig("robot:\n  scorbot:\n    control_off_at_end: true\n", "arm.yaml");
+  EXPECT_TRUE(off.robot.scorbot.control_off_at_end);
 }
 
 }  // namespace
