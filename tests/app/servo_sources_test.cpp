@@ -30,22 +30,8 @@ namespace fs = std::filesystem;
 
 // What the configured camera sees from cMo, as the renderer draws it, written as PNG.
 void WriteView(const ServoAppConfig& config, const vpHomogeneousMatrix& cMo, std::uint64_t seed,
-               const std::string& path);
-
-vpImage<unsigned char> View(const ServoAppConfig& config, const vpHomogeneousMatrix& cMo,
-                            std::uint64_t seed) {
-  RenderOptions render;
-  render.width = config.camera.width;
-  render.height = config.camera.height;
-  render.camera = config.camera.Camera();
-  render.noise_sigma = config.camera.noise;
-  render.blur_sigma_px = config.camera.blur;
-  return SceneRenderer(config.target, render).Render(cMo, seed).image;
-}
-
-void WriteView(const ServoAppConfig& config, const vpHomogeneousMatrix& cMo, std::uint64_t seed,
                const std::string& path) {
-  vpImage<unsigned char> image = View(config, cMo, seed);
+  vpImage<unsigned char> image = test::CameraView(config, cMo, seed);
   cv::imwrite(path, cv::Mat(static_cast<int>(image.getHeight()), static_cast<int>(image.getWidth()),
                             CV_8UC1, image.bitmap));
 }

@@ -359,19 +359,12 @@ TEST(ServoLoop, AFlippedFirstPoseIsNotConfirmedAndTheRobotDoesNotMove) {
   const vpHomogeneousMatrix flipped_cMo(true_cMo.getTranslationVector(),
                                         vpRotationMatrix(S * true_cMo.getRotationMatrix() * S));
   ASSERT_GT(vpMath::deg(Distance(true_cMo, flipped_cMo).rotation_rad), 15.0);
-  RenderOptions render;
-  render.width = config.camera.width;
-  render.height = config.camera.height;
-  render.camera = config.camera.Camera();
-  render.noise_sigma = config.camera.noise;
-  render.blur_sigma_px = config.camera.blur;
-  const SceneRenderer renderer(config.target, render);
-  const RenderedFrame flipped = renderer.Render(flipped_cMo, 7);
+  const vpImage<unsigned char> flipped = test::CameraView(config, flipped_cMo, 7);
   ServoRunHooks hooks;
   hooks.on_grab = [&](int iteration, cv::Mat* gray) {
     if (iteration != 0) return;
-    const cv::Mat view(static_cast<int>(flipped.image.getHeight()),
-                       static_cast<int>(flipped.image.getWidth()), CV_8UC1, flipped.image.bitmap);
+    const cv::Mat view(static_cast<int>(flipped.getHeight()), static_cast<int>(flipped.getWidth()),
+                       CV_8UC1, flipped.bitmap);
     view.copyTo(*gray);
   };
   std::vector<vpHomogeneousMatrix> estimates;

@@ -1,11 +1,13 @@
 // Helpers shared by the servo app's tests.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "app/config.h"
 #include "app/servo_command.h"
 #include "robots/robot.h"
+#include "scene/scene.h"
 #include "tests/app/command_test_util.h"
 
 namespace oal::test {
@@ -25,6 +27,18 @@ inline ServoAppConfig ShippedServoConfig(const std::string& name) {
   ServoCommandOptions options;
   options.config_path = std::string(OAL_SOURCE_DIR) + "/config/" + name;
   return LoadServoConfig(options);
+}
+
+/// What the configured camera sees from cMo, as the servo loop's simulated camera renders it.
+inline vpImage<unsigned char> CameraView(const ServoAppConfig& config,
+                                         const vpHomogeneousMatrix& cMo, std::uint64_t seed) {
+  RenderOptions render;
+  render.width = config.camera.width;
+  render.height = config.camera.height;
+  render.camera = config.camera.Camera();
+  render.noise_sigma = config.camera.noise;
+  render.blur_sigma_px = config.camera.blur;
+  return SceneRenderer(config.target, render).Render(cMo, seed).image;
 }
 
 inline bool SamePose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
