@@ -71,15 +71,22 @@ TEST(ServoConfigSections, SourceOutputAndGoalImageAreReadAndChecked) {
   EXPECT_THAT(ErrorOf("goal: {image: ''}\n"), HasSubstr("'goal.image' must not be empty"));
 }
 
-TEST(ServoSources, ReplayRunsOpenLoopToTheEndWithoutMovingTheRobot) {
-  const test::TestDir dir;
+// The small default config replaying `count` frames (frame_0000.png ...) written to `dir`,
+// all seen from the robot's start pose.
+ServoAppConfig ReplayOfStillFrames(const test::TestDir& dir, int count) {
   ServoAppConfig config = Small(DefaultServoConfig());
   const vpHomogeneousMatrix start_cMo = config.robot.start_wMc.inverse() * config.target_wMo;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < count; ++i) {
     WriteView(config, start_cMo, 7 + i, dir / ("frame_000" + std::to_string(i) + ".png"));
   }
   config.source.type = "replay";
   config.source.path = dir / "frame_%04d.png";
+  return config;
+}
+
+TEST(ServoSources, ReplayRunsOpenLoopToTheEndWithoutMovingTheRobot) {
+  const test::TestDir dir;
+  const ServoAppConfig config = ReplayOfStillFrames(dir, 3);
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   EXPECT_EQ(report.status, ServoRunStatus::kEndOfInput) << report.message;
@@ -108,13 +115,7 @@ TEST(ServoSources, ReplayRunsOpenLoopToTheEndWithoutMovingTheRobot) {
 // (exit 0), as a longer one would be cut by the limit and a shorter one end on its own.
 TEST(ServoSources, ReplayAsLongAsTheIterationLimitEndsWithEndOfInput) {
   const test::TestDir dir;
-  ServoAppConfig config = Small(DefaultServoConfig());
-  const vpHomogeneousMatrix start_cMo = config.robot.start_wMc.inverse() * config.target_wMo;
-  for (int i = 0; i < 4; ++i) {
-    WriteView(config, start_cMo, 7 + i, dir / ("frame_000" + std::to_string(i) + ".png"));
-  }
-  config.source.type = "replay";
-  config.source.path = dir / "frame_%04d.png";
+  ServoAppConfig config = ReplayOfStillFrames(dir, 4);
   config.servo.max_iterations = 4;
   std::ostringstream log;
   ServoRunReport report = RunServo(config, log);
