@@ -11,18 +11,28 @@
 namespace oal {
 namespace {
 
-// Signed angle whose sine is `s`, for |s| <= sin(45 deg): asin's Taylor series to s^9, exact
-// to 1e-9 rad over the angles anglechange allows.
-double SmallAsin(double s) {
+// Signed angle whose sine is `s`: asin's Taylor series to s^9 (error below 1e-10 rad) up to
+// sin(10 deg), which covers the default anglechange (2 deg) without a library call; beyond,
+// up to the 45 deg anglechange allows, std::asin.
+double StepAsin(double s) {
+  constexpr double kSeriesLimit = 0.17;  // ~ sin(10 deg)
+  if (std::fabs(s) > kSeriesLimit) return std::asin(s);
   const double s2 = s * s;
   return s * (1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0 + s2 * 35.0 / 1152.0))));
 }
 
-// Rotates the unit vector (c, s) by a small angle a, with sin/cos series good to 1e-12 for
-// |a| < 0.1 rad, and renormalises: the squared norm n is 1 to about 1e-12, so one Newton
-// step for 1 / sqrt(n), (3 - n) / 2, is exact to double precision (and costs no sqrt or
-// division).
-void RotateSmall(double a, double* c, double* s) {
+// Rotates the unit vector (c, s) by the angle a. For |a| < 0.1 rad (every step of the default
+// anglechange) sin/cos series good to 1e-12 and a renormalisation: the squared norm n is 1 to
+// about 1e-12, so one Newton step for 1 / sqrt(n), (3 - n) / 2, is exact to double precision
+// (and costs no sqrt or division). Larger steps use std::cos and std::sin.
+void Rotate(double a, double* c, double* s) {
+  if (std::fabs(a) >= 0.1) {
+    const double cos_a = std::cos(a), sin_a = std::sin(a);
+    const double new_c = *c * cos_a - *s * sin_a;
+    *s = *s * cos_a + *c * sin_a;
+    *c = new_c;
+    return;
+  }
   const double a2 = a * a;
   // Horner form with constant coefficients (x / 24.0 would be a real division).
   const double cos_a = 1.0 + a2 * (-1.0 / 2.0 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0)));
@@ -180,7 +190,7 @@ int OrderedAccumulatorList::Vote(double cos_theta, double sin_theta, double rho_
     const double prior = static_cast<double>(entry.weight);
     // theta moves to the vote-weighted mean of the angles: the normal turns by that step.
     const double share = 1.0 / (prior + 1.0);  // the new vote's share of the mean
-    RotateSmall(SmallAsin(cross) * share, &entry.cos_theta, &entry.sin_theta);
+    Rotate(StepAsin(cross) * share, &entry.cos_theta, &entry.sin_theta);
     entry.rho_px = (prior * entry.rho_px + rho) * share;
     KeepUpperHalf(&entry.cos_theta, &entry.sin_theta, &entry.rho_px);
     ++entry.weight;

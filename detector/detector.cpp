@@ -274,13 +274,15 @@ void OalDetector::ReadOff(int width, int height) {
     candidates_[j] = moving;
   }
 
+  // Near-duplicates are judged with rho from the image centre, as the list matches lines, so
+  // that the same two lines are duplicates wherever they lie in the image.
   const double duplicate_angle = options_.duplicate_angle_deg * kDegToRad;
+  const Point2d centre{centre_u_, centre_v_};
   for (const DetectedLine& candidate : candidates_) {
     if (static_cast<int>(lines_.size()) >= options_.max_output_lines) break;
     const bool duplicate = std::any_of(lines_.begin(), lines_.end(), [&](const DetectedLine& kept) {
-      return AngleBetween(kept.line, candidate.line) <= duplicate_angle &&
-             std::fabs(RhoAlignedTo(kept.line, candidate.line) - kept.line.rho_px) <=
-                 options_.duplicate_r_px;
+      return NearDuplicate(kept.line, candidate.line, centre, duplicate_angle,
+                           options_.duplicate_r_px);
     });
     if (!duplicate) lines_.push_back(candidate);
   }

@@ -1,6 +1,6 @@
 // The ordered-accumulator-list (OAL) line detector of ../shared/paper/ordered-list-hough.md,
 // sections 2 and 3, with the remedies of ../shared/paper/NOTES.md behind switches
-// (DetectorOptions::Paper() turns them all off).
+// (DetectorOptions::Paper() turns them off; the lens correction follows the camera given).
 //
 //   for each border d = start, start + step, ... until the centre:
 //     1. scan the border, feature points = middles of line runs     (border_scan.h)
@@ -9,6 +9,27 @@
 //     4. count, reorder by weight - count/2 (Eq. 3)
 //     5. cull entries with weight - count/2 < 0 beyond max_lines (Eq. 4)
 //   6. read off the best lines, dropping near-duplicates          (line_fit.h for the refit)
+//
+// Where the paper is vague, the choices made here:
+//   - Borders: d = start, start + step, ... while the rectangle is at least 2 x 2 pixels; a
+//     centre border that degenerates to a line or a point is not scanned.
+//   - Step 2: pairs of points on the same side of a border are skipped when
+//     skip_same_side_pairs (they cannot belong to a line crossing the rectangle).
+//   - Step 3: "weighted by the number of votes prior to this iteration" is read per vote (the
+//     entry's weight before this vote), so the entry is the running mean of its votes. The
+//     thresholds are decided on the list's float copies of the parameters (about 7
+//     significant digits of the double values that are averaged). The list holds at most
+//     max_lines + the pairs of one border (memory bounded); a vote matching nothing while it
+//     is full is dropped.
+//   - Step 4: every entry's count grows, the one created on this border included ("the count
+//     on all the lines"); the sort is stable. The paper's "renormalise the vote counts" is not
+//     done: Eq. 4 compares absolute weights and counts, which a renormalisation would change.
+//   - Step 5: entries with a negative score are culled from the bottom only until max_lines
+//     remain ("lines will only be removed if there are more than 20").
+//   - Step 6: "close parameters" are within duplicate_angle_deg and duplicate_r_px, rho taken
+//     from the image centre (NearDuplicate, line.h). anglechange 2 deg, rchange 4 px and these
+//     thresholds are ours (the paper gives no values), set on the accuracy evaluation
+//     (oalservo detect-accuracy, docs/BENCHMARKS.md).
 //
 // Lines are reported in the convention of line.h. With a camera that has distortion, the
 // feature points are undistorted before step 2 and the lines are in undistorted pixel

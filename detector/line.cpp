@@ -57,6 +57,16 @@ double RhoAlignedTo(const LineParams& a, const LineParams& b) {
   return std::fabs(a.theta_rad - b.theta_rad) > kPi / 2.0 ? -b.rho_px : b.rho_px;
 }
 
+bool NearDuplicate(const LineParams& a, const LineParams& b, const Point2d& origin,
+                   double max_angle_rad, double max_r_px) {
+  if (AngleBetween(a, b) > max_angle_rad) return false;
+  const auto from_origin = [&origin](const LineParams& line) {
+    return LineParams{line.SignedDistance(origin.u, origin.v) * -1.0, line.theta_rad};
+  };
+  const LineParams a0 = from_origin(a), b0 = from_origin(b);
+  return std::fabs(RhoAlignedTo(a0, b0) - a0.rho_px) <= max_r_px;
+}
+
 bool Intersect(const LineParams& a, const LineParams& b, Point2d* out, double eps_rad) {
   const double ca = std::cos(a.theta_rad), sa = std::sin(a.theta_rad);
   const double cb = std::cos(b.theta_rad), sb = std::sin(b.theta_rad);

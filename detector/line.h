@@ -48,6 +48,13 @@ double AngleBetween(const LineParams& a, const LineParams& b);
 /// of the 0/pi wrap, b's rho changes sign. Used to compare rho across the wrap.
 double RhoAlignedTo(const LineParams& a, const LineParams& b);
 
+/// True when `a` and `b` are within `max_angle_rad` of each other and their distances from
+/// `origin` (rho measured from there, across the 0/pi wrap) within `max_r_px`. Measured from
+/// a point near both lines (the detector uses the image centre), the rho gap of two lines a
+/// small angle apart does not grow with their distance from the image's top-left corner.
+bool NearDuplicate(const LineParams& a, const LineParams& b, const Point2d& origin,
+                   double max_angle_rad, double max_r_px);
+
 /// Intersection of two lines; false when they are parallel within `eps_rad`.
 bool Intersect(const LineParams& a, const LineParams& b, Point2d* out, double eps_rad = 1e-9);
 

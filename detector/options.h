@@ -108,7 +108,14 @@ struct DetectorOptions {
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
 
-  /// The algorithm exactly as written in the paper: every remedy switched off.
+  /// The paper's algorithm: every remedy switch off (min_crossing_angle_deg 90,
+  /// skip_same_side_pairs, max_pair_width_ratio, count_visible_borders_only, refit_lines,
+  /// rank_by_support). What stays ours, as the paper leaves it open (detector.h lists each
+  /// choice): an Otsu threshold per border with its contrast gate, intensity-weighted run
+  /// centres, a run wrapping a rectangle corner taken by the midpoint of its ends, min_votes,
+  /// max_points_per_border, and the list's capacity bound (a vote matching nothing while the
+  /// list is full is dropped; the paper has no bound). Lens correction follows the camera
+  /// given to the detector, not these options.
   static DetectorOptions Paper();
 };
 

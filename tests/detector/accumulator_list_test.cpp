@@ -39,6 +39,18 @@ TEST(OrderedAccumulatorList, MatchesAverageWeightedByPriorVotes) {
   EXPECT_EQ(list.entries()[0].weight, 3);
 }
 
+// With a wide anglechange (Check() allows up to 45 deg) the mean is still exact: the step's
+// angle and rotation leave the small-angle series for the library functions.
+TEST(OrderedAccumulatorList, WideAngleChangeStillAveragesExactly) {
+  OrderedAccumulatorList list(40 * kDeg, 4.0, 20, 40);
+  VoteFor(&list, 10.0, 0.5);
+  EXPECT_EQ(VoteFor(&list, 12.0, 0.5 + 35 * kDeg), 0);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5 + 17.5 * kDeg, kTol);
+  EXPECT_EQ(VoteFor(&list, 11.0, 0.5 + 3 * kDeg), 0);  // (2 * 17.5 + 3) / 3 = 12.67 deg
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5 + (38.0 / 3.0) * kDeg, kTol);
+  EXPECT_NEAR(std::hypot(list.entries()[0].cos_theta, list.entries()[0].sin_theta), 1.0, 1e-15);
+}
+
 TEST(OrderedAccumulatorList, ThresholdsOfEquationsOneAndTwo) {
   OrderedAccumulatorList list(2 * kDeg, 4.0, 20, 40);
   VoteFor(&list, 10.0, 0.5);

@@ -102,5 +102,30 @@ TEST(Line, FitLineOfTwoPointsIsLineThrough) {
   EXPECT_NEAR(RhoAlignedTo(fit, through), fit.rho_px, kTol);
 }
 
+// Two lines through the image centre of a 640x480 frame, 2.5 deg apart: one line for the
+// read-off (within 3 deg and 8 px) wherever they point. Measured from the top-left corner,
+// their rho gap would be 6.4 px at theta = 1 rad but 17 px at theta = 2 rad.
+TEST(Line, NearDuplicateMeasuresRhoFromTheGivenOrigin) {
+  const Point2d centre{319.5, 239.5};
+  const double angle = 3.0 * kPi / 180.0, gap = 2.5 * kPi / 180.0;
+  const auto through_centre = [&](double theta) {
+    return LineParams{centre.u * std::cos(theta) + centre.v * std::sin(theta), theta};
+  };
+  for (const double theta : {1.0, 2.0}) {
+    const LineParams a = through_centre(theta), b = through_centre(theta + gap);
+    EXPECT_TRUE(NearDuplicate(a, b, centre, angle, 8.0)) << theta;
+    EXPECT_EQ(NearDuplicate(a, b, Point2d{0.0, 0.0}, angle, 8.0), theta == 1.0) << theta;
+  }
+  // Across the 0/pi wrap: theta 0.01 and pi - 0.01 through the centre are 1.1 deg apart.
+  const LineParams near_zero = through_centre(0.01);
+  const LineParams near_pi = Normalized(through_centre(kPi - 0.01).rho_px, kPi - 0.01);
+  EXPECT_TRUE(NearDuplicate(near_zero, near_pi, centre, angle, 8.0));
+  // Parallel, 10 px apart; and 4 deg apart: not duplicates.
+  const LineParams shifted{near_zero.rho_px + 10.0, near_zero.theta_rad};
+  EXPECT_FALSE(NearDuplicate(near_zero, shifted, centre, angle, 8.0));
+  EXPECT_FALSE(
+      NearDuplicate(near_zero, through_centre(0.01 + 4.0 * kPi / 180.0), centre, angle, 8.0));
+}
+
 }  // namespace
 }  // namespace oal
