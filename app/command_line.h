@@ -78,9 +78,6 @@ class StopSignalScope {
   void (*previous_[kSignals])(int);
 };
 
-/// The scope's former name, when it handled Ctrl-C only.
-using SigintScope = StopSignalScope;
-
 /// A stop signal for the user: "Ctrl-C (SIGINT)", "SIGTERM (a request to terminate)",
 /// "SIGHUP (the terminal or session was closed)"; "signal N" for another.
 std::string StopSignalName(int signal_number);

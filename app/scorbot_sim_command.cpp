@@ -181,7 +181,7 @@ int RunScorbotSim(int argc, char** argv) {
     MeasureScorbotLink(options, std::cout);
     return kExitOk;
   }
-  const SigintScope sigint;
+  const StopSignalScope sigint;
   return RunScorbotSimServer(options, std::cout, sigint.interrupted());
 }
 

@@ -61,7 +61,7 @@ bool NearDuplicate(const LineParams& a, const LineParams& b, const Point2d& orig
                    double max_angle_rad, double max_r_px) {
   if (AngleBetween(a, b) > max_angle_rad) return false;
   const auto from_origin = [&origin](const LineParams& line) {
-    return LineParams{line.SignedDistance(origin.u, origin.v) * -1.0, line.theta_rad};
+    return LineParams{-line.SignedDistance(origin.u, origin.v), line.theta_rad};
   };
   const LineParams a0 = from_origin(a), b0 = from_origin(b);
   return std::fabs(RhoAlignedTo(a0, b0) - a0.rho_px) <= max_r_px;
