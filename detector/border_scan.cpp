@@ -388,7 +388,7 @@ int ScanRuns(const std::uint8_t* s, int p, int threshold, int min_gap, Run* runs
 // Whether a corner of the loop lies strictly inside the run. Runs start in [-p, p) and end
 // before p, so it is enough to compare the end with the first corner after the start
 // (corners[0] = 0 comes back as p).
-bool HasCornerInside(const Run& run, const std::array<int, 4>& corners, int p) {
+bool CornerInsideRun(const Run& run, const std::array<int, 4>& corners, int p) {
   const int offset = run.first < 0 ? -p : 0;
   const int start = run.first - offset;  // in [0, p)
   const int next = start < corners[1]   ? corners[1]
@@ -482,11 +482,47 @@ double WeightedCentre(const std::uint8_t* s, int p, const Run& run, int threshol
                         : 0.5 * (s_a + s_b);
 }
 
-}  // namespace
+// The loop geometry FindPoints needs, for a border rectangle and for a region's polygon.
+class RectGeometry {
+ public:
+  explicit RectGeometry(const BorderRect& rect) : rect_(rect), corners_(Corners(rect)) {}
+  bool HasCornerInside(const Run& run, int p) const { return CornerInsideRun(run, corners_, p); }
+  std::uint16_t Locate(double s, Point2d* pixel) const { return rect_.Locate(s, pixel); }
+  // The side's direction when the point lies on one side only (a side's width across the
+  // line is then measurable).
+  Point2d Along(double, std::uint16_t sides) const {
+    const bool horizontal = (sides & (kTop | kBottom)) != 0;
+    const bool vertical = (sides & (kRight | kLeft)) != 0;
+    if (horizontal == vertical) return Point2d{};
+    return horizontal ? Point2d{1.0, 0.0} : Point2d{0.0, 1.0};
+  }
+  double Spacing(double) const { return 1.0; }
 
-int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect& rect,
-                     int threshold, const DetectorOptions& options,
-                     std::vector<BorderPoint>* points) {
+ private:
+  const BorderRect& rect_;
+  std::array<int, 4> corners_;
+};
+
+class PolygonGeometry {
+ public:
+  explicit PolygonGeometry(const PolygonLoop& loop) : loop_(loop) {}
+  bool HasCornerInside(const Run& run, int) const {
+    return loop_.HasCornerInside(run.first, run.last);
+  }
+  std::uint16_t Locate(double s, Point2d* pixel) const { return loop_.Locate(s, pixel); }
+  Point2d Along(double s, std::uint16_t sides) const {
+    if ((sides & (sides - 1)) != 0) return Point2d{};  // more than one edge
+    return loop_.Direction(s);
+  }
+  double Spacing(double s) const { return loop_.Spacing(s); }
+
+ private:
+  const PolygonLoop& loop_;
+};
+
+template <typename Geometry>
+int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometry, int threshold,
+               const DetectorOptions& options, std::vector<BorderPoint>* points) {
   const int p = static_cast<int>(samples.size());
   if (p < 4) return 0;
   const bool light = options.polarity == Polarity::kLightLines;
@@ -510,7 +546,6 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
     --run_count;
   }
 
-  const auto corners = Corners(rect);
   // (Computed only for runs wider than max_width_px, which are rare: sin is not cheap.)
   auto longer_than_max_run = [&](double length) {
     return length > options.max_width_px &&
@@ -520,13 +555,15 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
   int added = 0;
   // Appends a point, built in place (copying in a just-built local point stalled on store
   // forwarding); false once the border has its maximum.
-  auto push = [&](const Point2d& pixel, double run_px, std::uint8_t sides, bool straight) {
+  auto push = [&](const Point2d& pixel, double run_px, std::uint16_t sides, bool straight,
+                  const Point2d& along) {
     if (added >= options.max_points_per_border) return false;
     BorderPoint& point = points->emplace_back();
     point.pixel = pixel;
     point.run_px = run_px;
     point.sides = sides;
     point.straight = straight;
+    point.along = along;
     ++added;
     return true;
   };
@@ -544,29 +581,46 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
     if (edges) {
       if (length >= p - options.min_width_px) continue;
       Point2d a, b;
-      const std::uint8_t sides_a = rect.Locate(s_a, &a), sides_b = rect.Locate(s_b, &b);
-      if (!push(a, 0.0, sides_a, true)) break;
-      if (!push(b, 0.0, sides_b, true)) break;
+      const std::uint16_t sides_a = geometry.Locate(s_a, &a), sides_b = geometry.Locate(s_b, &b);
+      if (!push(a, 0.0, sides_a, true, Point2d{})) break;
+      if (!push(b, 0.0, sides_b, true, Point2d{})) break;
       continue;
     }
     if (longer_than_max_run(length)) continue;
 
-    const bool straight = !HasCornerInside(run, corners, p);
-    Point2d pixel;
-    std::uint8_t sides = 0;
+    const bool straight = !geometry.HasCornerInside(run, p);
+    Point2d pixel, along;
+    std::uint16_t sides = 0;
+    double run_px = length;
     if (straight) {
       const double centre =
           light ? WeightedCentre<true>(samples.data(), p, run, threshold, s_a, s_b)
                 : WeightedCentre<false>(samples.data(), p, run, threshold, s_a, s_b);
-      sides = rect.Locate(centre, &pixel);
+      sides = geometry.Locate(centre, &pixel);
+      along = geometry.Along(centre, sides);
+      run_px = length * geometry.Spacing(centre);
     } else {
       Point2d a, b;
-      sides = rect.Locate(s_a, &a) | rect.Locate(s_b, &b);
+      sides = static_cast<std::uint16_t>(geometry.Locate(s_a, &a) | geometry.Locate(s_b, &b));
       pixel = Point2d{0.5 * (a.u + b.u), 0.5 * (a.v + b.v)};
     }
-    if (!push(pixel, length, sides, straight)) break;
+    if (!push(pixel, run_px, sides, straight, along)) break;
   }
   return added;
+}
+
+}  // namespace
+
+int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect& rect,
+                     int threshold, const DetectorOptions& options,
+                     std::vector<BorderPoint>* points) {
+  return FindPoints(samples, RectGeometry(rect), threshold, options, points);
+}
+
+int FindBorderPoints(const std::vector<std::uint8_t>& samples, const PolygonLoop& loop,
+                     int threshold, const DetectorOptions& options,
+                     std::vector<BorderPoint>* points) {
+  return FindPoints(samples, PolygonGeometry(loop), threshold, options, points);
 }
 
 }  // namespace oal

@@ -14,6 +14,7 @@
 #include "detector/image_view.h"
 #include "detector/line.h"
 #include "detector/options.h"
+#include "detector/region.h"
 
 namespace oal {
 
@@ -44,10 +45,12 @@ BorderRect BorderAt(int width, int height, int d);
 
 /// A feature point found on a border.
 struct BorderPoint {
-  Point2d pixel;           ///< sub-pixel image position
-  double run_px = 0.0;     ///< length of the run along the loop (0 for edges)
-  std::uint8_t sides = 0;  ///< BorderSide bits
-  bool straight = true;    ///< the run lies on one side (its width can be measured)
+  Point2d pixel;            ///< sub-pixel image position
+  double run_px = 0.0;      ///< length of the run along the loop, pixels (0 for edges)
+  std::uint16_t sides = 0;  ///< BorderSide bits (a rectangle), or 1 << edge (a polygon)
+  bool straight = true;     ///< the run lies on one side (its width can be measured)
+  /// Unit direction of the side the run lies on; (0, 0) when it is not on one side only.
+  Point2d along;
 };
 
 /// Copies the loop's pixels, in loop order, into `samples` (resized; no allocation once it
@@ -91,6 +94,10 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast);
 /// intensity-weighted centroid; a run that wraps a corner gives the midpoint of its two
 /// sub-pixel ends, which lies on the centre line of a stripe with parallel edges.
 int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect& rect,
+                     int threshold, const DetectorOptions& options,
+                     std::vector<BorderPoint>* points);
+/// The same for a border of a region (region.h), as PolygonLoop::Gather wrote its samples.
+int FindBorderPoints(const std::vector<std::uint8_t>& samples, const PolygonLoop& loop,
                      int threshold, const DetectorOptions& options,
                      std::vector<BorderPoint>* points);
 

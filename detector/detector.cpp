@@ -60,7 +60,8 @@ void RectangleOutline(const BorderRect& rect, int per_side, std::vector<Point2d>
 
 }  // namespace
 
-OalDetector::BorderOutline::BorderOutline(const std::vector<Point2d>& outline) {
+template <std::size_t kPoints>
+OalDetector::BorderOutline<kPoints>::BorderOutline(const std::vector<Point2d>& outline) {
   for (std::size_t k = 0; k < kPoints; ++k) {
     const Point2d& p = outline[std::min(k, outline.size() - 1)];
     u[k] = p.u;
@@ -70,7 +71,8 @@ OalDetector::BorderOutline::BorderOutline(const std::vector<Point2d>& outline) {
 
 // The highest distance of a point along the line's normal is above rho and the lowest
 // below: the same decisions as testing each point's sign of distance - rho.
-bool OalDetector::BorderOutline::Crossed(const OalEntry& entry) const {
+template <std::size_t kPoints>
+bool OalDetector::BorderOutline<kPoints>::Crossed(const OalEntry& entry) const {
 #if OAL_HAVE_SSE2
   // Two points at a time.
   const __m128d c = _mm_set1_pd(entry.cos_theta), s = _mm_set1_pd(entry.sin_theta);
@@ -142,50 +144,146 @@ void OalDetector::PrepareFor(int width, int height) {
   lines_.reserve(static_cast<std::size_t>(options_.max_output_lines));
 }
 
+void OalDetector::PrepareRegion() {
+  // The region inside the image, where its lines end; its centroid is the list's origin.
+  const std::vector<Point2d>& inside = region_borders_.inside();
+  region_outline_.clear();
+  for (const Point2d& p : inside) region_outline_.push_back(ToWorking(p));
+  const Point2d centroid = region_borders_.count() > 0 ? Centroid(region_borders_.Polygon(0))
+                                                       : Point2d{centre_u_, centre_v_};
+  const Point2d origin = ToWorking(inside.empty() ? centroid : Centroid(inside));
+  origin_u_ = origin.u;
+  origin_v_ = origin.v;
+  // The borders' outlines for the visibility counts: their vertices (at most 12: 8 of the
+  // region's edges and the image's 4), undistorted, centred on the origin.
+  region_outlines_.clear();
+  region_outlines_long_.clear();
+  std::size_t most_vertices = 0;
+  for (int k = 0; k < region_borders_.count(); ++k) {
+    most_vertices = std::max(most_vertices, region_borders_.Polygon(k).size());
+  }
+  std::vector<Point2d>& outline = outline_scratch_;
+  for (int k = 0; k < region_borders_.count(); ++k) {
+    outline.clear();
+    for (const Point2d& p : region_borders_.Polygon(k)) {
+      const Point2d working = ToWorking(p);
+      outline.push_back(Point2d{working.u - origin_u_, working.v - origin_v_});
+    }
+    if (most_vertices <= 8) {
+      region_outlines_.emplace_back(outline);
+    } else {
+      region_outlines_long_.emplace_back(outline);
+    }
+  }
+}
+
 const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
                                                      const std::vector<LineSeed>& seeds) {
+  return Detect(image, seeds, ScanRegion{});
+}
+
+namespace {
+
+void CheckView(const GrayImageView& image) {
   if (image.empty() || image.stride < image.width) {
     throw std::invalid_argument("OalDetector::Detect: empty image or stride < width");
   }
+}
+
+}  // namespace
+
+const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
+                                                     const std::vector<LineSeed>& seeds,
+                                                     const ScanRegion& region) {
+  CheckView(image);
+  if (region.empty()) return DetectInRegion(image, seeds);
+  region.Check();
   PrepareFor(image.width, image.height);
+  region_borders_.Build(region, image.width, image.height, options_.start_px, options_.step_px,
+                        options_.region_max_borders);
+  in_region_ = true;
+  return DetectInRegion(image, seeds);
+}
+
+const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
+                                                     const std::vector<LineSeed>& seeds,
+                                                     const ScanBorders& borders) {
+  CheckView(image);
+  if (borders.empty()) return DetectInRegion(image, seeds);
+  borders.Check();
+  PrepareFor(image.width, image.height);
+  region_borders_.Assign(borders, image.width, image.height, options_.start_px, options_.step_px);
+  in_region_ = true;
+  return DetectInRegion(image, seeds);
+}
+
+// The whole image when in_region_ is false (and resets it for the next call), else the
+// borders region_borders_ holds.
+const std::vector<DetectedLine>& OalDetector::DetectInRegion(const GrayImageView& image,
+                                                             const std::vector<LineSeed>& seeds) {
+  PrepareFor(image.width, image.height);
+  const bool in_region = in_region_;
+  in_region_ = false;
+  if (in_region) {
+    PrepareRegion();
+  } else {
+    region_borders_ = RegionBorders();
+    origin_u_ = centre_u_;
+    origin_v_ = centre_v_;
+  }
   oal_.Clear();
   frame_points_.clear();
   lines_.clear();
   for (const LineSeed& seed : seeds) {
-    // To the list's origin at the image centre.
+    // To the list's origin.
     const double c = std::cos(seed.line.theta_rad), s = std::sin(seed.line.theta_rad);
-    oal_.Seed(c, s, seed.line.rho_px - centre_u_ * c - centre_v_ * s, seed.id);
+    oal_.Seed(c, s, seed.line.rho_px - origin_u_ * c - origin_v_ * s, seed.id);
   }
-  loops_.Read(image);
-  for (int border = 0; border < loops_.count(); ++border) ScanBorder(image, border);
+  scanned_region_ = in_region;
+  if (in_region) {
+    for (int border = 0; border < region_borders_.count(); ++border) {
+      ScanRegionBorder(image, border);
+    }
+  } else {
+    loops_.Read(image);
+    for (int border = 0; border < loops_.count(); ++border) ScanBorder(image, border);
+  }
   ReadOff(image.width, image.height);
   return lines_;
+}
+
+bool OalDetector::BorderThreshold(const std::vector<std::uint8_t>& samples, int* threshold) const {
+  *threshold = options_.fixed_threshold;
+  if (options_.threshold_mode != ThresholdMode::kOtsu) return true;
+  int contrast = 0;
+  *threshold = OtsuThreshold(samples, &contrast);
+  return contrast >= options_.min_contrast;
+}
+
+void OalDetector::AddBorderPoints(int border) {
+  const std::size_t first_point = frame_points_.size();
+  for (const BorderPoint& point : border_points_) {
+    // Built in place: copying in a just-built local stalled on store forwarding.
+    FramePoint& frame_point = frame_points_.emplace_back();
+    frame_point.p = ToWorking(point.pixel);
+    const double run = point.straight ? point.run_px : 0.0;
+    frame_point.across_u = static_cast<float>(run * point.along.u);
+    frame_point.across_v = static_cast<float>(run * point.along.v);
+    frame_point.sides = point.sides;
+    frame_point.straight = point.straight;
+    frame_point.border = static_cast<std::int16_t>(border);
+  }
+  VotePairs(border, first_point);
 }
 
 void OalDetector::ScanBorder(const GrayImageView& image, int border) {
   const BorderRect rect = loops_.Rect(border);
   const std::vector<std::uint8_t>& samples = loops_.Gather(image, border);
-  int threshold = options_.fixed_threshold;
-  bool has_contrast = true;
-  if (options_.threshold_mode == ThresholdMode::kOtsu) {
-    int contrast = 0;
-    threshold = OtsuThreshold(samples, &contrast);
-    has_contrast = contrast >= options_.min_contrast;
-  }
-  const std::size_t first_point = frame_points_.size();
-  if (has_contrast) {
+  int threshold = 0;
+  if (BorderThreshold(samples, &threshold)) {
     border_points_.clear();
     FindBorderPoints(samples, rect, threshold, options_, &border_points_);
-    for (const BorderPoint& point : border_points_) {
-      // Built in place: copying in a just-built local stalled on store forwarding.
-      FramePoint& frame_point = frame_points_.emplace_back();
-      frame_point.p = ToWorking(point.pixel);
-      frame_point.run_px = static_cast<float>(point.run_px);
-      frame_point.sides = point.sides;
-      frame_point.straight = point.straight;
-      frame_point.border = static_cast<std::int16_t>(border);
-    }
-    VotePairs(border, first_point);
+    AddBorderPoints(border);
   }
 
   if (!options_.count_visible_borders_only) {
@@ -194,8 +292,30 @@ void OalDetector::ScanBorder(const GrayImageView& image, int border) {
   }
   // A local copy, captured by value: the compiler keeps it in registers across the entries
   // (it would reload member arrays after every count update, which might alias them).
-  const BorderOutline outline = outlines_[static_cast<std::size_t>(border)];
+  const BorderOutline<8> outline = outlines_[static_cast<std::size_t>(border)];
   oal_.EndBorder([outline](const OalEntry& entry) { return outline.Crossed(entry); });
+}
+
+void OalDetector::ScanRegionBorder(const GrayImageView& image, int border) {
+  const PolygonLoop& loop = region_borders_.Loop(border);
+  loop.Gather(image, &region_samples_);
+  int threshold = 0;
+  if (BorderThreshold(region_samples_, &threshold)) {
+    border_points_.clear();
+    FindBorderPoints(region_samples_, loop, threshold, options_, &border_points_);
+    AddBorderPoints(border);
+  }
+  if (!options_.count_visible_borders_only) {
+    oal_.EndBorder([](const OalEntry&) { return true; });
+    return;
+  }
+  if (region_outlines_long_.empty()) {
+    const BorderOutline<8> outline = region_outlines_[static_cast<std::size_t>(border)];
+    oal_.EndBorder([outline](const OalEntry& entry) { return outline.Crossed(entry); });
+  } else {
+    const BorderOutline<16> outline = region_outlines_long_[static_cast<std::size_t>(border)];
+    oal_.EndBorder([outline](const OalEntry& entry) { return outline.Crossed(entry); });
+  }
 }
 
 void OalDetector::VotePairs(int border, std::size_t first_point) {
@@ -211,7 +331,7 @@ void OalDetector::VotePairs(int border, std::size_t first_point) {
       if (!WidthsAgree(a, b, du, dv, length_sq)) continue;
       const double inverse = 1.0 / std::sqrt(length_sq);
       const double c = -dv * inverse, s = du * inverse;  // unit normal of the chord
-      const double rho = c * (a.p.u - centre_u_) + s * (a.p.v - centre_v_);
+      const double rho = c * (a.p.u - origin_u_) + s * (a.p.v - origin_v_);
       oal_.Vote(c, s, rho, border);
     }
   }
@@ -241,8 +361,8 @@ void OalDetector::ReadOff(int width, int height) {
   candidates_.clear();
   for (const OalEntry& entry : oal_.entries()) {
     if (entry.weight < options_.min_votes) continue;
-    // From the list's centred origin to the image's top-left origin.
-    const double rho = entry.rho_px + centre_u_ * entry.cos_theta + centre_v_ * entry.sin_theta;
+    // From the list's origin to the image's top-left origin.
+    const double rho = entry.rho_px + origin_u_ * entry.cos_theta + origin_v_ * entry.sin_theta;
     DetectedLine line;
     line.line = Normalized(rho, entry.Line().theta_rad);
     if (options_.refit_lines) {
@@ -258,6 +378,8 @@ void OalDetector::ReadOff(int width, int height) {
     line.borders = stats.borders;
     line.support = stats.points;
     line.width_px = stats.width_px;
+    line.support_a = stats.first;
+    line.support_b = stats.last;
     candidates_.push_back(line);
   }
   // Best first; an insertion sort because it is stable and, unlike std::stable_sort,
@@ -274,10 +396,10 @@ void OalDetector::ReadOff(int width, int height) {
     candidates_[j] = moving;
   }
 
-  // Near-duplicates are judged with rho from the image centre, as the list matches lines, so
-  // that the same two lines are duplicates wherever they lie in the image.
+  // Near-duplicates are judged with rho from the list's origin, as the list matches lines,
+  // so that the same two lines are duplicates wherever they lie in the image.
   const double duplicate_angle = options_.duplicate_angle_deg * kDegToRad;
-  const Point2d centre{centre_u_, centre_v_};
+  const Point2d centre{origin_u_, origin_v_};
   for (const DetectedLine& candidate : candidates_) {
     if (static_cast<int>(lines_.size()) >= options_.max_output_lines) break;
     const bool duplicate = std::any_of(lines_.begin(), lines_.end(), [&](const DetectedLine& kept) {
@@ -287,9 +409,15 @@ void OalDetector::ReadOff(int width, int height) {
     if (!duplicate) lines_.push_back(candidate);
   }
 
-  // End points on the image border (the undistorted image border when correcting).
+  // End points on the image border (the undistorted image border when correcting), or on
+  // the region's outline.
   for (DetectedLine& line : lines_) {
-    if (undistorter_) {
+    if (scanned_region_) {
+      if (!ClipToOutline(line.line, region_outline_, &line.end_a, &line.end_b)) {
+        line.end_a = line.support_a;
+        line.end_b = line.support_b;
+      }
+    } else if (undistorter_) {
       ClipToOutline(line.line, image_outline_, &line.end_a, &line.end_b);
     } else {
       ClipToRect(line.line, 0.0, 0.0, width - 1.0, height - 1.0, &line.end_a, &line.end_b);

@@ -49,6 +49,7 @@
 #include "detector/line.h"
 #include "detector/line_fit.h"
 #include "detector/options.h"
+#include "detector/region.h"
 
 namespace oal {
 
@@ -59,8 +60,13 @@ struct DetectedLine {
   int borders = 0;        ///< borders with at least one feature point on the line
   int support = 0;        ///< feature points of all borders within support_tolerance_px
   double width_px = 0.0;  ///< mean line thickness across the line (0 for edges)
-  Point2d end_a, end_b;   ///< where the line meets the image border
-  int seed_id = -1;       ///< the LineSeed whose entry collected this line's votes, or -1
+  /// Where the line meets the image border, or the region's outline when a region was
+  /// scanned (the undistorted one when correcting).
+  Point2d end_a, end_b;
+  /// The first and last supporting feature point along the line, projected onto it: the
+  /// part of the line that was seen.
+  Point2d support_a, support_b;
+  int seed_id = -1;  ///< the LineSeed whose entry collected this line's votes, or -1
 };
 
 /// A line expected in the next frame, e.g. a tracked line, in the coordinates of the
@@ -90,6 +96,23 @@ class OalDetector {
   /// from its seed collects its votes in the seed's entry and comes out with its seed_id.
   const std::vector<DetectedLine>& Detect(const GrayImageView& image,
                                           const std::vector<LineSeed>& seeds);
+  /// As above, scanning the concentric borders of `region` (region.h) instead of the
+  /// image's: border d is the region moved inward by d = start_px, start_px + step_px, ...
+  /// (the image's edges too, where the region leaves the image); the list's rho is measured
+  /// from the region's centroid. An empty region scans the whole image. Throws
+  /// std::invalid_argument for a region failing ScanRegion::Check().
+  const std::vector<DetectedLine>& Detect(const GrayImageView& image,
+                                          const std::vector<LineSeed>& seeds,
+                                          const ScanRegion& region);
+  /// As above with the borders given one by one (region.h: ScanBorders; border k clipped to
+  /// the image moved inward by start_px + k step_px), e.g. rectangles concentric on a planar
+  /// target. The list's origin is the centroid of the first border inside the image; lines
+  /// end on its outline.
+  /// No borders scans the whole image. Throws std::invalid_argument for a polygon failing
+  /// ScanRegion::Check().
+  const std::vector<DetectedLine>& Detect(const GrayImageView& image,
+                                          const std::vector<LineSeed>& seeds,
+                                          const ScanBorders& borders);
 
   bool Undistorts() const { return undistorter_.has_value(); }
   const DetectorOptions& options() const { return options_; }
@@ -97,13 +120,17 @@ class OalDetector {
   const std::vector<FramePoint>& feature_points() const { return frame_points_; }
   /// The accumulator list as the last frame left it.
   const OrderedAccumulatorList& accumulator_list() const { return oal_; }
+  /// The borders the last frame's region was scanned on, outermost first, in image pixels
+  /// (count() 0 when the whole image was scanned).
+  const RegionBorders& region_borders() const { return region_borders_; }
 
  private:
-  /// A border's outline (detector.cpp: RectangleOutline) in working coordinates centred on
-  /// the image centre, as fixed-size arrays padded by repeating the last point, so that
-  /// Crossed is a short loop, unrolled and two points at a time with SSE2.
+  /// A border's outline (detector.cpp: RectangleOutline, or a region border's vertices) in
+  /// working coordinates centred on the list's origin, as fixed-size arrays padded by
+  /// repeating the last point, so that Crossed is a short loop, unrolled and two points at a
+  /// time with SSE2. kPoints is even: Crossed takes two at a time.
+  template <std::size_t kPoints>
   struct BorderOutline {
-    static constexpr std::size_t kPoints = 8;  // even: Crossed takes two at a time
     std::array<double, kPoints> u, v;
 
     explicit BorderOutline(const std::vector<Point2d>& outline);  // outline not empty
@@ -112,7 +139,17 @@ class OalDetector {
   };
 
   void PrepareFor(int width, int height);
+  /// The working state of region_borders_ once they are built: origin, outlines, where lines
+  /// end.
+  void PrepareRegion();
+  const std::vector<DetectedLine>& DetectInRegion(const GrayImageView& image,
+                                                  const std::vector<LineSeed>& seeds);
   void ScanBorder(const GrayImageView& image, int border);
+  void ScanRegionBorder(const GrayImageView& image, int border);
+  /// Step 1's threshold for a border's samples; false when the border has no contrast.
+  bool BorderThreshold(const std::vector<std::uint8_t>& samples, int* threshold) const;
+  /// Appends border_points_ to the frame's points (working coordinates) and votes their pairs.
+  void AddBorderPoints(int border);
   void VotePairs(int border, std::size_t first_point);
   /// The pair width test of DetectorOptions::max_pair_width_ratio for the chord from a to b,
   /// (du, dv) = b - a, length_sq = du² + dv².
@@ -128,11 +165,24 @@ class OalDetector {
   // Working memory, sized once per image size (no allocation per frame after that).
   int width_ = 0, height_ = 0;
   double centre_u_ = 0.0, centre_v_ = 0.0;
+  /// The list's rho origin this frame: the image centre, or the region's centroid.
+  double origin_u_ = 0.0, origin_v_ = 0.0;
   BorderLoops loops_;
   std::vector<BorderPoint> border_points_;
   std::vector<FramePoint> frame_points_;
-  std::vector<BorderOutline> outlines_;  ///< per border
-  std::vector<Point2d> image_outline_;   ///< the image border in working coordinates
+  std::vector<BorderOutline<8>> outlines_;  ///< per border
+  std::vector<Point2d> image_outline_;      ///< the image border in working coordinates
+  // A region's borders (the last region's; rebuilt for each frame with a region).
+  bool in_region_ = false;       ///< the next DetectInRegion scans region_borders_
+  bool scanned_region_ = false;  ///< the last frame was scanned in a region
+  RegionBorders region_borders_;
+  // A region border has at most 12 vertices; most have 8 or fewer (a quadrilateral, clipped
+  // by the image), whose test is half as long.
+  std::vector<BorderOutline<8>> region_outlines_;
+  std::vector<BorderOutline<16>> region_outlines_long_;
+  std::vector<Point2d> region_outline_;  ///< the region (inside the image), working coordinates
+  std::vector<Point2d> outline_scratch_;
+  std::vector<std::uint8_t> region_samples_;
   std::vector<DetectedLine> candidates_;
   std::vector<DetectedLine> lines_;
 };

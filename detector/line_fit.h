@@ -12,9 +12,11 @@ namespace oal {
 
 /// A feature point of the whole frame, in the detector's working coordinates.
 struct FramePoint {
-  Point2d p;                ///< undistorted when the detector corrects distortion
-  float run_px = 0.0f;      ///< run length along the border (0: unknown, e.g. edges)
-  std::uint8_t sides = 0;   ///< BorderSide bits of the border the point is on
+  Point2d p;  ///< undistorted when the detector corrects distortion
+  /// The run along its border side: its length times the side's unit direction, pixels;
+  /// (0, 0) when its width is unknown (edges, runs around a corner of the border).
+  float across_u = 0.0f, across_v = 0.0f;
+  std::uint16_t sides = 0;  ///< sides of the border the point is on (BorderPoint::sides)
   bool straight = true;     ///< the run lay on one side of the border
   std::int16_t border = 0;  ///< index of the border, 0 = outermost
 };
@@ -23,16 +25,18 @@ struct SupportStats {
   int points = 0;         ///< feature points within the tolerance
   int borders = 0;        ///< distinct borders among them
   double width_px = 0.0;  ///< mean line width across the line (0 if unknown)
+  /// The extreme points among them along the line, projected onto it (the foot of the line's
+  /// normal from the origin when there are none).
+  Point2d first, last;
 };
 
-/// Width across a line of normal (cos_theta, sin_theta) of the stripe whose run gave
-/// `point`: a stripe of width w crosses a horizontal side in a run of w / |cos theta| and a
-/// vertical side in a run of w / |sin theta|. 0 when unknown (corner runs, edges).
+/// Width across a line of normal n = (cos_theta, sin_theta) of the stripe whose run gave
+/// `point`: a stripe of width w crosses a side of unit direction e in a run of w / |e·n| (a
+/// horizontal side: w / |cos theta|, a vertical one: w / |sin theta|). 0 when unknown (corner
+/// runs, edges). Linear in n, so an unnormalised normal scales the result.
 inline double WidthAcross(const FramePoint& point, double cos_theta, double sin_theta) {
-  const bool horizontal = (point.sides & 0x5) != 0;  // kTop | kBottom
-  const bool vertical = (point.sides & 0xA) != 0;    // kRight | kLeft
-  if (point.run_px <= 0.0f || !point.straight || horizontal == vertical) return 0.0;
-  return point.run_px * (horizontal ? std::fabs(cos_theta) : std::fabs(sin_theta));
+  return std::fabs(static_cast<double>(point.across_u) * cos_theta +
+                   static_cast<double>(point.across_v) * sin_theta);
 }
 
 /// The total-least-squares line of the points within `tolerance_px` of `line`; unchanged if

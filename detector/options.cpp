@@ -57,6 +57,8 @@ void DetectorOptions::Check() const {
           min_crossing_angle_deg, "1 <= min_crossing_angle_deg <= 90");
   Require(max_points_per_border >= 2 && max_points_per_border <= 64, "max_points_per_border",
           max_points_per_border, "2 <= max_points_per_border <= 64");
+  Require(region_max_borders >= 0 && region_max_borders <= 1000, "region_max_borders",
+          region_max_borders, "0 <= region_max_borders <= 1000");
   Require(
       max_pair_width_ratio == 0.0 || (max_pair_width_ratio >= 1.0 && max_pair_width_ratio <= 100.0),
       "max_pair_width_ratio", max_pair_width_ratio,

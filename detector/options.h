@@ -61,6 +61,12 @@ struct DetectorOptions {
   double min_crossing_angle_deg = 15.0;
   /// Runs beyond this many on one border are ignored (a textured border). Range [2, 64].
   int max_points_per_border = 24;
+  /// With a region of interest (OalDetector::Detect with a ScanRegion), at most this many
+  /// borders are scanned: a region so large that step_px would give more is scanned every
+  /// k step_px, k the smallest that gives at most this many (a sheet filling the view costs
+  /// what a smaller one does; the full-image scan always uses step_px). 0: no limit.
+  /// Range [0, 1000].
+  int region_max_borders = 16;
 
   // --- Step 2: pairwise correlation ------------------------------------------------------
   /// Two points on the same side of a border rectangle span that side, never a line that

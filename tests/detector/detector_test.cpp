@@ -234,16 +234,18 @@ TEST(OalDetector, PairWidthCheckKeepsCrossPairsOutOfTheList) {
 }
 
 TEST(LineFit, WidthAcrossUsesTheSideTheRunLiesOn) {
-  FramePoint top;
-  top.run_px = 10.0f;
-  top.sides = kTop;
+  FramePoint top;  // a 10 px run along a horizontal side
+  top.across_u = 10.0f;
   EXPECT_NEAR(WidthAcross(top, std::cos(0.5), std::sin(0.5)), 10.0 * std::cos(0.5), 1e-6);
-  FramePoint left = top;
-  left.sides = kLeft;
+  FramePoint left;  // ... along a vertical side
+  left.across_v = -10.0f;
   EXPECT_NEAR(WidthAcross(left, std::cos(0.5), std::sin(0.5)), 10.0 * std::sin(0.5), 1e-6);
-  FramePoint corner = top;
-  corner.sides = kTop | kLeft;
-  EXPECT_EQ(WidthAcross(corner, 1.0, 0.0), 0.0);
+  FramePoint slanted;  // ... along a side at 30 degrees: the width is the run times |e . n|
+  slanted.across_u = static_cast<float>(10.0 * std::cos(kPi / 6));
+  slanted.across_v = static_cast<float>(10.0 * std::sin(kPi / 6));
+  EXPECT_NEAR(WidthAcross(slanted, std::cos(0.5), std::sin(0.5)),
+              10.0 * std::fabs(std::cos(kPi / 6 - 0.5)), 1e-5);
+  EXPECT_EQ(WidthAcross(FramePoint{}, 1.0, 0.0), 0.0);  // a corner run: unknown
 }
 
 }  // namespace

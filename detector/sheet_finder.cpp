@@ -1,0 +1,477 @@
+#include "detector/sheet_finder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "detector/options.h"
+#include "detector/region.h"
+#include "detector/simd.h"
+
+namespace oal {
+namespace {
+
+// A quadrilateral is kept only when its cells fill at least this much of it.
+constexpr double kMinFill = 0.6;
+// Refinement: points probed along each side, and how far along the normal, in cells.
+constexpr int kEdgePoints = 7;
+constexpr double kEdgeSearchCells = 1.5;
+
+// Otsu's threshold over the values of histogram[lo, 256): values >= the result are the
+// light class; *contrast gets the two classes' mean difference (0 when a class is empty).
+int OtsuOfHistogram(const std::array<int, 256>& histogram, int lo, double* contrast) {
+  double total = 0.0, sum = 0.0;
+  for (int g = lo; g < 256; ++g) {
+    total += histogram[g];
+    sum += static_cast<double>(g) * histogram[g];
+  }
+  *contrast = 0.0;
+  double weight_low = 0.0, sum_low = 0.0, best = -1.0;
+  int threshold = 256;
+  for (int g = lo; g < 255; ++g) {
+    weight_low += histogram[g];
+    sum_low += static_cast<double>(g) * histogram[g];
+    const double weight_high = total - weight_low;
+    if (weight_low <= 0.0 || weight_high <= 0.0) continue;
+    const double gap = (sum - sum_low) / weight_high - sum_low / weight_low;
+    const double between = weight_low * weight_high * gap * gap;
+    if (between > best) {
+      best = between;
+      threshold = g + 1;
+      *contrast = gap;
+    }
+  }
+  return threshold;
+}
+
+double TriangleArea(const Point2d& a, const Point2d& b, const Point2d& c) {
+  return 0.5 * std::fabs((b.u - a.u) * (c.v - a.v) - (b.v - a.v) * (c.u - a.u));
+}
+
+// Drops the vertices of a convex polygon whose triangle with their neighbours is smallest,
+// one at a time, until `count` remain (the polygon shrinks, staying inside the original).
+void ReduceTo(std::vector<Point2d>* polygon, std::size_t count) {
+  std::vector<Point2d>& p = *polygon;
+  while (p.size() > count) {
+    std::size_t best = 0;
+    double smallest = HUGE_VAL;
+    const std::size_t n = p.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double a = TriangleArea(p[(i + n - 1) % n], p[i], p[(i + 1) % n]);
+      if (a < smallest) {
+        smallest = a;
+        best = i;
+      }
+    }
+    p.erase(p.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+}
+
+// The grey level at (u, v): the mean of the pixel and its neighbours one pixel away along
+// (du, dv) on both sides, nearest pixels; -1 when one of them lies outside the image.
+double Probe(const GrayImageView& image, double u, double v, double du, double dv) {
+  int sum = 0;
+  for (int k = -1; k <= 1; ++k) {
+    const double x = u + k * du + 0.5, y = v + k * dv + 0.5;
+    if (!(x >= 0.0 && y >= 0.0 && x < image.width && y < image.height)) return -1.0;
+    sum += image.at(static_cast<int>(x), static_cast<int>(y));
+  }
+  return sum / 3.0;
+}
+
+// A side from a to b of a quadrilateral turning like the image borders: its unit direction
+// and outward unit normal.
+struct Side {
+  Point2d a, b, direction, outward;
+  double length = 0.0;
+
+  Side(const Point2d& from, const Point2d& to) : a(from), b(to) {
+    const double du = to.u - from.u, dv = to.v - from.v;
+    length = std::sqrt(du * du + dv * dv);
+    direction = length > 0.0 ? Point2d{du / length, dv / length} : Point2d{1.0, 0.0};
+    outward = Point2d{direction.v, -direction.u};
+  }
+  Point2d At(double t, double s) const {
+    return Point2d{a.u + t * (b.u - a.u) + s * outward.u, a.v + t * (b.v - a.v) + s * outward.v};
+  }
+};
+
+// Whether, going outward from the side at t, dark pixels (min_contrast below `light`, over
+// at least 2 px) and then light ones again (at least 2 px above the middle of the light and
+// the darkest seen) follow within `reach` px.
+bool ClosedAt(const GrayImageView& image, const Side& side, double t, double light, double reach,
+              int min_contrast) {
+  const int n = static_cast<int>(reach);
+  double darkest = 255.0;
+  int dark_from = -1, light_again = 0;
+  for (int s = 0; s < n; ++s) {
+    const Point2d p = side.At(t, s);
+    const double x = p.u + 0.5, y = p.v + 0.5;  // one pixel: the band is far below the noise
+    if (!(x >= 0.0 && y >= 0.0 && x < image.width && y < image.height)) return false;
+    const double g = image.at(static_cast<int>(x), static_cast<int>(y));
+    if (dark_from < 0) {
+      if (g < light - min_contrast) {
+        dark_from = s;
+        darkest = g;
+      }
+      continue;
+    }
+    darkest = std::min(darkest, g);
+    if (g >= 0.5 * (light + darkest)) {
+      if (s - dark_from < 2) return false;  // too thin a band: noise
+      if (++light_again >= 2) return true;
+    } else if (light_again > 0) {
+      return false;  // dark again straight after: not paper beyond the band
+    }
+  }
+  return false;
+}
+
+// The light/dark edge nearest to the side at t along its normal, within +-search px: false
+// when there is none with enough contrast.
+bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light, double search,
+            int min_contrast, Point2d* edge) {
+  const int n = static_cast<int>(2.0 * search) + 1;
+  std::array<double, 256> profile;
+  if (n > static_cast<int>(profile.size())) return false;
+  double darkest = 255.0;
+  for (int i = 0; i < n; ++i) {
+    const Point2d p = side.At(t, i - search);
+    profile[static_cast<std::size_t>(i)] =
+        Probe(image, p.u, p.v, side.direction.u, side.direction.v);
+    if (profile[static_cast<std::size_t>(i)] < 0.0) return false;
+    darkest = std::min(darkest, profile[static_cast<std::size_t>(i)]);
+  }
+  if (light - darkest < min_contrast) return false;
+  const double threshold = 0.5 * (light + darkest);
+  double best = HUGE_VAL;
+  for (int i = 0; i + 1 < n; ++i) {
+    const double g0 = profile[static_cast<std::size_t>(i)],
+                 g1 = profile[static_cast<std::size_t>(i + 1)];
+    if (!(g0 >= threshold && g1 < threshold)) continue;  // light to dark, outward
+    const double s = i - search + (g0 - threshold) / (g0 - g1);
+    if (std::fabs(s) < std::fabs(best)) best = s;
+  }
+  if (!std::isfinite(best)) return false;
+  *edge = side.At(t, best);
+  return true;
+}
+
+// The side moved onto the light/dark edge: a line through the edge points found along it
+// (at least 4 of kEdgePoints, those more than 1.5 px off the first fit dropped).
+bool RefineSide(const GrayImageView& image, const Side& side, double light, double search,
+                int min_contrast, LineParams* line) {
+  std::vector<Point2d> points;
+  for (int k = 0; k < kEdgePoints; ++k) {
+    const double t = 0.15 + 0.7 * k / (kEdgePoints - 1.0);
+    Point2d edge;
+    if (EdgeAt(image, side, t, light, search, min_contrast, &edge)) points.push_back(edge);
+  }
+  if (points.size() < 4) return false;
+  LineParams fit = FitLine(points);
+  std::vector<Point2d> close;
+  for (const Point2d& p : points) {
+    if (std::fabs(fit.SignedDistance(p.u, p.v)) <= 1.5) close.push_back(p);
+  }
+  if (close.size() < 4) return false;
+  *line = FitLine(close);
+  return true;
+}
+
+}  // namespace
+
+int LightQuad::ClosedSideCount() const {
+  int count = 0;
+  for (int k = 0; k < 4; ++k) count += (closed_sides >> k) & 1;
+  return count;
+}
+
+void SheetFinderOptions::Check() const {
+  RequireOption(cell_px >= 2 && cell_px <= 64, "SheetFinderOptions::cell_px", cell_px,
+                "2 <= cell_px <= 64");
+  RequireOption(min_area_fraction > 0.0 && min_area_fraction <= 1.0,
+                "SheetFinderOptions::min_area_fraction", min_area_fraction,
+                "0 < min_area_fraction <= 1");
+  RequireOption(min_contrast >= 0 && min_contrast <= 255, "SheetFinderOptions::min_contrast",
+                min_contrast, "0 <= min_contrast <= 255");
+  RequireOption(max_candidates >= 1 && max_candidates <= 16, "SheetFinderOptions::max_candidates",
+                max_candidates, "1 <= max_candidates <= 16");
+}
+
+SheetFinder::SheetFinder(const SheetFinderOptions& options)
+    : options_((options.Check(), options)) {}
+
+void SheetFinder::ComputeCells(const GrayImageView& image) {
+  const int c = options_.cell_px;
+  grid_width_ = image.width / c;
+  grid_height_ = image.height / c;
+  cells_.assign(static_cast<std::size_t>(grid_width_) * grid_height_, 0);
+  std::vector<std::uint32_t> sums(static_cast<std::size_t>(grid_width_));
+  // Every other row of each cell: the mean of half its pixels is plenty for paper.
+  const int rows_used = (c + 1) / 2;
+  const std::uint32_t count = static_cast<std::uint32_t>(rows_used * c);
+  for (int gy = 0; gy < grid_height_; ++gy) {
+    std::fill(sums.begin(), sums.end(), 0u);
+    for (int r = 0; r < c; r += 2) {
+      const std::uint8_t* row = image.data + static_cast<std::ptrdiff_t>(gy * c + r) * image.stride;
+      int gx = 0;
+#if OAL_HAVE_SSE2
+      if (c == 8) {  // one psadbw sums two cells' eight pixels
+        const __m128i zero = _mm_setzero_si128();
+        for (; gx + 1 < grid_width_; gx += 2) {
+          const __m128i pixels = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + gx * 8));
+          const __m128i sad = _mm_sad_epu8(pixels, zero);
+          sums[static_cast<std::size_t>(gx)] += static_cast<std::uint32_t>(_mm_cvtsi128_si32(sad));
+          sums[static_cast<std::size_t>(gx) + 1] +=
+              static_cast<std::uint32_t>(_mm_extract_epi16(sad, 4));
+        }
+      }
+#endif
+      for (; gx < grid_width_; ++gx) {
+        const std::uint8_t* p = row + gx * c;
+        std::uint32_t s = 0;
+        for (int k = 0; k < c; ++k) s += p[k];
+        sums[static_cast<std::size_t>(gx)] += s;
+      }
+    }
+    std::uint8_t* out = cells_.data() + static_cast<std::size_t>(gy) * grid_width_;
+    for (int gx = 0; gx < grid_width_; ++gx) {
+      out[gx] = static_cast<std::uint8_t>((sums[static_cast<std::size_t>(gx)] + count / 2) / count);
+    }
+  }
+}
+
+bool SheetFinder::Describe(const GrayImageView& image, int threshold,
+                           const std::vector<CellRun>& runs, LightQuad* quad) const {
+  const int c = options_.cell_px;
+  // Cell edges in pixel coordinates (pixel centres at integers), clamped to the image.
+  const double max_u = image.width - 1.0, max_v = image.height - 1.0;
+  auto edge_u = [&](int gx) { return std::clamp(gx * c - 0.5, 0.0, max_u); };
+  auto edge_v = [&](int gy) { return std::clamp(gy * c - 0.5, 0.0, max_v); };
+  // Each grid row's leftmost and rightmost cell is enough for the convex hull.
+  double light_sum = 0.0, cells = 0.0;
+  std::vector<Point2d> corners;
+  for (std::size_t i = 0; i < runs.size();) {
+    const int row = runs[i].row;
+    int left = runs[i].first, right = runs[i].last;
+    for (; i < runs.size() && runs[i].row == row; ++i) {
+      const CellRun& run = runs[i];
+      left = std::min(left, run.first);
+      right = std::max(right, run.last);
+      const std::uint32_t* sums =
+          row_sums_.data() + static_cast<std::size_t>(row) * (grid_width_ + 1);
+      light_sum += sums[run.last + 1] - sums[run.first];
+      cells += run.last - run.first + 1;
+    }
+    if (row == 0 || row == grid_height_ - 1 || left == 0 || right == grid_width_ - 1) {
+      quad->touches_border = true;
+    }
+    // The row's top and bottom edges; a bottom edge is the next row's top edge, so only the
+    // extremes of both are kept.
+    const double u0 = edge_u(left), u1 = edge_u(right + 1), top = edge_v(row);
+    if (!corners.empty() && corners.back().v == top) {
+      corners[corners.size() - 2].u = std::min(corners[corners.size() - 2].u, u0);
+      corners.back().u = std::max(corners.back().u, u1);
+    } else {
+      corners.push_back({u0, top});
+      corners.push_back({u1, top});
+    }
+    corners.push_back({u0, edge_v(row + 1)});
+    corners.push_back({u1, edge_v(row + 1)});
+  }
+  std::vector<Point2d> hull = ConvexHull(corners);
+  if (hull.size() < 4) return false;
+  ReduceTo(&hull, 4);
+  const double n = cells;
+  const double quad_cells = std::fabs(SignedArea(hull)) / (c * c);
+  quad->fill = quad_cells > 0.0 ? std::min(1.0, n / quad_cells) : 0.0;
+  if (quad->fill < kMinFill) return false;
+  for (int k = 0; k < 4; ++k)
+    quad->corners[static_cast<std::size_t>(k)] = hull[static_cast<std::size_t>(k)];
+  quad->threshold = threshold;
+  quad->light = static_cast<int>(std::lround(light_sum / n));
+  quad->area_fraction = n * c * c / (static_cast<double>(image.width) * image.height);
+
+  // Which sides are closed in by a dark band with light beyond (the stripes round a '#'s
+  // middle cell).
+  std::array<Side, 4> sides{Side(hull[0], hull[1]), Side(hull[1], hull[2]), Side(hull[2], hull[3]),
+                            Side(hull[3], hull[0])};
+  double shortest = HUGE_VAL;
+  for (const Side& side : sides) shortest = std::min(shortest, side.length);
+  const double reach = 0.5 * shortest;
+  // Two of three probes decide a side; once two sides are open the cell cannot be a grid's
+  // middle one, and the rest is not probed.
+  quad->closed_sides = 0;
+  int open = 0;
+  for (int k = 0; k < 4 && open < 2; ++k) {
+    const Side& side = sides[static_cast<std::size_t>(k)];
+    auto closed_at = [&](double t) {
+      return ClosedAt(image, side, t, quad->light, reach, options_.min_contrast);
+    };
+    const int first_two = closed_at(0.3) + closed_at(0.7);
+    const bool closed = first_two == 2 || (first_two == 1 && closed_at(0.5));
+    if (closed) {
+      quad->closed_sides |= static_cast<std::uint8_t>(1u << k);
+    } else {
+      ++open;
+    }
+  }
+
+  // Closed in on three sides or more: the sides onto the light/dark edges, at pixel level.
+  if (quad->ClosedSideCount() >= 3) {
+    std::array<LineParams, 4> lines;
+    bool all = true;
+    for (int k = 0; k < 4 && all; ++k) {
+      all = RefineSide(image, sides[static_cast<std::size_t>(k)], quad->light, kEdgeSearchCells * c,
+                       options_.min_contrast, &lines[static_cast<std::size_t>(k)]);
+    }
+    std::array<Point2d, 4> refined{};
+    for (int k = 0; k < 4 && all; ++k) {
+      all = Intersect(lines[static_cast<std::size_t>((k + 3) % 4)],
+                      lines[static_cast<std::size_t>(k)], &refined[static_cast<std::size_t>(k)],
+                      0.05);
+    }
+    // Each side moved by at most the search window; the corners of a sharp cell can move
+    // further (the cells cut them off), so the check is on the shape: convex, and of an area
+    // near the cells'.
+    if (all) {
+      std::vector<Point2d> check(refined.begin(), refined.end());
+      const double coarse_area = SignedArea(hull), refined_area = SignedArea(check);
+      if (ConvexHull(check).size() == 4 && refined_area > 0.8 * coarse_area &&
+          refined_area < 1.6 * coarse_area) {
+        quad->corners = refined;
+        quad->refined = true;
+      }
+    }
+  }
+  quad->score = 10.0 * quad->ClosedSideCount() + 5.0 * quad->fill + quad->area_fraction;
+  return true;
+}
+
+int SheetFinder::Root(int run) {
+  while (runs_[static_cast<std::size_t>(run)].parent != run) {
+    CellRun& r = runs_[static_cast<std::size_t>(run)];
+    r.parent = runs_[static_cast<std::size_t>(r.parent)].parent;  // path halving
+    run = r.parent;
+  }
+  return run;
+}
+
+void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
+  // Runs of light cells row by row, each joined to the runs of the row above that it touches
+  // (4-connectivity: overlapping columns).
+  runs_.clear();
+  std::size_t above_begin = 0, above_end = 0;
+  for (int gy = 0; gy < grid_height_; ++gy) {
+    const std::uint8_t* row = cells_.data() + static_cast<std::size_t>(gy) * grid_width_;
+    const std::size_t row_begin = runs_.size();
+    for (int gx = 0; gx < grid_width_;) {
+      if (row[gx] < threshold) {
+        ++gx;
+        continue;
+      }
+      const int first = gx;
+      while (gx < grid_width_ && row[gx] >= threshold) ++gx;
+      const int index = static_cast<int>(runs_.size());
+      runs_.push_back(CellRun{gy, first, gx - 1, index});
+      for (std::size_t a = above_begin; a < above_end; ++a) {
+        const CellRun& up = runs_[a];
+        if (up.last < first || up.first > gx - 1) continue;
+        const int ra = Root(static_cast<int>(a)), rb = Root(index);
+        if (ra != rb) runs_[static_cast<std::size_t>(std::max(ra, rb))].parent = std::min(ra, rb);
+      }
+    }
+    above_begin = row_begin;
+    above_end = runs_.size();
+  }
+  // The runs grouped by component, in row order within each.
+  order_.resize(runs_.size());
+  for (std::size_t i = 0; i < runs_.size(); ++i) {
+    order_[i] = static_cast<int>(i);
+    runs_[i].parent = Root(static_cast<int>(i));
+  }
+  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) {
+    return runs_[static_cast<std::size_t>(a)].parent < runs_[static_cast<std::size_t>(b)].parent;
+  });
+  const int c = options_.cell_px;
+  const int total = grid_width_ * grid_height_;
+  const int min_cells =
+      std::max(4, static_cast<int>(std::ceil(options_.min_area_fraction * image.width *
+                                             image.height / (c * c))));
+  for (std::size_t i = 0; i < order_.size();) {
+    const int root = runs_[static_cast<std::size_t>(order_[i])].parent;
+    component_.clear();
+    int cells = 0;
+    for (; i < order_.size() && runs_[static_cast<std::size_t>(order_[i])].parent == root; ++i) {
+      const CellRun& run = runs_[static_cast<std::size_t>(order_[i])];
+      component_.push_back(run);
+      cells += run.last - run.first + 1;
+    }
+    // Too small, or most of the image (the bench, not a cell of a printed grid).
+    if (cells < min_cells || 2 * cells > total) continue;
+    // A quadrilateral fills at least half its bounding box (a square turned by 45 degrees);
+    // a grid's middle cell lies inside the image, its crossings in view.
+    int left = grid_width_, right = -1;
+    for (const CellRun& run : component_) {
+      left = std::min(left, run.first);
+      right = std::max(right, run.last);
+    }
+    const int rows = component_.back().row - component_.front().row + 1;
+    const bool at_edge = left == 0 || right == grid_width_ - 1 || component_.front().row == 0 ||
+                         component_.back().row == grid_height_ - 1;
+    if (at_edge || 2.2 * cells < static_cast<double>(rows) * (right - left + 1)) continue;
+    LightQuad quad;
+    if (!Describe(image, threshold, component_, &quad)) continue;
+    // The same quadrilateral found at another threshold is kept once, with the better score.
+    bool merged = false;
+    for (LightQuad& kept : candidates_) {
+      double offset = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        offset = std::max(offset, std::hypot(kept.corners[static_cast<std::size_t>(k)].u -
+                                                 quad.corners[static_cast<std::size_t>(k)].u,
+                                             kept.corners[static_cast<std::size_t>(k)].v -
+                                                 quad.corners[static_cast<std::size_t>(k)].v));
+      }
+      if (offset <= 2.0 * c) {
+        if (quad.score > kept.score) kept = quad;
+        merged = true;
+        break;
+      }
+    }
+    if (!merged) candidates_.push_back(quad);
+  }
+}
+
+const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
+  if (image.empty() || image.stride < image.width) {
+    throw std::invalid_argument("SheetFinder::Find: empty image or stride < width");
+  }
+  candidates_.clear();
+  ComputeCells(image);
+  if (grid_width_ < 2 || grid_height_ < 2) return candidates_;
+  std::array<int, 256> histogram{};
+  for (const std::uint8_t value : cells_) ++histogram[value];
+  row_sums_.assign(static_cast<std::size_t>(grid_height_) * (grid_width_ + 1), 0u);
+  for (int gy = 0; gy < grid_height_; ++gy) {
+    std::uint32_t* sums = row_sums_.data() + static_cast<std::size_t>(gy) * (grid_width_ + 1);
+    const std::uint8_t* row = cells_.data() + static_cast<std::size_t>(gy) * grid_width_;
+    for (int gx = 0; gx < grid_width_; ++gx) sums[gx + 1] = sums[gx] + row[gx];
+  }
+  // Light against dark, then the light class split again (a light bench, a bright photo).
+  int lo = 0;
+  for (int level = 0; level < 3; ++level) {
+    double contrast = 0.0;
+    const int threshold = OtsuOfHistogram(histogram, lo, &contrast);
+    if (threshold > 255 || contrast < options_.min_contrast) break;
+    AddComponents(image, threshold);
+    lo = threshold;
+  }
+  std::stable_sort(candidates_.begin(), candidates_.end(),
+                   [](const LightQuad& a, const LightQuad& b) { return a.score > b.score; });
+  if (static_cast<int>(candidates_.size()) > options_.max_candidates) {
+    candidates_.resize(static_cast<std::size_t>(options_.max_candidates));
+  }
+  return candidates_;
+}
+
+}  // namespace oal

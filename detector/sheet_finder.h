@@ -1,0 +1,116 @@
+// Where a printed grid target might be in a frame with no prior: light quadrilaterals closed
+// in by dark bands, for the caller to turn into regions of interest (region.h).
+//
+// A '#' target printed on a sheet lying on a bench splits the paper into nine light cells;
+// the middle one is closed in on all four sides by the stripes, beyond which lies paper again.
+// That cell is the anchor: it is in view whenever the target's four crossings are, it is a
+// clean light quadrilateral whatever lies around the sheet (a light bench, a bright photo
+// beside it, a shadow), and from it the target's geometry predicts where the rest of the
+// target lies. The finder works on a grid of cells (cell_px x cell_px pixel means, about 5000
+// for 640 x 480; one pass over every other row):
+//   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
+//      Otsu's over the light class again (a light bench, a bright photo), while the classes
+//      differ by at least min_contrast;
+//   2. at each threshold, the 4-connected components of light cells of at least
+//      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
+//      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
+//      its neighbours is smallest (the quadrilateral stays inside the hull);
+//   3. each side of the quadrilateral is probed in the image at three points along the
+//      outward normal, up to 3/4 of the quadrilateral's shorter side: a side is closed in
+//      when dark pixels (a band of at least 2 px, min_contrast below the cell) and light ones
+//      again follow;
+//   4. a quadrilateral closed in on at least three sides is refined at pixel level: every
+//      side is moved onto the light/dark edge found along its normal at seven points
+//      (sub-pixel, a line fitted through them), and the corners are the sides' crossings;
+//   5. candidates are ranked by the sides closed in, how well the cells fill the
+//      quadrilateral, and its area; the same quadrilateral found at another threshold is
+//      kept once.
+// The finder knows nothing of any target: which candidate is the middle cell of which target,
+// and where that puts the target, is the caller's to decide (servo/target_tracker.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "detector/image_view.h"
+#include "detector/line.h"
+
+namespace oal {
+
+struct SheetFinderOptions {
+  /// Side of the grid's cells, pixels. Range [2, 64].
+  int cell_px = 8;
+  /// Smallest light region, as a fraction of the image's area. Range (0, 1].
+  double min_area_fraction = 0.006;
+  /// Light and dark must differ by at least this, grey levels. Range [0, 255].
+  int min_contrast = 30;
+  /// Candidates returned at most. Range [1, 16].
+  int max_candidates = 4;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// A light quadrilateral of the frame.
+struct LightQuad {
+  /// Corners in the image borders' turning sense (region.h), image pixels; on the light/dark
+  /// edges when `refined`.
+  std::array<Point2d, 4> corners;
+  bool refined = false;
+  /// Sides (0-3; side k runs from corner k to corner k+1) beyond which a dark band and light
+  /// again were found, as bits 1 << k.
+  std::uint8_t closed_sides = 0;
+  double area_fraction = 0.0;   ///< of the image, by its light cells
+  double fill = 0.0;            ///< light cells over the cells of the quadrilateral, [0, 1]
+  int light = 0;                ///< mean grey level of its light cells
+  int threshold = 0;            ///< the grey level that separated it
+  bool touches_border = false;  ///< some of its cells lie on the image's edge
+  double score = 0.0;           ///< higher is more likely a grid's middle cell
+
+  int ClosedSideCount() const;
+};
+
+class SheetFinder {
+ public:
+  /// Throws std::invalid_argument for options failing Check().
+  explicit SheetFinder(const SheetFinderOptions& options = SheetFinderOptions());
+
+  /// The candidates of `image`, best first (may be none). The reference stays valid until
+  /// the next call. Throws std::invalid_argument for an empty view.
+  const std::vector<LightQuad>& Find(const GrayImageView& image);
+
+  const SheetFinderOptions& options() const { return options_; }
+  /// The last frame's cell means, row by row (grid_width() x grid_height()).
+  const std::vector<std::uint8_t>& cells() const { return cells_; }
+  int grid_width() const { return grid_width_; }
+  int grid_height() const { return grid_height_; }
+
+ private:
+  /// A horizontal run of light cells [first, last] of one grid row, and its component (a
+  /// union-find parent index into runs_, the root is its own parent).
+  struct CellRun {
+    int row = 0, first = 0, last = 0;
+    int parent = 0;
+  };
+
+  void ComputeCells(const GrayImageView& image);
+  /// Adds the candidates of the light cells at `threshold` to candidates_.
+  void AddComponents(const GrayImageView& image, int threshold);
+  int Root(int run);
+  /// One component, given as its runs (sorted by row), into a candidate; false when it is no
+  /// quadrilateral.
+  bool Describe(const GrayImageView& image, int threshold, const std::vector<CellRun>& runs,
+                LightQuad* quad) const;
+
+  SheetFinderOptions options_;
+  int grid_width_ = 0, grid_height_ = 0;
+  std::vector<std::uint8_t> cells_;
+  std::vector<std::uint32_t> row_sums_;  ///< per grid row, prefix sums of the cell means
+  std::vector<CellRun> runs_;
+  std::vector<CellRun> component_;
+  std::vector<int> order_;
+  std::vector<LightQuad> candidates_;
+};
+
+}  // namespace oal
