@@ -1,0 +1,215 @@
+#include "servo/target_layout.h"
+
+#include <visp3/core/vpException.h>
+#include <visp3/core/vpPixelMeterConversion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "servo/pose_internal.h"
+
+namespace oal {
+namespace {
+
+// The outer rectangle lies this far inside the stripes' printed ends (a border right at an
+// end would cut the stripe's end), the inner one this far outside the crossings. Metres.
+constexpr double kInsideEndsM = 0.0025;
+constexpr double kOutsideCrossingsM = 0.003;
+// Pixels beyond which a mapped corner is taken as "at infinity" (a border seen edge-on).
+constexpr double kFarPx = 1e5;
+
+double Cross(const Point2d& a, const Point2d& b) {
+  return a.u * b.v - a.v * b.u;
+}
+
+// '#' coordinates (a, b) of an object-plane point.
+struct HashFrame {
+  Point2d origin, axis_a, axis_b;
+  double det = 1.0;
+
+  void Coordinates(double x, double y, double* a, double* b) const {
+    const Point2d d{x - origin.u, y - origin.v};
+    *a = Cross(d, axis_b) / det;
+    *b = Cross(axis_a, d) / det;
+  }
+};
+
+// The span of target line `k`, which runs along axis b (`along_b`) or axis a.
+StripeSpan SpanOf(const HashFrame& frame, const TargetLine& line, bool along_b, double sin_angle) {
+  double a1 = 0.0, b1 = 0.0, a2 = 0.0, b2 = 0.0;
+  frame.Coordinates(line.x1_m, line.y1_m, &a1, &b1);
+  frame.Coordinates(line.x2_m, line.y2_m, &a2, &b2);
+  StripeSpan span;
+  span.along_b = along_b;
+  span.at = along_b ? 0.5 * (a1 + a2) : 0.5 * (b1 + b2);
+  const double from = along_b ? b1 : a1, to = along_b ? b2 : a2;
+  span.along = Interval{std::min(from, to), std::max(from, to)};
+  span.half = 0.5 * line.width_m / sin_angle;
+  return span;
+}
+
+// Where both stripes of a pair are printed, less the margin inside their ends.
+Interval BothPrinted(const StripeSpan& s, const StripeSpan& t) {
+  return Interval{std::max(s.along.lo, t.along.lo) + kInsideEndsM,
+                  std::min(s.along.hi, t.along.hi) - kInsideEndsM};
+}
+
+// Just outside the pair's stripes (their outer edges plus the margin).
+Interval OutsidePair(const StripeSpan& s, const StripeSpan& t) {
+  return Interval{std::min(s.at - s.half, t.at - t.half) - kOutsideCrossingsM,
+                  std::max(s.at + s.half, t.at + t.half) + kOutsideCrossingsM};
+}
+
+// Between the pair's inner edges.
+Interval BetweenPair(const StripeSpan& s, const StripeSpan& t) {
+  const StripeSpan& low = s.at <= t.at ? s : t;
+  const StripeSpan& high = s.at <= t.at ? t : s;
+  return Interval{low.at + low.half, high.at - high.half};
+}
+
+}  // namespace
+
+Point2d TargetLayout::ToPlane(double a, double b) const {
+  return Point2d{origin.u + a * axis_a.u + b * axis_b.u, origin.v + a * axis_a.v + b * axis_b.v};
+}
+
+Point2d TargetLayout::OnStripe(int k, double along, double across) const {
+  const StripeSpan& stripe = stripes[static_cast<std::size_t>(k)];
+  const double at = stripe.at + across;
+  return stripe.along_b ? ToPlane(at, along) : ToPlane(along, at);
+}
+
+TargetLayout TargetLayout::Of(const LineTarget& target) {
+  const pose_internal::HashTarget hash = pose_internal::HashTargetFrom(target);
+  TargetLayout layout;
+  for (const auto& corner : hash.corner) {
+    layout.origin.u += 0.25 * corner.x;
+    layout.origin.v += 0.25 * corner.y;
+  }
+  layout.axis_a = Point2d{hash.direction[1].x, hash.direction[1].y};
+  layout.axis_b = Point2d{hash.direction[0].x, hash.direction[0].y};
+  const HashFrame frame{layout.origin, layout.axis_a, layout.axis_b,
+                        Cross(layout.axis_a, layout.axis_b)};
+  const double sin_angle = std::fabs(frame.det);
+  const StripeSpan line1 = SpanOf(frame, target.lines[0], true, sin_angle);
+  const StripeSpan line3 = SpanOf(frame, target.lines[2], true, sin_angle);
+  const StripeSpan line2 = SpanOf(frame, target.lines[1], false, sin_angle);
+  const StripeSpan line4 = SpanOf(frame, target.lines[3], false, sin_angle);
+  layout.stripes = {line1, line2, line3, line4};
+  // Lines 2 and 4 run along a: their printed ends bound a; lines 1 and 3 bound b.
+  layout.outer_a = BothPrinted(line2, line4);
+  layout.outer_b = BothPrinted(line1, line3);
+  layout.inner_a = OutsidePair(line1, line3);
+  layout.inner_b = OutsidePair(line2, line4);
+  if (!(layout.outer_a.lo < layout.inner_a.lo && layout.outer_a.hi > layout.inner_a.hi &&
+        layout.outer_b.lo < layout.inner_b.lo && layout.outer_b.hi > layout.inner_b.hi)) {
+    throw std::invalid_argument(
+        "target '" + target.name +
+        "': its stripes do not reach beyond the crossings on every side (each must run at least " +
+        std::to_string(1000.0 * (kInsideEndsM + kOutsideCrossingsM)) +
+        " mm past the stripes it crosses), so no border crosses all four");
+  }
+  const Interval cell_a = BetweenPair(line1, line3), cell_b = BetweenPair(line2, line4);
+  layout.middle_cell = {layout.ToPlane(cell_a.lo, cell_b.lo), layout.ToPlane(cell_a.hi, cell_b.lo),
+                        layout.ToPlane(cell_a.hi, cell_b.hi), layout.ToPlane(cell_a.lo, cell_b.hi)};
+  std::vector<Point2d> cell(layout.middle_cell.begin(), layout.middle_cell.end());
+  if (SignedArea(cell) < 0.0) std::reverse(layout.middle_cell.begin(), layout.middle_cell.end());
+  return layout;
+}
+
+vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo) {
+  vpHomography h;
+  for (unsigned int r = 0; r < 3; ++r) {
+    h[r][0] = cMo[r][0];
+    h[r][1] = cMo[r][1];
+    h[r][2] = cMo[r][3];
+  }
+  return h;
+}
+
+bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,
+                       const Point2d& plane, Point2d* pixel) {
+  const vpHomography& h = plane_to_image;
+  const double w = h[2][0] * plane.u + h[2][1] * plane.v + h[2][2];
+  if (!(w > 1e-9)) return false;
+  const double x = (h[0][0] * plane.u + h[0][1] * plane.v + h[0][2]) / w;
+  const double y = (h[1][0] * plane.u + h[1][1] * plane.v + h[1][2]) / w;
+  *pixel = DistortedPixel(camera, x, y);
+  return std::isfinite(pixel->u) && std::isfinite(pixel->v) && std::fabs(pixel->u) < kFarPx &&
+         std::fabs(pixel->v) < kFarPx;
+}
+
+ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
+                          const vpCameraParameters& camera, int count) {
+  ScanBorders borders;
+  auto lerp = [](const Interval& from, const Interval& to, double f) {
+    return Interval{from.lo + f * (to.lo - from.lo), from.hi + f * (to.hi - from.hi)};
+  };
+  for (int k = 0; k < count; ++k) {
+    const double f = count > 1 ? static_cast<double>(k) / (count - 1) : 0.0;
+    const Interval a = lerp(layout.outer_a, layout.inner_a, f);
+    const Interval b = lerp(layout.outer_b, layout.inner_b, f);
+    const Point2d corners[4] = {layout.ToPlane(a.lo, b.lo), layout.ToPlane(a.hi, b.lo),
+                                layout.ToPlane(a.hi, b.hi), layout.ToPlane(a.lo, b.hi)};
+    std::vector<Point2d> polygon(4);
+    bool ok = true;
+    for (int c = 0; c < 4 && ok; ++c) {
+      ok = ProjectPlanePoint(plane_to_image, camera, corners[c],
+                             &polygon[static_cast<std::size_t>(c)]);
+    }
+    // The lens can fold a quadrilateral seen near the edge of its reach: keep convex ones.
+    if (!ok || ConvexHull(polygon).size() != 4 || !(std::fabs(SignedArea(polygon)) > 1.0)) continue;
+    borders.polygons.push_back(std::move(polygon));
+  }
+  return borders;
+}
+
+std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
+                                                 const vpCameraParameters& camera) {
+  std::vector<double> x_image(4), y_image(4), x_plane(4), y_plane(4);
+  for (int k = 0; k < 4; ++k) {
+    vpPixelMeterConversion::convertPoint(camera, cell.corners[static_cast<std::size_t>(k)].u,
+                                         cell.corners[static_cast<std::size_t>(k)].v,
+                                         x_image[static_cast<std::size_t>(k)],
+                                         y_image[static_cast<std::size_t>(k)]);
+    if (!std::isfinite(x_image[static_cast<std::size_t>(k)]) ||
+        !std::isfinite(y_image[static_cast<std::size_t>(k)])) {
+      return std::nullopt;
+    }
+  }
+  std::optional<vpHomography> best;
+  double best_cost = HUGE_VAL;
+  for (int shift = 0; shift < 2; ++shift) {
+    for (int k = 0; k < 4; ++k) {
+      const Point2d& corner = layout.middle_cell[static_cast<std::size_t>((k + 4 - shift) % 4)];
+      x_plane[static_cast<std::size_t>(k)] = corner.u;
+      y_plane[static_cast<std::size_t>(k)] = corner.v;
+    }
+    vpHomography h;
+    try {
+      vpHomography::DLT(x_plane, y_plane, x_image, y_image, h, true);
+    } catch (const vpException&) {
+      continue;
+    }
+    // Scaled so that the cell lies in front (positive third coordinate).
+    const double w = h[2][0] * layout.origin.u + h[2][1] * layout.origin.v + h[2][2];
+    if (!(std::fabs(w) > 0.0) || !std::isfinite(w)) continue;
+    if (w < 0.0) h = h * -1.0;
+    const double h1[3] = {h[0][0], h[1][0], h[2][0]}, h2[3] = {h[0][1], h[1][1], h[2][1]};
+    const double n1 = std::sqrt(h1[0] * h1[0] + h1[1] * h1[1] + h1[2] * h1[2]);
+    const double n2 = std::sqrt(h2[0] * h2[0] + h2[1] * h2[1] + h2[2] * h2[2]);
+    if (!(n1 > 0.0 && n2 > 0.0)) continue;
+    const double log_ratio = std::log(n1 / n2);
+    const double cosine = (h1[0] * h2[0] + h1[1] * h2[1] + h1[2] * h2[2]) / (n1 * n2);
+    const double cost = log_ratio * log_ratio + cosine * cosine;
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = h;
+    }
+  }
+  return best;
+}
+
+}  // namespace oal

@@ -1,0 +1,97 @@
+// Where to look for a '#' target (pose.h) in a frame: borders concentric on the target's own
+// plane, mapped into the image through a plane-to-image homography, for the detector's border
+// scans (detector/region.h: ScanBorders).
+//
+// The paper scans concentric borders of the image, which every line crosses twice when the
+// lines traverse the image. A target printed on a sheet does not fill the view, but each of its
+// stripes runs the sheet's length, so every rectangle of the target plane that lies inside the
+// stripes' printed ends and outside the four crossings is crossed twice by every stripe,
+// wherever the camera is. The borders here are `count` such rectangles, evenly spread from
+// just inside the ink's ends (outer) to just outside the crossings (inner), each mapped into
+// the image; the detector clips them to the image. Rectangles in the '#'s own frame: a point
+// is origin + a·axis_a + b·axis_b with axis_a along lines 2 and 4 and axis_b along lines 1 and
+// 3 (oblique when the '#' is), so for the built-in targets a and b are the target's x and y.
+//
+// The homography comes from a pose (tracking: the previous or the predicted one) or, with no
+// prior, from the target's middle cell found in the image (detector/sheet_finder.h): the
+// light cell the four stripes close in, whose corners are the stripes' inner edges.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+#include <visp3/vision/vpHomography.h>
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "detector/line.h"
+#include "detector/region.h"
+#include "detector/sheet_finder.h"
+#include "scene/scene.h"
+
+namespace oal {
+
+/// A range [lo, hi] of one of the '#' frame's coordinates, metres.
+struct Interval {
+  double lo = 0.0, hi = 0.0;
+};
+
+/// One stripe in the '#' frame: its centre line at `at` across it (a for lines 1 and 3, b for
+/// lines 2 and 4), printed from along.lo to along.hi, `half` its half width measured along the
+/// other axis.
+struct StripeSpan {
+  double at = 0.0;
+  Interval along;
+  double half = 0.0;
+  bool along_b = true;  ///< lines 1 and 3 run along axis b, lines 2 and 4 along axis a
+};
+
+struct TargetLayout {
+  /// The '#' frame on the target plane (object frame, metres): origin at the middle of the
+  /// four crossings, unit axes along lines 2/4 (a) and lines 1/3 (b).
+  Point2d origin, axis_a, axis_b;
+  /// Lines 1-4.
+  std::array<StripeSpan, 4> stripes{};
+  /// Rectangles every stripe crosses twice: the outer one just inside the ink's ends (where
+  /// all four are printed), the inner one just outside the crossings.
+  Interval outer_a, outer_b, inner_a, inner_b;
+  /// The middle cell, bounded by the four stripes' inner edges: corners on the target plane
+  /// (object x, y in metres), in the image borders' turning sense (region.h).
+  std::array<Point2d, 4> middle_cell{};
+
+  /// Object-plane point of '#' coordinates (a, b).
+  Point2d ToPlane(double a, double b) const;
+  /// Object-plane point at `along` on stripe k's line, `across` from its centre line.
+  Point2d OnStripe(int k, double along, double across) const;
+
+  /// The layout of a '#' target. Throws std::invalid_argument unless `target` is a '#'
+  /// (pose.h) whose stripes reach beyond the crossings on every side, so that borders exist.
+  static TargetLayout Of(const LineTarget& target);
+};
+
+/// The homography from the target plane (object x, y, metres) to normalised image
+/// coordinates of a camera at cMo: H = [r1 r2 t].
+vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo);
+
+/// `count` borders (>= 2) from the outer to the inner rectangle, mapped through
+/// `plane_to_image` (to normalised coordinates) and `camera`'s lens into image pixels. A
+/// rectangle with a corner behind the camera, too far out, or whose image is not convex is
+/// left out (the borders may then be fewer; none when the target is not in front).
+ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
+                          const vpCameraParameters& camera, int count);
+
+/// The plane-to-image homography (normalised coordinates) that maps the layout's middle cell
+/// onto `cell`, a light quadrilateral of the frame: of the two ways to lay the cell's sides
+/// on the quadrilateral's (a turn by 180 degrees maps the middle cell nearly onto itself and
+/// changes no border), the one whose homography is nearer a rotation's first two columns.
+/// Nothing when the corners cannot be undistorted or the homography is degenerate.
+std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
+                                                 const vpCameraParameters& camera);
+
+/// The image of a target point seen through `plane_to_image` and the lens: distorted pixels;
+/// false when it lies behind the camera or beyond the lens model's reach.
+bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,
+                       const Point2d& plane, Point2d* pixel);
+
+}  // namespace oal

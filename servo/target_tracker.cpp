@@ -1,0 +1,349 @@
+#include "servo/target_tracker.h"
+
+#include <visp3/core/vpThetaUVector.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "detector/options.h"
+
+namespace oal {
+namespace {
+
+// Samples per stripe for the model check: across the stripe at its centre line and at this
+// fraction of its width either side (inside the ink: a pose a degree or two off moves these
+// onto the paper at the stripe's far end), and beside it, its half width plus a fraction of
+// its width (at least kMinBesideM) away, on the paper.
+constexpr int kStripeSamples = 24;
+constexpr double kInsideFraction = 0.3;
+constexpr double kBesideFraction = 0.5;
+constexpr double kMinBesideM = 0.003;
+// A stripe with fewer samples in view than this counts as not seen.
+constexpr int kMinStripeSamples = 4;
+
+constexpr double kDegPerRad = 180.0 / kPi;
+
+double Microseconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
+      .count();
+}
+
+// The grey level of the pixel nearest to p; false outside the image (a pixel's margin kept).
+bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
+  const double u = p.u + 0.5, v = p.v + 0.5;
+  if (!(u >= 1.0 && v >= 1.0 && u < image.width - 1.0 && v < image.height - 1.0)) return false;
+  *grey = image.at(static_cast<int>(u), static_cast<int>(v));
+  return true;
+}
+
+// Translation (metres) and rotation (degrees) between two poses.
+void PoseDifference(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double* metres,
+                    double* degrees) {
+  const vpHomogeneousMatrix d = a * b.inverse();
+  *metres = (a.getTranslationVector() - b.getTranslationVector()).frobeniusNorm();
+  *degrees = vpThetaUVector(d.getRotationMatrix()).getTheta() * kDegPerRad;
+}
+
+}  // namespace
+
+std::string ToString(ScanMode mode) {
+  return mode == ScanMode::kImage ? "image" : "target";
+}
+
+std::string ToString(ScanSource source) {
+  switch (source) {
+    case ScanSource::kNone:
+      return "none";
+    case ScanSource::kPrior:
+      return "prior";
+    case ScanSource::kMiddleCell:
+      return "middle-cell";
+    case ScanSource::kImage:
+      return "image";
+  }
+  return "unknown";
+}
+
+std::string ToString(TargetStatus status) {
+  switch (status) {
+    case TargetStatus::kOk:
+      return "ok";
+    case TargetStatus::kNotFound:
+      return "not-found";
+    case TargetStatus::kModelMismatch:
+      return "model-mismatch";
+    case TargetStatus::kJump:
+      return "jump";
+  }
+  return "unknown";
+}
+
+ScanMode ScanModeFromString(const std::string& text) {
+  if (text == "target") return ScanMode::kTarget;
+  if (text == "image") return ScanMode::kImage;
+  throw std::invalid_argument("scan mode '" + text + "' is not one of: target, image");
+}
+
+void TargetTrackerOptions::Check() const {
+  finder.Check();
+  RequireOption(borders >= 2 && borders <= 64, "TargetTrackerOptions::borders", borders,
+                "2 <= borders <= 64");
+  RequireOption(max_candidates >= 1 && max_candidates <= 16, "TargetTrackerOptions::max_candidates",
+                max_candidates, "1 <= max_candidates <= 16");
+  RequireOption(min_line_support >= 0 && min_line_support <= 1000,
+                "TargetTrackerOptions::min_line_support", min_line_support,
+                "0 <= min_line_support <= 1000");
+  RequireOption(min_stripe_agreement >= 0.0 && min_stripe_agreement <= 1.0,
+                "TargetTrackerOptions::min_stripe_agreement", min_stripe_agreement,
+                "0 <= min_stripe_agreement <= 1");
+  RequireOption(min_stripe_contrast >= 1 && min_stripe_contrast <= 255,
+                "TargetTrackerOptions::min_stripe_contrast", min_stripe_contrast,
+                "1 <= min_stripe_contrast <= 255");
+  RequireOption(max_jump_m >= 0.0 && max_jump_m <= 100.0, "TargetTrackerOptions::max_jump_m",
+                max_jump_m, "0 <= max_jump_m <= 100");
+  RequireOption(max_jump_deg >= 0.0 && max_jump_deg <= 180.0, "TargetTrackerOptions::max_jump_deg",
+                max_jump_deg, "0 <= max_jump_deg <= 180");
+}
+
+double StripeAgreement::Worst() const {
+  double worst = 1.0;
+  for (int k = 0; k < 4; ++k) {
+    const int n = samples[static_cast<std::size_t>(k)];
+    if (n < kMinStripeSamples) return 0.0;
+    worst = std::min(worst, static_cast<double>(dark[static_cast<std::size_t>(k)]) / n);
+  }
+  return worst;
+}
+
+StripeAgreement CheckStripes(const GrayImageView& image, const LineTarget& target,
+                             const TargetLayout& layout, const vpHomogeneousMatrix& cMo,
+                             const vpCameraParameters& camera, int min_contrast) {
+  StripeAgreement agreement;
+  const vpHomography plane_to_image = PlaneToImage(cMo);
+  for (int k = 0; k < 4; ++k) {
+    const StripeSpan& stripe = layout.stripes[static_cast<std::size_t>(k)];
+    const double width = 2.0 * stripe.half;
+    const double beside = stripe.half + std::max(kBesideFraction * width, kMinBesideM);
+    // Where the other pair's stripes cross this one, with room for the paper beside.
+    const StripeSpan& cross1 = layout.stripes[static_cast<std::size_t>((k + 1) % 4)];
+    const StripeSpan& cross2 = layout.stripes[static_cast<std::size_t>((k + 3) % 4)];
+    auto near_crossing = [&](double along) {
+      for (const StripeSpan* other : {&cross1, &cross2}) {
+        const double other_beside =
+            other->half + std::max(kBesideFraction * 2.0 * other->half, kMinBesideM);
+        if (std::fabs(along - other->at) < other_beside + kMinBesideM) return true;
+      }
+      return false;
+    };
+    for (int i = 0; i < kStripeSamples; ++i) {
+      const double along =
+          stripe.along.lo + (stripe.along.hi - stripe.along.lo) * (i + 0.5) / kStripeSamples;
+      if (near_crossing(along)) continue;
+      // Across the stripe: beside, inside, centre, inside, beside.
+      const double across[5] = {-beside, -kInsideFraction * width, 0.0, kInsideFraction * width,
+                                beside};
+      int grey[5] = {};
+      bool seen = true;
+      for (int j = 0; j < 5 && seen; ++j) {
+        Point2d pixel;
+        seen = ProjectPlanePoint(plane_to_image, camera, layout.OnStripe(k, along, across[j]),
+                                 &pixel) &&
+               GreyAt(image, pixel, &grey[j]);
+      }
+      if (!seen) continue;
+      ++agreement.samples[static_cast<std::size_t>(k)];
+      const int darkest_paper = std::min(grey[0], grey[4]);
+      const int lightest_ink = std::max({grey[1], grey[2], grey[3]});
+      if (lightest_ink + min_contrast <= darkest_paper)
+        ++agreement.dark[static_cast<std::size_t>(k)];
+    }
+  }
+  (void)target;
+  return agreement;
+}
+
+TargetPoseTracker::TargetPoseTracker(const LineTarget& target, const vpCameraParameters& camera,
+                                     const DetectorOptions& detector, const PoseOptions& pose,
+                                     const TargetTrackerOptions& options)
+    : target_(target),
+      camera_(camera),
+      layout_(TargetLayout::Of(target)),
+      pose_options_(pose),
+      options_((options.Check(), options)),
+      detector_(detector, camera),
+      finder_(options.finder) {
+  pose_options_.camera = camera;
+  pose_options_.lines_undistorted = detector_.Undistorts();
+  pose_options_.Check();
+}
+
+void TargetPoseTracker::Reset() {
+  last_cMo_.reset();
+  held_cMo_.reset();
+  frames_since_ok_ = 0;
+}
+
+std::vector<LineSeed> TargetPoseTracker::SeedsFrom(const vpHomography& plane_to_image) const {
+  std::vector<LineSeed> seeds;
+  for (int k = 0; k < 4; ++k) {
+    const StripeSpan& stripe = layout_.stripes[static_cast<std::size_t>(k)];
+    Point2d ends[2];
+    bool ok = true;
+    for (int e = 0; e < 2 && ok; ++e) {
+      const Point2d plane = layout_.OnStripe(k, e == 0 ? stripe.along.lo : stripe.along.hi, 0.0);
+      const vpHomography& h = plane_to_image;
+      const double w = h[2][0] * plane.u + h[2][1] * plane.v + h[2][2];
+      ok = w > 1e-9;
+      if (!ok) break;
+      const double x = (h[0][0] * plane.u + h[0][1] * plane.v + h[0][2]) / w;
+      const double y = (h[1][0] * plane.u + h[1][1] * plane.v + h[1][2]) / w;
+      // The detector's coordinates: undistorted pixels when it undistorts.
+      ends[e] = detector_.Undistorts() ? Point2d{camera_.get_u0() + camera_.get_px() * x,
+                                                 camera_.get_v0() + camera_.get_py() * y}
+                                       : DistortedPixel(camera_, x, y);
+      ok = std::isfinite(ends[e].u) && std::isfinite(ends[e].v);
+    }
+    if (ok && std::hypot(ends[1].u - ends[0].u, ends[1].v - ends[0].v) > 1.0) {
+      seeds.push_back(LineSeed{k, LineThrough(ends[0], ends[1])});
+    }
+  }
+  return seeds;
+}
+
+bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& borders,
+                                const std::vector<LineSeed>& seeds,
+                                const std::optional<vpHomogeneousMatrix>& prior,
+                                ScanSource source) {
+  auto start = std::chrono::steady_clock::now();
+  const std::vector<DetectedLine>& lines = detector_.Detect(image, seeds, borders);
+  frame_.detect_us += Microseconds(start);
+  lines_ = lines;
+  frame_.source = source;
+  frame_.borders = detector_.region_borders().count();
+  frame_.region =
+      frame_.borders > 0 ? detector_.region_borders().Polygon(0) : std::vector<Point2d>{};
+  start = std::chrono::steady_clock::now();
+  frame_.pose = EstimatePose(lines_, target_, pose_options_, prior);
+  frame_.pose_us += Microseconds(start);
+  frame_.agreement = StripeAgreement{};
+  if (frame_.pose.status != PoseStatus::kOk) {
+    frame_.status = TargetStatus::kNotFound;
+    frame_.message = frame_.pose.message;
+    return false;
+  }
+  for (int k = 0; k < 4; ++k) {
+    const DetectedLine& line =
+        lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
+    if (line.support < options_.min_line_support) {
+      frame_.status = TargetStatus::kNotFound;
+      frame_.message =
+          "line " + std::to_string(k + 1) + " has " + std::to_string(line.support) +
+          " feature points on it (min_line_support = " + std::to_string(options_.min_line_support) +
+          "): too few to trust the pose";
+      return false;
+    }
+  }
+  frame_.agreement =
+      CheckStripes(image, target_, layout_, frame_.pose.cMo, camera_, options_.min_stripe_contrast);
+  if (frame_.agreement.Worst() < options_.min_stripe_agreement) {
+    std::ostringstream message;
+    message << "the image does not show the target where the pose puts it: ";
+    for (int k = 0; k < 4; ++k) {
+      message << (k > 0 ? ", " : "") << "line " << k + 1 << " dark in "
+              << frame_.agreement.dark[static_cast<std::size_t>(k)] << " of "
+              << frame_.agreement.samples[static_cast<std::size_t>(k)] << " samples";
+    }
+    message << " (min_stripe_agreement = " << options_.min_stripe_agreement << ")";
+    frame_.status = TargetStatus::kModelMismatch;
+    frame_.message = message.str();
+    return false;
+  }
+  frame_.status = TargetStatus::kOk;
+  frame_.message.clear();
+  return true;
+}
+
+const TargetFrame& TargetPoseTracker::Track(
+    const GrayImageView& image, const std::optional<vpHomogeneousMatrix>& predicted_cMo) {
+  frame_ = TargetFrame{};
+  pose_options_.image_width = image.width;
+  pose_options_.image_height = image.height;
+  const std::optional<vpHomogeneousMatrix> prior = predicted_cMo ? predicted_cMo : last_cMo_;
+  bool found = false;
+  if (options_.scan == ScanMode::kImage) {
+    found = Attempt(image, ScanBorders{}, {}, prior, ScanSource::kImage);
+  } else {
+    if (prior) {
+      const ScanBorders borders =
+          TargetBorders(layout_, PlaneToImage(*prior), camera_, options_.borders);
+      if (!borders.empty()) {
+        found = Attempt(image, borders, SeedsFrom(PlaneToImage(*prior)), prior, ScanSource::kPrior);
+      }
+    }
+    if (!found) {
+      const auto start = std::chrono::steady_clock::now();
+      const std::vector<LightQuad>& cells = finder_.Find(image);
+      frame_.find_us = Microseconds(start);
+      for (const LightQuad& cell : cells) {
+        if (cell.ClosedSideCount() < 3 || frame_.candidates >= options_.max_candidates) continue;
+        const std::optional<vpHomography> plane_to_image =
+            PlaneToImageFromCell(layout_, cell, camera_);
+        if (!plane_to_image) continue;
+        const ScanBorders borders =
+            TargetBorders(layout_, *plane_to_image, camera_, options_.borders);
+        if (borders.empty()) continue;
+        ++frame_.candidates;
+        // Each candidate on its own: a prior that failed above says nothing about it.
+        if ((found = Attempt(image, borders, SeedsFrom(*plane_to_image), std::nullopt,
+                             ScanSource::kMiddleCell))) {
+          break;
+        }
+      }
+    }
+    if (!found && options_.image_fallback) {
+      found = Attempt(image, ScanBorders{}, {}, std::nullopt, ScanSource::kImage);
+    }
+  }
+  if (!found) {
+    if (frame_.source == ScanSource::kNone) frame_.message = "no border could be scanned";
+    frames_since_ok_ = frames_since_ok_ > 0 ? frames_since_ok_ + 1 : 0;
+    return frame_;
+  }
+  Accept(predicted_cMo.has_value());
+  return frame_;
+}
+
+void TargetPoseTracker::Accept(bool predicted) {
+  const vpHomogeneousMatrix& cMo = frame_.pose.cMo;
+  const bool consecutive = frames_since_ok_ == 1 && last_cMo_.has_value();
+  const bool checked =
+      !predicted && consecutive && (options_.max_jump_m > 0.0 || options_.max_jump_deg > 0.0);
+  auto within = [&](const vpHomogeneousMatrix& other, double* metres, double* degrees) {
+    PoseDifference(cMo, other, metres, degrees);
+    return (options_.max_jump_m <= 0.0 || *metres <= options_.max_jump_m) &&
+           (options_.max_jump_deg <= 0.0 || *degrees <= options_.max_jump_deg);
+  };
+  double metres = 0.0, degrees = 0.0;
+  if (checked && !within(*last_cMo_, &metres, &degrees)) {
+    double held_m = 0.0, held_deg = 0.0;
+    if (!(held_cMo_ && within(*held_cMo_, &held_m, &held_deg))) {
+      held_cMo_ = cMo;
+      std::ostringstream message;
+      message << "the pose moved " << metres << " m and " << degrees
+              << " deg since the last frame (max_jump_m = " << options_.max_jump_m
+              << ", max_jump_deg = " << options_.max_jump_deg
+              << "): held until the next frame agrees";
+      frame_.status = TargetStatus::kJump;
+      frame_.message = message.str();
+      return;  // the last accepted pose stays the prior; frames_since_ok_ unchanged
+    }
+  }
+  held_cMo_.reset();
+  last_cMo_ = cMo;
+  frames_since_ok_ = 1;
+}
+
+}  // namespace oal

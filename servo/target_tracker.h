@@ -1,0 +1,175 @@
+// The four-line target's pose over a stream of frames: where to scan, the detection, the pose,
+// and the checks that keep a wrong pose from being passed on.
+//
+// Per frame (ScanMode::kTarget, the default):
+//   1. With a prior pose (the caller's prediction, e.g. from the robot's motion, else the
+//      last accepted pose), the detector scans borders concentric on the target's plane seen
+//      from it (target_layout.h), seeded with the four lines where the prior puts them, and the
+//      pose is estimated from the prior.
+//   2. Without one, or when that fails: the target's middle cell is looked for
+//      (detector/sheet_finder.h); for each candidate closed in on three sides or more, best
+//      first (at most max_candidates), the borders its homography gives are scanned.
+//   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
+//      with the paper's concentric image borders.
+// A pose is accepted only when the image shows the target where it says: along each stripe's
+// projected centre line, between the crossings and the printed ends, the pixels must be darker
+// than the paper on both sides (min_stripe_agreement of the samples inside the image);
+// otherwise the frame's status is kModelMismatch. Without a caller's prediction, a pose that
+// moved more than max_jump_m / max_jump_deg from the last accepted one is held (kJump) and
+// accepted only when the next frame agrees with it: one bad frame is refused, a real fast
+// move costs one frame. ScanMode::kImage is the paper's condition: the whole image every frame
+// (steps 1-2 skipped), the same checks.
+//
+// Coordinates: the lines and corners are in undistorted pixels when the camera has
+// distortion (the detector undistorts the feature points), as pose.h states.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "detector/detector.h"
+#include "detector/region.h"
+#include "detector/sheet_finder.h"
+#include "scene/scene.h"
+#include "servo/pose.h"
+#include "servo/target_layout.h"
+
+namespace oal {
+
+enum class ScanMode {
+  kTarget,  ///< borders on the target's plane, from a prior pose or the middle cell
+  kImage,   ///< the paper's concentric image borders, every frame
+};
+
+/// How a frame's pose was found (or the last place looked).
+enum class ScanSource {
+  kNone,        ///< nothing was scanned
+  kPrior,       ///< borders from the prior pose
+  kMiddleCell,  ///< borders from a middle-cell candidate of the sheet finder
+  kImage,       ///< the whole image
+};
+
+enum class TargetStatus {
+  kOk,             ///< a pose, checked
+  kNotFound,       ///< no pose (the last attempt's PoseResult says why)
+  kModelMismatch,  ///< a pose the image does not support (stripes not where it puts them)
+  kJump,           ///< a pose too far from the last accepted one, held for the next frame
+};
+
+/// The one place where these enums meet strings ("target", "image"; "none", "prior",
+/// "middle-cell", "image"; "ok", "not-found", "model-mismatch", "jump").
+std::string ToString(ScanMode mode);
+std::string ToString(ScanSource source);
+std::string ToString(TargetStatus status);
+/// Throws std::invalid_argument naming the accepted values.
+ScanMode ScanModeFromString(const std::string& text);
+
+struct TargetTrackerOptions {
+  ScanMode scan = ScanMode::kTarget;
+  /// Borders on the target plane (target_layout.h). Range [2, 64].
+  int borders = 16;
+  SheetFinderOptions finder;
+  /// Middle-cell candidates scanned per frame at most. Range [1, 16].
+  int max_candidates = 3;
+  /// When no candidate gives a pose, scan the whole image as the paper does.
+  bool image_fallback = true;
+  /// Each of the four lines the pose uses needs at least this many feature points on it
+  /// (DetectedLine::support): a line seen on a few borders only is too poorly placed to
+  /// trust. Range [0, 1000].
+  int min_line_support = 12;
+  /// Fraction of the samples along each stripe (inside the image) that must be darker than
+  /// the paper beside it. Range [0, 1].
+  double min_stripe_agreement = 0.75;
+  /// A stripe sample is dark when at least this many grey levels below both sides. Range
+  /// [1, 255].
+  int min_stripe_contrast = 20;
+  /// Largest move of the pose between consecutive frames without a prediction, metres and
+  /// degrees; 0 turns the check off. Ranges [0, 100], [0, 180].
+  double max_jump_m = 0.05;
+  double max_jump_deg = 10.0;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// Samples of the target model against the image for one pose (the model check).
+struct StripeAgreement {
+  std::array<int, 4> samples{};  ///< per line 1-4, inside the image
+  std::array<int, 4> dark{};     ///< ... of which darker than the paper on both sides
+  /// The smallest fraction over the lines (0 when a line has fewer than 4 samples in view).
+  double Worst() const;
+};
+
+/// What the tracker did with one frame.
+struct TargetFrame {
+  TargetStatus status = TargetStatus::kNotFound;
+  std::string message;  ///< empty when kOk; why otherwise
+  PoseResult pose;      ///< the last pose estimated (kOk: the accepted one)
+  ScanSource source = ScanSource::kNone;
+  /// The outermost border scanned, image pixels (empty for the whole image), and how many.
+  std::vector<Point2d> region;
+  int borders = 0;
+  int candidates = 0;  ///< middle-cell candidates scanned
+  StripeAgreement agreement;
+  double find_us = 0.0, detect_us = 0.0, pose_us = 0.0;  ///< time spent in each step
+};
+
+class TargetPoseTracker {
+ public:
+  /// Throws std::invalid_argument for options failing Check(), detector or pose options
+  /// failing theirs, or a target that is not a '#' whose stripes reach past the crossings.
+  TargetPoseTracker(const LineTarget& target, const vpCameraParameters& camera,
+                    const DetectorOptions& detector, const PoseOptions& pose,
+                    const TargetTrackerOptions& options = TargetTrackerOptions());
+
+  /// Forgets the previous frames (the next one is found from scratch).
+  void Reset();
+  /// The pose in `image`; `predicted_cMo` (the robot's motion applied to the last pose) is
+  /// used as the prior instead of the last accepted pose, and the jump check is the caller's.
+  const TargetFrame& Track(const GrayImageView& image,
+                           const std::optional<vpHomogeneousMatrix>& predicted_cMo = std::nullopt);
+
+  /// The lines of the last scan that gave the frame's pose (or of the last scan), best first.
+  const std::vector<DetectedLine>& lines() const { return lines_; }
+  const OalDetector& detector() const { return detector_; }
+  const LineTarget& target() const { return target_; }
+  const TargetTrackerOptions& options() const { return options_; }
+  /// The last accepted pose, if the last frames had one.
+  const std::optional<vpHomogeneousMatrix>& last_cMo() const { return last_cMo_; }
+
+ private:
+  /// Detects in `borders` (the whole image when empty) and estimates the pose from `prior`;
+  /// true when the pose is accepted by the model check.
+  bool Attempt(const GrayImageView& image, const ScanBorders& borders,
+               const std::vector<LineSeed>& seeds, const std::optional<vpHomogeneousMatrix>& prior,
+               ScanSource source);
+  /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
+  std::vector<LineSeed> SeedsFrom(const vpHomography& plane_to_image) const;
+  /// The model check and the jump check on an estimated pose: the frame's status.
+  void Accept(bool predicted);
+
+  LineTarget target_;
+  vpCameraParameters camera_;
+  TargetLayout layout_;
+  PoseOptions pose_options_;
+  TargetTrackerOptions options_;
+  OalDetector detector_;
+  SheetFinder finder_;
+  std::vector<DetectedLine> lines_;
+  TargetFrame frame_;
+  GrayImageView image_{};
+  std::optional<vpHomogeneousMatrix> last_cMo_;
+  std::optional<vpHomogeneousMatrix> held_cMo_;  ///< a jump, waiting for the next frame
+  int frames_since_ok_ = 0;  ///< 1: the last frame's pose was accepted; 0: none ever was
+};
+
+/// The model check alone: how well `image` shows `target`'s stripes at cMo.
+StripeAgreement CheckStripes(const GrayImageView& image, const LineTarget& target,
+                             const TargetLayout& layout, const vpHomogeneousMatrix& cMo,
+                             const vpCameraParameters& camera, int min_contrast);
+
+}  // namespace oal
