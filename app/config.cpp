@@ -242,7 +242,7 @@ void ReadDetectorSection(const YAML::Node& section, const std::string& file, App
 }
 
 // ------------------------------------------------------------------------------------------
-// `target:`: a shipped target by name, or a full description (config/four-line-target.yaml).
+// `target:`: a shipped target by name, or a full description (config/four-line-board.yaml).
 
 constexpr const char* kShippedTargets = "two-line, four-line";
 

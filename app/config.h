@@ -7,7 +7,7 @@
 //     step_px: 5
 //
 //   target: {name: four-line}   # a shipped target (scene/scene.h TargetByName), or in full:
-//   target:              # oal::LineTarget (config/four-line-target.yaml documents the keys)
+//   target:              # oal::LineTarget (config/four-line-board.yaml documents the keys)
 //     name: my-board     # required
 //     board_width_m: 0.4 # required, > 0; the board is centred on the object origin
 //     board_height_m: 0.3

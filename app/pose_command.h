@@ -34,7 +34,7 @@ namespace oal {
 /// stream passed to EstimatePoses()); annotate_dir (pose_0000.png...); max_frames.
 struct PoseCommandOptions : FrameCommandOptions {
   /// YAML configuration: `detector:`, `target:` (default four-line) and `pose:` sections
-  /// (config/detector.yaml, config/four-line-target.yaml, config/pose.yaml); empty: none.
+  /// (config/detector.yaml, config/four-line-board.yaml, config/pose.yaml); empty: none.
   std::string config_path;
   /// ViSP camera XML; empty: camera.xml in the first input's directory, else an error.
   std::string camera_path;

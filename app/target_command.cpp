@@ -261,7 +261,7 @@ int RunTarget(int argc, char** argv) {
       "oalservo target");
   cli.add_option("--config", options.config,
                  "YAML file whose 'target:' section gives the target (default: the built-in "
-                 "four-line target, config/four-line-target.yaml)");
+                 "four-line target, config/four-line-board.yaml)");
   cli.add_option("--out", options.out, "the SVG file to write")->required();
   cli.add_option("--page", options.page, "sheet: a4, a3, letter, or auto (A4, else A3)")
       ->check(CLI::IsMember({"a4", "a3", "letter", "auto"}))

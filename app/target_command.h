@@ -1,5 +1,5 @@
 // `oalservo target`: a printable, true-scale SVG drawing of the planar line target (the
-// `target:` section of a config file, config/four-line-target.yaml by default the built-in
+// `target:` section of a config file, config/four-line-board.yaml by default the built-in
 // four-line target).
 //
 // The drawing: 1 SVG unit = 1 mm (width/height in mm, viewBox in mm), the object frame's x

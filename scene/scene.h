@@ -50,12 +50,23 @@ struct LineTarget {
   void Check() const;
 };
 
-/// Two parallel stripes (the paper's line-detection target).
+/// Two parallel stripes on a 2 m board (the paper's line-detection target).
 LineTarget TwoLineTarget();
-/// Four stripes in a '#' whose asymmetric spacing and widths make lines 1-4 identifiable
-/// (the paper's pose target, Figure 2). Line 1 is the widest.
+/// Four stripes in a '#' on a 2 m x 2 m board, whose asymmetric spacing and widths make
+/// lines 1-4 identifiable (the paper's pose target, Figure 2, in the paper's condition: the
+/// lines traverse the image). Line 1 is the widest. Named "four-line-board".
 LineTarget FourLineTarget();
-/// "two-line" or "four-line"; throws std::invalid_argument otherwise.
+/// The '#' printed on one landscape sheet: the sheet is the board, the stripes end 10 mm
+/// inside its edges, the four crossings are centred on it (config/four-line-a3.yaml gives
+/// the geometry and why). A3 (420 x 297 mm), A4 (297 x 210 mm), US letter (279.4 x 215.9).
+LineTarget FourLineA3Target();
+LineTarget FourLineA4Target();
+LineTarget FourLineLetterTarget();
+/// The built-in targets' names, the default first: "four-line-a3", "four-line-a4",
+/// "four-line-letter", "four-line-board", "two-line".
+const std::vector<std::string>& TargetNames();
+/// One of TargetNames() ("four-line" is kept as a name of "four-line-board"); throws
+/// std::invalid_argument listing them otherwise.
 LineTarget TargetByName(const std::string& name);
 
 struct RenderOptions {

@@ -223,10 +223,10 @@ TEST(ConfigTarget, DefaultIsTheFourLineTargetAndSectionsReplaceIt) {
 
 TEST(ConfigTarget, ShippedFilesAreExactlyTheBuiltInTargets) {
   const std::string dir = std::string(OAL_SOURCE_DIR) + "/config/";
-  ExpectSameTarget(LoadConfig(dir + "four-line-target.yaml").target, FourLineTarget());
+  ExpectSameTarget(LoadConfig(dir + "four-line-board.yaml").target, FourLineTarget());
   ExpectSameTarget(LoadConfig(dir + "two-line-target.yaml").target, TwoLineTarget());
   // They leave the detector alone.
-  ExpectSameOptions(LoadConfig(dir + "four-line-target.yaml").detector, DetectorOptions());
+  ExpectSameOptions(LoadConfig(dir + "four-line-board.yaml").detector, DetectorOptions());
 }
 
 TEST(ConfigTarget, ReadsAFullDescription) {

@@ -270,7 +270,7 @@ TEST(RenderSequence, WritesFramesTruthAndSequenceJson) {
   EXPECT_EQ(sequence.at("kind"), "occlusion");
   EXPECT_EQ(sequence.at("seed"), 5);
   EXPECT_EQ(sequence.at("count"), 10);
-  EXPECT_EQ(sequence.at("target"), "four-line");
+  EXPECT_EQ(sequence.at("target"), "four-line-board");
   EXPECT_THAT(sequence.at("description").get<std::string>(), HasSubstr("rectangle"));
   const CameraFile camera = LoadCameraFile(options.out_dir + "/camera.xml");
   EXPECT_EQ(camera.width, 640u);

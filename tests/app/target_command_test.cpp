@@ -314,7 +314,7 @@ TEST(TargetCommand, BinaryWarnsAboutALargeBoard) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0);
   const std::string err = test::ReadText(dir / "err.txt");
-  EXPECT_THAT(err, HasSubstr("oalservo target: warning: target 'four-line'"));
+  EXPECT_THAT(err, HasSubstr("oalservo target: warning: target 'four-line-board'"));
   EXPECT_THAT(err, HasSubstr("does not fit on A4"));
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "four.svg"));
   // The help's examples: the built-in board without a page it cannot fit, and a board of

@@ -89,7 +89,7 @@ TEST(Sequence, CommonSettings) {
     SCOPED_TRACE(ToString(kind));
     EXPECT_EQ(s.kind, kind);
     EXPECT_EQ(s.seed, kSeed);
-    EXPECT_EQ(s.target.name, "four-line");
+    EXPECT_EQ(s.target.name, "four-line-board");
     EXPECT_EQ(s.frames.size(), static_cast<std::size_t>(kFrames));
     EXPECT_EQ(s.options.width, 640);
     EXPECT_EQ(s.options.height, 480);

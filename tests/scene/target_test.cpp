@@ -28,7 +28,9 @@ bool IsVertical(const TargetLine& line) {
 TEST(Targets, TargetByNameReturnsTheShippedTargets) {
   EXPECT_EQ(TargetByName("two-line").name, "two-line");
   EXPECT_EQ(TargetByName("two-line").lines.size(), 2u);
-  EXPECT_EQ(TargetByName("four-line").name, "four-line");
+  EXPECT_EQ(TargetByName("four-line").name, "four-line-board");  // the older name
+  EXPECT_EQ(TargetByName("four-line-board").name, "four-line-board");
+  for (const std::string& name : TargetNames()) EXPECT_EQ(TargetByName(name).name, name);
   EXPECT_EQ(TargetByName("four-line").lines.size(), 4u);
   const std::string message = InvalidArgumentMessage([] { TargetByName("nope"); });
   EXPECT_NE(message.find("'nope'"), std::string::npos) << message;
