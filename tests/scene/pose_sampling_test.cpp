@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "scene/scene.h"
+#include "tests/scene/scene_image_util.h"
 #include "tests/scene/scene_test_util.h"
 
 namespace oal {
@@ -107,6 +108,30 @@ TEST(SamplePose, EveryLineIsLongEnough) {
   }
   sampling.min_visible_length_px = 5000.0;  // longer than the image diagonal
   EXPECT_THROW(SamplePose(renderer, sampling, &state), std::runtime_error);
+}
+
+// Poses drawn with the fields that existed before the sheet requirements (crossings in view):
+// their checksums were computed from SamplePose before those were added, so data sets and
+// figures made from the same seeds stay reproducible (bit-exact doubles: computed on x86-64
+// Debian bookworm, the CI's platform).
+TEST(SamplePose, OldFieldsGiveThePosesOfBefore) {
+  const SceneRenderer board(FourLineTarget(), RenderOptions());
+  PoseSampling sampling;
+  std::uint64_t state = 2024, hash = 0;
+  for (int i = 0; i < 50; ++i) {
+    hash = testing::PoseChecksum(SamplePose(board, sampling, &state), hash);
+  }
+  const SceneRenderer sheet(FourLineA3Target(), RenderOptions());
+  sampling.max_tilt_deg = 40.0;
+  sampling.max_offset_m = 0.12;
+  sampling.min_visible_length_px = 120.0;
+  std::uint64_t hash2 = 0;
+  for (int i = 0; i < 50; ++i) {
+    hash2 = testing::PoseChecksum(SamplePose(sheet, sampling, &state), hash2);
+  }
+  EXPECT_EQ(hash, 0x0a95535601803ce2ull);
+  EXPECT_EQ(hash2, 0x398bddfe47e78479ull);
+  EXPECT_EQ(state, 146452912055701122ull);
 }
 
 // The camera sees the printed side, unmirrored: the stripes are dark on the light board, and

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "scene/scene.h"
+#include "tests/scene/scene_image_util.h"
 #include "tests/scene/scene_test_util.h"
 
 namespace oal {
@@ -16,6 +17,7 @@ namespace {
 
 using testing::Darkness;
 using testing::FrontoParallel;
+using testing::ImageChecksum;
 using testing::ReferenceGrey;
 using testing::SameImage;
 
@@ -271,6 +273,63 @@ TEST(Render, BackgroundImageIsShownAroundTheBoardOnly) {
   // The background is fixed to the board plane: moving the camera moves it in the image.
   const RenderedFrame moved = renderer.Render(FrontoParallel(5.0, 0.1, 0.0), 1);
   EXPECT_FALSE(SameImage(frame.image, moved.image));
+}
+
+// Frames rendered with options that existed before the scene effects of sheets on a bench
+// (background image, light fall-off, shadow, annotations, clutter): their checksums were
+// computed from the renderer before those were added, so figures made with the old options
+// stay reproducible. A change here means old data sets and figures change too. (Computed on
+// x86-64 Debian bookworm with OpenCV 4.6, the CI's platform: another libm or OpenCV may round
+// a few pixels differently.)
+vpHomogeneousMatrix TiltedView(double distance_m, double x_m, double y_m, double roll_rad) {
+  vpHomogeneousMatrix tilt;
+  tilt.buildFrom(0.0, 0.0, 0.0, 0.35, -0.25, 0.0);
+  return tilt * FrontoParallel(distance_m, x_m, y_m, roll_rad);
+}
+
+RenderOptions OldEffects() {
+  RenderOptions options;
+  options.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  options.noise_sigma = 4.0;
+  options.blur_sigma_px = 1.0;
+  options.illumination_gradient = 0.3;
+  options.gradient_angle_rad = 0.7;
+  return options;
+}
+
+FrameEffects OldFrameEffects() {
+  FrameEffects effects;
+  effects.gain = 0.9;
+  effects.offset = 3.0;
+  Occluder disc;
+  disc.shape = Occluder::Shape::kDisc;
+  disc.centre_u_px = 500.0;
+  disc.centre_v_px = 100.0;
+  disc.half_width_px = 40.0;
+  disc.grey = 60;
+  effects.occluders = {disc};
+  return effects;
+}
+
+TEST(RenderRegression, DefaultOptionsGiveTheFramesOfBefore) {
+  const SceneRenderer sheet(FourLineA3Target(), RenderOptions());
+  const std::uint64_t a = ImageChecksum(sheet.Render(TiltedView(0.6, 0.03, -0.02, 0.4), 1).image);
+  const SceneRenderer board(FourLineTarget(), OldEffects());
+  const std::uint64_t b =
+      ImageChecksum(board.Render(TiltedView(0.8, 0.01, 0.02, -0.3), 5, OldFrameEffects()).image);
+  EXPECT_EQ(a, 0x878c8ffb90ebe51bull);
+  EXPECT_EQ(b, 0x02a814192561b888ull);
+}
+
+TEST(RenderRegression, BackgroundFileGivesTheFrameOfBefore) {
+  const std::string path = std::string(OAL_VISP_IMAGES_DIR) + "/Klimt/Klimt.pgm";
+  if (!std::ifstream(path).good()) GTEST_SKIP() << "ViSP test image missing: " << path;
+  RenderOptions options = OldEffects();
+  options.background_image = path;
+  const SceneRenderer sheet(FourLineA3Target(), options);
+  const std::uint64_t a =
+      ImageChecksum(sheet.Render(TiltedView(0.7, -0.05, 0.03, 1.1), 9, OldFrameEffects()).image);
+  EXPECT_EQ(a, 0x824b16d68999c6d4ull);
 }
 
 TEST(Render, NothingIsSeenWhenTheBoardIsBehindTheCamera) {
