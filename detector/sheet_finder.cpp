@@ -96,37 +96,6 @@ struct Side {
   }
 };
 
-// Whether, going outward from the side at t, dark pixels (min_contrast below `light`, over
-// at least 2 px) and then light ones again (at least 2 px above the middle of the light and
-// the darkest seen) follow within `reach` px.
-bool ClosedAt(const GrayImageView& image, const Side& side, double t, double light, double reach,
-              int min_contrast) {
-  const int n = static_cast<int>(reach);
-  double darkest = 255.0;
-  int dark_from = -1, light_again = 0;
-  for (int s = 0; s < n; ++s) {
-    const Point2d p = side.At(t, s);
-    const double x = p.u + 0.5, y = p.v + 0.5;  // one pixel: the band is far below the noise
-    if (!(x >= 0.0 && y >= 0.0 && x < image.width && y < image.height)) return false;
-    const double g = image.at(static_cast<int>(x), static_cast<int>(y));
-    if (dark_from < 0) {
-      if (g < light - min_contrast) {
-        dark_from = s;
-        darkest = g;
-      }
-      continue;
-    }
-    darkest = std::min(darkest, g);
-    if (g >= 0.5 * (light + darkest)) {
-      if (s - dark_from < 2) return false;  // too thin a band: noise
-      if (++light_again >= 2) return true;
-    } else if (light_again > 0) {
-      return false;  // dark again straight after: not paper beyond the band
-    }
-  }
-  return false;
-}
-
 // The light/dark edge nearest to the side at t along its normal, within +-search px: false
 // when there is none with enough contrast.
 bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light, double search,
@@ -207,12 +176,14 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
   grid_height_ = image.height / c;
   cells_.assign(static_cast<std::size_t>(grid_width_) * grid_height_, 0);
   std::vector<std::uint32_t> sums(static_cast<std::size_t>(grid_width_));
-  // Every other row of each cell: the mean of half its pixels is plenty for paper.
-  const int rows_used = (c + 1) / 2;
+  // Every fourth row of each cell (from the middle of the first four): the mean of a quarter
+  // of its pixels is plenty to tell paper from ink.
+  const int first_row = std::min(1, c - 1);
+  const int rows_used = (c - first_row + 3) / 4;
   const std::uint32_t count = static_cast<std::uint32_t>(rows_used * c);
   for (int gy = 0; gy < grid_height_; ++gy) {
     std::fill(sums.begin(), sums.end(), 0u);
-    for (int r = 0; r < c; r += 2) {
+    for (int r = first_row; r < c; r += 4) {
       const std::uint8_t* row = image.data + static_cast<std::ptrdiff_t>(gy * c + r) * image.stride;
       int gx = 0;
 #if OAL_HAVE_SSE2
@@ -300,13 +271,15 @@ bool SheetFinder::Describe(const GrayImageView& image, int threshold,
   for (const Side& side : sides) shortest = std::min(shortest, side.length);
   const double reach = 0.5 * shortest;
   // Two of three probes decide a side; once two sides are open the cell cannot be a grid's
-  // middle one, and the rest is not probed.
+  // middle one, and the rest is not probed. The probes step through the grid's cells: the
+  // dark band around a component is dark at its threshold by construction, and light cells
+  // beyond it belong to another component.
   quad->closed_sides = 0;
   int open = 0;
   for (int k = 0; k < 4 && open < 2; ++k) {
     const Side& side = sides[static_cast<std::size_t>(k)];
     auto closed_at = [&](double t) {
-      return ClosedAt(image, side, t, quad->light, reach, options_.min_contrast);
+      return ClosedInCells(side.At(t, 0.0), side.outward, threshold, reach);
     };
     const int first_two = closed_at(0.3) + closed_at(0.7);
     const bool closed = first_two == 2 || (first_two == 1 && closed_at(0.5));
@@ -317,35 +290,41 @@ bool SheetFinder::Describe(const GrayImageView& image, int threshold,
     }
   }
 
-  // Closed in on three sides or more: the sides onto the light/dark edges, at pixel level.
-  if (quad->ClosedSideCount() >= 3) {
-    std::array<LineParams, 4> lines;
-    bool all = true;
-    for (int k = 0; k < 4 && all; ++k) {
-      all = RefineSide(image, sides[static_cast<std::size_t>(k)], quad->light, kEdgeSearchCells * c,
-                       options_.min_contrast, &lines[static_cast<std::size_t>(k)]);
-    }
-    std::array<Point2d, 4> refined{};
-    for (int k = 0; k < 4 && all; ++k) {
-      all = Intersect(lines[static_cast<std::size_t>((k + 3) % 4)],
-                      lines[static_cast<std::size_t>(k)], &refined[static_cast<std::size_t>(k)],
-                      0.05);
-    }
-    // Each side moved by at most the search window; the corners of a sharp cell can move
-    // further (the cells cut them off), so the check is on the shape: convex, and of an area
-    // near the cells'.
-    if (all) {
-      std::vector<Point2d> check(refined.begin(), refined.end());
-      const double coarse_area = SignedArea(hull), refined_area = SignedArea(check);
-      if (ConvexHull(check).size() == 4 && refined_area > 0.8 * coarse_area &&
-          refined_area < 1.6 * coarse_area) {
-        quad->corners = refined;
-        quad->refined = true;
-      }
-    }
-  }
   quad->score = 10.0 * quad->ClosedSideCount() + 5.0 * quad->fill + quad->area_fraction;
   return true;
+}
+
+bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
+  if (quad->refined) return true;
+  const int c = options_.cell_px;
+  const std::array<Point2d, 4>& q = quad->corners;
+  const std::array<Side, 4> sides{Side(q[0], q[1]), Side(q[1], q[2]), Side(q[2], q[3]),
+                                  Side(q[3], q[0])};
+  std::array<LineParams, 4> lines;
+  for (int k = 0; k < 4; ++k) {
+    if (!RefineSide(image, sides[static_cast<std::size_t>(k)], quad->light, kEdgeSearchCells * c,
+                    options_.min_contrast, &lines[static_cast<std::size_t>(k)])) {
+      return false;
+    }
+  }
+  std::array<Point2d, 4> refined{};
+  for (int k = 0; k < 4; ++k) {
+    if (!Intersect(lines[static_cast<std::size_t>((k + 3) % 4)], lines[static_cast<std::size_t>(k)],
+                   &refined[static_cast<std::size_t>(k)], 0.05)) {
+      return false;
+    }
+  }
+  // Each side moved by at most the search window; the corners of a sharp cell can move
+  // further (the cells cut them off), so the check is on the shape: convex, and of an area
+  // near the cells'.
+  const std::vector<Point2d> coarse(q.begin(), q.end()), check(refined.begin(), refined.end());
+  const double coarse_area = SignedArea(coarse), refined_area = SignedArea(check);
+  if (ConvexHull(check).size() == 4 && refined_area > 0.8 * coarse_area &&
+      refined_area < 1.6 * coarse_area) {
+    quad->corners = refined;
+    quad->refined = true;
+  }
+  return quad->refined;
 }
 
 int SheetFinder::Root(int run) {
@@ -355,6 +334,26 @@ int SheetFinder::Root(int run) {
     run = r.parent;
   }
   return run;
+}
+
+bool SheetFinder::ClosedInCells(const Point2d& from, const Point2d& outward, int threshold,
+                                double reach) const {
+  const double c = options_.cell_px;
+  const int steps = static_cast<int>(reach / c) + 1;
+  int dark = 0;
+  for (int s = 0; s <= steps; ++s) {
+    const Point2d p{from.u + s * c * outward.u, from.v + s * c * outward.v};
+    const int gx = static_cast<int>(std::floor((p.u + 0.5) / c));
+    const int gy = static_cast<int>(std::floor((p.v + 0.5) / c));
+    if (gx < 0 || gy < 0 || gx >= grid_width_ || gy >= grid_height_) return false;
+    const bool light = cells_[static_cast<std::size_t>(gy) * grid_width_ + gx] >= threshold;
+    if (!light) {
+      ++dark;
+    } else if (dark > 0) {
+      return true;  // light, dark, light again
+    }
+  }
+  return false;
 }
 
 void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
@@ -384,15 +383,20 @@ void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
     above_begin = row_begin;
     above_end = runs_.size();
   }
-  // The runs grouped by component, in row order within each.
-  order_.resize(runs_.size());
-  for (std::size_t i = 0; i < runs_.size(); ++i) {
-    order_[i] = static_cast<int>(i);
+  // The runs grouped by component, in row order within each (a counting sort by root: the
+  // runs are already in row order).
+  const std::size_t n_runs = runs_.size();
+  starts_.assign(n_runs + 1, 0);
+  for (std::size_t i = 0; i < n_runs; ++i) {
     runs_[i].parent = Root(static_cast<int>(i));
+    ++starts_[static_cast<std::size_t>(runs_[i].parent) + 1];
   }
-  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) {
-    return runs_[static_cast<std::size_t>(a)].parent < runs_[static_cast<std::size_t>(b)].parent;
-  });
+  for (std::size_t i = 0; i < n_runs; ++i) starts_[i + 1] += starts_[i];
+  order_.resize(n_runs);
+  for (std::size_t i = 0; i < n_runs; ++i) {
+    order_[static_cast<std::size_t>(starts_[static_cast<std::size_t>(runs_[i].parent)]++)] =
+        static_cast<int>(i);
+  }
   const int c = options_.cell_px;
   const int total = grid_width_ * grid_height_;
   const int min_cells =
@@ -420,25 +424,22 @@ void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
     const bool at_edge = left == 0 || right == grid_width_ - 1 || component_.front().row == 0 ||
                          component_.back().row == grid_height_ - 1;
     if (at_edge || 2.2 * cells < static_cast<double>(rows) * (right - left + 1)) continue;
+    // The same component found at another threshold (its cell box within a cell) is kept
+    // once, as first found.
+    const std::array<int, 4> box{left, component_.front().row, right, component_.back().row};
+    const bool seen = std::any_of(boxes_.begin(), boxes_.end(), [&](const std::array<int, 4>& b) {
+      for (int k = 0; k < 4; ++k) {
+        if (std::abs(b[static_cast<std::size_t>(k)] - box[static_cast<std::size_t>(k)]) > 1) {
+          return false;
+        }
+      }
+      return true;
+    });
+    if (seen) continue;
     LightQuad quad;
     if (!Describe(image, threshold, component_, &quad)) continue;
-    // The same quadrilateral found at another threshold is kept once, with the better score.
-    bool merged = false;
-    for (LightQuad& kept : candidates_) {
-      double offset = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        offset = std::max(offset, std::hypot(kept.corners[static_cast<std::size_t>(k)].u -
-                                                 quad.corners[static_cast<std::size_t>(k)].u,
-                                             kept.corners[static_cast<std::size_t>(k)].v -
-                                                 quad.corners[static_cast<std::size_t>(k)].v));
-      }
-      if (offset <= 2.0 * c) {
-        if (quad.score > kept.score) kept = quad;
-        merged = true;
-        break;
-      }
-    }
-    if (!merged) candidates_.push_back(quad);
+    boxes_.push_back(box);
+    candidates_.push_back(quad);
   }
 }
 
@@ -447,6 +448,7 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
     throw std::invalid_argument("SheetFinder::Find: empty image or stride < width");
   }
   candidates_.clear();
+  boxes_.clear();
   ComputeCells(image);
   if (grid_width_ < 2 || grid_height_ < 2) return candidates_;
   std::array<int, 256> histogram{};

@@ -7,7 +7,7 @@
 // clean light quadrilateral whatever lies around the sheet (a light bench, a bright photo
 // beside it, a shadow), and from it the target's geometry predicts where the rest of the
 // target lies. The finder works on a grid of cells (cell_px x cell_px pixel means, about 5000
-// for 640 x 480; one pass over every other row):
+// for 640 x 480, from every fourth row):
 //   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
 //      Otsu's over the light class again (a light bench, a bright photo), while the classes
 //      differ by at least min_contrast;
@@ -79,6 +79,10 @@ class SheetFinder {
   /// The candidates of `image`, best first (may be none). The reference stays valid until
   /// the next call. Throws std::invalid_argument for an empty view.
   const std::vector<LightQuad>& Find(const GrayImageView& image);
+  /// Step 4 for one candidate of the same image (done on demand: a caller usually needs the
+  /// first only): its sides moved onto the light/dark edges, sub-pixel. True when quad is
+  /// (now) refined; its corners are unchanged otherwise.
+  bool Refine(const GrayImageView& image, LightQuad* quad) const;
 
   const SheetFinderOptions& options() const { return options_; }
   /// The last frame's cell means, row by row (grid_width() x grid_height()).
@@ -95,6 +99,10 @@ class SheetFinder {
   };
 
   void ComputeCells(const GrayImageView& image);
+  /// Whether, stepping from `from` along `outward` (unit) through the grid's cells, dark
+  /// cells and then light ones follow within `reach` px (at `threshold`).
+  bool ClosedInCells(const Point2d& from, const Point2d& outward, int threshold,
+                     double reach) const;
   /// Adds the candidates of the light cells at `threshold` to candidates_.
   void AddComponents(const GrayImageView& image, int threshold);
   int Root(int run);
@@ -109,8 +117,9 @@ class SheetFinder {
   std::vector<std::uint32_t> row_sums_;  ///< per grid row, prefix sums of the cell means
   std::vector<CellRun> runs_;
   std::vector<CellRun> component_;
-  std::vector<int> order_;
+  std::vector<int> order_, starts_;
   std::vector<LightQuad> candidates_;
+  std::vector<std::array<int, 4>> boxes_;  ///< candidates' cell boxes (left, top, right, bottom)
 };
 
 }  // namespace oal

@@ -24,6 +24,20 @@ double Cross(const Point2d& a, const Point2d& b) {
   return a.u * b.v - a.v * b.u;
 }
 
+// Whether the four points turn the same way at every corner, enclosing more than a pixel.
+bool IsConvexQuadrilateral(const std::vector<Point2d>& q) {
+  double first = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const Point2d& a = q[static_cast<std::size_t>(k)];
+    const Point2d& b = q[static_cast<std::size_t>((k + 1) % 4)];
+    const Point2d& c = q[static_cast<std::size_t>((k + 2) % 4)];
+    const double turn = Cross(Point2d{b.u - a.u, b.v - a.v}, Point2d{c.u - b.u, c.v - b.v});
+    if (k == 0) first = turn;
+    if (!(turn * first > 0.0)) return false;
+  }
+  return std::fabs(SignedArea(q)) > 1.0;
+}
+
 // '#' coordinates (a, b) of an object-plane point.
 struct HashFrame {
   Point2d origin, axis_a, axis_b;
@@ -144,6 +158,14 @@ bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParamet
 ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
                           const vpCameraParameters& camera, int count) {
   ScanBorders borders;
+  TargetBorders(layout, plane_to_image, camera, count, &borders);
+  return borders;
+}
+
+void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
+                   const vpCameraParameters& camera, int count, ScanBorders* out) {
+  std::vector<std::vector<Point2d>>& polygons = out->polygons;
+  std::size_t used = 0;
   auto lerp = [](const Interval& from, const Interval& to, double f) {
     return Interval{from.lo + f * (to.lo - from.lo), from.hi + f * (to.hi - from.hi)};
   };
@@ -153,17 +175,19 @@ ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_
     const Interval b = lerp(layout.outer_b, layout.inner_b, f);
     const Point2d corners[4] = {layout.ToPlane(a.lo, b.lo), layout.ToPlane(a.hi, b.lo),
                                 layout.ToPlane(a.hi, b.hi), layout.ToPlane(a.lo, b.hi)};
-    std::vector<Point2d> polygon(4);
+    if (polygons.size() <= used) polygons.emplace_back();
+    std::vector<Point2d>& polygon = polygons[used];
+    polygon.resize(4);
     bool ok = true;
     for (int c = 0; c < 4 && ok; ++c) {
       ok = ProjectPlanePoint(plane_to_image, camera, corners[c],
                              &polygon[static_cast<std::size_t>(c)]);
     }
     // The lens can fold a quadrilateral seen near the edge of its reach: keep convex ones.
-    if (!ok || ConvexHull(polygon).size() != 4 || !(std::fabs(SignedArea(polygon)) > 1.0)) continue;
-    borders.polygons.push_back(std::move(polygon));
+    if (!ok || !IsConvexQuadrilateral(polygon)) continue;
+    ++used;
   }
-  return borders;
+  polygons.resize(used);
 }
 
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,

@@ -80,6 +80,9 @@ vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo);
 /// left out (the borders may then be fewer; none when the target is not in front).
 ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
                           const vpCameraParameters& camera, int count);
+/// The same into *borders, reusing the memory it holds (for a loop).
+void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
+                   const vpCameraParameters& camera, int count, ScanBorders* borders);
 
 /// The plane-to-image homography (normalised coordinates) that maps the layout's middle cell
 /// onto `cell`, a light quadrilateral of the frame: of the two ways to lay the cell's sides

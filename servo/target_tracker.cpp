@@ -17,7 +17,7 @@ namespace {
 // fraction of its width either side (inside the ink: a pose a degree or two off moves these
 // onto the paper at the stripe's far end), and beside it, its half width plus a fraction of
 // its width (at least kMinBesideM) away, on the paper.
-constexpr int kStripeSamples = 24;
+constexpr int kStripeSamples = 16;
 constexpr double kInsideFraction = 0.3;
 constexpr double kBesideFraction = 0.5;
 constexpr double kMinBesideM = 0.003;
@@ -91,6 +91,9 @@ void TargetTrackerOptions::Check() const {
   finder.Check();
   RequireOption(borders >= 2 && borders <= 64, "TargetTrackerOptions::borders", borders,
                 "2 <= borders <= 64");
+  RequireOption(tracked_borders >= 2 && tracked_borders <= 64,
+                "TargetTrackerOptions::tracked_borders", tracked_borders,
+                "2 <= tracked_borders <= 64");
   RequireOption(max_candidates >= 1 && max_candidates <= 16, "TargetTrackerOptions::max_candidates",
                 max_candidates, "1 <= max_candidates <= 16");
   RequireOption(min_line_support >= 0 && min_line_support <= 1000,
@@ -277,27 +280,29 @@ const TargetFrame& TargetPoseTracker::Track(
     found = Attempt(image, ScanBorders{}, {}, prior, ScanSource::kImage);
   } else {
     if (prior) {
-      const ScanBorders borders =
-          TargetBorders(layout_, PlaneToImage(*prior), camera_, options_.borders);
-      if (!borders.empty()) {
-        found = Attempt(image, borders, SeedsFrom(PlaneToImage(*prior)), prior, ScanSource::kPrior);
+      const vpHomography plane_to_image = PlaneToImage(*prior);
+      TargetBorders(layout_, plane_to_image, camera_, options_.tracked_borders, &borders_);
+      if (!borders_.empty()) {
+        found = Attempt(image, borders_, SeedsFrom(plane_to_image), prior, ScanSource::kPrior);
       }
     }
     if (!found) {
       const auto start = std::chrono::steady_clock::now();
       const std::vector<LightQuad>& cells = finder_.Find(image);
       frame_.find_us = Microseconds(start);
-      for (const LightQuad& cell : cells) {
+      for (LightQuad cell : cells) {
         if (cell.ClosedSideCount() < 3 || frame_.candidates >= options_.max_candidates) continue;
+        const auto refine_start = std::chrono::steady_clock::now();
+        finder_.Refine(image, &cell);
+        frame_.find_us += Microseconds(refine_start);
         const std::optional<vpHomography> plane_to_image =
             PlaneToImageFromCell(layout_, cell, camera_);
         if (!plane_to_image) continue;
-        const ScanBorders borders =
-            TargetBorders(layout_, *plane_to_image, camera_, options_.borders);
-        if (borders.empty()) continue;
+        TargetBorders(layout_, *plane_to_image, camera_, options_.borders, &borders_);
+        if (borders_.empty()) continue;
         ++frame_.candidates;
         // Each candidate on its own: a prior that failed above says nothing about it.
-        if ((found = Attempt(image, borders, SeedsFrom(*plane_to_image), std::nullopt,
+        if ((found = Attempt(image, borders_, SeedsFrom(*plane_to_image), std::nullopt,
                              ScanSource::kMiddleCell))) {
           break;
         }

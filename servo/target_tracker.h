@@ -70,8 +70,12 @@ ScanMode ScanModeFromString(const std::string& text);
 
 struct TargetTrackerOptions {
   ScanMode scan = ScanMode::kTarget;
-  /// Borders on the target plane (target_layout.h). Range [2, 64].
+  /// Borders on the target plane (target_layout.h) when the target is looked for (no prior,
+  /// or the prior failed). Range [2, 64].
   int borders = 16;
+  /// ... and when it is tracked from a prior pose, whose seeded lines need fewer votes to
+  /// stand out. Range [2, 64].
+  int tracked_borders = 12;
   SheetFinderOptions finder;
   /// Middle-cell candidates scanned per frame at most. Range [1, 16].
   int max_candidates = 3;
@@ -160,6 +164,7 @@ class TargetPoseTracker {
   OalDetector detector_;
   SheetFinder finder_;
   std::vector<DetectedLine> lines_;
+  ScanBorders borders_;  ///< working memory for each attempt's borders
   TargetFrame frame_;
   GrayImageView image_{};
   std::optional<vpHomogeneousMatrix> last_cMo_;
