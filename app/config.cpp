@@ -211,6 +211,8 @@ const std::vector<Field<DetectorOptions>>& DetectorFields() {
       DoubleField("max_width_px", &O::max_width_px),
       DoubleField("min_crossing_angle_deg", &O::min_crossing_angle_deg),
       IntField("max_points_per_border", &O::max_points_per_border),
+      BoolField("centre_from_background", &O::centre_from_background),
+      IntField("region_max_borders", &O::region_max_borders),
       BoolField("skip_same_side_pairs", &O::skip_same_side_pairs),
       DoubleField("max_pair_width_ratio", &O::max_pair_width_ratio),
       DoubleField("angle_change_deg", &O::angle_change_deg),

@@ -61,6 +61,10 @@ struct DetectorOptions {
   double min_crossing_angle_deg = 15.0;
   /// Runs beyond this many on one border are ignored (a textured border). Range [2, 64].
   int max_points_per_border = 24;
+  /// A run's point is its centroid weighted by each sample's contrast to the background
+  /// beside the run (the mean of the two samples past each end), over the run and one sample
+  /// either side; false: weighted by the contrast to the threshold over the run only.
+  bool centre_from_background = true;
   /// With a region of interest (OalDetector::Detect with a ScanRegion), at most this many
   /// borders are scanned: a region so large that step_px would give more is scanned every
   /// k step_px, k the smallest that gives at most this many (a sheet filling the view costs

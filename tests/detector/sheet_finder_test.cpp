@@ -1,0 +1,119 @@
+// The sheet finder on rendered sheets: the '#'s middle cell is found, closed in on its four
+// sides, and refined onto the stripes' inner edges; nothing of the kind in a frame without it.
+#include "detector/sheet_finder.h"
+
+#include <gtest/gtest.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+#include "scene/scene.h"
+
+namespace oal {
+namespace {
+
+constexpr double kDeg = kPi / 180.0;
+
+// The middle cell of a '#' target whose lines 1 and 3 run along y and 2 and 4 along x (the
+// built-in sheets): between the stripes' inner edges, object frame.
+std::array<Point2d, 4> MiddleCell(const LineTarget& target) {
+  const TargetLine& l1 = target.lines[0];
+  const TargetLine& l2 = target.lines[1];
+  const TargetLine& l3 = target.lines[2];
+  const TargetLine& l4 = target.lines[3];
+  const double x0 = l1.x1_m + 0.5 * l1.width_m, x1 = l3.x1_m - 0.5 * l3.width_m;
+  const double y0 = l2.y1_m + 0.5 * l2.width_m, y1 = l4.y1_m - 0.5 * l4.width_m;
+  return {Point2d{x0, y0}, Point2d{x1, y0}, Point2d{x1, y1}, Point2d{x0, y1}};
+}
+
+Point2d Image(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera, const Point2d& p) {
+  const double x = cMo[0][0] * p.u + cMo[0][1] * p.v + cMo[0][3];
+  const double y = cMo[1][0] * p.u + cMo[1][1] * p.v + cMo[1][3];
+  const double z = cMo[2][0] * p.u + cMo[2][1] * p.v + cMo[2][3];
+  return DistortedPixel(camera, x / z, y / z);
+}
+
+struct SheetCase {
+  const char* target;
+  double distance_m, roll_deg, tilt_deg;
+  int background_grey;
+};
+
+class SheetFinderOnRenderedSheets : public ::testing::TestWithParam<SheetCase> {};
+
+TEST_P(SheetFinderOnRenderedSheets, FindsTheMiddleCellClosedInAndRefinesItOntoTheStripes) {
+  const SheetCase param = GetParam();
+  RenderOptions render;
+  render.camera = CameraWithKdu(600, 600, 319.5, 239.5, 0.15, 640, 480);
+  render.noise_sigma = 5.0;
+  render.blur_sigma_px = 1.0;
+  render.illumination_gradient = 0.2;
+  render.background_grey = param.background_grey;
+  const LineTarget target = TargetByName(param.target);
+  const SceneRenderer renderer(target, render);
+  const vpHomogeneousMatrix cMo(0.01, -0.01, param.distance_m, param.tilt_deg * kDeg, 0.0,
+                                param.roll_deg * kDeg);
+  const RenderedFrame frame = renderer.Render(cMo, 7);
+
+  SheetFinder finder;
+  const std::vector<LightQuad>& found = finder.Find(ViewOf(frame.image));
+  ASSERT_FALSE(found.empty());
+  LightQuad best = found.front();
+  EXPECT_EQ(best.ClosedSideCount(), 4);
+  ASSERT_TRUE(finder.Refine(ViewOf(frame.image), &best));
+  // Its corners are the middle cell's, in some cyclic order, within 2 px.
+  const std::array<Point2d, 4> cell = MiddleCell(target);
+  std::array<Point2d, 4> expected;
+  for (int k = 0; k < 4; ++k)
+    expected[static_cast<std::size_t>(k)] =
+        Image(cMo, render.camera, cell[static_cast<std::size_t>(k)]);
+  double best_error = HUGE_VAL;
+  for (int shift = 0; shift < 4; ++shift) {
+    double error = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const Point2d& a = best.corners[static_cast<std::size_t>(k)];
+      const Point2d& b = expected[static_cast<std::size_t>((k + shift) % 4)];
+      error = std::max(error, std::hypot(a.u - b.u, a.v - b.v));
+    }
+    best_error = std::min(best_error, error);
+  }
+  EXPECT_LT(best_error, 2.0) << param.target << " at " << param.distance_m << " m";
+}
+
+INSTANTIATE_TEST_SUITE_P(Sheets, SheetFinderOnRenderedSheets,
+                         ::testing::Values(SheetCase{"four-line-a3", 0.5, 0.0, 0.0, 90},
+                                           SheetCase{"four-line-a3", 0.8, 35.0, 20.0, 90},
+                                           SheetCase{"four-line-a3", 0.35, 200.0, 25.0, 60},
+                                           SheetCase{"four-line-a4", 0.4, 120.0, 15.0,
+                                                     170},  // a light bench
+                                           SheetCase{"four-line-a4", 0.55, 300.0, 28.0, 30},
+                                           SheetCase{"four-line-letter", 0.45, 80.0, 10.0, 120}));
+
+TEST(SheetFinder, AFrameWithoutAGridHasNoCandidateClosedIn) {
+  RenderOptions render;
+  render.noise_sigma = 5.0;
+  LineTarget blank = TargetByName("four-line-a3");
+  blank.lines.clear();  // the paper alone
+  const SceneRenderer renderer(blank, render);
+  const RenderedFrame frame = renderer.Render(vpHomogeneousMatrix(0, 0, 0.6, 0.2, 0.1, 0.3), 3);
+  SheetFinder finder;
+  for (const LightQuad& quad : finder.Find(ViewOf(frame.image))) {
+    EXPECT_LT(quad.ClosedSideCount(), 3);
+  }
+}
+
+TEST(SheetFinder, OptionsAreChecked) {
+  SheetFinderOptions options;
+  options.cell_px = 1;
+  EXPECT_THROW(SheetFinder{options}, std::invalid_argument);
+  options = SheetFinderOptions();
+  options.min_area_fraction = 0.0;
+  EXPECT_THROW(SheetFinder{options}, std::invalid_argument);
+  SheetFinder finder;
+  EXPECT_THROW(finder.Find(GrayImageView{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace oal
