@@ -84,7 +84,9 @@ TEST(BorderScan, RunMidpointIsIntensityWeighted) {
   samples[12] = 20;
   samples[13] = 60;
   std::vector<BorderPoint> points;
-  ASSERT_EQ(FindBorderPoints(samples, rect, 128, LineOptions(), &points), 1);
+  DetectorOptions options = LineOptions();
+  options.centre_from_background = false;
+  ASSERT_EQ(FindBorderPoints(samples, rect, 128, options, &points), 1);
   // Weights 128 - I: 28, 108, 108, 68.
   const double expected = (10 * 28.0 + 11 * 108.0 + 12 * 108.0 + 13 * 68.0) / 312.0;
   EXPECT_NEAR(points[0].pixel.u, expected, kSubPixelTol);
@@ -93,6 +95,27 @@ TEST(BorderScan, RunMidpointIsIntensityWeighted) {
   EXPECT_EQ(points[0].sides, kTop);
   // Sub-pixel run ends: 9 + 72/100 and 13 + 68/140.
   EXPECT_NEAR(points[0].run_px, (13.0 + 68.0 / 140.0) - (9.0 + 72.0 / 100.0), kSubPixelTol);
+}
+
+TEST(BorderScan, RunCentreWeightedByContrastToThePaperBesideIt) {
+  const BorderRect rect = BorderAt(100, 100, 0);
+  std::vector<std::uint8_t> samples(rect.Perimeter(), 200);
+  samples[10] = 150;  // partly covered, above the threshold: it still counts
+  samples[11] = 20;
+  samples[12] = 20;
+  samples[13] = 20;
+  samples[14] = 170;
+  std::vector<BorderPoint> points;
+  ASSERT_EQ(FindBorderPoints(samples, rect, 128, LineOptions(), &points), 1);
+  // The paper beside: samples 8, 9 and 15, 16, all 200. Weights 200 - I over 10..14.
+  const double expected = (10 * 50.0 + 11 * 180.0 + 12 * 180.0 + 13 * 180.0 + 14 * 30.0) / 620.0;
+  EXPECT_NEAR(points[0].pixel.u, expected, kSubPixelTol);
+  // Clipped at the threshold, the partly covered samples would not count: 12.
+  DetectorOptions clipped = LineOptions();
+  clipped.centre_from_background = false;
+  points.clear();
+  ASSERT_EQ(FindBorderPoints(samples, rect, 128, clipped, &points), 1);
+  EXPECT_NEAR(points[0].pixel.u, 12.0, kSubPixelTol);
 }
 
 // The weighted centres are summed 16 samples at a time where SSE2 is available: runs spanning
@@ -115,6 +138,7 @@ TEST(BorderScan, WeightedCentresOfRunsAnywhereOnTheLoop) {
   }
   DetectorOptions options = LineOptions();
   options.max_width_px = 40.0;
+  options.centre_from_background = false;  // the weights clipped at the threshold, within the run
   for (const Polarity polarity : {Polarity::kDarkLines, Polarity::kLightLines}) {
     options.polarity = polarity;
     const bool light = polarity == Polarity::kLightLines;
