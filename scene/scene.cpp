@@ -1467,6 +1467,8 @@ void PoseSampling::Check() const {
   RequireOption(min_visible_length_px >= 0.0 && std::isfinite(min_visible_length_px),
                 "PoseSampling::min_visible_length_px", min_visible_length_px,
                 "min_visible_length_px >= 0");
+  RequireOption(InRange(crossings_margin_px, 0.0, 1000.0), "PoseSampling::crossings_margin_px",
+                crossings_margin_px, "0 <= crossings_margin_px <= 1000");
 }
 
 // -------------------------------------------------------------------------------------------
@@ -1627,14 +1629,79 @@ vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, dou
   return camera;
 }
 
+std::vector<StripeCrossing> StripeCrossings(const LineTarget& target) {
+  const double min_sin = std::sin(kPi / 180.0);
+  std::vector<StripeCrossing> crossings;
+  for (std::size_t a = 0; a < target.lines.size(); ++a) {
+    for (std::size_t b = a + 1; b < target.lines.size(); ++b) {
+      const TargetLine& la = target.lines[a];
+      const TargetLine& lb = target.lines[b];
+      const double dax = la.x2_m - la.x1_m, day = la.y2_m - la.y1_m;
+      const double dbx = lb.x2_m - lb.x1_m, dby = lb.y2_m - lb.y1_m;
+      const double cross = dax * dby - day * dbx;
+      if (std::fabs(cross) <= min_sin * std::hypot(dax, day) * std::hypot(dbx, dby)) continue;
+      // la.1 + s da = lb.1 + t db with s, t in [0, 1].
+      const double ex = lb.x1_m - la.x1_m, ey = lb.y1_m - la.y1_m;
+      const double sa = (ex * dby - ey * dbx) / cross, tb = (ex * day - ey * dax) / cross;
+      if (sa < 0.0 || sa > 1.0 || tb < 0.0 || tb > 1.0) continue;
+      // Each stripe's sides: n . P = offset +- width / 2, n its unit normal.
+      const double na = std::hypot(dax, day), nb = std::hypot(dbx, dby);
+      const double ax = -day / na, ay = dax / na, bx = -dby / nb, by = dbx / nb;
+      const double oa = ax * la.x1_m + ay * la.y1_m, ob = bx * lb.x1_m + by * lb.y1_m;
+      const double det = ax * by - ay * bx;
+      StripeCrossing crossing;
+      crossing.line_a = static_cast<int>(a);
+      crossing.line_b = static_cast<int>(b);
+      const double signs[4][2] = {{1.0, 1.0}, {1.0, -1.0}, {-1.0, -1.0}, {-1.0, 1.0}};
+      for (int i = 0; i < 4; ++i) {
+        const double ca = oa + signs[i][0] * 0.5 * la.width_m;
+        const double cb = ob + signs[i][1] * 0.5 * lb.width_m;
+        crossing.corners_m[i] = {(ca * by - cb * ay) / det, (ax * cb - bx * ca) / det};
+      }
+      crossings.push_back(crossing);
+    }
+  }
+  return crossings;
+}
+
+namespace {
+
+bool CornersInView(const RenderOptions& options, const vpHomogeneousMatrix& cMo,
+                   const std::vector<StripeCrossing>& crossings, double margin_px) {
+  for (const StripeCrossing& crossing : crossings) {
+    for (const auto& corner : crossing.corners_m) {
+      const Vec3 p = ToCamera(cMo, corner[0], corner[1]);
+      if (!(p.z > kMinDepthM)) return false;
+      const Point2d pixel = DistortedPixel(options.camera, p.x / p.z, p.y / p.z);
+      if (!(pixel.u >= margin_px && pixel.u <= options.width - 1 - margin_px &&
+            pixel.v >= margin_px && pixel.v <= options.height - 1 - margin_px)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool CrossingsInView(const SceneRenderer& renderer, const vpHomogeneousMatrix& cMo,
+                     double margin_px) {
+  return CornersInView(renderer.options(), cMo, StripeCrossings(renderer.target()), margin_px);
+}
+
 vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling& sampling,
                                std::uint64_t* state) {
   sampling.Check();
+  const std::vector<StripeCrossing> crossings = sampling.crossings_in_view
+                                                    ? StripeCrossings(renderer.target())
+                                                    : std::vector<StripeCrossing>();
   std::mt19937_64 gen(*state);
   for (int attempt = 0; attempt < 1000; ++attempt) {
     const vpHomogeneousMatrix cMo = DrawPose(sampling, gen);
-    if (sampling.min_visible_length_px <= 0.0 ||
-        LongEnough(renderer.Truth(cMo), sampling.min_visible_length_px)) {
+    if ((sampling.min_visible_length_px <= 0.0 ||
+         LongEnough(renderer.Truth(cMo), sampling.min_visible_length_px)) &&
+        (!sampling.crossings_in_view ||
+         CornersInView(renderer.options(), cMo, crossings, sampling.crossings_margin_px))) {
       *state = gen();
       return cMo;
     }
@@ -1642,6 +1709,10 @@ vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling
   std::ostringstream message;
   message << "SamplePose: none of 1000 poses shows every line of target '" << renderer.target().name
           << "' over min_visible_length_px = " << sampling.min_visible_length_px << " px";
+  if (sampling.crossings_in_view) {
+    message << " with every crossing square crossings_margin_px = " << sampling.crossings_margin_px
+            << " px inside the image";
+  }
   throw std::runtime_error(message.str());
 }
 

@@ -28,6 +28,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpImage.h>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -268,15 +269,39 @@ struct PoseSampling {
   bool any_roll = true;        ///< roll uniform in [0, 360) deg; else within +-max_tilt_deg
   /// Every target line must cross the image over at least this length (0: no check).
   double min_visible_length_px = 0.0;
+  /// Every crossing square of the target (StripeCrossings) must be in view: its four corners
+  /// in front of the camera and at least crossings_margin_px inside the image's border in the
+  /// distorted image. With max_offset_m larger than the crossings' extent this keeps what the
+  /// pose needs in view while the board is often partly out of it. A target without crossings
+  /// passes.
+  bool crossings_in_view = false;
+  double crossings_margin_px = 10.0;  ///< pixels, [0, 1000]
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;
 };
 
+/// Where two stripes of a target cross: the parallelogram both cover.
+struct StripeCrossing {
+  int line_a = 0, line_b = 0;  ///< indices in LineTarget::lines, line_a < line_b
+  /// Its corners (X, Y) in the board plane (object frame, metres), in order around it.
+  std::array<std::array<double, 2>, 4> corners_m{};
+};
+
+/// Every crossing of `target`: each pair of non-parallel stripes (more than 1 degree apart)
+/// whose centre segments intersect, in the order of (line_a, line_b). Four for a '#'.
+std::vector<StripeCrossing> StripeCrossings(const LineTarget& target);
+
+/// True when every corner of every StripeCrossings(renderer.target()) square is in front of
+/// the camera at `cMo` and at least margin_px inside the image's border (distorted pixels).
+bool CrossingsInView(const SceneRenderer& renderer, const vpHomogeneousMatrix& cMo,
+                     double margin_px);
+
 /// A pose drawn from `sampling` with the pseudo-random generator state `*state`
 /// (deterministic: the same state gives the same pose, and *state is advanced so that calls in
-/// a row give a reproducible sequence). Retries until the visibility requirement holds (at
-/// most 1000 draws, then throws std::runtime_error).
+/// a row give a reproducible sequence). Retries until the visibility requirements hold (at
+/// most 1000 draws, then throws std::runtime_error). The requirements only reject draws, so
+/// with crossings_in_view false the same state gives the same poses as before it existed.
 vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling& sampling,
                                std::uint64_t* state);
 
