@@ -230,6 +230,13 @@ void WriteFrame(const fs::path& dir, int index, const RenderedFrame& frame, cons
   WriteFileAtomically(dir / FrameName(index, ".json"), truth.dump(2) + "\n");
 }
 
+// "four-line-a3, four-line-a4, ...": the names --target takes (and "four-line", older).
+std::string TargetNameList() {
+  std::string list;
+  for (const std::string& name : TargetNames()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 // The target to render: the config's `target:` section if a config is given, else by name.
 LineTarget TargetOf(const RenderCommandOptions& options) {
   return options.config.empty() ? TargetByName(options.target) : LoadConfig(options.config).target;
@@ -302,8 +309,12 @@ void RenderCommandOptions::Check() const {
                     ("it is one of: " + SequenceKindNames()).c_str());
     }
   }
-  RequireOption(!config.empty() || target == "two-line" || target == "four-line", "--target",
-                target, "it is two-line or four-line");
+  if (config.empty()) {
+    const std::vector<std::string>& names = TargetNames();
+    RequireOption(
+        target == "four-line" || std::find(names.begin(), names.end(), target) != names.end(),
+        "--target", target, "it is one of " + TargetNameList());
+  }
   RequireOption(count >= 1 && count <= 100000, "--count", count, "1 <= --count <= 100000");
   if (out_dir.empty()) throw std::invalid_argument("no output folder given (--out DIR)");
   RequireOption(width >= 16 && width <= 8192, "--width", width, "16 <= --width <= 8192");
@@ -354,8 +365,10 @@ int RunRender(int argc, char** argv) {
       "--sequence", options.sequence,
       "render a reproducible sequence instead of random poses: " + SequenceKindNames() +
           " (sets size, camera, noise, blur and poses)");
-  CLI::Option* target =
-      cli.add_option("--target", options.target, "two-line or four-line")->capture_default_str();
+  CLI::Option* target = cli.add_option("--target", options.target,
+                                       "a built-in target: " + TargetNameList() +
+                                           " (four-line is an older name of four-line-board)")
+                            ->capture_default_str();
   cli.add_option("--config", options.config,
                  "YAML file whose 'target:' section gives the target (instead of --target)")
       ->excludes(target);
@@ -404,6 +417,8 @@ int RunRender(int argc, char** argv) {
       "(DIR.tmp-PID) and moved into --out only when all are written; on an error nothing is "
       "left behind, and a data set already in --out is untouched.\n\n"
       "Examples:\n  oalservo render --count 20 --kdu 0.33 --noise 4 --out data/\n"
+      "  oalservo render --target four-line-a3 --min-distance 0.3 --max-distance 0.85 "
+      "--count 20 --out a3/\n"
       "  oalservo detect data/ --camera data/camera.xml --out data/lines.jsonl\n"
       "  oalservo render --sequence fast --count 60 --seed 1 --out fast/\n"
       "  oalservo render --count 5 --out data/ --overwrite   # replaces the 20 frames above");

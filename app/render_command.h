@@ -31,7 +31,9 @@ struct RenderCommandOptions {
   /// (SequenceKindNames()); the sequence then sets the image size, camera, noise, blur,
   /// illumination and poses, and only target, count, seed and out_dir are used.
   std::string sequence;
-  std::string target = "four-line";  ///< "two-line" or "four-line"
+  /// A built-in target: one of TargetNames() (scene/scene.h), or "four-line", an older name
+  /// of "four-line-board".
+  std::string target = "four-line";
   /// YAML file whose `target:` section gives the target instead of `target` (app/config.h);
   /// empty: use `target`. The data set's JSON then names the config's target.
   std::string config;

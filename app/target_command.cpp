@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -21,30 +23,41 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kMarginMm = 10.0;        // blank border of the page, each side
-constexpr double kFooterGapMm = 6.0;      // board edge to the first footer line
-constexpr double kFooterHeightMm = 30.0;  // title, note, scale bar and its label
-constexpr double kFooterWidthMm = 120.0;  // the footer block, centred under the board
+constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+constexpr double kFullMarginMm = 10.0;  // --page full: blank paper around the board
+constexpr double kGapMm = 1.5;          // between two printed items other than stripes
+constexpr double kSlackMm = 0.02;       // kept beyond every clearance (survives rounding)
+constexpr double kTextMm = 3.0;         // font size of everything printed
+constexpr double kLineSpacingMm = 4.5;  // the legend's lines, baseline to baseline
 constexpr double kScaleBarMm = 100.0;
-constexpr double kTextMm = 4.0;          // footer font size
-constexpr double kNumberMm = 3.5;        // line-number font size
-constexpr double kNumberInsetMm = 12.0;  // line number, from the line's end along the line
-constexpr double kNumberGapMm = 3.0;     // line number, from the stripe's side
+constexpr double kBarStrokeMm = 0.3;
+constexpr double kTickStrokeMm = 0.25;
+constexpr double kLongTickMm = 3.0;   // at 0, 50 and 100 mm
+constexpr double kShortTickMm = 1.5;  // every other 10 mm
+const char* const kGrey = "#808080";
 
 struct Sheet {
-  const char* name;  // as on the command line
-  const char* label;
+  const char* name;            // as on the command line
+  const char* label;           // as in messages
   double width_mm, height_mm;  // portrait
+  const char* target;          // the built-in made for it
 };
 
-constexpr Sheet kSheets[] = {
-    {"a4", "A4", 210.0, 297.0}, {"a3", "A3", 297.0, 420.0}, {"letter", "US letter", 215.9, 279.4}};
+constexpr Sheet kSheets[] = {{"a4", "A4", 210.0, 297.0, "four-line-a4"},
+                             {"a3", "A3", 297.0, 420.0, "four-line-a3"},
+                             {"letter", "US letter", 215.9, 279.4, "four-line-letter"}};
 
-const Sheet& SheetByName(const std::string& name) {
+const Sheet* SheetByName(const std::string& name) {
   for (const Sheet& sheet : kSheets) {
-    if (name == sheet.name) return sheet;
+    if (name == sheet.name) return &sheet;
   }
-  throw std::invalid_argument("page '" + name + "' is not one of: a4, a3, letter, auto");
+  return nullptr;  // "full"
+}
+
+void CheckPageName(const std::string& page) {
+  if (page != "full" && SheetByName(page) == nullptr) {
+    throw std::invalid_argument("--page = " + page + ": it is one of a4, a3, letter, full");
+  }
 }
 
 // Millimetres with at most 4 decimals, trailing zeros dropped ("12.5", "-80", "0.0125").
@@ -58,227 +71,762 @@ std::string Mm(double value) {
   return out;
 }
 
-// The page for a drawing of need_w x need_h mm (margins included), or nothing if none fits.
-bool FitOnSheet(const Sheet& sheet, double need_w, double need_h, TargetDrawing* drawing) {
-  if (need_w <= sheet.width_mm && need_h <= sheet.height_mm) {
-    drawing->page_width_mm = sheet.width_mm;
-    drawing->page_height_mm = sheet.height_mm;
-    drawing->page = std::string(sheet.label) + " portrait";
-    return true;
-  }
-  if (need_w <= sheet.height_mm && need_h <= sheet.width_mm) {
-    drawing->page_width_mm = sheet.height_mm;
-    drawing->page_height_mm = sheet.width_mm;
-    drawing->page = std::string(sheet.label) + " landscape";
-    return true;
-  }
-  return false;
+// ------------------------------------------------------------------------------------------
+// Plane geometry, millimetres, in the board's frame (origin at its centre, x right, y down).
+
+struct P {
+  double x = 0.0, y = 0.0;
+};
+P operator+(P a, P b) {
+  return {a.x + b.x, a.y + b.y};
+}
+P operator-(P a, P b) {
+  return {a.x - b.x, a.y - b.y};
+}
+P operator*(double s, P a) {
+  return {s * a.x, s * a.y};
+}
+double Dot(P a, P b) {
+  return a.x * b.x + a.y * b.y;
+}
+double Cross(P a, P b) {
+  return a.x * b.y - a.y * b.x;
+}
+P Rotated(P a, double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  return {c * a.x - s * a.y, s * a.x + c * a.y};
 }
 
-// The largest board that fits on `sheet` in portrait, with the margins and the footer.
-std::pair<double, double> LargestBoardMm(const Sheet& sheet) {
-  return {sheet.width_mm - 2.0 * kMarginMm,
-          sheet.height_mm - 2.0 * kMarginMm - kFooterGapMm - kFooterHeightMm};
+using Polygon = std::vector<P>;  // convex, its corners in order
+
+double PointSegmentDistance(P p, P a, P b) {
+  const P ab = b - a;
+  const double length2 = Dot(ab, ab);
+  const double t = length2 > 0.0 ? std::clamp(Dot(p - a, ab) / length2, 0.0, 1.0) : 0.0;
+  const P d = p - (a + t * ab);
+  return std::hypot(d.x, d.y);
 }
 
-std::string TooLargeWarning(const LineTarget& target, const Sheet& sheet, double need_w,
-                            double need_h) {
-  const double usable_w = sheet.width_mm - 2.0 * kMarginMm;
-  const double usable_h = sheet.height_mm - 2.0 * kMarginMm;
-  const int across = static_cast<int>(std::ceil(need_w / usable_w));
-  const int down = static_cast<int>(std::ceil(need_h / usable_h));
-  const auto [largest_w, largest_h] = LargestBoardMm(sheet);
+bool SegmentsCross(P a, P b, P c, P d) {
+  const double d1 = Cross(b - a, c - a), d2 = Cross(b - a, d - a);
+  const double d3 = Cross(d - c, a - c), d4 = Cross(d - c, b - c);
+  return ((d1 > 0.0) != (d2 > 0.0)) && ((d3 > 0.0) != (d4 > 0.0));
+}
+
+bool InsideConvex(P p, const Polygon& polygon) {
+  bool positive = false, negative = false;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const double side = Cross(polygon[(i + 1) % polygon.size()] - polygon[i], p - polygon[i]);
+    positive = positive || side > 0.0;
+    negative = negative || side < 0.0;
+  }
+  return !(positive && negative);
+}
+
+// 0 when they overlap, else the shortest distance between their outlines.
+double PolygonDistance(const Polygon& a, const Polygon& b) {
+  if (InsideConvex(a[0], b) || InsideConvex(b[0], a)) return 0.0;
+  double distance = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const P a0 = a[i], a1 = a[(i + 1) % a.size()];
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      const P b0 = b[j], b1 = b[(j + 1) % b.size()];
+      if (SegmentsCross(a0, a1, b0, b1)) return 0.0;
+      distance =
+          std::min({distance, PointSegmentDistance(a0, b0, b1), PointSegmentDistance(b0, a0, a1)});
+    }
+  }
+  return distance;
+}
+
+struct Box {
+  double x0, y0, x1, y1;
+};
+
+Box BoundsOf(const Polygon& polygon) {
+  Box box{polygon[0].x, polygon[0].y, polygon[0].x, polygon[0].y};
+  for (const P& p : polygon) {
+    box = {std::min(box.x0, p.x), std::min(box.y0, p.y), std::max(box.x1, p.x),
+           std::max(box.y1, p.y)};
+  }
+  return box;
+}
+
+// A lower bound of the distance between anything in `a` and anything in `b`.
+double BoxDistance(const Box& a, const Box& b) {
+  const double dx = std::max({0.0, a.x0 - b.x1, b.x0 - a.x1});
+  const double dy = std::max({0.0, a.y0 - b.y1, b.y0 - a.y1});
+  return std::hypot(dx, dy);
+}
+
+Polygon Rectangle(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+}
+
+// The rectangle of segment a-b widened by half_width on both sides (flat ends).
+Polygon WidenedSegment(P a, P b, double half_width) {
+  const P d = b - a;
+  const double length = std::hypot(d.x, d.y);
+  const P n{-d.y / length * half_width, d.x / length * half_width};
+  return {a + n, b + n, b - n, a - n};
+}
+
+// The convex hull (Andrew's monotone chain), corners in order.
+Polygon ConvexHull(std::vector<P> points) {
+  std::sort(points.begin(), points.end(),
+            [](P a, P b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  Polygon hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && Cross(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && Cross(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+// The stripe of `line`: its centre line widened by width / 2, flat ends; millimetres.
+Polygon StripeOf(const TargetLine& line) {
+  return WidenedSegment({1000.0 * line.x1_m, 1000.0 * line.y1_m},
+                        {1000.0 * line.x2_m, 1000.0 * line.y2_m}, 500.0 * line.width_m);
+}
+
+// ------------------------------------------------------------------------------------------
+// What is printed besides the stripes: items made of texts and thin lines, in their own
+// frame; an item's pose puts its origin at `at` on the board, turned by angle_deg.
+
+struct TextPart {
+  P centre;  // of its estimated extent
+  std::string text;
+  std::string attributes;  // id or class
+};
+
+struct LinePart {
+  P a, b;
+  double stroke_mm;
+  std::string attributes;
+};
+
+struct Item {
+  std::vector<TextPart> texts;
+  std::vector<LinePart> lines;
+};
+
+struct Pose {
+  P at;
+  double angle_deg = 0.0;
+};
+
+// A text's estimated extent in its item's frame (upright: the item turns it).
+Polygon TextExtent(const TextPart& text) {
+  const double half_w = 0.5 * kTextWidthEm * kTextMm * static_cast<double>(text.text.size());
+  const double half_h = 0.5 * kTextHeightEm * kTextMm;
+  return Rectangle(text.centre.x - half_w, text.centre.y - half_h, text.centre.x + half_w,
+                   text.centre.y + half_h);
+}
+
+// Everything an item inks, as convex polygons in its own frame.
+std::vector<Polygon> PartsOf(const Item& item) {
+  std::vector<Polygon> parts;
+  for (const TextPart& text : item.texts) parts.push_back(TextExtent(text));
+  for (const LinePart& line : item.lines) {
+    parts.push_back(WidenedSegment(line.a, line.b, 0.5 * line.stroke_mm));
+  }
+  return parts;
+}
+
+std::vector<Polygon> Placed(const std::vector<Polygon>& parts, const Pose& pose) {
+  const double angle = pose.angle_deg * kRadPerDeg;
+  std::vector<Polygon> out = parts;
+  for (Polygon& polygon : out) {
+    for (P& p : polygon) p = pose.at + Rotated(p, angle);
+  }
+  return out;
+}
+
+// The stripes, the middle cell and the items placed so far; how much room a new item has.
+class Layout {
+ public:
+  // half_w_mm, half_h_mm: the page's half extents along the board's x and y.
+  Layout(const LineTarget& target, double half_w_mm, double half_h_mm)
+      : half_w_(half_w_mm), half_h_(half_h_mm) {
+    for (const TargetLine& line : target.lines) Add(&stripes_, StripeOf(line));
+    // The crossings of the centre lines; their bounding rectangle holds the middle cell.
+    std::vector<P> crossings;
+    for (std::size_t i = 0; i < target.lines.size(); ++i) {
+      for (std::size_t j = i + 1; j < target.lines.size(); ++j) {
+        const TargetLine& a = target.lines[i];
+        const TargetLine& b = target.lines[j];
+        const P a0{1000.0 * a.x1_m, 1000.0 * a.y1_m}, a1{1000.0 * a.x2_m, 1000.0 * a.y2_m};
+        const P b0{1000.0 * b.x1_m, 1000.0 * b.y1_m}, b1{1000.0 * b.x2_m, 1000.0 * b.y2_m};
+        const double denominator = Cross(a1 - a0, b1 - b0);
+        if (std::fabs(denominator) < 1e-12) continue;  // parallel
+        const double s = Cross(b0 - a0, b1 - b0) / denominator;
+        const double t = Cross(b0 - a0, a1 - a0) / denominator;
+        if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0) crossings.push_back(a0 + s * (a1 - a0));
+      }
+    }
+    if (crossings.size() >= 2) {
+      const Box box = BoundsOf(crossings);
+      if (box.x1 - box.x0 > 1e-6 && box.y1 - box.y0 > 1e-6) {
+        middle_ = box;
+        Add(&obstacles_, Rectangle(box.x0, box.y0, box.x1, box.y1));
+      }
+    }
+  }
+
+  // The smallest of: room to the page's edge, to every stripe and to the middle cell, each
+  // less kClearanceMm, and to every item placed, less kGapMm. >= 0: the item may go there.
+  // Stops early (returning a value below `bound`) once it is below `bound`.
+  double Clearance(const std::vector<Polygon>& parts, double bound) const {
+    double room = std::numeric_limits<double>::infinity();
+    std::vector<Box> boxes;
+    for (const Polygon& part : parts) {
+      for (const P& p : part) {
+        room = std::min({room, half_w_ - std::fabs(p.x), half_h_ - std::fabs(p.y)});
+      }
+      boxes.push_back(BoundsOf(part));
+    }
+    room -= kClearanceMm;
+    if (room < bound) return room;
+    for (const auto& [polygons, keep] : {std::pair<const Shapes*, double>{&stripes_, kClearanceMm},
+                                         {&obstacles_, kClearanceMm},
+                                         {&items_, kGapMm}}) {
+      for (std::size_t k = 0; k < parts.size(); ++k) {
+        for (const auto& [polygon, box] : *polygons) {
+          if (BoxDistance(boxes[k], box) - keep >= room) continue;
+          room = std::min(room, PolygonDistance(parts[k], polygon) - keep);
+          if (room < bound) return room;
+        }
+      }
+    }
+    return room;
+  }
+
+  // Whether every part lies in one corner cell: beyond the middle cell's rectangle both
+  // across and along, all on the same side. Without a middle cell, anywhere is a corner.
+  bool InCorner(const std::vector<Polygon>& parts) const {
+    if (!middle_) return true;
+    int side_x = 0, side_y = 0;
+    for (const Polygon& part : parts) {
+      for (const P& p : part) {
+        const int sx = p.x < middle_->x0 ? -1 : (p.x > middle_->x1 ? 1 : 0);
+        const int sy = p.y < middle_->y0 ? -1 : (p.y > middle_->y1 ? 1 : 0);
+        if (sx == 0 || sy == 0) return false;
+        if (side_x == 0) side_x = sx, side_y = sy;
+        if (sx != side_x || sy != side_y) return false;
+      }
+    }
+    return true;
+  }
+
+  void Place(const std::vector<Polygon>& parts) {
+    for (const Polygon& part : parts) Add(&items_, part);
+  }
+
+  double half_w() const { return half_w_; }
+  double half_h() const { return half_h_; }
+  std::optional<P> centre() const {
+    if (!middle_) return std::nullopt;
+    return P{0.5 * (middle_->x0 + middle_->x1), 0.5 * (middle_->y0 + middle_->y1)};
+  }
+
+ private:
+  using Shapes = std::vector<std::pair<Polygon, Box>>;
+  static void Add(Shapes* shapes, Polygon polygon) {
+    const Box box = BoundsOf(polygon);
+    shapes->emplace_back(std::move(polygon), box);
+  }
+
+  double half_w_, half_h_;
+  Shapes stripes_, obstacles_, items_;
+  std::optional<Box> middle_;
+};
+
+// One way of placing an item: a set of angles tried over the whole page, optionally only in
+// a corner cell; `angle_span_deg` > 0 lets the refinement turn it that much more.
+struct SearchStep {
+  bool corner_only;
+  std::vector<double> angles_deg;
+  double angle_span_deg = 0.0;
+};
+
+struct Found {
+  Pose pose;
+  double clearance = -std::numeric_limits<double>::infinity();
+};
+
+// The pose with the most room for `item` in the first step that has room at all: a grid over
+// the page (the item's convex hull, which has less room than the item), then a pattern search
+// from the best few (the item's own parts).
+std::optional<Pose> PlaceItem(const Item& item, const std::vector<SearchStep>& steps,
+                              const Layout& layout) {
+  const std::vector<Polygon> parts = PartsOf(item);
+  std::vector<P> corners;
+  for (const Polygon& part : parts) corners.insert(corners.end(), part.begin(), part.end());
+  const std::vector<Polygon> hull = {ConvexHull(corners)};
+  const double grid_mm = std::max(2.0, 2.0 * std::max(layout.half_w(), layout.half_h()) / 250.0);
+  constexpr std::size_t kStarts = 8;
+
+  for (const SearchStep& step : steps) {
+    const auto room_at = [&](const std::vector<Polygon>& shape, const Pose& pose, double bound) {
+      const std::vector<Polygon> placed = Placed(shape, pose);
+      if (step.corner_only && !layout.InCorner(placed)) return -kClearanceMm * 10.0;
+      return layout.Clearance(placed, bound);
+    };
+    // The grid, bottom row first, keeping the best kStarts at least a grid step apart.
+    std::vector<Found> starts;
+    for (const double angle : step.angles_deg) {
+      for (double y = layout.half_h(); y >= -layout.half_h(); y -= grid_mm) {
+        for (double x = -layout.half_w(); x <= layout.half_w(); x += grid_mm) {
+          const Pose pose{{x, y}, angle};
+          const double worst = starts.size() < kStarts ? -kClearanceMm : starts.back().clearance;
+          const double room = room_at(hull, pose, worst);
+          if (room <= worst) continue;
+          bool merged = false;
+          for (Found& start : starts) {
+            if (start.pose.angle_deg == angle && std::fabs(start.pose.at.x - x) < 1.5 * grid_mm &&
+                std::fabs(start.pose.at.y - y) < 1.5 * grid_mm) {
+              if (room > start.clearance) start = {pose, room};
+              merged = true;
+              break;
+            }
+          }
+          if (!merged) starts.push_back({pose, room});
+          std::stable_sort(starts.begin(), starts.end(), [](const Found& a, const Found& b) {
+            return a.clearance > b.clearance;
+          });
+          if (starts.size() > kStarts) starts.pop_back();
+        }
+      }
+    }
+    // Pattern search from each, on the item's own parts.
+    Found best;
+    for (const Found& start : starts) {
+      Found here{start.pose, room_at(parts, start.pose, -kClearanceMm * 10.0)};
+      const double base_angle = start.pose.angle_deg;
+      for (double h = 0.5 * grid_mm; h >= 0.005; h *= 0.5) {
+        const double turn = step.angle_span_deg > 0.0 ? std::min(1.0, h) : 0.0;
+        for (bool moved = true; moved;) {
+          moved = false;
+          const double moves[10][3] = {{h, 0, 0},    {-h, 0, 0},   {0, h, 0},  {0, -h, 0},
+                                       {h, h, 0},    {h, -h, 0},   {-h, h, 0}, {-h, -h, 0},
+                                       {0, 0, turn}, {0, 0, -turn}};
+          for (const auto& move : moves) {
+            const Pose pose{{here.pose.at.x + move[0], here.pose.at.y + move[1]},
+                            here.pose.angle_deg + move[2]};
+            if (move[2] != 0.0 &&
+                std::fabs(pose.angle_deg - base_angle) > step.angle_span_deg + 1e-9) {
+              continue;
+            }
+            if (move[0] == 0.0 && move[1] == 0.0 && move[2] == 0.0) continue;
+            const double room = room_at(parts, pose, here.clearance);
+            if (room > here.clearance + 1e-9) {
+              here = {pose, room};
+              moved = true;
+            }
+          }
+        }
+      }
+      if (here.clearance > best.clearance + 1e-3) best = here;
+    }
+    if (best.clearance >= kSlackMm) return best.pose;
+  }
+  return std::nullopt;
+}
+
+// Where line `index`'s number goes beside its `from` end (at_from) or its `to` end: beside
+// the stripe, as near the end as there is room, on the side away from the middle first.
+std::optional<Pose> PlaceLineNumber(const Item& number, const TargetLine& line, bool at_from,
+                                    const Layout& layout) {
+  const P from{1000.0 * line.x1_m, 1000.0 * line.y1_m}, to{1000.0 * line.x2_m, 1000.0 * line.y2_m};
+  const P end = at_from ? from : to;
+  const P d = (at_from ? to : from) - end;
+  const double length = std::hypot(d.x, d.y);
+  const P along = (1.0 / length) * d;  // inward from the end
+  const P across{-along.y, along.x};
+  const P centre = layout.centre().value_or(P{0.0, 0.0});
+  const double outward = Dot(end - centre, across) >= 0.0 ? 1.0 : -1.0;
+  const std::vector<Polygon> parts = PartsOf(number);
+  const Box extent = BoundsOf(parts[0]);
+  const double support = 0.5 * ((extent.x1 - extent.x0) * std::fabs(across.x) +
+                                (extent.y1 - extent.y0) * std::fabs(across.y));
+  const double side = 500.0 * line.width_m + kClearanceMm + support + kSlackMm;
+  for (const double sign : {outward, -outward}) {
+    for (double t = 0.0; t <= std::min(40.0, 0.5 * length); t += 1.0) {
+      for (const double extra : {0.0, 0.5, 1.0, 2.0, 4.0, 8.0}) {
+        const Pose pose{end + t * along + (sign * (side + extra)) * across, 0.0};
+        if (layout.Clearance(Placed(parts, pose), kSlackMm) >= kSlackMm) return pose;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+std::string SheetSize(const LineTarget& target) {
+  return Mm(1000.0 * target.board_width_m) + " x " + Mm(1000.0 * target.board_height_m) + " mm";
+}
+
+Item ScaleBar() {
+  Item bar;
+  const double half = 0.5 * kScaleBarMm;
+  bar.lines.push_back({{-half, 0.0}, {half, 0.0}, kBarStrokeMm, "id=\"scale-bar\""});
+  for (int mm = 0; mm <= static_cast<int>(kScaleBarMm); mm += 10) {
+    const double tick = mm % 50 == 0 ? kLongTickMm : kShortTickMm;
+    const double x = -half + mm;
+    bar.lines.push_back({{x, 0.0}, {x, -tick}, kTickStrokeMm, "class=\"scale-tick\""});
+  }
+  const double label_y = 0.5 * kBarStrokeMm + 0.8 + 0.5 * kTextHeightEm * kTextMm;
+  bar.texts.push_back({{0.0, label_y}, "100 mm", "id=\"scale-label\""});
+  return bar;
+}
+
+Item Legend(const LineTarget& target) {
+  const std::string name = target.name.empty() ? "unnamed" : target.name;
+  Item legend;
+  legend.texts.push_back({{0.0, -kLineSpacingMm}, "target " + name, "id=\"name\""});
+  legend.texts.push_back({{0.0, 0.0}, "board " + SheetSize(target), "id=\"size\""});
+  legend.texts.push_back({{0.0, kLineSpacingMm}, "print at 100 %, do not scale", "id=\"note\""});
+  return legend;
+}
+
+std::vector<double> SlantsDeg() {
+  std::vector<double> slants;
+  for (double a = 5.0; a < 90.0; a += 5.0) slants.insert(slants.end(), {-a, a});
+  return slants;
+}
+
+// The page: its size and whether the board is drawn turned on it.
+struct Page {
+  double width_mm = 0.0, height_mm = 0.0;
+  std::string label;
+  bool turned = false;
+};
+
+std::string DoesNotFit(const LineTarget& target, const Sheet& sheet, const Page& page) {
+  const auto holds = [&](const Sheet& other) {
+    const double w = 1000.0 * target.board_width_m, h = 1000.0 * target.board_height_m;
+    const double eps = 1e-6;
+    return (w <= other.width_mm + eps && h <= other.height_mm + eps) ||
+           (h <= other.width_mm + eps && w <= other.height_mm + eps);
+  };
+  std::string larger;
+  for (const Sheet& other : kSheets) {
+    if (holds(other)) larger += std::string(larger.empty() ? "" : " or ") + "--page " + other.name;
+  }
   std::ostringstream message;
-  message << "target '" << target.name << "' (board " << Mm(1000.0 * target.board_width_m) << " x "
-          << Mm(1000.0 * target.board_height_m) << " mm) does not fit on " << sheet.label << " ("
-          << Mm(sheet.width_mm) << " x " << Mm(sheet.height_mm) << " mm, " << Mm(kMarginMm)
-          << " mm margins) at true scale, so the SVG is written at full size, " << Mm(need_w)
-          << " x " << Mm(need_h) << " mm. To print it: at 100 % on a plotter or at a print shop, "
-          << "or tiled with a poster tool onto about " << across * down << " " << sheet.label
-          << " sheets (" << across << " x " << down << ") joined edge to edge. Do not shrink it "
-          << "to one page: the pose takes the target's lengths as printed (a scaled print needs "
-          << "a target config scaled by the same factor). For one " << sheet.label
-          << " sheet, draw a board of at most " << Mm(largest_w) << " x " << Mm(largest_h)
-          << " mm: a config whose target: section has that board_width_m and board_height_m "
-          << "(the stripes are clipped to the board; keep every line and crossing on it)";
+  message << "target '" << target.name << "' (board " << SheetSize(target)
+          << ") does not fit on the " << sheet.label << " page (" << Mm(page.width_mm) << " x "
+          << Mm(page.height_mm) << " mm), upright or turned, and is not scaled to fit (the "
+          << "pose takes the target's lengths as printed); nothing was written. Instead: "
+          << "print the target made for this sheet (--page " << sheet.name
+          << " without --target or --config prints " << sheet.target << ")";
+  if (!larger.empty()) message << ", or a page that holds this one (" << larger << ")";
+  message << ", or this target at its full size with --page full ("
+          << Mm(1000.0 * target.board_width_m + 2.0 * kFullMarginMm) << " x "
+          << Mm(1000.0 * target.board_height_m + 2.0 * kFullMarginMm)
+          << " mm, for a plotter or a print shop)";
   return message.str();
 }
 
-// The stripe of `line` as a polygon, millimetres in the drawing (board centre at cx, cy).
-std::string StripePoints(const TargetLine& line, double cx, double cy) {
-  const double dx = line.x2_m - line.x1_m, dy = line.y2_m - line.y1_m;
-  const double length = std::hypot(dx, dy);
-  const double nx = -dy / length * 0.5 * line.width_m, ny = dx / length * 0.5 * line.width_m;
-  const double corners[4][2] = {{line.x1_m + nx, line.y1_m + ny},
-                                {line.x2_m + nx, line.y2_m + ny},
-                                {line.x2_m - nx, line.y2_m - ny},
-                                {line.x1_m - nx, line.y1_m - ny}};
-  std::string points;
-  for (const auto& corner : corners) {
-    points += (points.empty() ? "" : " ") + Mm(cx + 1000.0 * corner[0]) + "," +
-              Mm(cy + 1000.0 * corner[1]);
+Page LayOutPage(const LineTarget& target, const std::string& page_name, bool landscape) {
+  CheckPageName(page_name);
+  const double board_w = 1000.0 * target.board_width_m, board_h = 1000.0 * target.board_height_m;
+  Page page;
+  const Sheet* sheet = SheetByName(page_name);
+  if (sheet == nullptr) {
+    if (landscape) {
+      throw std::invalid_argument(
+          "--landscape is for a sheet (--page a4, a3 or letter): --page full is the board's own "
+          "size and orientation");
+    }
+    page.width_mm = board_w + 2.0 * kFullMarginMm;
+    page.height_mm = board_h + 2.0 * kFullMarginMm;
+    page.label = "full size";
+    return page;
   }
-  return points;
-}
-
-// The number of line `index` beside both of its ends, inside the board.
-std::string LineNumbers(const TargetLine& line, int index, double cx, double cy) {
-  const double dx = line.x2_m - line.x1_m, dy = line.y2_m - line.y1_m;
-  const double length_mm = 1000.0 * std::hypot(dx, dy);
-  const double ex = 1000.0 * dx / length_mm, ey = 1000.0 * dy / length_mm;  // unit, along
-  const double nx = -ey, ny = ex;                                           // unit, across
-  const double inset = std::min(kNumberInsetMm, 0.25 * length_mm);
-  const double side = 500.0 * line.width_m + kNumberGapMm + 0.5 * kNumberMm;
-  std::string text;
-  for (const double sign : {1.0, -1.0}) {
-    // From the `from` end inward (sign +1), from the `to` end inward (sign -1).
-    const double ax = cx + 1000.0 * (sign > 0 ? line.x1_m : line.x2_m);
-    const double ay = cy + 1000.0 * (sign > 0 ? line.y1_m : line.y2_m);
-    const double x = ax + sign * inset * ex + side * nx;
-    const double y = ay + sign * inset * ey + side * ny;
-    text += "    <text class=\"line-number\" x=\"" + Mm(x) + "\" y=\"" + Mm(y) + "\">" +
-            std::to_string(index + 1) + "</text>\n";
+  page.width_mm = landscape ? sheet->height_mm : sheet->width_mm;
+  page.height_mm = landscape ? sheet->width_mm : sheet->height_mm;
+  page.label = std::string(sheet->label) + (landscape ? " landscape" : " portrait");
+  constexpr double kEps = 1e-6;  // mm: a board the size of the sheet fits it
+  if (board_w <= page.width_mm + kEps && board_h <= page.height_mm + kEps) return page;
+  if (board_h <= page.width_mm + kEps && board_w <= page.height_mm + kEps) {
+    page.turned = true;
+    return page;
   }
-  return text;
+  throw TargetDoesNotFit(DoesNotFit(target, *sheet, page));
 }
 
 }  // namespace
 
-TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page) {
+TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page_name,
+                            bool landscape) {
   target.Check();
-  if (page != "auto") SheetByName(page);  // rejects an unknown name
-  const double board_w = 1000.0 * target.board_width_m;
-  const double board_h = 1000.0 * target.board_height_m;
-  const double content_w = std::max(board_w, kFooterWidthMm);
-  const double content_h = board_h + kFooterGapMm + kFooterHeightMm;
-  const double need_w = content_w + 2.0 * kMarginMm, need_h = content_h + 2.0 * kMarginMm;
-
+  const Page page = LayOutPage(target, page_name, landscape);
   TargetDrawing drawing;
-  bool placed = false;
-  if (page == "auto") {
-    placed = FitOnSheet(SheetByName("a4"), need_w, need_h, &drawing) ||
-             FitOnSheet(SheetByName("a3"), need_w, need_h, &drawing);
-  } else {
-    placed = FitOnSheet(SheetByName(page), need_w, need_h, &drawing);
-  }
-  if (!placed) {
-    drawing.fits = false;
-    drawing.page = "full size";
-    drawing.page_width_mm = need_w;
-    drawing.page_height_mm = need_h;
-    drawing.warning =
-        TooLargeWarning(target, SheetByName(page == "auto" ? "a3" : page), need_w, need_h);
+  drawing.page_width_mm = page.width_mm;
+  drawing.page_height_mm = page.height_mm;
+  drawing.page = page.label;
+  drawing.turned = page.turned;
+  const std::string name = target.name.empty() ? "unnamed" : target.name;
+  if (page.turned) {
+    drawing.note = "'" + name + "' (board " + SheetSize(target) +
+                   ") is drawn turned by 90 degrees to fit the " + page.label +
+                   " page: print it as it is, at 100 % (the print is the same target), and "
+                   "hold the sheet turned a quarter turn counterclockwise to see it upright; "
+                   "or write it with --landscape to have it upright on a landscape page";
   }
 
-  // The content block centred on the page; the board at its top, centred across.
-  const double left = 0.5 * (drawing.page_width_mm - content_w);
-  const double top = 0.5 * (drawing.page_height_mm - content_h);
-  const double cx = left + 0.5 * content_w;  // board centre = object origin
-  const double cy = top + 0.5 * board_h;
-  const double board_x = cx - 0.5 * board_w, board_y = top;
-  const double footer_x = cx - 0.5 * kFooterWidthMm;
-  const double footer_y = top + board_h + kFooterGapMm;
-  const std::string name = MarkupEscaped(target.name.empty() ? "unnamed" : target.name);
+  // Board frame -> page: the board centred on the page, turned by +90 degrees (clockwise on
+  // the page, whose y points down) when page.turned.
+  const double cx = 0.5 * page.width_mm, cy = 0.5 * page.height_mm;
+  const auto to_page = [&](P p) {
+    return page.turned ? P{cx - p.y, cy + p.x} : P{cx + p.x, cy + p.y};
+  };
+  const double extra_turn_deg = page.turned ? 90.0 : 0.0;
+  Layout layout(target, 0.5 * (page.turned ? page.height_mm : page.width_mm),
+                0.5 * (page.turned ? page.width_mm : page.height_mm));
+
+  // A stripe within kClearanceMm of the page's edge (a target of one's own).
+  for (std::size_t i = 0; i < target.lines.size(); ++i) {
+    double room = std::numeric_limits<double>::infinity();
+    for (const P& p : StripeOf(target.lines[i])) {
+      const double x = std::clamp(p.x, -500.0 * target.board_width_m, 500.0 * target.board_width_m);
+      const double y =
+          std::clamp(p.y, -500.0 * target.board_height_m, 500.0 * target.board_height_m);
+      room = std::min({room, layout.half_w() - std::fabs(x), layout.half_h() - std::fabs(y)});
+    }
+    if (room < kClearanceMm - 1e-9) {
+      drawing.warning += std::string(drawing.warning.empty() ? "" : "; ") + "line " +
+                         std::to_string(i + 1) + "'s stripe comes within " + Mm(room) +
+                         " mm of the page's edge, where printers leave 3-6 mm blank: its ink "
+                         "there will be missing (end the stripes at least 10 mm inside the board)";
+    }
+  }
+
+  // The scale bar, the legend, then the line numbers (each avoids those before it).
+  struct Drawn {
+    Item item;
+    Pose pose;
+  };
+  std::vector<Drawn> drawn;
+  const std::vector<SearchStep> bar_steps = {
+      {true, {0.0}}, {true, {-90.0}}, {false, {0.0}}, {false, {-90.0}}, {false, SlantsDeg(), 2.5}};
+  const Item bar = ScaleBar();
+  const std::optional<Pose> bar_pose = PlaceItem(bar, bar_steps, layout);
+  if (!bar_pose) {
+    throw std::runtime_error("target '" + name + "': no room on the " + page.label +
+                             " page for the 100 mm scale bar " + Mm(kClearanceMm) +
+                             " mm clear of every stripe and of the page's edge; use a larger "
+                             "page (--page full prints the board at its full size)");
+  }
+  layout.Place(Placed(PartsOf(bar), *bar_pose));
+  drawn.push_back({bar, *bar_pose});
+  const Item legend = Legend(target);
+  const std::optional<Pose> legend_pose =
+      PlaceItem(legend, {{true, {0.0}}, {false, {0.0}}, {true, {-90.0}}, {false, {-90.0}}}, layout);
+  if (!legend_pose) {
+    throw std::runtime_error("target '" + name + "': no room on the " + page.label +
+                             " page for its name and \"print at 100 %\" " + Mm(kClearanceMm) +
+                             " mm clear of every stripe and of the page's edge; use a larger "
+                             "page or a shorter name");
+  }
+  layout.Place(Placed(PartsOf(legend), *legend_pose));
+  drawn.push_back({legend, *legend_pose});
+  std::vector<Drawn> numbers;
+  for (std::size_t i = 0; i < target.lines.size(); ++i) {
+    Item number;
+    number.texts.push_back({{0.0, 0.0}, std::to_string(i + 1), "class=\"line-number\""});
+    for (const bool at_from : {true, false}) {
+      if (const auto pose = PlaceLineNumber(number, target.lines[i], at_from, layout)) {
+        layout.Place(Placed(PartsOf(number), *pose));
+        numbers.push_back({number, *pose});
+      }
+    }
+  }
+
+  // The SVG, in page coordinates.
+  const auto text_svg = [&](const TextPart& text, const Pose& pose) {
+    const double angle = pose.angle_deg * kRadPerDeg;
+    const P baseline = text.centre + P{0.0, kTextBaselineEm * kTextMm};
+    const P at = to_page(pose.at + Rotated(baseline, angle));
+    const double turn = pose.angle_deg + extra_turn_deg;
+    std::string out = "    <text " + text.attributes + " x=\"" + Mm(at.x) + "\" y=\"" + Mm(at.y) +
+                      "\" font-size=\"" + Mm(kTextMm) + "\"";
+    if (turn != 0.0) {
+      out += " transform=\"rotate(" + Mm(turn) + " " + Mm(at.x) + " " + Mm(at.y) + ")\"";
+    }
+    return out + ">" + MarkupEscaped(text.text) + "</text>\n";
+  };
+  const auto line_svg = [&](const LinePart& line, const Pose& pose) {
+    const double angle = pose.angle_deg * kRadPerDeg;
+    const P a = to_page(pose.at + Rotated(line.a, angle));
+    const P b = to_page(pose.at + Rotated(line.b, angle));
+    return "    <line " + line.attributes + " x1=\"" + Mm(a.x) + "\" y1=\"" + Mm(a.y) + "\" x2=\"" +
+           Mm(b.x) + "\" y2=\"" + Mm(b.y) + "\" stroke=\"" + kGrey + "\" stroke-width=\"" +
+           Mm(line.stroke_mm) + "\"/>\n";
+  };
+  const P board_corner =
+      to_page(page.turned ? P{-500.0 * target.board_width_m, 500.0 * target.board_height_m}
+                          : P{-500.0 * target.board_width_m, -500.0 * target.board_height_m});
+  const double board_page_w = 1000.0 * (page.turned ? target.board_height_m : target.board_width_m);
+  const double board_page_h = 1000.0 * (page.turned ? target.board_width_m : target.board_height_m);
+  const std::string escaped = MarkupEscaped(name);
 
   std::ostringstream svg;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\""
-      << Mm(drawing.page_width_mm) << "mm\" height=\"" << Mm(drawing.page_height_mm)
-      << "mm\" viewBox=\"0 0 " << Mm(drawing.page_width_mm) << " " << Mm(drawing.page_height_mm)
-      << "\">\n"
-      << "  <title>oalservo target " << name << "</title>\n"
-      << "  <desc>True scale: 1 unit = 1 mm. Object frame: x right, y down, origin at the board "
-         "centre ("
-      << Mm(cx) << ", " << Mm(cy) << "). Print at 100 %, do not scale.</desc>\n"
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << Mm(page.width_mm)
+      << "mm\" height=\"" << Mm(page.height_mm) << "mm\" viewBox=\"0 0 " << Mm(page.width_mm) << " "
+      << Mm(page.height_mm) << "\">\n"
+      << "  <title>oalservo target " << escaped << "</title>\n"
+      << "  <desc>Target " << escaped << " (board " << SheetSize(target) << "), page " << page.label
+      << ", " << Mm(page.width_mm) << " x " << Mm(page.height_mm)
+      << " mm. True scale: 1 unit = 1 mm; print at 100 %, do not scale, and check the 100 mm "
+         "scale bar. ";
+  if (page.turned) {
+    svg << "The target is drawn turned by 90 degrees clockwise to fit the page: its x axis "
+           "points down the page and its y axis to the left; print it as it is (the print is "
+           "the same target) and hold the sheet turned a quarter turn counterclockwise to see "
+           "it upright, or write it with --landscape. ";
+  } else {
+    svg << "Object frame: x to the right, y down. ";
+  }
+  svg << "The board's centre, the object origin, is at (" << Mm(cx) << ", " << Mm(cy)
+      << "); its outline is not printed.</desc>\n"
       << "  <defs>\n"
-      << "    <clipPath id=\"board-clip\"><rect x=\"" << Mm(board_x) << "\" y=\"" << Mm(board_y)
-      << "\" width=\"" << Mm(board_w) << "\" height=\"" << Mm(board_h) << "\"/></clipPath>\n"
+      << "    <clipPath id=\"board-clip\"><rect x=\"" << Mm(board_corner.x) << "\" y=\""
+      << Mm(board_corner.y) << "\" width=\"" << Mm(board_page_w) << "\" height=\""
+      << Mm(board_page_h) << "\"/></clipPath>\n"
       << "  </defs>\n"
-      << "  <rect id=\"board\" x=\"" << Mm(board_x) << "\" y=\"" << Mm(board_y) << "\" width=\""
-      << Mm(board_w) << "\" height=\"" << Mm(board_h)
-      << "\" fill=\"none\" stroke=\"#b0b0b0\" stroke-width=\"0.25\"/>\n"
       << "  <g id=\"stripes\" clip-path=\"url(#board-clip)\" fill=\"#000000\" stroke=\"none\">\n";
   for (std::size_t i = 0; i < target.lines.size(); ++i) {
-    svg << "    <polygon class=\"stripe\" id=\"line-" << i + 1 << "\" points=\""
-        << StripePoints(target.lines[i], cx, cy) << "\"/>\n";
+    std::string points;
+    for (const P& corner : StripeOf(target.lines[i])) {
+      const P p = to_page(corner);
+      points += (points.empty() ? "" : " ") + Mm(p.x) + "," + Mm(p.y);
+    }
+    svg << "    <polygon class=\"stripe\" id=\"line-" << i + 1 << "\" points=\"" << points
+        << "\"/>\n";
   }
   svg << "  </g>\n"
-      << "  <g id=\"line-numbers\" fill=\"#808080\" font-family=\"sans-serif\" font-size=\""
-      << Mm(kNumberMm) << "\" text-anchor=\"middle\" dominant-baseline=\"central\">\n";
-  for (std::size_t i = 0; i < target.lines.size(); ++i) {
-    svg << LineNumbers(target.lines[i], static_cast<int>(i), cx, cy);
-  }
-  const double bar_y = footer_y + 2.0 * kTextMm + 10.0;
+      << "  <g id=\"line-numbers\" fill=\"" << kGrey
+      << "\" stroke=\"none\" font-family=\"sans-serif\" text-anchor=\"middle\">\n";
+  for (const Drawn& number : numbers) svg << text_svg(number.item.texts[0], number.pose);
   svg << "  </g>\n"
-      << "  <g id=\"footer\" fill=\"#000000\" font-family=\"sans-serif\" font-size=\""
-      << Mm(kTextMm) << "\">\n"
-      << "    <text id=\"name\" x=\"" << Mm(footer_x) << "\" y=\"" << Mm(footer_y + kTextMm)
-      << "\">target " << name << ": board " << Mm(board_w) << " x " << Mm(board_h) << " mm, "
-      << target.lines.size() << " lines</text>\n"
-      << "    <text id=\"note\" x=\"" << Mm(footer_x) << "\" y=\""
-      << Mm(footer_y + 2.0 * kTextMm + 2.0) << "\">print at 100 %, do not scale</text>\n"
-      << "    <line id=\"scale-bar\" x1=\"" << Mm(footer_x) << "\" y1=\"" << Mm(bar_y) << "\" x2=\""
-      << Mm(footer_x + kScaleBarMm) << "\" y2=\"" << Mm(bar_y)
-      << "\" stroke=\"#000000\" stroke-width=\"0.5\"/>\n";
-  for (int mm = 0; mm <= static_cast<int>(kScaleBarMm); mm += 10) {
-    const double tick = mm % 50 == 0 ? 3.0 : 1.5;
-    svg << "    <line class=\"scale-tick\" x1=\"" << Mm(footer_x + mm) << "\" y1=\""
-        << Mm(bar_y - tick) << "\" x2=\"" << Mm(footer_x + mm) << "\" y2=\"" << Mm(bar_y)
-        << "\" stroke=\"#000000\" stroke-width=\"0.3\"/>\n";
-  }
-  svg << "    <text id=\"scale-label\" x=\"" << Mm(footer_x + kScaleBarMm + 3.0) << "\" y=\""
-      << Mm(bar_y + 0.5 * kTextMm - 0.5) << "\">100 mm</text>\n"
-      << "  </g>\n"
+      << "  <g id=\"legend\" fill=\"" << kGrey
+      << "\" stroke=\"none\" font-family=\"sans-serif\" text-anchor=\"middle\">\n";
+  for (const TextPart& text : legend.texts) svg << text_svg(text, *legend_pose);
+  svg << "  </g>\n"
+      << "  <g id=\"scale\" fill=\"" << kGrey
+      << "\" stroke=\"none\" stroke-linecap=\"butt\" font-family=\"sans-serif\" "
+         "text-anchor=\"middle\">\n";
+  for (const LinePart& line : bar.lines) svg << line_svg(line, *bar_pose);
+  for (const TextPart& text : bar.texts) svg << text_svg(text, *bar_pose);
+  svg << "  </g>\n"
       << "</svg>\n";
   drawing.svg = svg.str();
   return drawing;
 }
 
+void TargetCommandOptions::Check() const {
+  if (!target.empty() && !config.empty()) {
+    throw std::invalid_argument("--target " + target + " and --config " + config +
+                                " both name a target: give one");
+  }
+  if (!target.empty()) {
+    const std::vector<std::string>& names = TargetNames();
+    if (target != "four-line" && std::find(names.begin(), names.end(), target) == names.end()) {
+      std::string list;
+      for (const std::string& known : names) list += (list.empty() ? "" : ", ") + known;
+      throw std::invalid_argument("--target = " + target + ": it is one of " + list);
+    }
+  }
+  CheckPageName(page);
+  if (landscape && page == "full") {
+    throw std::invalid_argument(
+        "--landscape is for a sheet (--page a4, a3 or letter): --page full is the board's own "
+        "size and orientation");
+  }
+  if (out.empty()) throw std::invalid_argument("no output file given (--out FILE.svg)");
+}
+
+LineTarget TargetToPrint(const TargetCommandOptions& options) {
+  if (!options.target.empty()) return TargetByName(options.target);
+  if (!options.config.empty()) return LoadConfig(options.config).target;
+  const Sheet* sheet = SheetByName(options.page);
+  return TargetByName(sheet != nullptr ? sheet->target : TargetNames().front());
+}
+
 TargetDrawing WriteTargetSvg(const TargetCommandOptions& options) {
-  if (options.out.empty()) throw std::invalid_argument("no output file given (--out FILE.svg)");
-  const LineTarget target =
-      options.config.empty() ? FourLineTarget() : LoadConfig(options.config).target;
-  TargetDrawing drawing = DrawTargetSvg(target, options.page);
+  options.Check();
   const fs::path out(options.out);
   const fs::path dir = out.parent_path();
   if (!dir.empty() && !fs::is_directory(dir)) {
-    throw std::runtime_error("cannot write '" + options.out + "': directory '" + dir.string() +
+    throw std::runtime_error("cannot write --out " + options.out + ": directory '" + dir.string() +
                              "' does not exist");
   }
   if (fs::is_directory(out)) {
-    throw std::runtime_error("cannot write '" + options.out + "': it is a directory");
+    throw std::runtime_error("cannot write --out " + options.out + ": it is a directory");
   }
+  const TargetDrawing drawing =
+      DrawTargetSvg(TargetToPrint(options), options.page, options.landscape);
   WriteFileAtomically(out, drawing.svg);
   return drawing;
 }
 
 int RunTarget(int argc, char** argv) {
   TargetCommandOptions options;
+  std::string names;
+  for (const std::string& name : TargetNames()) names += (names.empty() ? "" : ", ") + name;
   CLI::App cli(
-      "Write a printable, true-scale SVG drawing of the line target (1 unit = 1 mm; stripes "
-      "black, line numbers, a 100 mm scale bar). A board larger than the page is written at "
-      "full size with a warning saying how to print it; the built-in two-line and four-line "
-      "targets are 2 m x 2 m boards, so they always are.",
+      "Write a printable, true-scale SVG of a line target on one page (1 unit = 1 mm): the "
+      "stripes in black, and, small and grey and at least 5 mm clear of every stripe and of the "
+      "page's edge, the line numbers, the target's name, \"print at 100 %, do not scale\" and a "
+      "100 mm scale bar. Without --target or --config it prints the sheet target made for the "
+      "page (a4: four-line-a4, a3: four-line-a3, letter: four-line-letter). The page is "
+      "portrait unless --landscape; a board that fits it only turned by 90 degrees is drawn "
+      "turned (the same print). A board larger than the page is refused (nothing is "
+      "written); --page full prints it at its full size.",
       "oalservo target");
+  CLI::Option* target = cli.add_option("--target", options.target,
+                                       "a built-in target: " + names +
+                                           " (four-line is an older "
+                                           "name of four-line-board)");
   cli.add_option("--config", options.config,
-                 "YAML file whose 'target:' section gives the target (default: the built-in "
-                 "four-line target, config/four-line-board.yaml)");
-  cli.add_option("--out", options.out, "the SVG file to write")->required();
-  cli.add_option("--page", options.page, "sheet: a4, a3, letter, or auto (A4, else A3)")
-      ->check(CLI::IsMember({"a4", "a3", "letter", "auto"}))
+                 "YAML file whose 'target:' section gives the target (config/four-line-a3.yaml "
+                 "and the other config/four-line-*.yaml are the built-ins written out)")
+      ->excludes(target);
+  cli.add_option("--page", options.page,
+                 "a4 (210 x 297 mm), a3 (297 x 420 mm), letter (215.9 x 279.4 mm), or full: the "
+                 "board at its full size with 10 mm around it, for a plotter or a print shop")
+      ->check(CLI::IsMember({"a4", "a3", "letter", "full"}))
       ->capture_default_str();
-  const auto [a3_w, a3_h] = LargestBoardMm(SheetByName("a3"));
+  cli.add_flag("--landscape", options.landscape,
+               "the page's long side across (a4, a3, letter): the sheet targets print upright");
+  cli.add_option("--out", options.out, "the SVG file to write")->required();
   cli.footer(
       "Examples:\n"
-      "  oalservo target --out four-line.svg\n"
-      "      the built-in 2 m x 2 m board at full size, for a plotter or a print shop (or tiles)\n"
-      "  oalservo target --config my-board.yaml --page a3 --out board.svg\n"
-      "      a board of your own (its target: section) up to " +
-      Mm(a3_w) + " x " + Mm(a3_h) + " mm, on one A3 sheet");
+      "  oalservo target --out four-line-a3.svg\n"
+      "      four-line-a3 on an A3 page (portrait: drawn turned, the same print)\n"
+      "  oalservo target --page a3 --landscape --out four-line-a3.svg\n"
+      "      the same, upright on a landscape A3 page\n"
+      "  oalservo target --page a4 --landscape --out four-line-a4.svg\n"
+      "      four-line-a4 on an A4 sheet (--page letter: four-line-letter on US letter)\n"
+      "  oalservo target --target four-line-board --page full --out four-line-board.svg\n"
+      "      the 2 m x 2 m board (the paper's condition) at its full size, for a plotter\n"
+      "  oalservo target --config my-target.yaml --page a4 --out mine.svg\n"
+      "      a target of your own (its target: section); refused if its board does not fit\n\n"
+      "Print at 100 % (no \"fit to page\") and check the scale bar with a ruler: the pose takes "
+      "the target's lengths as printed.");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   const TargetDrawing drawing = WriteTargetSvg(options);
-  if (!drawing.fits) Warn("target", drawing.warning);
+  if (!drawing.warning.empty()) Warn("target", drawing.warning);
   std::cerr << "oalservo target: " << options.out << " written (" << drawing.page << ", "
             << Mm(drawing.page_width_mm) << " x " << Mm(drawing.page_height_mm) << " mm)\n";
+  if (drawing.turned) std::cerr << "oalservo target: " << drawing.note << '\n';
   return kExitOk;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -26,8 +27,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMinDepthM = 1e-6;
 // Rays meeting the board plane farther than this see background_grey (metres).
 constexpr double kMaxDepthM = 1e6;
-// Size on the board plane of one texel of the background image (metres).
-constexpr double kBackgroundTexelM = 0.002;
 // Samples of a target line used to find its visible part, and to fit its distorted image.
 constexpr int kVisibilitySamples = 1000;
 constexpr int kFitSamples = 400;
@@ -425,11 +424,12 @@ class PixelCoverage {
 // What is seen around the board: a grey level, or an image tiled on the board plane.
 class BackgroundShade {
  public:
-  BackgroundShade(const vpImage<unsigned char>& image, double grey) : image_(image), grey_(grey) {}
+  BackgroundShade(const vpImage<unsigned char>& image, double texel_m, double grey)
+      : image_(image), texel_m_(texel_m), grey_(grey) {}
 
   double At(double X, double Y) const {
     if (image_.getSize() == 0) return grey_;
-    const double fx = X / kBackgroundTexelM, fy = Y / kBackgroundTexelM;
+    const double fx = X / texel_m_, fy = Y / texel_m_;
     if (!(std::fabs(fx) < 1e9 && std::fabs(fy) < 1e9)) return grey_;
     const double x0 = std::floor(fx), y0 = std::floor(fy);
     const double ax = fx - x0, ay = fy - y0;
@@ -447,6 +447,7 @@ class BackgroundShade {
   }
 
   const vpImage<unsigned char>& image_;
+  double texel_m_;
   double grey_;
 };
 
@@ -462,6 +463,41 @@ void ApplyIllumination(double gradient, double angle_rad, cv::Mat1f* image) {
     for (int u = 0; u < image->cols; ++u) {
       const double t = (u * c + v * s - t_min) / (t_max - t_min);
       row[u] = static_cast<float>(row[u] * (1.0 - gradient * t));
+    }
+  }
+}
+
+// Multiplies by the vignetting 1 - k (r / r_corner)^2, r from the principal point, and by the
+// hot spot 1 + g exp(-d^2 / (2 s^2)); both are separable, so they are tabulated per column and
+// per row.
+void ApplyLightFalloff(const RenderOptions& options, cv::Mat1f* image) {
+  if (options.vignetting <= 0.0 && options.hot_spot_gain <= 0.0) return;
+  const double u0 = options.camera.get_u0(), v0 = options.camera.get_v0();
+  const double w = image->cols - 1.0, h = image->rows - 1.0;
+  double corner2 = 0.0;
+  for (const double cu : {0.0, w}) {
+    for (const double cv : {0.0, h}) {
+      corner2 = std::max(corner2, (cu - u0) * (cu - u0) + (cv - v0) * (cv - v0));
+    }
+  }
+  const double k = options.vignetting / std::max(corner2, 1e-12);
+  const double hu = options.hot_spot_u * w, hv = options.hot_spot_v * h;
+  const double sigma = options.hot_spot_sigma * std::hypot(static_cast<double>(image->cols),
+                                                           static_cast<double>(image->rows));
+  const double inv_2s2 = 1.0 / (2.0 * sigma * sigma);
+  // r^2 = ru[u] + rv[v]; the spot's Gaussian = gu[u] * gv[v].
+  std::vector<double> ru(image->cols), gu(image->cols);
+  for (int u = 0; u < image->cols; ++u) {
+    ru[u] = (u - u0) * (u - u0);
+    gu[u] = std::exp(-(u - hu) * (u - hu) * inv_2s2);
+  }
+  for (int v = 0; v < image->rows; ++v) {
+    const double rv = (v - v0) * (v - v0);
+    const double gv = options.hot_spot_gain * std::exp(-(v - hv) * (v - hv) * inv_2s2);
+    float* row = image->ptr<float>(v);
+    for (int u = 0; u < image->cols; ++u) {
+      const double factor = (1.0 - k * (ru[u] + rv)) * (1.0 + gv * gu[u]);
+      row[u] = static_cast<float>(row[u] * factor);
     }
   }
 }
@@ -564,6 +600,652 @@ bool LongEnough(const std::vector<TruthLine>& truth, double min_length_px) {
   return std::all_of(truth.begin(), truth.end(), [min_length_px](const TruthLine& line) {
     return line.visible && line.visible_length_px >= min_length_px;
   });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene dressing: what lies on the board plane besides the stripes (annotations printed on the
+// board, clutter on the surface, the board's shadow, the paper's texture).
+
+// Annotations: at least this far from every stripe and this far inside the board, 1 mm apart.
+constexpr double kAnnotationClearanceM = 0.005;
+constexpr double kAnnotationEdgeM = 0.004;
+constexpr double kAnnotationGapM = 0.001;
+// Their texels, text cap height and strokes (metres).
+constexpr double kAnnotationTexelM = 0.0001;
+constexpr double kAnnotationTextM = 0.003;
+constexpr double kAnnotationStrokeM = 0.00035;
+// Clutter: at least this far from the board; the texel of a clutter sheet's picture.
+constexpr double kClutterGapM = 0.010;
+constexpr double kClutterTexelM = 0.0004;
+constexpr int kClutterPlacementDraws = 100;
+// Plane boxes used to skip items are grown by this much (their anti-aliased rims reach
+// half a pixel's footprint beyond them).
+constexpr double kCullMarginM = 0.01;
+// Cells of the paper's value noise (metres).
+constexpr double kPaperCellM = 0.001;
+
+// A convex quadrilateral on the board plane, corners in order around it.
+using Quad = std::array<std::array<double, 2>, 4>;
+
+Quad RotatedRect(double cx, double cy, double angle_rad, double half_x, double half_y) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  const double sx[4] = {-1.0, 1.0, 1.0, -1.0}, sy[4] = {-1.0, -1.0, 1.0, 1.0};
+  Quad q;
+  for (int i = 0; i < 4; ++i) {
+    const double lx = sx[i] * half_x, ly = sy[i] * half_y;
+    q[i] = {cx + c * lx - s * ly, cy + s * lx + c * ly};
+  }
+  return q;
+}
+
+// True when the convex quadrilaterals overlap or touch (separating axis theorem).
+bool QuadsOverlap(const Quad& a, const Quad& b) {
+  for (const Quad* q : {&a, &b}) {
+    for (int i = 0; i < 4; ++i) {
+      const auto& p0 = (*q)[i];
+      const auto& p1 = (*q)[(i + 1) % 4];
+      const double nx = p0[1] - p1[1], ny = p1[0] - p0[0];
+      double a_lo = 1e300, a_hi = -1e300, b_lo = 1e300, b_hi = -1e300;
+      for (int j = 0; j < 4; ++j) {
+        const double pa = nx * a[j][0] + ny * a[j][1], pb = nx * b[j][0] + ny * b[j][1];
+        a_lo = std::min(a_lo, pa);
+        a_hi = std::max(a_hi, pa);
+        b_lo = std::min(b_lo, pb);
+        b_hi = std::max(b_hi, pb);
+      }
+      if (a_hi < b_lo || b_hi < a_lo) return false;
+    }
+  }
+  return true;
+}
+
+// The rectangle each stripe covers.
+std::vector<Quad> StripeQuads(const LineTarget& target) {
+  std::vector<Quad> quads;
+  for (const TargetLine& line : target.lines) {
+    const double dx = line.x2_m - line.x1_m, dy = line.y2_m - line.y1_m;
+    quads.push_back(RotatedRect(0.5 * (line.x1_m + line.x2_m), 0.5 * (line.y1_m + line.y2_m),
+                                std::atan2(dy, dx), 0.5 * std::hypot(dx, dy), 0.5 * line.width_m));
+  }
+  return quads;
+}
+
+// An axis-aligned box of the plane.
+struct Box {
+  double min_x = 0.0, min_y = 0.0, max_x = 0.0, max_y = 0.0;
+
+  static Box Of(const Quad& q, double margin) {
+    Box b{1e300, 1e300, -1e300, -1e300};
+    for (const auto& p : q) {
+      b.min_x = std::min(b.min_x, p[0] - margin);
+      b.min_y = std::min(b.min_y, p[1] - margin);
+      b.max_x = std::max(b.max_x, p[0] + margin);
+      b.max_y = std::max(b.max_y, p[1] + margin);
+    }
+    return b;
+  }
+  bool Contains(double X, double Y) const {
+    return X >= min_x && X <= max_x && Y >= min_y && Y <= max_y;
+  }
+};
+
+// The length on the plane of one pixel's longer side at the sample s (metres).
+double Footprint(const PlaneSample& s) {
+  return std::sqrt(std::max(s.Xu * s.Xu + s.Yu * s.Yu, s.Xv * s.Xv + s.Yv * s.Yv));
+}
+
+// A picture lying on the board plane (an annotation printed on the board, a sheet of clutter):
+// premultiplied (grey * alpha, alpha) texels in its own frame, with an area-averaged pyramid
+// (OpenCV INTER_AREA) so that a pixel sees about the mean of the texels under it, not one of
+// them; levels are blended trilinearly by the pixel's footprint.
+class Decal {
+ public:
+  // `grey` and `alpha` (0: transparent, 255: opaque) of one size, one texel = texel_m on the
+  // plane; the picture's centre lies at (centre_x, centre_y), its rows run along angle_rad from
+  // the object x axis and its columns along angle_rad + pi/2.
+  Decal(const cv::Mat1b& grey, const cv::Mat1b& alpha, double texel_m, double centre_x,
+        double centre_y, double angle_rad)
+      : texel_m_(texel_m),
+        width_m_(grey.cols * texel_m),
+        height_m_(grey.rows * texel_m),
+        cos_(std::cos(angle_rad)),
+        sin_(std::sin(angle_rad)) {
+    origin_x_ = centre_x - 0.5 * (cos_ * width_m_ - sin_ * height_m_);
+    origin_y_ = centre_y - 0.5 * (sin_ * width_m_ + cos_ * height_m_);
+    box_ = Box::Of(RotatedRect(centre_x, centre_y, angle_rad, 0.5 * width_m_, 0.5 * height_m_),
+                   kCullMarginM);
+    cv::Mat1f a, p;
+    alpha.convertTo(a, CV_32F, 1.0 / 255.0);
+    grey.convertTo(p, CV_32F);
+    const std::vector<cv::Mat> channels = {p.mul(a), a};
+    cv::Mat level;
+    cv::merge(channels, level);
+    levels_.push_back(level);
+    while (level.cols > 1 || level.rows > 1) {
+      cv::Mat next;
+      cv::resize(level, next, cv::Size((level.cols + 1) / 2, (level.rows + 1) / 2), 0.0, 0.0,
+                 cv::INTER_AREA);
+      levels_.push_back(next);
+      level = next;
+    }
+  }
+
+  const Box& box() const { return box_; }
+
+  // `under` seen through the decal at the plane point (X, Y), for a pixel of footprint_m.
+  double Over(double under, double X, double Y, double footprint_m) const {
+    if (!box_.Contains(X, Y)) return under;
+    const double dx = X - origin_x_, dy = Y - origin_y_;
+    const double lx = cos_ * dx + sin_ * dy, ly = -sin_ * dx + cos_ * dy;
+    const double lod = std::log2(std::max(footprint_m / texel_m_, 1.0));
+    const int last = static_cast<int>(levels_.size()) - 1;
+    const int l0 = std::min(static_cast<int>(lod), last);
+    cv::Vec2d texel = Sample(l0, lx, ly);
+    if (l0 < last && lod > l0) {
+      const double t = lod - l0;
+      texel = (1.0 - t) * texel + t * Sample(l0 + 1, lx, ly);
+    }
+    return under * (1.0 - texel[1]) + texel[0];
+  }
+
+ private:
+  // Bilinear (premultiplied grey, alpha) of level `level` at the local point (lx, ly) metres;
+  // transparent outside the picture.
+  cv::Vec2d Sample(int level, double lx, double ly) const {
+    const cv::Mat& m = levels_[level];
+    const double cx = lx / width_m_ * m.cols - 0.5, cy = ly / height_m_ * m.rows - 0.5;
+    if (!(cx > -1.0 && cy > -1.0 && cx < m.cols && cy < m.rows)) return cv::Vec2d(0.0, 0.0);
+    const double fx = std::floor(cx), fy = std::floor(cy);
+    const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fy);
+    const double ax = cx - fx, ay = cy - fy;
+    const auto at = [&m](int i, int j) {
+      if (i < 0 || j < 0 || i >= m.cols || j >= m.rows) return cv::Vec2d(0.0, 0.0);
+      return cv::Vec2d(m.at<cv::Vec2f>(j, i));
+    };
+    return (1.0 - ay) * ((1.0 - ax) * at(i0, j0) + ax * at(i0 + 1, j0)) +
+           ay * ((1.0 - ax) * at(i0, j0 + 1) + ax * at(i0 + 1, j0 + 1));
+  }
+
+  double texel_m_, width_m_, height_m_, cos_, sin_;
+  double origin_x_ = 0.0, origin_y_ = 0.0;  // plane point of the picture's (0, 0) corner
+  Box box_;
+  std::vector<cv::Mat> levels_;  // CV_32FC2, finest first
+};
+
+// A dark object lying on the surface (a tool): a rectangle or a disc, anti-aliased from the
+// distance to its rim in pixels (exact for a straight rim away from corners).
+struct BenchObject {
+  bool disc = false;
+  double cx = 0.0, cy = 0.0, cos = 1.0, sin = 0.0;
+  double half_x = 0.0, half_y = 0.0;  // rectangle half sizes along its axes; disc: radius
+  double grey = 40.0;
+  Box box;
+
+  Quad Outline() const {
+    return RotatedRect(cx, cy, std::atan2(sin, cos), half_x, disc ? half_x : half_y);
+  }
+
+  // Fraction of the pixel whose centre sees the plane sample s that the object covers.
+  double Coverage(const PlaneSample& s) const {
+    const double dx = s.X - cx, dy = s.Y - cy;
+    if (disc) {
+      const double r = std::hypot(dx, dy);
+      const double nx = r > 0.0 ? dx / r : 1.0, ny = r > 0.0 ? dy / r : 0.0;
+      const double g = std::hypot(nx * s.Xu + ny * s.Yu, nx * s.Xv + ny * s.Yv);  // m / px
+      return std::clamp(0.5 + (half_x - r) / std::max(g, 1e-300), 0.0, 1.0);
+    }
+    const double lx = cos * dx + sin * dy, ly = -sin * dx + cos * dy;
+    const double gx = std::hypot(cos * s.Xu + sin * s.Yu, cos * s.Xv + sin * s.Yv);
+    const double gy = std::hypot(-sin * s.Xu + cos * s.Yu, -sin * s.Xv + cos * s.Yv);
+    return std::clamp(0.5 + (half_x - std::fabs(lx)) / std::max(gx, 1e-300), 0.0, 1.0) *
+           std::clamp(0.5 + (half_y - std::fabs(ly)) / std::max(gy, 1e-300), 0.0, 1.0);
+  }
+};
+
+// Items binned on a square grid of the plane by their boxes, so that a pixel looks only at the
+// few whose box covers its cell (in drawing order).
+class PlaneGrid {
+ public:
+  PlaneGrid() = default;
+  explicit PlaneGrid(const std::vector<Box>& boxes) {
+    if (boxes.empty()) return;
+    bounds_ = boxes[0];
+    for (const Box& b : boxes) {
+      bounds_.min_x = std::min(bounds_.min_x, b.min_x);
+      bounds_.min_y = std::min(bounds_.min_y, b.min_y);
+      bounds_.max_x = std::max(bounds_.max_x, b.max_x);
+      bounds_.max_y = std::max(bounds_.max_y, b.max_y);
+    }
+    const double extent = std::max(bounds_.max_x - bounds_.min_x, bounds_.max_y - bounds_.min_y);
+    cell_m_ = std::max(0.05, extent / 128.0);
+    nx_ = static_cast<int>((bounds_.max_x - bounds_.min_x) / cell_m_) + 1;
+    ny_ = static_cast<int>((bounds_.max_y - bounds_.min_y) / cell_m_) + 1;
+    cells_.resize(static_cast<std::size_t>(nx_) * ny_);
+    for (std::size_t id = 0; id < boxes.size(); ++id) {
+      const Box& b = boxes[id];
+      const int i0 = Cell(b.min_x, bounds_.min_x, nx_), i1 = Cell(b.max_x, bounds_.min_x, nx_);
+      const int j0 = Cell(b.min_y, bounds_.min_y, ny_), j1 = Cell(b.max_y, bounds_.min_y, ny_);
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+          cells_[static_cast<std::size_t>(j) * nx_ + i].push_back(static_cast<int>(id));
+        }
+      }
+    }
+  }
+
+  // The items whose box may contain (X, Y); null when none.
+  const std::vector<int>* At(double X, double Y) const {
+    if (cells_.empty() || !bounds_.Contains(X, Y)) return nullptr;
+    const std::vector<int>& cell =
+        cells_[static_cast<std::size_t>(Cell(Y, bounds_.min_y, ny_)) * nx_ +
+               Cell(X, bounds_.min_x, nx_)];
+    return cell.empty() ? nullptr : &cell;
+  }
+
+ private:
+  int Cell(double value, double lo, int n) const {
+    return std::clamp(static_cast<int>((value - lo) / cell_m_), 0, n - 1);
+  }
+
+  Box bounds_;
+  double cell_m_ = 1.0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::vector<int>> cells_;
+};
+
+// Smooth value noise in [-1, 1] on kPaperCellM cells of the plane.
+double PaperNoise(double X, double Y, std::uint64_t seed) {
+  const double fx = X / kPaperCellM, fy = Y / kPaperCellM;
+  if (!(std::fabs(fx) < 1e9 && std::fabs(fy) < 1e9)) return 0.0;
+  const double x0 = std::floor(fx), y0 = std::floor(fy);
+  const double ax = fx - x0, ay = fy - y0;
+  const auto lattice = [seed](double i, double j) {
+    const auto key = static_cast<std::uint64_t>(static_cast<long long>(i)) * 0x9E3779B97F4A7C15ull ^
+                     static_cast<std::uint64_t>(static_cast<long long>(j));
+    return static_cast<double>(Mix(seed ^ Mix(key)) >> 11) * 0x1.0p-52 - 1.0;
+  };
+  const double top = (1.0 - ax) * lattice(x0, y0) + ax * lattice(x0 + 1.0, y0);
+  const double bottom = (1.0 - ax) * lattice(x0, y0 + 1.0) + ax * lattice(x0 + 1.0, y0 + 1.0);
+  return (1.0 - ay) * top + ay * bottom;
+}
+
+// Text in OpenCV's Hershey simplex font, lines from top to bottom, cap height cap_m, strokes
+// of about stroke_m, in an 8-bit mask (255: ink) of texel_m texels cropped to the ink with a
+// 2-texel transparent border.
+cv::Mat1b TextMask(const std::vector<std::string>& lines, double cap_m, double stroke_m,
+                   double texel_m) {
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  const int thickness = std::max(1, static_cast<int>(std::lround(stroke_m / texel_m)));
+  int baseline = 0;
+  const cv::Size unit = cv::getTextSize("H", font, 1.0, 1, &baseline);
+  const double scale = cap_m / texel_m / unit.height;
+  const int pitch = static_cast<int>(std::ceil(1.7 * cap_m / texel_m));
+  int width = 0;
+  for (const std::string& line : lines) {
+    width = std::max(width, cv::getTextSize(line, font, scale, thickness, &baseline).width);
+  }
+  const int pad = 4 * thickness;
+  cv::Mat1b mask(pad * 2 + pitch * static_cast<int>(lines.size()), width + 2 * pad,
+                 static_cast<unsigned char>(0));
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const int y = pad + static_cast<int>(std::ceil(cap_m / texel_m)) + static_cast<int>(i) * pitch;
+    cv::putText(mask, lines[i], cv::Point(pad, y), font, scale, cv::Scalar(255), thickness,
+                cv::LINE_AA);
+  }
+  std::vector<cv::Point> ink;
+  cv::findNonZero(mask, ink);
+  if (ink.empty()) return cv::Mat1b(4, 4, static_cast<unsigned char>(0));
+  cv::Rect crop = cv::boundingRect(ink);
+  crop.x -= 2;
+  crop.y -= 2;
+  crop.width += 4;
+  crop.height += 4;
+  crop &= cv::Rect(0, 0, mask.cols, mask.rows);
+  return mask(crop).clone();
+}
+
+// A scale bar of length_m: a 0.35 mm bar, ticks every 10 mm (taller at both ends and the
+// middle) above it and "<length> mm" below it, in an 8-bit mask of kAnnotationTexelM texels.
+cv::Mat1b ScaleBarMask(double length_m) {
+  const double t = kAnnotationTexelM;
+  const auto px = [t](double m) { return static_cast<int>(std::lround(m / t)); };
+  const cv::Mat1b label = TextMask({std::to_string(std::lround(length_m * 1000.0)) + " mm"},
+                                   0.6 * kAnnotationTextM, kAnnotationStrokeM, t);
+  const int pad = 2, stroke = px(kAnnotationStrokeM), tall = px(0.003), tick = px(0.002);
+  const int width = px(length_m) + stroke + 2 * pad;
+  const int bar_top = pad + tall;
+  cv::Mat1b mask(bar_top + stroke + px(0.001) + label.rows + pad, std::max(width, label.cols),
+                 static_cast<unsigned char>(0));
+  cv::rectangle(mask, cv::Rect(pad, bar_top, px(length_m) + stroke, stroke), cv::Scalar(255),
+                cv::FILLED);
+  const int ticks = static_cast<int>(std::lround(length_m / 0.01));
+  for (int i = 0; i <= ticks; ++i) {
+    const int height = (i == 0 || i == ticks || 2 * i == ticks) ? tall : tick;
+    cv::rectangle(mask, cv::Rect(pad + px(0.01 * i), bar_top - height, stroke, height),
+                  cv::Scalar(255), cv::FILLED);
+  }
+  const int label_x = (mask.cols - label.cols) / 2, label_y = bar_top + stroke + px(0.001);
+  label.copyTo(mask(cv::Rect(label_x, label_y, label.cols, label.rows)));
+  return mask;
+}
+
+// Where annotation marks may go: inside the board by kAnnotationEdgeM, kAnnotationClearanceM
+// clear of every stripe and kAnnotationGapM clear of the marks placed before.
+class AnnotationSpace {
+ public:
+  explicit AnnotationSpace(const LineTarget& target)
+      : half_w_(0.5 * target.board_width_m - kAnnotationEdgeM),
+        half_h_(0.5 * target.board_height_m - kAnnotationEdgeM),
+        stripes_(StripeQuads(target)) {}
+
+  // An axis-aligned mark of half sizes (hx, hy) centred at (cx, cy). A square grown by the
+  // clearance contains the disc grown by it, so no overlap means at least the clearance.
+  bool Fits(double cx, double cy, double hx, double hy) const {
+    if (std::fabs(cx) + hx > half_w_ || std::fabs(cy) + hy > half_h_) return false;
+    const Quad clear =
+        RotatedRect(cx, cy, 0.0, hx + kAnnotationClearanceM, hy + kAnnotationClearanceM);
+    for (const Quad& stripe : stripes_) {
+      if (QuadsOverlap(clear, stripe)) return false;
+    }
+    const Quad apart = RotatedRect(cx, cy, 0.0, hx + kAnnotationGapM, hy + kAnnotationGapM);
+    for (const Quad& mark : marks_) {
+      if (QuadsOverlap(apart, mark)) return false;
+    }
+    return true;
+  }
+
+  void Take(double cx, double cy, double hx, double hy) {
+    marks_.push_back(RotatedRect(cx, cy, 0.0, hx, hy));
+  }
+
+  // The free centre nearest to the board corner (sx * w/2, sy * h/2) on a grid of about 2 mm;
+  // false when there is none.
+  bool NearestToCorner(double sx, double sy, double hx, double hy, double* cx, double* cy) const {
+    const double step = std::max(0.002, std::max(half_w_, half_h_) / 100.0);
+    std::vector<std::pair<double, std::array<double, 2>>> candidates;
+    for (double x = -half_w_ + hx; x <= half_w_ - hx; x += step) {
+      for (double y = -half_h_ + hy; y <= half_h_ - hy; y += step) {
+        const double ex = x - sx * half_w_, ey = y - sy * half_h_;
+        candidates.push_back({ex * ex + ey * ey, {x, y}});
+      }
+    }
+    std::sort(candidates.begin(), candidates.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [unused, c] : candidates) {
+      if (Fits(c[0], c[1], hx, hy)) {
+        *cx = c[0];
+        *cy = c[1];
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  double half_w_, half_h_;
+  std::vector<Quad> stripes_;
+  std::vector<Quad> marks_;
+};
+
+// The annotations `oalservo target` prints (approximately): line numbers beside both ends of
+// each stripe, the name and "print at 100 %" near the top-left corner, the scale bar near the
+// bottom-left one.
+std::vector<Decal> LayOutAnnotations(const LineTarget& target, int grey) {
+  std::vector<Decal> decals;
+  AnnotationSpace space(target);
+  const auto add = [&](const cv::Mat1b& mask, double cx, double cy) {
+    const double hx = 0.5 * mask.cols * kAnnotationTexelM, hy = 0.5 * mask.rows * kAnnotationTexelM;
+    space.Take(cx, cy, hx, hy);
+    decals.emplace_back(cv::Mat1b(mask.size(), static_cast<unsigned char>(grey)), mask,
+                        kAnnotationTexelM, cx, cy, 0.0);
+  };
+  for (std::size_t i = 0; i < target.lines.size(); ++i) {
+    const TargetLine& line = target.lines[i];
+    const cv::Mat1b mask =
+        TextMask({std::to_string(i + 1)}, kAnnotationTextM, kAnnotationStrokeM, kAnnotationTexelM);
+    const double hx = 0.5 * mask.cols * kAnnotationTexelM, hy = 0.5 * mask.rows * kAnnotationTexelM;
+    const double length = std::hypot(line.x2_m - line.x1_m, line.y2_m - line.y1_m);
+    for (const int end : {0, 1}) {
+      // e points from this end into the stripe, n across it.
+      const double sign = end == 0 ? 1.0 : -1.0;
+      const double ex = sign * (line.x2_m - line.x1_m) / length;
+      const double ey = sign * (line.y2_m - line.y1_m) / length;
+      const double nx = -ey, ny = ex;
+      const double px = end == 0 ? line.x1_m : line.x2_m, py = end == 0 ? line.y1_m : line.y2_m;
+      const double along = std::fabs(ex) * hx + std::fabs(ey) * hy;
+      const double across = 0.5 * line.width_m + kAnnotationClearanceM + 0.0005 +
+                            std::fabs(nx) * hx + std::fabs(ny) * hy;
+      bool placed = false;
+      for (int step = 0; step <= 20 && !placed; ++step) {
+        const double t = along + 0.001 * step;
+        for (const double side : {-1.0, 1.0}) {
+          const double cx = px + ex * t + side * nx * across, cy = py + ey * t + side * ny * across;
+          if (space.Fits(cx, cy, hx, hy)) {
+            add(mask, cx, cy);
+            placed = true;
+            break;
+          }
+        }
+      }
+    }
+  }
+  const std::string name = target.name.empty() ? "target" : target.name;
+  const cv::Mat1b title = TextMask({"oalservo " + name, "print at 100 %"}, kAnnotationTextM,
+                                   kAnnotationStrokeM, kAnnotationTexelM);
+  double cx = 0.0, cy = 0.0;
+  if (space.NearestToCorner(-1.0, -1.0, 0.5 * title.cols * kAnnotationTexelM,
+                            0.5 * title.rows * kAnnotationTexelM, &cx, &cy)) {
+    add(title, cx, cy);
+  }
+  for (const double length_m : {0.1, 0.05}) {
+    const cv::Mat1b bar = ScaleBarMask(length_m);
+    if (space.NearestToCorner(-1.0, 1.0, 0.5 * bar.cols * kAnnotationTexelM,
+                              0.5 * bar.rows * kAnnotationTexelM, &cx, &cy)) {
+      add(bar, cx, cy);
+      break;
+    }
+  }
+  return decals;
+}
+
+// A sheet of printed text of w_m x h_m (portrait picture) on the surface: light paper, a
+// heading and paragraphs of random words in Hershey simplex, 20 mm margins.
+cv::Mat1b TextSheetPicture(double w_m, double h_m, std::mt19937_64& gen, cv::Mat1b* alpha) {
+  const double t = kClutterTexelM;
+  const int pad = 2;
+  const int cols = static_cast<int>(std::lround(w_m / t)),
+            rows = static_cast<int>(std::lround(h_m / t));
+  const auto paper = static_cast<unsigned char>(190 + 45 * Uniform(gen));
+  const double ink = 20 + 50 * Uniform(gen);
+  cv::Mat1b grey(rows + 2 * pad, cols + 2 * pad, paper);
+  *alpha = cv::Mat1b(grey.size(), static_cast<unsigned char>(0));
+  (*alpha)(cv::Rect(pad, pad, cols, rows)).setTo(255);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  int baseline = 0;
+  const double unit = cv::getTextSize("H", font, 1.0, 1, &baseline).height;
+  const auto word = [&gen](int letters) {
+    std::string w;
+    for (int i = 0; i < letters; ++i)
+      w += static_cast<char>('a' + static_cast<int>(26 * Uniform(gen)));
+    return w;
+  };
+  const int margin = static_cast<int>(0.02 / t);
+  const int right = cols - margin;
+  // Heading: cap height 4 mm, bolder.
+  double y = margin + 0.004 / t;
+  {
+    std::string heading;
+    const int words = 2 + static_cast<int>(3 * Uniform(gen));
+    for (int i = 0; i < words; ++i)
+      heading += (i ? " " : "") + word(3 + static_cast<int>(6 * Uniform(gen)));
+    cv::putText(grey, heading, cv::Point(pad + margin, pad + static_cast<int>(y)), font,
+                0.004 / t / unit, cv::Scalar(ink), 2, cv::LINE_AA);
+  }
+  // Body: cap height 2.2 mm, 5 mm line pitch, paragraphs of 3-8 lines.
+  const double scale = 0.0022 / t / unit, pitch = 0.005 / t;
+  y += 2.0 * pitch;
+  while (y < rows - margin) {
+    const int lines = 3 + static_cast<int>(6 * Uniform(gen));
+    for (int l = 0; l < lines && y < rows - margin; ++l, y += pitch) {
+      const int end =
+          l + 1 == lines ? margin + static_cast<int>((right - margin) * Uniform(gen)) : right;
+      std::string text;
+      while (true) {
+        const std::string next =
+            (text.empty() ? "" : text + " ") + word(1 + static_cast<int>(9 * Uniform(gen)));
+        if (margin + cv::getTextSize(next, font, scale, 1, &baseline).width > end) break;
+        text = next;
+      }
+      cv::putText(grey, text, cv::Point(pad + margin, pad + static_cast<int>(y)), font, scale,
+                  cv::Scalar(ink), 1, cv::LINE_AA);
+    }
+    y += pitch;
+  }
+  return grey;
+}
+
+// True when the disc (cx, cy, r) comes within `gap` of the rectangle |X| <= hw, |Y| <= hh.
+bool DiscNearRect(double cx, double cy, double r, double hw, double hh, double gap) {
+  const double dx = std::max(std::fabs(cx) - hw, 0.0), dy = std::max(std::fabs(cy) - hh, 0.0);
+  return std::hypot(dx, dy) <= r + gap;
+}
+
+}  // namespace
+
+// -------------------------------------------------------------------------------------------
+// Scene dressing.
+
+// Everything on the board plane besides the board and its stripes, laid out once by the
+// renderer's constructor.
+struct SceneDressing {
+  // On the board.
+  double paper_texture_grey = 0.0;
+  std::uint64_t paper_seed = 0;
+  std::vector<Decal> annotations;
+  // On the surface, in drawing order: sheets, then objects; `clutter` bins them (ids: sheets
+  // first).
+  std::vector<Decal> sheets;
+  std::vector<BenchObject> objects;
+  PlaneGrid clutter;
+  // The board's shadow: its outline moved to (shadow_x, shadow_y).
+  double shadow_darkness = 0.0, shadow_x = 0.0, shadow_y = 0.0;
+  double shadow_half_w = 0.0, shadow_half_h = 0.0, shadow_softness = 0.0;
+
+  // The paper's grey at the plane sample s (the board's grey `board`, textured, annotated).
+  double Paper(double board, const PlaneSample& s, double footprint_m) const {
+    double value = board;
+    if (paper_texture_grey > 0.0) value += paper_texture_grey * PaperNoise(s.X, s.Y, paper_seed);
+    for (const Decal& decal : annotations) value = decal.Over(value, s.X, s.Y, footprint_m);
+    return value;
+  }
+
+  // The surface's grey at the plane sample s: `background` under the clutter, in the shadow.
+  double Surface(double background, const PlaneSample& s, double footprint_m) const {
+    double value = background;
+    if (const std::vector<int>* ids = clutter.At(s.X, s.Y)) {
+      for (const int id : *ids) {
+        if (static_cast<std::size_t>(id) < sheets.size()) {
+          value = sheets[id].Over(value, s.X, s.Y, footprint_m);
+          continue;
+        }
+        const BenchObject& object = objects[id - sheets.size()];
+        if (!object.box.Contains(s.X, s.Y)) continue;
+        value += object.Coverage(s) * (object.grey - value);
+      }
+    }
+    if (shadow_darkness > 0.0) {
+      // The penumbra is at least one pixel wide, so that the shadow's edge is anti-aliased.
+      const double w = std::max(shadow_softness, footprint_m);
+      const double in_x =
+          std::clamp(0.5 + (shadow_half_w - std::fabs(s.X - shadow_x)) / w, 0.0, 1.0);
+      const double in_y =
+          std::clamp(0.5 + (shadow_half_h - std::fabs(s.Y - shadow_y)) / w, 0.0, 1.0);
+      value *= 1.0 - shadow_darkness * in_x * in_y;
+    }
+    return value;
+  }
+};
+
+namespace {
+
+bool NeedsDressing(const RenderOptions& o) {
+  return o.paper_texture_grey > 0.0 || o.annotations || o.shadow_darkness > 0.0 ||
+         o.clutter_sheets > 0 || o.clutter_objects > 0;
+}
+
+// Other sheets and objects on the surface, drawn from options.scene_seed.
+void LayOutClutter(const LineTarget& target, const RenderOptions& options, SceneDressing* d) {
+  std::mt19937_64 gen(Mix(options.scene_seed ^ 0x636c7574746572ull));
+  const double hw = 0.5 * target.board_width_m, hh = 0.5 * target.board_height_m;
+  const double reach_x = hw + options.clutter_reach_m, reach_y = hh + options.clutter_reach_m;
+  const Quad board_grown = RotatedRect(0.0, 0.0, 0.0, hw + kClutterGapM, hh + kClutterGapM);
+  // A centre and angle for a rectangle of half sizes (half_x, half_y), or a disc of radius
+  // half_x, clear of the board; false when none of the draws is.
+  const auto place = [&](bool disc, double half_x, double half_y, double* cx, double* cy,
+                         double* angle) {
+    for (int draw = 0; draw < kClutterPlacementDraws; ++draw) {
+      *cx = reach_x * (2.0 * Uniform(gen) - 1.0);
+      *cy = reach_y * (2.0 * Uniform(gen) - 1.0);
+      *angle = 2.0 * kPi * Uniform(gen);
+      const bool near =
+          disc ? DiscNearRect(*cx, *cy, half_x, hw, hh, kClutterGapM)
+               : QuadsOverlap(RotatedRect(*cx, *cy, *angle, half_x, half_y), board_grown);
+      if (!near) return true;
+    }
+    return false;
+  };
+  std::vector<Box> boxes;
+  for (int i = 0; i < options.clutter_sheets; ++i) {
+    const bool a4 = Uniform(gen) < 0.6;
+    const double w = a4 ? 0.210 : 0.148, h = a4 ? 0.297 : 0.210;
+    double cx = 0.0, cy = 0.0, angle = 0.0;
+    if (!place(false, 0.5 * w, 0.5 * h, &cx, &cy, &angle)) continue;
+    cv::Mat1b alpha;
+    const cv::Mat1b grey = TextSheetPicture(w, h, gen, &alpha);
+    d->sheets.emplace_back(grey, alpha, kClutterTexelM, cx, cy, angle);
+    boxes.push_back(d->sheets.back().box());
+  }
+  for (int i = 0; i < options.clutter_objects; ++i) {
+    BenchObject object;
+    const double kind = Uniform(gen);
+    if (kind < 0.4) {  // a bar: a ruler, a screwdriver, a pen
+      object.half_x = 0.05 + 0.075 * Uniform(gen);
+      object.half_y = 0.004 + 0.0135 * Uniform(gen);
+    } else if (kind < 0.7) {  // a block: a phone, a box, a multimeter
+      object.half_x = 0.03 + 0.045 * Uniform(gen);
+      object.half_y = 0.02 + 0.025 * Uniform(gen);
+    } else {  // a disc: a roll of tape, a cup
+      object.disc = true;
+      object.half_x = 0.02 + 0.03 * Uniform(gen);
+      object.half_y = object.half_x;
+    }
+    object.grey = 15.0 + 55.0 * Uniform(gen);
+    double angle = 0.0;
+    if (!place(object.disc, object.half_x, object.half_y, &object.cx, &object.cy, &angle)) continue;
+    object.cos = std::cos(angle);
+    object.sin = std::sin(angle);
+    object.box = Box::Of(object.Outline(), kCullMarginM);
+    d->objects.push_back(object);
+    boxes.push_back(object.box);
+  }
+  d->clutter = PlaneGrid(boxes);
+}
+
+std::shared_ptr<const SceneDressing> BuildDressing(const LineTarget& target,
+                                                   const RenderOptions& options) {
+  if (!NeedsDressing(options)) return nullptr;
+  auto d = std::make_shared<SceneDressing>();
+  d->paper_texture_grey = options.paper_texture_grey;
+  d->paper_seed = Mix(options.scene_seed ^ 0x7061706572ull);
+  if (options.annotations) d->annotations = LayOutAnnotations(target, options.annotation_grey);
+  LayOutClutter(target, options, d.get());
+  d->shadow_darkness = options.shadow_darkness;
+  d->shadow_x = options.shadow_offset_m * std::cos(options.shadow_angle_rad);
+  d->shadow_y = options.shadow_offset_m * std::sin(options.shadow_angle_rad);
+  d->shadow_half_w = 0.5 * target.board_width_m;
+  d->shadow_half_h = 0.5 * target.board_height_m;
+  d->shadow_softness = options.shadow_softness_m;
+  return d;
 }
 
 }  // namespace
@@ -708,6 +1390,40 @@ void RenderOptions::Check() const {
                 "0 <= background_grey <= 255");
   RequireOption(InRange(supersample, 1, 8), "RenderOptions::supersample", supersample,
                 "1 <= supersample <= 8");
+  RequireOption(background == nullptr || background_image.empty(),
+                "RenderOptions::background_image", "'" + background_image + "'",
+                "empty when RenderOptions::background is set");
+  RequireOption(background_texel_m > 0.0 && background_texel_m <= 1.0,
+                "RenderOptions::background_texel_m", background_texel_m,
+                "0 < background_texel_m <= 1");
+  RequireOption(InRange(vignetting, 0.0, 0.9), "RenderOptions::vignetting", vignetting,
+                "0 <= vignetting <= 0.9");
+  RequireOption(InRange(hot_spot_gain, 0.0, 2.0), "RenderOptions::hot_spot_gain", hot_spot_gain,
+                "0 <= hot_spot_gain <= 2");
+  RequireOption(InRange(hot_spot_u, -2.0, 3.0), "RenderOptions::hot_spot_u", hot_spot_u,
+                "-2 <= hot_spot_u <= 3");
+  RequireOption(InRange(hot_spot_v, -2.0, 3.0), "RenderOptions::hot_spot_v", hot_spot_v,
+                "-2 <= hot_spot_v <= 3");
+  RequireOption(InRange(hot_spot_sigma, 0.01, 10.0), "RenderOptions::hot_spot_sigma",
+                hot_spot_sigma, "0.01 <= hot_spot_sigma <= 10");
+  RequireOption(InRange(shadow_darkness, 0.0, 0.95), "RenderOptions::shadow_darkness",
+                shadow_darkness, "0 <= shadow_darkness <= 0.95");
+  RequireOption(InRange(shadow_offset_m, 0.0, 0.1), "RenderOptions::shadow_offset_m",
+                shadow_offset_m, "0 <= shadow_offset_m <= 0.1");
+  RequireOption(std::isfinite(shadow_angle_rad), "RenderOptions::shadow_angle_rad",
+                shadow_angle_rad, "shadow_angle_rad is finite");
+  RequireOption(InRange(shadow_softness_m, 0.0, 0.05), "RenderOptions::shadow_softness_m",
+                shadow_softness_m, "0 <= shadow_softness_m <= 0.05");
+  RequireOption(InRange(paper_texture_grey, 0.0, 20.0), "RenderOptions::paper_texture_grey",
+                paper_texture_grey, "0 <= paper_texture_grey <= 20");
+  RequireOption(InRange(annotation_grey, 0, 255), "RenderOptions::annotation_grey", annotation_grey,
+                "0 <= annotation_grey <= 255");
+  RequireOption(InRange(clutter_sheets, 0, 10), "RenderOptions::clutter_sheets", clutter_sheets,
+                "0 <= clutter_sheets <= 10");
+  RequireOption(InRange(clutter_objects, 0, 50), "RenderOptions::clutter_objects", clutter_objects,
+                "0 <= clutter_objects <= 50");
+  RequireOption(clutter_reach_m > 0.0 && clutter_reach_m <= 10.0, "RenderOptions::clutter_reach_m",
+                clutter_reach_m, "0 < clutter_reach_m <= 10");
 }
 
 bool Occluder::Contains(double u, double v) const {
@@ -751,6 +1467,8 @@ void PoseSampling::Check() const {
   RequireOption(min_visible_length_px >= 0.0 && std::isfinite(min_visible_length_px),
                 "PoseSampling::min_visible_length_px", min_visible_length_px,
                 "min_visible_length_px >= 0");
+  RequireOption(InRange(crossings_margin_px, 0.0, 1000.0), "PoseSampling::crossings_margin_px",
+                crossings_margin_px, "0 <= crossings_margin_px <= 1000");
 }
 
 // -------------------------------------------------------------------------------------------
@@ -760,18 +1478,26 @@ SceneRenderer::SceneRenderer(LineTarget target, RenderOptions options)
     : target_(std::move(target)), options_(std::move(options)) {
   target_.Check();
   options_.Check();
-  if (!options_.background_image.empty()) {
+  if (options_.background != nullptr) {
+    background_ = options_.background;
+  } else if (!options_.background_image.empty()) {
+    // Deprecated (RenderOptions::background_image): to be removed with the field.
     // Checked first: OpenCV logs a warning when asked to read a missing file.
     const bool exists = std::ifstream(options_.background_image).good();
     const cv::Mat grey =
         exists ? cv::imread(options_.background_image, cv::IMREAD_GRAYSCALE) : cv::Mat();
     RequireOption(!grey.empty(), "RenderOptions::background_image",
                   "'" + options_.background_image + "'", "a readable image file");
-    background_.resize(static_cast<unsigned>(grey.rows), static_cast<unsigned>(grey.cols));
+    auto image = std::make_shared<vpImage<unsigned char>>(static_cast<unsigned>(grey.rows),
+                                                          static_cast<unsigned>(grey.cols));
     for (int r = 0; r < grey.rows; ++r) {
-      std::copy_n(grey.ptr<unsigned char>(r), grey.cols, background_[r]);
+      std::copy_n(grey.ptr<unsigned char>(r), grey.cols, (*image)[r]);
     }
+    background_ = image;
+  } else {
+    background_ = std::make_shared<vpImage<unsigned char>>();
   }
+  dressing_ = BuildDressing(target_, options_);
   const std::size_t n = static_cast<std::size_t>(options_.width) * options_.height;
   ray_x_.resize(n);
   ray_y_.resize(n);
@@ -796,8 +1522,10 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_
   effects.Check();
   const PlaneProjector projector(cMo, options_.camera);
   PixelCoverage coverage(BuildRegions(target_), options_.supersample);
-  const BackgroundShade background(background_, options_.background_grey);
+  const BackgroundShade background(*background_, options_.background_texel_m,
+                                   options_.background_grey);
   const double board = target_.board_grey, line = target_.line_grey;
+  const SceneDressing* dressing = dressing_.get();
 
   cv::Mat1f radiance(options_.height, options_.width);
   for (int v = 0; v < options_.height; ++v) {
@@ -810,13 +1538,20 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_
         continue;
       }
       const Coverage c = coverage.Of(s);
-      const double around = c.board < 1.0 ? background.At(s.X, s.Y) : 0.0;
+      double around = c.board < 1.0 ? background.At(s.X, s.Y) : 0.0;
+      double paper = board;
+      if (dressing != nullptr) {
+        const double footprint_m = Footprint(s);
+        if (c.board < 1.0) around = dressing->Surface(around, s, footprint_m);
+        if (c.board > 0.0) paper = dressing->Paper(board, s, footprint_m);
+      }
       row[u] =
-          static_cast<float>(around * (1.0 - c.board) + board * (c.board - c.dark) + line * c.dark);
+          static_cast<float>(around * (1.0 - c.board) + paper * (c.board - c.dark) + line * c.dark);
     }
   }
   PaintOccluders(effects.occluders, &radiance);
   ApplyIllumination(options_.illumination_gradient, options_.gradient_angle_rad, &radiance);
+  ApplyLightFalloff(options_, &radiance);
   ApplyGainOffset(effects.gain, effects.offset, &radiance);
   if (options_.blur_sigma_px > 0.0) {
     cv::GaussianBlur(radiance, radiance, cv::Size(), options_.blur_sigma_px, options_.blur_sigma_px,
@@ -894,14 +1629,79 @@ vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, dou
   return camera;
 }
 
+std::vector<StripeCrossing> StripeCrossings(const LineTarget& target) {
+  const double min_sin = std::sin(kPi / 180.0);
+  std::vector<StripeCrossing> crossings;
+  for (std::size_t a = 0; a < target.lines.size(); ++a) {
+    for (std::size_t b = a + 1; b < target.lines.size(); ++b) {
+      const TargetLine& la = target.lines[a];
+      const TargetLine& lb = target.lines[b];
+      const double dax = la.x2_m - la.x1_m, day = la.y2_m - la.y1_m;
+      const double dbx = lb.x2_m - lb.x1_m, dby = lb.y2_m - lb.y1_m;
+      const double cross = dax * dby - day * dbx;
+      if (std::fabs(cross) <= min_sin * std::hypot(dax, day) * std::hypot(dbx, dby)) continue;
+      // la.1 + s da = lb.1 + t db with s, t in [0, 1].
+      const double ex = lb.x1_m - la.x1_m, ey = lb.y1_m - la.y1_m;
+      const double sa = (ex * dby - ey * dbx) / cross, tb = (ex * day - ey * dax) / cross;
+      if (sa < 0.0 || sa > 1.0 || tb < 0.0 || tb > 1.0) continue;
+      // Each stripe's sides: n . P = offset +- width / 2, n its unit normal.
+      const double na = std::hypot(dax, day), nb = std::hypot(dbx, dby);
+      const double ax = -day / na, ay = dax / na, bx = -dby / nb, by = dbx / nb;
+      const double oa = ax * la.x1_m + ay * la.y1_m, ob = bx * lb.x1_m + by * lb.y1_m;
+      const double det = ax * by - ay * bx;
+      StripeCrossing crossing;
+      crossing.line_a = static_cast<int>(a);
+      crossing.line_b = static_cast<int>(b);
+      const double signs[4][2] = {{1.0, 1.0}, {1.0, -1.0}, {-1.0, -1.0}, {-1.0, 1.0}};
+      for (int i = 0; i < 4; ++i) {
+        const double ca = oa + signs[i][0] * 0.5 * la.width_m;
+        const double cb = ob + signs[i][1] * 0.5 * lb.width_m;
+        crossing.corners_m[i] = {(ca * by - cb * ay) / det, (ax * cb - bx * ca) / det};
+      }
+      crossings.push_back(crossing);
+    }
+  }
+  return crossings;
+}
+
+namespace {
+
+bool CornersInView(const RenderOptions& options, const vpHomogeneousMatrix& cMo,
+                   const std::vector<StripeCrossing>& crossings, double margin_px) {
+  for (const StripeCrossing& crossing : crossings) {
+    for (const auto& corner : crossing.corners_m) {
+      const Vec3 p = ToCamera(cMo, corner[0], corner[1]);
+      if (!(p.z > kMinDepthM)) return false;
+      const Point2d pixel = DistortedPixel(options.camera, p.x / p.z, p.y / p.z);
+      if (!(pixel.u >= margin_px && pixel.u <= options.width - 1 - margin_px &&
+            pixel.v >= margin_px && pixel.v <= options.height - 1 - margin_px)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool CrossingsInView(const SceneRenderer& renderer, const vpHomogeneousMatrix& cMo,
+                     double margin_px) {
+  return CornersInView(renderer.options(), cMo, StripeCrossings(renderer.target()), margin_px);
+}
+
 vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling& sampling,
                                std::uint64_t* state) {
   sampling.Check();
+  const std::vector<StripeCrossing> crossings = sampling.crossings_in_view
+                                                    ? StripeCrossings(renderer.target())
+                                                    : std::vector<StripeCrossing>();
   std::mt19937_64 gen(*state);
   for (int attempt = 0; attempt < 1000; ++attempt) {
     const vpHomogeneousMatrix cMo = DrawPose(sampling, gen);
-    if (sampling.min_visible_length_px <= 0.0 ||
-        LongEnough(renderer.Truth(cMo), sampling.min_visible_length_px)) {
+    if ((sampling.min_visible_length_px <= 0.0 ||
+         LongEnough(renderer.Truth(cMo), sampling.min_visible_length_px)) &&
+        (!sampling.crossings_in_view ||
+         CornersInView(renderer.options(), cMo, crossings, sampling.crossings_margin_px))) {
       *state = gen();
       return cMo;
     }
@@ -909,6 +1709,10 @@ vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling
   std::ostringstream message;
   message << "SamplePose: none of 1000 poses shows every line of target '" << renderer.target().name
           << "' over min_visible_length_px = " << sampling.min_visible_length_px << " px";
+  if (sampling.crossings_in_view) {
+    message << " with every crossing square crossings_margin_px = " << sampling.crossings_margin_px
+            << " px inside the image";
+  }
   throw std::runtime_error(message.str());
 }
 

@@ -16,13 +16,21 @@
 // map pixel -> board plane; a pixel where edges meet (corners, crossings, stripe ends) is split
 // into supersample x supersample sub-squares treated the same way. The board is printed on both
 // sides; the camera sees its front when the object z axis points away from the camera.
+//
+// Scene dressing (RenderOptions: the surface's image, clutter, the board's shadow, the paper's
+// texture and annotations) is sampled where the pixel centre's ray meets the plane, pictures
+// through an area-averaged pyramid chosen by the pixel's footprint and objects anti-aliased from
+// their distance to the pixel centre: close to, not exactly, a box filter. The stripes and the
+// board's edges stay exact, and the ground truth never depends on the dressing.
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpImage.h>
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,12 +86,73 @@ struct RenderOptions {
   /// Illumination falls linearly by this fraction across the image along gradient_angle_rad.
   double illumination_gradient = 0.0;  ///< [0, 0.9]
   double gradient_angle_rad = 0.0;
-  /// Grey image shown around the board (any size, tiled); empty: uniform background_grey.
-  /// It is pasted on the board plane around the board (one texel = 2 mm, tiles repeat from the
-  /// object origin), so it moves with the board; rays that miss the plane see background_grey.
+
+  // The surface the board lies on. ------------------------------------------------------------
+  /// Grey image of the surface around the board (any size; null or empty: uniform
+  /// background_grey). It is pasted on the board plane around the board: texel (column i,
+  /// row j) is seen at the plane point (X, Y) = (i, j) * background_texel_m (object frame),
+  /// interpolated bilinearly in between and tiled in both directions, so it moves with the
+  /// board; rays that miss the plane see background_grey. Shared, not copied, by copies of the
+  /// options and by the renderer.
+  std::shared_ptr<const vpImage<unsigned char>> background;
+  double background_texel_m = 0.002;  ///< size of one background texel on the plane, m, (0, 1]
+  /// Deprecated, to be removed once app/ decodes the image itself and sets `background`: an
+  /// image file the constructor reads as `background` (exclusive with it).
   std::string background_image;
   int background_grey = 90;  ///< [0, 255]
   int supersample = 4;       ///< anti-aliasing factor per axis where edges meet, [1, 8]
+
+  // Light fall-off, applied with the illumination gradient (after occluders, before gain). -----
+  /// Vignetting: brightness times 1 - vignetting * (r / r_corner)^2, r the distance of the pixel
+  /// from the principal point (u0, v0) and r_corner that of the farthest image corner. 0: none.
+  double vignetting = 0.0;  ///< [0, 0.9]
+  /// A broad light spot: brightness times 1 + hot_spot_gain * exp(-d^2 / (2 s^2)), d the pixel's
+  /// distance from (hot_spot_u * (width - 1), hot_spot_v * (height - 1)) and s = hot_spot_sigma
+  /// times the image diagonal. 0: none.
+  double hot_spot_gain = 0.0;   ///< [0, 2]
+  double hot_spot_u = 0.5;      ///< centre, fraction of the image width (0: column 0), [-2, 3]
+  double hot_spot_v = 0.5;      ///< centre, fraction of the image height (0: row 0), [-2, 3]
+  double hot_spot_sigma = 0.4;  ///< width, fraction of the image diagonal, [0.01, 10]
+
+  // Shadow of the board on the surface. -------------------------------------------------------
+  /// The board lies a little above the surface (or a lamp is low): the board's outline moved by
+  /// shadow_offset_m along shadow_angle_rad darkens the surface inside it by the factor
+  /// 1 - shadow_darkness, seen as a band of about shadow_offset_m outside the board's edges
+  /// that face that direction. It falls on the surface and what lies on it, never on the
+  /// board. 0: no shadow.
+  double shadow_darkness = 0.0;    ///< [0, 0.95]
+  double shadow_offset_m = 0.006;  ///< metres on the plane, [0, 0.1]
+  /// Direction of the shadow's offset in the object frame, from +x towards +y, radians, finite
+  /// (pi/4: the band lies along the board's +x and +y edges).
+  double shadow_angle_rad = 0.7853981633974483;
+  /// Penumbra: the shadow's edge ramps linearly over this width on the plane, metres, [0, 0.05]
+  /// (at least one pixel's footprint, so a hard shadow is still anti-aliased).
+  double shadow_softness_m = 0.003;
+
+  // Paper and ink. -----------------------------------------------------------------------------
+  /// The paper's grey varies smoothly by up to +-paper_texture_grey grey levels (value noise on
+  /// 1 mm cells fixed to the board, from scene_seed); the stripes' ink does not. 0: uniform.
+  double paper_texture_grey = 0.0;  ///< grey levels, [0, 20]
+  /// Printed annotations on the board, as `oalservo target` prints them in the paper between
+  /// the stripes: the line numbers 1-4 beside both ends of each stripe, the target's name and
+  /// "print at 100 %" near the board's top-left corner, a 100 mm scale bar with 10 mm ticks
+  /// (50 mm where 100 mm does not fit) near its bottom-left corner, in OpenCV's Hershey font.
+  /// Strokes about 0.4 mm, capitals 3 mm high; every mark is at least 5 mm clear of every
+  /// stripe and 4 mm inside the board (a mark that does not fit is left out). An approximation
+  /// of the printed layout, not a copy of it. The ground truth is unchanged.
+  bool annotations = false;
+  int annotation_grey = 110;  ///< the annotations' ink, [0, 255]
+
+  // Clutter on the surface, outside the board. ------------------------------------------------
+  /// Other printed sheets (A4 and A5, light paper with rows of dark text) and dark objects
+  /// (tools: bars, blocks and discs) lying on the surface at random positions and angles drawn
+  /// from scene_seed: each lies within clutter_reach_m of the board's outline and at least
+  /// 10 mm away from the board (an item that finds no place in 100 draws is left out); sheets
+  /// first, objects on top. The ground truth is unchanged.
+  int clutter_sheets = 0;        ///< [0, 10]
+  int clutter_objects = 0;       ///< [0, 50]
+  double clutter_reach_m = 0.3;  ///< metres, (0, 10]
+  std::uint64_t scene_seed = 1;  ///< the clutter's layout and the paper's texture
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;
@@ -140,16 +209,20 @@ struct RenderedFrame {
   std::vector<TruthLine> truth;
 };
 
+struct SceneDressing;  // scene.cpp
+
 class SceneRenderer {
  public:
   /// Throws std::invalid_argument if the target or the options fail Check(), or the
-  /// background image cannot be read.
+  /// (deprecated) background_image file cannot be read. Annotations and clutter are laid out
+  /// here, once.
   SceneRenderer(LineTarget target, RenderOptions options);
 
   /// Renders the target seen from `cMo`; `noise_seed` makes the noise reproducible.
   RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed) const;
   /// The same with per-frame effects: occluders are painted over the scene, then the
-  /// illumination gradient, gain and offset, blur and noise are applied in that order. Throws
+  /// illumination gradient, the light fall-off (vignetting, hot spot), gain and offset, blur and
+  /// noise are applied in that order. Throws
   /// std::invalid_argument if `effects` fails Check().
   RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed,
                        const FrameEffects& effects) const;
@@ -166,7 +239,9 @@ class SceneRenderer {
   RenderOptions options_;
   // Per-pixel ideal normalised coordinates of the distorted image (computed once).
   std::vector<float> ray_x_, ray_y_;
-  vpImage<unsigned char> background_;
+  std::shared_ptr<const vpImage<unsigned char>> background_;  // never null
+  // Annotations and clutter laid out on the plane (scene.cpp; null when there are none).
+  std::shared_ptr<const SceneDressing> dressing_;
 };
 
 /// Distorted pixel of an ideal normalised point (x, y) under the kdu model (numerical
@@ -194,15 +269,39 @@ struct PoseSampling {
   bool any_roll = true;        ///< roll uniform in [0, 360) deg; else within +-max_tilt_deg
   /// Every target line must cross the image over at least this length (0: no check).
   double min_visible_length_px = 0.0;
+  /// Every crossing square of the target (StripeCrossings) must be in view: its four corners
+  /// in front of the camera and at least crossings_margin_px inside the image's border in the
+  /// distorted image. With max_offset_m larger than the crossings' extent this keeps what the
+  /// pose needs in view while the board is often partly out of it. A target without crossings
+  /// passes.
+  bool crossings_in_view = false;
+  double crossings_margin_px = 10.0;  ///< pixels, [0, 1000]
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;
 };
 
+/// Where two stripes of a target cross: the parallelogram both cover.
+struct StripeCrossing {
+  int line_a = 0, line_b = 0;  ///< indices in LineTarget::lines, line_a < line_b
+  /// Its corners (X, Y) in the board plane (object frame, metres), in order around it.
+  std::array<std::array<double, 2>, 4> corners_m{};
+};
+
+/// Every crossing of `target`: each pair of non-parallel stripes (more than 1 degree apart)
+/// whose centre segments intersect, in the order of (line_a, line_b). Four for a '#'.
+std::vector<StripeCrossing> StripeCrossings(const LineTarget& target);
+
+/// True when every corner of every StripeCrossings(renderer.target()) square is in front of
+/// the camera at `cMo` and at least margin_px inside the image's border (distorted pixels).
+bool CrossingsInView(const SceneRenderer& renderer, const vpHomogeneousMatrix& cMo,
+                     double margin_px);
+
 /// A pose drawn from `sampling` with the pseudo-random generator state `*state`
 /// (deterministic: the same state gives the same pose, and *state is advanced so that calls in
-/// a row give a reproducible sequence). Retries until the visibility requirement holds (at
-/// most 1000 draws, then throws std::runtime_error).
+/// a row give a reproducible sequence). Retries until the visibility requirements hold (at
+/// most 1000 draws, then throws std::runtime_error). The requirements only reject draws, so
+/// with crossings_in_view false the same state gives the same poses as before it existed.
 vpHomogeneousMatrix SamplePose(const SceneRenderer& renderer, const PoseSampling& sampling,
                                std::uint64_t* state);
 

@@ -225,6 +225,30 @@ TEST(ConfigTarget, ShippedFilesAreExactlyTheBuiltInTargets) {
   const std::string dir = std::string(OAL_SOURCE_DIR) + "/config/";
   ExpectSameTarget(LoadConfig(dir + "four-line-board.yaml").target, FourLineTarget());
   ExpectSameTarget(LoadConfig(dir + "two-line-target.yaml").target, TwoLineTarget());
+  // The sheet targets: the built-in computes each stripe's end as half the sheet less the
+  // 10 mm margin in binary floating point (0.5 * 0.420 - 0.010 = 0.19999999999999998), the
+  // file writes the decimal (0.200); the two differ in the last bit only, so the ends are
+  // compared to 1e-12 m (a picometre) and everything else exactly.
+  const auto expect_same_sheet = [](const LineTarget& file, const LineTarget& built_in) {
+    constexpr double kLastBitM = 1e-12;
+    EXPECT_EQ(file.name, built_in.name);
+    EXPECT_EQ(file.board_width_m, built_in.board_width_m);
+    EXPECT_EQ(file.board_height_m, built_in.board_height_m);
+    EXPECT_EQ(file.board_grey, built_in.board_grey);
+    EXPECT_EQ(file.line_grey, built_in.line_grey);
+    ASSERT_EQ(file.lines.size(), built_in.lines.size());
+    for (std::size_t i = 0; i < file.lines.size(); ++i) {
+      SCOPED_TRACE(built_in.name + " line " + std::to_string(i + 1));
+      EXPECT_NEAR(file.lines[i].x1_m, built_in.lines[i].x1_m, kLastBitM);
+      EXPECT_NEAR(file.lines[i].y1_m, built_in.lines[i].y1_m, kLastBitM);
+      EXPECT_NEAR(file.lines[i].x2_m, built_in.lines[i].x2_m, kLastBitM);
+      EXPECT_NEAR(file.lines[i].y2_m, built_in.lines[i].y2_m, kLastBitM);
+      EXPECT_EQ(file.lines[i].width_m, built_in.lines[i].width_m);
+    }
+  };
+  expect_same_sheet(LoadConfig(dir + "four-line-a3.yaml").target, FourLineA3Target());
+  expect_same_sheet(LoadConfig(dir + "four-line-a4.yaml").target, FourLineA4Target());
+  expect_same_sheet(LoadConfig(dir + "four-line-letter.yaml").target, FourLineLetterTarget());
   // They leave the detector alone.
   ExpectSameOptions(LoadConfig(dir + "four-line-board.yaml").detector, DetectorOptions());
 }

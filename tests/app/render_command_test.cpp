@@ -119,6 +119,36 @@ TEST(Render, BadOptionsNameTheField) {
   EXPECT_FALSE(fs::exists(dir / "data"));
 }
 
+// --target takes every built-in (and "four-line", the 2 m board's older name); the error for
+// another names them all.
+TEST(Render, TargetIsAnyBuiltInByName) {
+  test::TestDir dir;
+  std::vector<std::string> names = TargetNames();
+  names.push_back("four-line");
+  for (const std::string& name : names) {
+    RenderCommandOptions options = SmallRender(dir / "data");
+    options.target = name;
+    EXPECT_NO_THROW(options.Check()) << name;
+  }
+  RenderCommandOptions options = SmallRender(dir / "data");
+  options.target = "four-line-a5";
+  const std::string error =
+      test::ErrorMessageOf<std::invalid_argument>([&] { RenderDataset(options); });
+  EXPECT_THAT(error, HasSubstr("--target = four-line-a5. Violated constraint: it is one of "));
+  for (const std::string& name : TargetNames()) EXPECT_THAT(error, HasSubstr(name));
+  EXPECT_FALSE(fs::exists(dir / "data"));
+  // A sheet target renders and names itself in the truth.
+  options = SmallRender(dir / "a4");
+  options.target = "four-line-a4";
+  options.count = 1;
+  options.min_distance_m = 0.3;
+  options.max_distance_m = 0.5;
+  ASSERT_EQ(RenderDataset(options), 1);
+  const json truth = json::parse(test::ReadText(dir / "a4/frame_0000.json"));
+  EXPECT_EQ(truth.at("target"), "four-line-a4");
+  EXPECT_EQ(truth.at("lines").size(), 4u);
+}
+
 // Options errors name the command-line option, not the struct's field.
 TEST(Render, BadOptionsNameTheCommandLineOption) {
   test::TestDir dir;

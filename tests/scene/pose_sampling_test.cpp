@@ -1,8 +1,12 @@
-// SamplePose: reproducible, within its bounds, facing the front of the board.
+// SamplePose: reproducible, within its bounds, facing the front of the board, the crossings in
+// view when asked.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "scene/scene.h"
 #include "tests/scene/scene_image_util.h"
@@ -132,6 +136,161 @@ TEST(SamplePose, OldFieldsGiveThePosesOfBefore) {
   EXPECT_EQ(hash, 0x0a95535601803ce2ull);
   EXPECT_EQ(hash2, 0x398bddfe47e78479ull);
   EXPECT_EQ(state, 146452912055701122ull);
+}
+
+// The '#' on an A3 sheet: lines 0 and 2 run along y (x fixed), lines 1 and 3 along x.
+TEST(StripeCrossings, AreTheFourSquaresOfTheHash) {
+  const LineTarget target = FourLineA3Target();
+  const std::vector<StripeCrossing> crossings = StripeCrossings(target);
+  ASSERT_EQ(crossings.size(), 4u);
+  const int pairs[4][2] = {{0, 1}, {0, 3}, {1, 2}, {2, 3}};
+  for (int i = 0; i < 4; ++i) {
+    const StripeCrossing& c = crossings[i];
+    EXPECT_EQ(c.line_a, pairs[i][0]);
+    EXPECT_EQ(c.line_b, pairs[i][1]);
+    const TargetLine& along_y = target.lines[c.line_a % 2 == 0 ? c.line_a : c.line_b];
+    const TargetLine& along_x = target.lines[c.line_a % 2 == 0 ? c.line_b : c.line_a];
+    double min_x = 1e9, max_x = -1e9, min_y = 1e9, max_y = -1e9;
+    for (const auto& corner : c.corners_m) {
+      min_x = std::min(min_x, corner[0]);
+      max_x = std::max(max_x, corner[0]);
+      min_y = std::min(min_y, corner[1]);
+      max_y = std::max(max_y, corner[1]);
+      EXPECT_NEAR(std::fabs(corner[0] - along_y.x1_m), 0.5 * along_y.width_m, 1e-12);
+      EXPECT_NEAR(std::fabs(corner[1] - along_x.y1_m), 0.5 * along_x.width_m, 1e-12);
+    }
+    EXPECT_NEAR(max_x - min_x, along_y.width_m, 1e-12);
+    EXPECT_NEAR(max_y - min_y, along_x.width_m, 1e-12);
+    // In order around the square: opposite corners are diagonal.
+    EXPECT_NEAR(
+        std::hypot(c.corners_m[2][0] - c.corners_m[0][0], c.corners_m[2][1] - c.corners_m[0][1]),
+        std::hypot(along_y.width_m, along_x.width_m), 1e-12);
+  }
+  EXPECT_TRUE(StripeCrossings(TwoLineTarget()).empty());  // parallel stripes never cross
+}
+
+// The evaluation's A3 scenes: 0.3-0.85 m, tilt up to 30 deg, any roll, the optical axis up to
+// 0.15 m from the centre (so the sheet is often partly out of view), the crossings in view.
+PoseSampling SheetSampling() {
+  PoseSampling sampling;
+  sampling.min_distance_m = 0.3;
+  sampling.max_distance_m = 0.85;
+  sampling.max_tilt_deg = 30.0;
+  sampling.max_offset_m = 0.15;
+  sampling.crossings_in_view = true;
+  sampling.crossings_margin_px = 10.0;
+  return sampling;
+}
+
+bool InImage(const Point2d& p, double margin_px) {
+  return p.u >= margin_px && p.u <= 639.0 - margin_px && p.v >= margin_px &&
+         p.v <= 479.0 - margin_px;
+}
+
+TEST(SamplePose, CrossingsInViewPutsEveryCrossingSquareInTheImage) {
+  const LineTarget target = FourLineA3Target();
+  RenderOptions options;  // pinhole: ideal pixels are the image's
+  const SceneRenderer renderer(target, options);
+  const PoseSampling sampling = SheetSampling();
+  std::uint64_t state = 99;
+  int partly_out = 0;
+  constexpr int kPoses = 400;
+  for (int i = 0; i < kPoses; ++i) {
+    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
+    // The squares' corners, from the stripes: x of lines 0 and 2, y of lines 1 and 3.
+    for (const int a : {0, 2}) {
+      for (const int b : {1, 3}) {
+        for (const double sx : {-0.5, 0.5}) {
+          for (const double sy : {-0.5, 0.5}) {
+            Point2d p;
+            ASSERT_TRUE(Project(cMo, options.camera,
+                                target.lines[a].x1_m + sx * target.lines[a].width_m,
+                                target.lines[b].y1_m + sy * target.lines[b].width_m, &p))
+                << "pose " << i;
+            EXPECT_TRUE(InImage(p, sampling.crossings_margin_px))
+                << "pose " << i << " lines " << a << ", " << b << ": " << p.u << ", " << p.v;
+          }
+        }
+      }
+    }
+    bool all_corners_in = true;
+    for (const double sx : {-0.5, 0.5}) {
+      for (const double sy : {-0.5, 0.5}) {
+        Point2d p;
+        all_corners_in = all_corners_in &&
+                         Project(cMo, options.camera, sx * target.board_width_m,
+                                 sy * target.board_height_m, &p) &&
+                         InImage(p, 0.0);
+      }
+    }
+    partly_out += !all_corners_in;
+  }
+  // max_offset_m is enough to put the sheet partly out of view often.
+  EXPECT_GT(partly_out, kPoses / 4);
+  EXPECT_LT(partly_out, kPoses);
+}
+
+TEST(SamplePose, CrossingsInViewHoldsThroughTheLensAndInTheImage) {
+  const LineTarget target = FourLineA3Target();
+  RenderOptions options;
+  options.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  const SceneRenderer renderer(target, options);
+  const PoseSampling sampling = SheetSampling();
+  std::uint64_t state = 5;
+  for (int i = 0; i < 200; ++i) {
+    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
+    ASSERT_TRUE(CrossingsInView(renderer, cMo, sampling.crossings_margin_px)) << "pose " << i;
+    for (const StripeCrossing& crossing : StripeCrossings(target)) {
+      for (const auto& corner : crossing.corners_m) {
+        Point2d ideal;
+        ASSERT_TRUE(Project(cMo, options.camera, corner[0], corner[1], &ideal));
+        const Point2d p =
+            DistortedPixel(options.camera, (ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
+        EXPECT_TRUE(InImage(p, sampling.crossings_margin_px)) << "pose " << i;
+      }
+    }
+    if (i % 40 != 0) continue;
+    // The centre of each square is dark in the rendered frame.
+    const RenderedFrame frame = renderer.Render(cMo, 1);
+    for (const StripeCrossing& crossing : StripeCrossings(target)) {
+      Point2d ideal;
+      ASSERT_TRUE(Project(cMo, options.camera,
+                          0.5 * (crossing.corners_m[0][0] + crossing.corners_m[2][0]),
+                          0.5 * (crossing.corners_m[0][1] + crossing.corners_m[2][1]), &ideal));
+      const Point2d p =
+          DistortedPixel(options.camera, (ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
+      EXPECT_EQ(frame.image[static_cast<int>(std::lround(p.v))][static_cast<int>(std::lround(p.u))],
+                target.line_grey)
+          << "pose " << i;
+    }
+  }
+}
+
+TEST(SamplePose, CrossingsInViewIsVacuousWithoutCrossings) {
+  const SceneRenderer renderer(TwoLineTarget(), RenderOptions());
+  PoseSampling plain;
+  PoseSampling crossings = plain;
+  crossings.crossings_in_view = true;
+  std::uint64_t a = 8, b = 8;
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_TRUE(SamePose(SamplePose(renderer, plain, &a), SamplePose(renderer, crossings, &b)));
+  }
+}
+
+TEST(SamplePose, CrossingsThatCannotBeInViewThrow) {
+  const SceneRenderer renderer(FourLineA3Target(), RenderOptions());
+  PoseSampling sampling = SheetSampling();
+  sampling.crossings_margin_px = 235.0;  // a 10 x 10 pixel window in the middle of the image
+  std::uint64_t state = 1;
+  try {
+    SamplePose(renderer, sampling, &state);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("crossings_margin_px = 235"), std::string::npos)
+        << error.what();
+  }
+  sampling.crossings_margin_px = -1.0;
+  EXPECT_THROW(SamplePose(renderer, sampling, &state), std::invalid_argument);
 }
 
 // The camera sees the printed side, unmirrored: the stripes are dark on the light board, and

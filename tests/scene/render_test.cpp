@@ -1,12 +1,18 @@
-// Rendering: anti-aliased stripes where the truth says, noise, blur, illumination, background.
+// Rendering: anti-aliased stripes where the truth says, noise, blur, illumination, background;
+// a sheet on a bench (background image, light fall-off, shadow, paper, annotations, clutter).
 #include <gtest/gtest.h>
 #include <visp3/core/vpPixelMeterConversion.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <memory>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "scene/scene.h"
 #include "tests/scene/scene_image_util.h"
@@ -330,6 +336,370 @@ TEST(RenderRegression, BackgroundFileGivesTheFrameOfBefore) {
   const std::uint64_t a =
       ImageChecksum(sheet.Render(TiltedView(0.7, -0.05, 0.03, 1.1), 9, OldFrameEffects()).image);
   EXPECT_EQ(a, 0x824b16d68999c6d4ull);
+}
+
+// ---------------------------------------------------------------------------------------------
+// A sheet on a bench: background image, light fall-off, shadow, paper, annotations, clutter.
+
+using testing::ReadPgm;
+
+// A fronto-parallel camera at 0.6 m with px = 600 sees 1 mm of the board plane per pixel, pixel
+// (u, v) looking at X = (u - 319.5) mm, Y = (v - 239.5) mm.
+constexpr double kMmPerPxAt06 = 0.001;
+
+double PlaneX(int u) {
+  return (u - 319.5) * kMmPerPxAt06;
+}
+double PlaneY(int v) {
+  return (v - 239.5) * kMmPerPxAt06;
+}
+
+// Distance on the plane from (X, Y) to the nearest stripe of `target` (0 inside one).
+double DistanceToStripes(const LineTarget& target, double X, double Y) {
+  double best = 1e300;
+  for (const TargetLine& line : target.lines) {
+    const double ex = line.x2_m - line.x1_m, ey = line.y2_m - line.y1_m;
+    const double length = std::hypot(ex, ey);
+    const double along = ((X - line.x1_m) * ex + (Y - line.y1_m) * ey) / length;
+    const double across = std::fabs((X - line.x1_m) * -ey + (Y - line.y1_m) * ex) / length;
+    const double da = std::max({0.0, -along, along - length});
+    const double dc = std::max(0.0, across - 0.5 * line.width_m);
+    best = std::min(best, std::hypot(da, dc));
+  }
+  return best;
+}
+
+// Distance on the plane from (X, Y) outside the board to it (negative inside, the distance to
+// its edge).
+double DistanceOutsideBoard(const LineTarget& target, double X, double Y) {
+  const double dx = std::fabs(X) - 0.5 * target.board_width_m;
+  const double dy = std::fabs(Y) - 0.5 * target.board_height_m;
+  if (dx <= 0.0 && dy <= 0.0) return std::max(dx, dy);
+  return std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
+}
+
+bool SameTruth(const std::vector<TruthLine>& a, const std::vector<TruthLine>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].visible != b[i].visible || a[i].ideal.rho_px != b[i].ideal.rho_px ||
+        a[i].ideal.theta_rad != b[i].ideal.theta_rad ||
+        a[i].distorted_fit.rho_px != b[i].distorted_fit.rho_px || a[i].end_a.u != b[i].end_a.u ||
+        a[i].end_b.v != b[i].end_b.v || a[i].width_px != b[i].width_px) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// A small image whose texels all differ: 10 + 8 i + 29 j at column i, row j.
+std::shared_ptr<const vpImage<unsigned char>> NumberedTexels(unsigned width, unsigned height) {
+  auto image = std::make_shared<vpImage<unsigned char>>(height, width);
+  for (unsigned j = 0; j < height; ++j) {
+    for (unsigned i = 0; i < width; ++i)
+      (*image)[j][i] = static_cast<unsigned char>(10 + 8 * i + 29 * j);
+  }
+  return image;
+}
+
+TEST(RenderBackground, TexelIsSeenAtItsPlanePointAndTiles) {
+  LineTarget small = TwoLineTarget();
+  small.lines.clear();
+  small.board_width_m = 0.02;
+  small.board_height_m = 0.02;
+  RenderOptions options;
+  options.background = NumberedTexels(6, 4);
+  options.background_texel_m = 0.004;  // 4 pixels at 0.6 m
+  // Pixel u looks at X = (u - 319) mm: texel column i at u = 319 + 4 i, row j at v = 239 + 4 j.
+  const SceneRenderer renderer(small, options);
+  const RenderedFrame frame = renderer.Render(FrontoParallel(0.6, 0.0005, 0.0005), 1);
+  EXPECT_EQ(frame.image[239 + 4 * 3][319 + 4 * 5], 10 + 8 * 5 + 29 * 3);  // (5, 3)
+  EXPECT_EQ(frame.image[239 + 4 * 1][319 + 4 * 4], 10 + 8 * 4 + 29 * 1);  // (4, 1)
+  // Tiled: column 5 + 6 = column 5, row 3 - 4 = row 3; column -3 = column 3.
+  EXPECT_EQ(frame.image[239 + 4 * -1][319 + 4 * 11], 10 + 8 * 5 + 29 * 3);
+  EXPECT_EQ(frame.image[239 + 4 * 2][319 + 4 * -3], 10 + 8 * 3 + 29 * 2);
+  // Half-way between columns 4 and 5 of row 1: the mean.
+  EXPECT_EQ(frame.image[239 + 4][319 + 18], 10 + 8 * 4.5 + 29 * 1);
+  // The board hides it.
+  EXPECT_EQ(frame.image[239][319], small.board_grey);
+}
+
+TEST(RenderBackground, AnImageGivesTheSameFrameAsItsFile) {
+  const std::string path = std::string(OAL_VISP_IMAGES_DIR) + "/Klimt/Klimt.pgm";
+  const auto image = ReadPgm(path);
+  if (image == nullptr) GTEST_SKIP() << "ViSP test image missing: " << path;
+  RenderOptions from_file = OldEffects();
+  from_file.background_image = path;
+  RenderOptions from_image = OldEffects();
+  from_image.background = image;
+  const vpHomogeneousMatrix cMo = TiltedView(0.7, -0.05, 0.03, 1.1);
+  EXPECT_TRUE(SameImage(SceneRenderer(FourLineA3Target(), from_file).Render(cMo, 9).image,
+                        SceneRenderer(FourLineA3Target(), from_image).Render(cMo, 9).image));
+}
+
+TEST(RenderBackground, ImageAndFileTogetherAreRefused) {
+  RenderOptions options;
+  options.background = NumberedTexels(2, 2);
+  options.background_image = "wall.png";
+  EXPECT_THROW(SceneRenderer(TwoLineTarget(), options), std::invalid_argument);
+}
+
+TEST(RenderLight, VignettingFallsWithTheSquaredRadiusFromThePrincipalPoint) {
+  LineTarget blank = TwoLineTarget();
+  blank.lines.clear();
+  RenderOptions options;
+  options.width = 101;
+  options.height = 81;
+  options.camera = vpCameraParameters(100.0, 100.0, 40.0, 30.0);  // off-centre principal point
+  options.vignetting = 0.6;
+  const RenderedFrame frame = SceneRenderer(blank, options).Render(FrontoParallel(0.5), 1);
+  // The farthest corner from (40, 30) is (100, 80): r_corner^2 = 60^2 + 50^2.
+  const double corner2 = 60.0 * 60.0 + 50.0 * 50.0;
+  for (const auto& [u, v] : {std::pair<int, int>{40, 30}, {100, 80}, {0, 0}, {70, 10}, {5, 77}}) {
+    const double r2 = (u - 40.0) * (u - 40.0) + (v - 30.0) * (v - 30.0);
+    EXPECT_NEAR(frame.image[v][u], blank.board_grey * (1.0 - 0.6 * r2 / corner2), 0.5001)
+        << u << ", " << v;
+  }
+  EXPECT_EQ(frame.image[30][40], blank.board_grey);
+}
+
+TEST(RenderLight, HotSpotBrightensAroundItsCentre) {
+  LineTarget blank = TwoLineTarget();
+  blank.lines.clear();
+  blank.board_grey = 150;
+  RenderOptions options;
+  options.width = 200;
+  options.height = 100;
+  options.hot_spot_gain = 0.5;
+  options.hot_spot_u = 0.25;     // column 49.75
+  options.hot_spot_v = 1.0;      // row 99
+  options.hot_spot_sigma = 0.2;  // 0.2 * hypot(200, 100) pixels
+  const RenderedFrame frame = SceneRenderer(blank, options).Render(FrontoParallel(0.5), 1);
+  const double sigma = 0.2 * std::hypot(200.0, 100.0);
+  for (const auto& [u, v] : {std::pair<int, int>{50, 99}, {120, 60}, {199, 0}, {0, 50}}) {
+    const double d2 = (u - 49.75) * (u - 49.75) + (v - 99.0) * (v - 99.0);
+    EXPECT_NEAR(frame.image[v][u], 150.0 * (1.0 + 0.5 * std::exp(-d2 / (2.0 * sigma * sigma))),
+                0.5001)
+        << u << ", " << v;
+  }
+  EXPECT_EQ(frame.image[99][50], 225);
+}
+
+// The A3 sheet fronto-parallel at 0.6 m, 1 mm a pixel: its right edge X = 0.21 m falls between
+// columns 529 and 530, its bottom edge Y = 0.1485 m between rows 388 and 389.
+TEST(RenderShadow, DarkensABandOutsideTheSheetByTheFactorAndNeverThePaper) {
+  const LineTarget sheet = FourLineA3Target();
+  RenderOptions plain;
+  plain.background_grey = 100;
+  RenderOptions shadowed = plain;
+  shadowed.shadow_darkness = 0.4;
+  shadowed.shadow_offset_m = 0.008;
+  shadowed.shadow_angle_rad = 0.0;  // towards +x: a band along the right edge
+  shadowed.shadow_softness_m = 0.002;
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.6);
+  const RenderedFrame a = SceneRenderer(sheet, plain).Render(cMo, 1);
+  const RenderedFrame b = SceneRenderer(sheet, shadowed).Render(cMo, 1);
+  // The moved outline's edge is at X = 0.218 m, its penumbra [0.217, 0.219] m.
+  for (int v : {100, 240, 380}) {
+    for (int u = 530; u <= 536; ++u) EXPECT_EQ(b.image[v][u], 60) << u << ", " << v;
+    EXPECT_EQ(b.image[v][537], 70);  // X = 0.2175: three quarters in the shadow
+    EXPECT_EQ(b.image[v][538], 90);  // X = 0.2185: one quarter
+    EXPECT_EQ(b.image[v][540], 100);
+  }
+  int changed = 0;
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) {
+      if (a.image[v][u] == b.image[v][u]) continue;
+      ++changed;
+      // Only on the surface (a pixel on the sheet's edge is half surface), inside the moved
+      // outline grown by half the penumbra and half a pixel.
+      const double X = PlaneX(u), Y = PlaneY(v);
+      EXPECT_GE(DistanceOutsideBoard(sheet, X, Y), -0.0005) << u << ", " << v;
+      EXPECT_LE(std::fabs(X - 0.008), 0.21 + 0.0015) << u << ", " << v;
+      EXPECT_LE(std::fabs(Y), 0.1485 + 0.0015) << u << ", " << v;
+    }
+  }
+  EXPECT_GT(changed, 8 * 290);
+  EXPECT_TRUE(SameTruth(a.truth, b.truth));
+}
+
+TEST(RenderShadow, FollowsItsDirectionOnThePlane) {
+  const LineTarget sheet = FourLineA3Target();
+  RenderOptions options;
+  options.background_grey = 100;
+  options.shadow_darkness = 0.5;
+  options.shadow_offset_m = 0.006;
+  options.shadow_angle_rad = kPi / 2.0;  // towards +y: along the bottom edge (rows > 388)
+  options.shadow_softness_m = 0.0;
+  const RenderedFrame frame = SceneRenderer(sheet, options).Render(FrontoParallel(0.6), 1);
+  EXPECT_EQ(frame.image[391][320], 50);
+  EXPECT_EQ(frame.image[400][320], 100);
+  EXPECT_EQ(frame.image[240][535], 100);  // beside the right edge: no shadow
+  EXPECT_EQ(frame.image[85][320], 100);   // above the top edge: none
+}
+
+TEST(RenderPaper, TextureStaysWithinItsAmplitudeOnThePaperOnly) {
+  const LineTarget sheet = FourLineA3Target();
+  RenderOptions options;
+  options.paper_texture_grey = 2.0;
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.6);
+  const RenderedFrame plain = SceneRenderer(sheet, RenderOptions()).Render(cMo, 1);
+  const RenderedFrame textured = SceneRenderer(sheet, options).Render(cMo, 1);
+  int lo = 255, hi = 0;
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) {
+      const int a = plain.image[v][u], b = textured.image[v][u];
+      if (a == sheet.board_grey) {
+        lo = std::min(lo, b);
+        hi = std::max(hi, b);
+      } else if (a == sheet.line_grey || a == RenderOptions().background_grey) {
+        EXPECT_EQ(a, b) << u << ", " << v;
+      }
+    }
+  }
+  EXPECT_GE(lo, sheet.board_grey - 2);
+  EXPECT_LE(hi, sheet.board_grey + 2);
+  EXPECT_LT(lo, hi);
+}
+
+// Renders `sheet` with and without `dressed`'s scene dressing from a few poses and reports the
+// plane points of the pixels that differ (fronto-parallel, 0.3 m: 0.5 mm a pixel).
+struct Difference {
+  double x = 0.0, y = 0.0;
+};
+std::vector<Difference> DressingDifferences(const LineTarget& sheet, const RenderOptions& dressed,
+                                            double distance_m, bool* same_truth) {
+  const SceneRenderer plain(sheet, RenderOptions());
+  const SceneRenderer renderer(sheet, dressed);
+  std::vector<Difference> differences;
+  *same_truth = true;
+  const double mm_per_px = distance_m / 600.0;
+  for (const double x : {-0.15, 0.0, 0.15}) {
+    for (const double y : {-0.1, 0.0, 0.1}) {
+      const vpHomogeneousMatrix cMo = FrontoParallel(distance_m, x, y);
+      const RenderedFrame a = plain.Render(cMo, 1);
+      const RenderedFrame b = renderer.Render(cMo, 1);
+      *same_truth = *same_truth && SameTruth(a.truth, b.truth);
+      for (int v = 0; v < 480; ++v) {
+        for (int u = 0; u < 640; ++u) {
+          if (a.image[v][u] != b.image[v][u]) {
+            differences.push_back({x + (u - 319.5) * mm_per_px, y + (v - 239.5) * mm_per_px});
+          }
+        }
+      }
+    }
+  }
+  return differences;
+}
+
+TEST(RenderAnnotations, InkStaysFiveMillimetresClearOfTheStripesOnThePaper) {
+  for (const LineTarget& sheet : {FourLineA3Target(), FourLineA4Target()}) {
+    RenderOptions options;
+    options.annotations = true;
+    bool same_truth = false;
+    const std::vector<Difference> ink = DressingDifferences(sheet, options, 0.3, &same_truth);
+    EXPECT_TRUE(same_truth) << sheet.name;
+    EXPECT_GT(ink.size(), 1000u) << sheet.name << ": the annotations are seen";
+    double nearest_stripe = 1e300, nearest_edge = 1e300;
+    for (const Difference& d : ink) {
+      nearest_stripe = std::min(nearest_stripe, DistanceToStripes(sheet, d.x, d.y));
+      nearest_edge = std::min(nearest_edge, -DistanceOutsideBoard(sheet, d.x, d.y));
+    }
+    // 5 mm less one pixel (0.5 mm) of filtering.
+    EXPECT_GE(nearest_stripe, 0.0045) << sheet.name;
+    EXPECT_GE(nearest_edge, 0.0035) << sheet.name;
+  }
+}
+
+TEST(RenderAnnotations, CarryTheLineNumbersTheNameAndTheScaleBar) {
+  // Ink near each stripe end, in the top-left corner cell and below the '#' (A3).
+  const LineTarget sheet = FourLineA3Target();
+  RenderOptions options;
+  options.annotations = true;
+  bool same_truth = false;
+  const std::vector<Difference> ink = DressingDifferences(sheet, options, 0.3, &same_truth);
+  const auto ink_near = [&ink](double x, double y, double radius) {
+    return std::any_of(ink.begin(), ink.end(),
+                       [&](const Difference& d) { return std::hypot(d.x - x, d.y - y) <= radius; });
+  };
+  for (const TargetLine& line : sheet.lines) {
+    EXPECT_TRUE(ink_near(line.x1_m, line.y1_m, 0.025)) << line.x1_m << ", " << line.y1_m;
+    EXPECT_TRUE(ink_near(line.x2_m, line.y2_m, 0.025)) << line.x2_m << ", " << line.y2_m;
+  }
+  EXPECT_TRUE(ink_near(-0.18, -0.135, 0.03));  // the name
+  // The scale bar: one row of pixels (0.5 mm) below line 4 inked over 100 mm.
+  std::map<long, std::set<long>> rows;  // row -> inked columns, in 0.5 mm steps
+  for (const Difference& d : ink) {
+    if (d.y > 0.075) rows[std::lround(d.y / 0.0005)].insert(std::lround(d.x / 0.0005));
+  }
+  std::size_t longest = 0;
+  for (const auto& [row, columns] : rows) longest = std::max(longest, columns.size());
+  EXPECT_GE(longest * 0.0005, 0.099);
+}
+
+TEST(RenderClutter, LiesOnTheSurfaceOnlyAndLeavesTheTruthUnchanged) {
+  const LineTarget sheet = FourLineA3Target();
+  RenderOptions options;
+  options.clutter_sheets = 4;
+  options.clutter_objects = 12;
+  options.clutter_reach_m = 0.15;
+  options.scene_seed = 3;
+  bool same_truth = false;
+  const std::vector<Difference> clutter = DressingDifferences(sheet, options, 0.6, &same_truth);
+  EXPECT_TRUE(same_truth);
+  EXPECT_GT(clutter.size(), 10000u) << "the clutter is seen";
+  double nearest = 1e300;
+  for (const Difference& d : clutter) {
+    nearest = std::min(nearest, DistanceOutsideBoard(sheet, d.x, d.y));
+  }
+  EXPECT_GE(nearest, 0.009);  // 10 mm less one pixel
+}
+
+TEST(RenderClutter, IsReproducibleFromTheSceneSeed) {
+  RenderOptions options;
+  options.clutter_sheets = 2;
+  options.clutter_objects = 6;
+  const vpHomogeneousMatrix cMo = FrontoParallel(1.2);
+  const RenderedFrame a = SceneRenderer(FourLineA4Target(), options).Render(cMo, 1);
+  const RenderedFrame b = SceneRenderer(FourLineA4Target(), options).Render(cMo, 1);
+  options.scene_seed = 2;
+  const RenderedFrame c = SceneRenderer(FourLineA4Target(), options).Render(cMo, 1);
+  EXPECT_TRUE(SameImage(a.image, b.image));
+  EXPECT_FALSE(SameImage(a.image, c.image));
+}
+
+TEST(RenderOptionsCheck, NamesEachBadSceneField) {
+  const auto message_for = [](void (*change)(RenderOptions&)) -> std::string {
+    RenderOptions options;
+    change(options);
+    try {
+      options.Check();
+    } catch (const std::invalid_argument& error) {
+      return error.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(message_for([](RenderOptions&) {}), "");
+  const std::pair<const char*, void (*)(RenderOptions&)> cases[] = {
+      {"background_texel_m", [](RenderOptions& o) { o.background_texel_m = 0.0; }},
+      {"vignetting", [](RenderOptions& o) { o.vignetting = 0.95; }},
+      {"hot_spot_gain", [](RenderOptions& o) { o.hot_spot_gain = -0.1; }},
+      {"hot_spot_u", [](RenderOptions& o) { o.hot_spot_u = 4.0; }},
+      {"hot_spot_v", [](RenderOptions& o) { o.hot_spot_v = -3.0; }},
+      {"hot_spot_sigma", [](RenderOptions& o) { o.hot_spot_sigma = 0.0; }},
+      {"shadow_darkness", [](RenderOptions& o) { o.shadow_darkness = 1.0; }},
+      {"shadow_offset_m", [](RenderOptions& o) { o.shadow_offset_m = 0.2; }},
+      {"shadow_angle_rad", [](RenderOptions& o) { o.shadow_angle_rad = std::nan(""); }},
+      {"shadow_softness_m", [](RenderOptions& o) { o.shadow_softness_m = -0.001; }},
+      {"paper_texture_grey", [](RenderOptions& o) { o.paper_texture_grey = 30.0; }},
+      {"annotation_grey", [](RenderOptions& o) { o.annotation_grey = 256; }},
+      {"clutter_sheets", [](RenderOptions& o) { o.clutter_sheets = 11; }},
+      {"clutter_objects", [](RenderOptions& o) { o.clutter_objects = -1; }},
+      {"clutter_reach_m", [](RenderOptions& o) { o.clutter_reach_m = 0.0; }},
+  };
+  for (const auto& [field, change] : cases) {
+    EXPECT_NE(message_for(change).find(std::string("RenderOptions::") + field), std::string::npos)
+        << field << ": " << message_for(change);
+  }
 }
 
 TEST(Render, NothingIsSeenWhenTheBoardIsBehindTheCamera) {
