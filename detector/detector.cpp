@@ -212,7 +212,8 @@ const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
   if (borders.empty()) return DetectInRegion(image, seeds);
   borders.Check();
   PrepareFor(image.width, image.height);
-  region_borders_.Assign(borders, image.width, image.height, options_.start_px, options_.step_px);
+  region_borders_.Assign(borders, image.width, image.height, borders.image_margin_px,
+                         borders.image_margin_step_px);
   in_region_ = true;
   return DetectInRegion(image, seeds);
 }
@@ -248,7 +249,7 @@ const std::vector<DetectedLine>& OalDetector::DetectInRegion(const GrayImageView
     loops_.Read(image);
     for (int border = 0; border < loops_.count(); ++border) ScanBorder(image, border);
   }
-  ReadOff(image.width, image.height);
+  ReadOff(image.width, image.height, in_region);
   return lines_;
 }
 
@@ -356,7 +357,7 @@ bool OalDetector::WidthsAgree(const FramePoint& a, const FramePoint& b, double d
   return excess <= 0.0 || excess * excess <= slack * slack * length_sq;
 }
 
-void OalDetector::ReadOff(int width, int height) {
+void OalDetector::ReadOff(int width, int height, bool in_region) {
   const double tolerance = options_.support_tolerance_px;
   candidates_.clear();
   for (const OalEntry& entry : oal_.entries()) {
@@ -367,8 +368,12 @@ void OalDetector::ReadOff(int width, int height) {
     line.line = Normalized(rho, entry.Line().theta_rad);
     if (options_.refit_lines) {
       const double wide = std::max(options_.r_change_px, 2.0 * tolerance);
-      line.line = RefitLine(line.line, frame_points_, wide);
-      line.line = RefitLine(line.line, frame_points_, tolerance);
+      // A region's borders leave the image and turn at the image's edge, often beside a
+      // stripe: the runs around those corners sit off its centre line. The image's own
+      // borders turn only at the image's corners, where such a run may be the line's only
+      // point near that end: it is kept.
+      line.line = RefitLine(line.line, frame_points_, wide, in_region);
+      line.line = RefitLine(line.line, frame_points_, tolerance, in_region);
     }
     const SupportStats stats = MeasureSupport(line.line, frame_points_, tolerance);
     if (options_.rank_by_support && stats.points < options_.min_support) continue;

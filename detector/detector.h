@@ -155,7 +155,7 @@ class OalDetector {
   /// (du, dv) = b - a, length_sq = du² + dv².
   bool WidthsAgree(const FramePoint& a, const FramePoint& b, double du, double dv,
                    double length_sq) const;
-  void ReadOff(int width, int height);
+  void ReadOff(int width, int height, bool in_region);
   Point2d ToWorking(const Point2d& pixel) const;
 
   DetectorOptions options_;

@@ -6,13 +6,21 @@
 namespace oal {
 
 LineParams RefitLine(const LineParams& line, const std::vector<FramePoint>& points,
-                     double tolerance_px) {
+                     double tolerance_px, bool prefer_straight) {
   const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
   // One pass: sums of the close points' offsets from the first close point (a reference
   // inside the cloud keeps the second moments well conditioned), centred afterwards.
   double n = 0.0, su = 0.0, sv = 0.0, suu = 0.0, svv = 0.0, suv = 0.0;
   double ref_u = 0.0, ref_v = 0.0;
+  int straight = 0, close = 0;
   for (const FramePoint& point : points) {
+    const bool near = std::fabs(point.p.u * c + point.p.v * s - line.rho_px) <= tolerance_px;
+    close += near;
+    straight += near && point.straight;
+  }
+  const bool straight_only = prefer_straight && straight >= 2 && 2 * straight >= close;
+  for (const FramePoint& point : points) {
+    if (straight_only && !point.straight) continue;
     if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) > tolerance_px) continue;
     if (n == 0.0) {
       ref_u = point.p.u;

@@ -39,10 +39,12 @@ inline double WidthAcross(const FramePoint& point, double cos_theta, double sin_
                    static_cast<double>(point.across_v) * sin_theta);
 }
 
-/// The total-least-squares line of the points within `tolerance_px` of `line`; unchanged if
-/// fewer than two points are that close.
+/// The total-least-squares line of the points within `tolerance_px` of `line`; with
+/// `prefer_straight`, of the straight ones among them when they are at least two and half of
+/// them (a run around a border's corner gives the midpoint of its ends, off the stripe's
+/// centre line: it votes, but does not fit). Unchanged if fewer than two points are close.
 LineParams RefitLine(const LineParams& line, const std::vector<FramePoint>& points,
-                     double tolerance_px);
+                     double tolerance_px, bool prefer_straight = false);
 
 /// Points, borders and mean width of the support of `line`.
 SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint>& points,

@@ -108,6 +108,9 @@ void ScanRegion::Check() const {
 }
 
 void ScanBorders::Check() const {
+  RequireOption(image_margin_px >= 0, "ScanBorders::image_margin_px", image_margin_px, ">= 0");
+  RequireOption(image_margin_step_px >= 0, "ScanBorders::image_margin_step_px",
+                image_margin_step_px, ">= 0");
   for (const std::vector<Point2d>& polygon : polygons) ScanRegion{polygon}.Check();
 }
 

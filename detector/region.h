@@ -38,15 +38,19 @@ struct ScanRegion {
 };
 
 /// Borders given one by one, e.g. the images of rectangles concentric on a planar target
-/// (servo/target_borders.h), instead of a region's insets.
+/// (servo/target_layout.h), instead of a region's insets.
 struct ScanBorders {
   /// Outermost first; each a convex polygon in image pixels (either turning sense, at most
   /// ScanRegion::kMaxVertices vertices), which may leave the image: border k is clipped to
-  /// the image moved inward by start_px + k step_px (DetectorOptions), as the paper's image
-  /// borders are, so that where several leave the image they stay apart (clipped to the same
-  /// line, their points there would repeat, and a stripe along that line would spoil them
-  /// all).
+  /// the image moved inward by image_margin_px + k image_margin_step_px. The clipped parts
+  /// follow the image's edge, so that a line leaving the image still crosses every border
+  /// twice (once on the edge); one pixel apart, they do not repeat each other's points, and
+  /// they stay in a narrow band at the edge: spread as deep as the image borders' step_px
+  /// would take them (16 borders: 85 px), they would run along a stripe that lies near and
+  /// parallel to the edge, which then no border crosses.
   std::vector<std::vector<Point2d>> polygons;
+  int image_margin_px = 3;       ///< >= 0
+  int image_margin_step_px = 1;  ///< >= 0
 
   bool empty() const { return polygons.empty(); }
   /// Throws std::invalid_argument unless every polygon passes ScanRegion::Check().

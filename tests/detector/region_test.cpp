@@ -225,20 +225,27 @@ TEST(RegionDetect, BordersGivenOneByOneAreScannedAsGiven) {
   const std::vector<DetectedLine>& lines = detector.Detect(image.View(), {}, borders);
   EXPECT_EQ(detector.region_borders().count(), 12);
   ASSERT_EQ(lines.size(), 2u);
-  // A border leaving the image is cut by the image moved inward by start_px + k step_px.
+  // A border leaving the image is cut by the image moved inward by image_margin_px +
+  // k image_margin_step_px.
   ScanBorders leaving;
-  leaving.polygons = {Square(-50, 100, 300), Square(-50, 100, 300)};
+  leaving.polygons = {Square(-50, 100, 300), Square(-50, 100, 300), Square(-50, 100, 300)};
+  leaving.image_margin_px = 4;
+  leaving.image_margin_step_px = 2;
   detector.Detect(image.View(), {}, leaving);
-  ASSERT_EQ(detector.region_borders().count(), 2);
-  const DetectorOptions defaults;
-  for (int k = 0; k < 2; ++k) {
+  ASSERT_EQ(detector.region_borders().count(), 3);
+  for (int k = 0; k < 3; ++k) {
     double lowest_u = 1e9;
     for (const Point2d& p : detector.region_borders().Polygon(k))
       lowest_u = std::min(lowest_u, p.u);
-    EXPECT_NEAR(lowest_u, defaults.start_px + k * defaults.step_px, kTight) << k;
+    EXPECT_NEAR(lowest_u, 4 + 2 * k, kTight) << k;
   }
-  const ScanBorders degenerate{{{{0, 0}, {1, 1}}}};
+  ScanBorders degenerate;
+  degenerate.polygons = {{{0, 0}, {1, 1}}};
   EXPECT_THROW(detector.Detect(image.View(), {}, degenerate), std::invalid_argument);
+  ScanBorders negative_margin;
+  negative_margin.polygons = {Square(-50, 100, 300)};
+  negative_margin.image_margin_px = -1;
+  EXPECT_THROW(detector.Detect(image.View(), {}, negative_margin), std::invalid_argument);
 }
 
 TEST(RegionDetect, ManyBordersOfALargeRegionAreThinnedToTheLimit) {
