@@ -1453,6 +1453,10 @@ void FrameEffects::Check() const {
   RequireOption(InRange(offset, -255.0, 255.0), "FrameEffects::offset", offset,
                 "-255 <= offset <= 255");
   for (const Occluder& occluder : occluders) occluder.Check();
+  RequireOption(noise_sigma < 0.0 || noise_sigma <= 100.0, "FrameEffects::noise_sigma", noise_sigma,
+                "noise_sigma <= 100 (negative: the renderer's)");
+  RequireOption(blur_sigma_px < 0.0 || blur_sigma_px <= 20.0, "FrameEffects::blur_sigma_px",
+                blur_sigma_px, "blur_sigma_px <= 20 (negative: the renderer's)");
 }
 
 void PoseSampling::Check() const {
@@ -1553,11 +1557,12 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_
   ApplyIllumination(options_.illumination_gradient, options_.gradient_angle_rad, &radiance);
   ApplyLightFalloff(options_, &radiance);
   ApplyGainOffset(effects.gain, effects.offset, &radiance);
-  if (options_.blur_sigma_px > 0.0) {
-    cv::GaussianBlur(radiance, radiance, cv::Size(), options_.blur_sigma_px, options_.blur_sigma_px,
-                     cv::BORDER_REFLECT);
+  const double blur = effects.blur_sigma_px >= 0.0 ? effects.blur_sigma_px : options_.blur_sigma_px;
+  if (blur > 0.0) {
+    cv::GaussianBlur(radiance, radiance, cv::Size(), blur, blur, cv::BORDER_REFLECT);
   }
-  AddNoise(options_.noise_sigma, noise_seed, &radiance);
+  AddNoise(effects.noise_sigma >= 0.0 ? effects.noise_sigma : options_.noise_sigma, noise_seed,
+           &radiance);
 
   RenderedFrame frame;
   frame.image.resize(static_cast<unsigned>(options_.height), static_cast<unsigned>(options_.width));

@@ -183,6 +183,10 @@ struct FrameEffects {
   double gain = 1.0;                ///< [0, 10]
   double offset = 0.0;              ///< grey levels, [-255, 255]
   std::vector<Occluder> occluders;  ///< drawn in order, the last one in front
+  /// This frame's noise and blur instead of RenderOptions' (a camera whose exposure or focus
+  /// varies); negative: RenderOptions'. Ranges as RenderOptions'.
+  double noise_sigma = -1.0;
+  double blur_sigma_px = -1.0;
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;

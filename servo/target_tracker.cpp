@@ -121,9 +121,46 @@ double StripeAgreement::Worst() const {
   return worst;
 }
 
-StripeAgreement CheckStripes(const GrayImageView& image, const LineTarget& target,
-                             const TargetLayout& layout, const vpHomogeneousMatrix& cMo,
-                             const vpCameraParameters& camera, int min_contrast) {
+namespace {
+
+// Whether the point `across` metres off stripe k's centre line at `along` is in view, and its
+// grey level.
+bool StripeGrey(const GrayImageView& image, const TargetLayout& layout,
+                const vpHomography& plane_to_image, const vpCameraParameters& camera, int k,
+                double along, double across, int* grey) {
+  Point2d pixel;
+  return ProjectPlanePoint(plane_to_image, camera, layout.OnStripe(k, along, across), &pixel) &&
+         GreyAt(image, pixel, grey);
+}
+
+// The part of stripe k's span whose centre line is in view, to kCoarseSteps of the span
+// (the whole span when both ends and the middle are; empty when no step is): a board's
+// stripe seen from near shows a tenth of its length, where evenly spread samples would miss.
+Interval StripeInView(const GrayImageView& image, const TargetLayout& layout,
+                      const vpHomography& plane_to_image, const vpCameraParameters& camera, int k) {
+  constexpr int kCoarseSteps = 64;
+  const Interval span = layout.stripes[static_cast<std::size_t>(k)].along;
+  int grey = 0;
+  auto seen = [&](double along) {
+    return StripeGrey(image, layout, plane_to_image, camera, k, along, 0.0, &grey);
+  };
+  if (seen(span.lo) && seen(span.hi) && seen(0.5 * (span.lo + span.hi))) return span;
+  const double step = (span.hi - span.lo) / kCoarseSteps;
+  int first = -1, last = -1;
+  for (int i = 0; i <= kCoarseSteps; ++i) {
+    if (!seen(span.lo + i * step)) continue;
+    if (first < 0) first = i;
+    last = i;
+  }
+  if (first < 0) return Interval{0.0, -1.0};
+  return Interval{span.lo + first * step, span.lo + last * step};
+}
+
+}  // namespace
+
+StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
+                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
+                             int min_contrast) {
   StripeAgreement agreement;
   const vpHomography plane_to_image = PlaneToImage(cMo);
   for (int k = 0; k < 4; ++k) {
@@ -141,20 +178,18 @@ StripeAgreement CheckStripes(const GrayImageView& image, const LineTarget& targe
       }
       return false;
     };
+    const Interval in_view = StripeInView(image, layout, plane_to_image, camera, k);
+    if (!(in_view.hi > in_view.lo)) continue;
+    // Across the stripe: beside, inside, centre, inside, beside.
+    const double across[5] = {-beside, -kInsideFraction * width, 0.0, kInsideFraction * width,
+                              beside};
     for (int i = 0; i < kStripeSamples; ++i) {
-      const double along =
-          stripe.along.lo + (stripe.along.hi - stripe.along.lo) * (i + 0.5) / kStripeSamples;
+      const double along = in_view.lo + (in_view.hi - in_view.lo) * (i + 0.5) / kStripeSamples;
       if (near_crossing(along)) continue;
-      // Across the stripe: beside, inside, centre, inside, beside.
-      const double across[5] = {-beside, -kInsideFraction * width, 0.0, kInsideFraction * width,
-                                beside};
       int grey[5] = {};
       bool seen = true;
       for (int j = 0; j < 5 && seen; ++j) {
-        Point2d pixel;
-        seen = ProjectPlanePoint(plane_to_image, camera, layout.OnStripe(k, along, across[j]),
-                                 &pixel) &&
-               GreyAt(image, pixel, &grey[j]);
+        seen = StripeGrey(image, layout, plane_to_image, camera, k, along, across[j], &grey[j]);
       }
       if (!seen) continue;
       ++agreement.samples[static_cast<std::size_t>(k)];
@@ -164,7 +199,6 @@ StripeAgreement CheckStripes(const GrayImageView& image, const LineTarget& targe
         ++agreement.dark[static_cast<std::size_t>(k)];
     }
   }
-  (void)target;
   return agreement;
 }
 
@@ -250,7 +284,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     }
   }
   frame_.agreement =
-      CheckStripes(image, target_, layout_, frame_.pose.cMo, camera_, options_.min_stripe_contrast);
+      CheckStripes(image, layout_, frame_.pose.cMo, camera_, options_.min_stripe_contrast);
   if (frame_.agreement.Worst() < options_.min_stripe_agreement) {
     std::ostringstream message;
     message << "the image does not show the target where the pose puts it: ";
@@ -323,7 +357,10 @@ const TargetFrame& TargetPoseTracker::Track(
 
 void TargetPoseTracker::Accept(bool predicted) {
   const vpHomogeneousMatrix& cMo = frame_.pose.cMo;
-  const bool consecutive = frames_since_ok_ == 1 && last_cMo_.has_value();
+  // Only a pose found on the borders of the last one is held to it: one found afresh, after
+  // those borders showed no target, says the target has moved.
+  const bool consecutive =
+      frames_since_ok_ == 1 && last_cMo_.has_value() && frame_.source == ScanSource::kPrior;
   const bool checked =
       !predicted && consecutive && (options_.max_jump_m > 0.0 || options_.max_jump_deg > 0.0);
   auto within = [&](const vpHomogeneousMatrix& other, double* metres, double* degrees) {

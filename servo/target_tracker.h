@@ -14,11 +14,12 @@
 // A pose is accepted only when the image shows the target where it says: along each stripe's
 // projected centre line, between the crossings and the printed ends, the pixels must be darker
 // than the paper on both sides (min_stripe_agreement of the samples inside the image);
-// otherwise the frame's status is kModelMismatch. Without a caller's prediction, a pose that
-// moved more than max_jump_m / max_jump_deg from the last accepted one is held (kJump) and
-// accepted only when the next frame agrees with it: one bad frame is refused, a real fast
-// move costs one frame. ScanMode::kImage is the paper's condition: the whole image every frame
-// (steps 1-2 skipped), the same checks.
+// otherwise the frame's status is kModelMismatch. Without a caller's prediction, a pose found
+// on the borders of the last accepted one (step 1) that moved more than max_jump_m /
+// max_jump_deg from it is held (kJump) and accepted only when the next frame agrees with it:
+// one bad frame is refused, a real fast move costs one frame. A pose found afresh (steps 2-3,
+// after the last pose's borders showed nothing) is not held: the target has moved. ScanMode::kImage
+// is the paper's condition: the whole image every frame (steps 1-2 skipped), the same checks.
 //
 // Coordinates: the lines and corners are in undistorted pixels when the camera has
 // distortion (the detector undistorts the feature points), as pose.h states.
@@ -172,9 +173,12 @@ class TargetPoseTracker {
   int frames_since_ok_ = 0;  ///< 1: the last frame's pose was accepted; 0: none ever was
 };
 
-/// The model check alone: how well `image` shows `target`'s stripes at cMo.
-StripeAgreement CheckStripes(const GrayImageView& image, const LineTarget& target,
-                             const TargetLayout& layout, const vpHomogeneousMatrix& cMo,
-                             const vpCameraParameters& camera, int min_contrast);
+/// The model check alone: how well `image` shows the target of `layout` at cMo. Each stripe
+/// is sampled at 16 points spread over the part of it in view (away from the crossings),
+/// five across each: a sample agrees when the three inside the ink are all min_contrast
+/// darker than the two on the paper beside it.
+StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
+                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
+                             int min_contrast);
 
 }  // namespace oal
