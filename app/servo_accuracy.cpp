@@ -47,6 +47,9 @@ std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoAppConfig& config,
   sampling.max_offset_m = 0.05;
   sampling.any_roll = false;  // roll within ±max_off_deg of the goal's
   sampling.min_visible_length_px = 0.15 * config.camera.width;
+  // A sheet is found by its middle cell: every start sees its four crossings.
+  const bool sheet = config.target.board_width_m <= 1.0 && config.target.board_height_m <= 1.0;
+  sampling.crossings_in_view = sheet;
   std::uint64_t state = options.seed;
   std::vector<vpHomogeneousMatrix> starts;
   for (int i = 0; i < options.starts; ++i) {

@@ -28,6 +28,7 @@
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {
@@ -122,15 +123,14 @@ struct LoopModel {
                    ? c.camera.Camera()
                    : vpCameraParameters(c.camera.px, c.camera.py, c.camera.u0, c.camera.v0)) {}
 
-  PoseOptions PoseOptionsFor(const OalDetector& detector) const {
+  // The tracker sets the camera, the undistortion and the image size from its own.
+  PoseOptions Pose() const {
     PoseOptions options = config.pose;
-    options.camera = camera;
-    options.lines_undistorted = detector.Undistorts();
-    options.image_width = config.camera.width;
-    options.image_height = config.camera.height;
     options.compute_covariance = false;  // the loop does not use it
-    options.Check();
     return options;
+  }
+  TargetPoseTracker Tracker() const {
+    return TargetPoseTracker(config.target, camera, config.detector, Pose(), config.tracking);
   }
 };
 
@@ -153,7 +153,7 @@ class LoopCamera {
 class RenderedCamera : public LoopCamera {
  public:
   explicit RenderedCamera(const ServoAppConfig& config)
-      : renderer_(config.target, RenderOptionsOf(config.camera)) {}
+      : renderer_(config.target, RenderOptionsOf(config)) {}
 
   bool Grab(const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) override {
     frame_ = renderer_.Render(true_cMo, kNoiseSeed + static_cast<std::uint64_t>(iteration));
@@ -164,8 +164,11 @@ class RenderedCamera : public LoopCamera {
   std::string Name() const override { return "the simulated camera"; }
 
  private:
-  static RenderOptions RenderOptionsOf(const CameraConfig& camera) {
+  // The camera's lens, noise and blur; the scene's surface, light and clutter.
+  static RenderOptions RenderOptionsOf(const ServoAppConfig& config) {
+    const CameraConfig& camera = config.camera;
     RenderOptions render;
+    config.scene.ApplyTo(&render);
     render.width = camera.width;
     render.height = camera.height;
     render.camera = camera.Camera();
@@ -257,30 +260,6 @@ RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> o
   options.on_poll = std::move(on_poll);
   rig.driver = std::make_unique<SimulatedCamera>(options);
   return rig;
-}
-
-// The target's centre lines seen from cMo, in the detector's coordinates (undistorted pixels;
-// the model camera's pinhole image), as detector seeds 1..n; lines behind the camera are left out.
-std::vector<LineSeed> PredictedSeeds(const LineTarget& target, const vpHomogeneousMatrix& cMo,
-                                     const vpCameraParameters& camera) {
-  const auto project = [&](double x, double y, Point2d* pixel) {
-    const double xc = cMo[0][0] * x + cMo[0][1] * y + cMo[0][3];
-    const double yc = cMo[1][0] * x + cMo[1][1] * y + cMo[1][3];
-    const double zc = cMo[2][0] * x + cMo[2][1] * y + cMo[2][3];
-    if (!(zc > 0.0)) return false;
-    *pixel = Point2d{camera.get_u0() + camera.get_px() * xc / zc,
-                     camera.get_v0() + camera.get_py() * yc / zc};
-    return true;
-  };
-  std::vector<LineSeed> seeds;
-  for (std::size_t i = 0; i < target.lines.size(); ++i) {
-    const TargetLine& line = target.lines[i];
-    Point2d a, b;
-    if (project(line.x1_m, line.y1_m, &a) && project(line.x2_m, line.y2_m, &b)) {
-      seeds.push_back(LineSeed{static_cast<int>(i) + 1, LineThrough(a, b)});
-    }
-  }
-  return seeds;
 }
 
 // Bytes and serial time the run cost on the Scorbot's link ("" for other robots).
@@ -438,14 +417,18 @@ ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomoge
 
 // Steps 3 and 4: no pose, or a pose that disagrees with the odometry's prediction;
 // `confirming`: the frame that confirms the first pose (the robot has not moved yet).
-std::optional<Stop> PoseStop(const PoseResult& pose,
+std::optional<Stop> PoseStop(const TargetFrame& tracked,
                              const std::optional<vpHomogeneousMatrix>& predicted_cMo,
                              const ServoLoopOptions& loop, int iteration, bool confirming) {
-  if (pose.status != PoseStatus::kOk) {
+  const PoseResult& pose = tracked.pose;
+  if (tracked.status != TargetStatus::kOk) {
+    // The pose's own status when it failed, else what the tracker refused it for.
+    const bool pose_failed = pose.status != PoseStatus::kOk;
+    const std::string& message = pose_failed ? pose.message : tracked.message;
     return Stop{ServoRunStatus::kTargetLost,
                 "target lost at iteration " + std::to_string(iteration) + ": " +
-                    ToString(pose.status) +
-                    (pose.message.empty() ? "" : " (" + pose.message + ")")};
+                    (pose_failed ? ToString(pose.status) : ToString(tracked.status)) +
+                    (message.empty() ? "" : " (" + message + ")")};
   }
   if (!predicted_cMo) return std::nullopt;
   const PoseDistance jump = Distance(*predicted_cMo, pose.cMo);
@@ -593,16 +576,15 @@ vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
                              std::to_string(config.camera.width) + "x" +
                              std::to_string(config.camera.height));
   }
-  const LoopModel model(config);
-  OalDetector detector(config.detector, model.camera);
-  const PoseResult pose =
-      EstimatePose(detector.Detect(ViewOf(gray)), config.target, model.PoseOptionsFor(detector));
-  if (pose.status != PoseStatus::kOk) {
-    throw std::runtime_error(where + ": no pose of target '" + config.target.name +
-                             "' in it: " + ToString(pose.status) +
-                             (pose.message.empty() ? "" : " (" + pose.message + ")"));
+  TargetPoseTracker tracker = LoopModel(config).Tracker();
+  const TargetFrame& found = tracker.Track(ViewOf(gray));
+  if (found.status != TargetStatus::kOk) {
+    const bool pose_failed = found.pose.status != PoseStatus::kOk;
+    throw std::runtime_error(where + ": no pose of target '" + config.target.name + "' in it: " +
+                             (pose_failed ? ToString(found.pose.status) : ToString(found.status)) +
+                             (found.message.empty() ? "" : " (" + found.message + ")"));
   }
-  return pose.cMo;
+  return found.pose.cMo;
 }
 
 ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
@@ -611,8 +593,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   CheckServoConfig(config);
   const bool velocity_law = config.servo.law.mode == ServoMode::kVelocity;
   const LoopModel model(config);
-  OalDetector detector(config.detector, model.camera);
-  const PoseOptions pose_options = model.PoseOptionsFor(detector);
+  TargetPoseTracker tracker = model.Tracker();
   std::vector<std::string> source_warnings;
   const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &source_warnings);
   for (const std::string& warning : source_warnings) log << "warning: " << warning << '\n';
@@ -692,7 +673,6 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
   bool confirmed = !moves_robot;
   cv::Mat gray;
-  std::vector<LineSeed> seeds;
   LogHeader(yaw_column, log);
   for (int iteration = 0;; ++iteration) {
     const bool interrupted =
@@ -727,28 +707,28 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (previous_cMo) predicted_cMo = wMc.inverse() * previous_wMc * *previous_cMo;
     // The frame that confirms the first pose: the robot has not moved since the first frame.
     const bool confirming = !confirmed && previous_cMo.has_value();
-    // Its lines seed the accumulator list: a line seen at a grazing place (an image corner)
-    // keeps its entry instead of being culled before it gathers its votes.
-    if (predicted_cMo) seeds = PredictedSeeds(config.target, *predicted_cMo, model.camera);
-    const std::vector<DetectedLine>& lines = detector.Detect(ViewOf(gray), seeds);
-    // The prediction seeds the estimate: the lines' identities and the solution of the planar
-    // pose ambiguity carried through the move (after a move that rolled the camera by 60 deg,
-    // the pose before it is nearer a 90-deg-turned assignment of a near-square target's lines
-    // than the right one). The confirming frame is estimated on its own, so that a wrong
-    // first pose cannot seed its own confirmation.
-    const PoseResult pose =
-        EstimatePose(lines, config.target, pose_options, confirming ? std::nullopt : predicted_cMo);
+    // The prediction places the borders on the target and seeds the accumulator list and the
+    // estimate: the lines' identities and the solution of the planar pose ambiguity carried
+    // through the move (after a move that rolled the camera by 60 deg, the pose before it is
+    // nearer a 90-deg-turned assignment of a near-square target's lines than the right one).
+    // The confirming frame is found on its own, so that a wrong first pose cannot seed its
+    // own confirmation.
+    if (confirming) tracker.Reset();
+    const TargetFrame& tracked =
+        tracker.Track(ViewOf(gray), confirming ? std::nullopt : predicted_cMo);
+    const PoseResult& pose = tracked.pose;
     std::optional<ServoStep> step;
-    if (pose.status == PoseStatus::kOk) {
+    if (tracked.status == TargetStatus::kOk) {
       step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);
       current.translation_error_mm = step->translation_error_m * 1e3;
       current.rotation_error_deg = vpMath::deg(step->rotation_error_rad);
       if (step->status == ServoStatus::kConverged) current.status = "converged";
     }
     if (hooks.on_frame) {
-      hooks.on_frame(ServoFrame{gray, lines, pose, current, model.camera, detector.Undistorts()});
+      hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, model.camera,
+                                tracker.detector().Undistorts()});
     }
-    std::optional<Stop> stop = PoseStop(pose, predicted_cMo, loop, iteration, confirming);
+    std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);
     LogRow(current, yaw_column, log);
     if (stop) return finish(*stop);

@@ -75,6 +75,7 @@
 #include "detector/detector.h"
 #include "robots/safe_robot.h"
 #include "servo/pose.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 
@@ -139,7 +140,8 @@ struct ServoRunReport {
 struct ServoFrame {
   const cv::Mat& gray;  ///< the frame, CV_8UC1
   const std::vector<DetectedLine>& lines;
-  const PoseResult& pose;
+  const PoseResult& pose;      ///< the last pose estimated (tracked.pose)
+  const TargetFrame& tracked;  ///< what the tracker did: status, region scanned
   const ServoIteration& row;
   const vpCameraParameters& camera;  ///< the camera model the detector and pose used
   bool lines_undistorted = false;    ///< the lines are in undistorted pixels

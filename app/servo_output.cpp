@@ -135,7 +135,8 @@ void WriteServoPlot(const ServoRunReport& report, const ServoOptions& law,
 cv::Mat AnnotateServoFrame(const ServoFrame& frame) {
   const std::optional<vpCameraParameters> undistorted_by =
       frame.lines_undistorted ? std::optional<vpCameraParameters>(frame.camera) : std::nullopt;
-  cv::Mat image = AnnotatePose(frame.gray, frame.lines, frame.pose, frame.camera, undistorted_by);
+  cv::Mat image = AnnotatePose(frame.gray, frame.lines, frame.pose, frame.camera, undistorted_by,
+                               frame.tracked.region);
   const ServoIteration& row = frame.row;
   std::string caption = "iteration " + std::to_string(row.iteration) + "  " + row.status;
   if (std::isfinite(row.translation_error_mm)) {

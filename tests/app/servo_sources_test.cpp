@@ -229,7 +229,7 @@ TEST(ServoGoal, AGoalImageWithoutTheTargetOrUnreadableIsAnErrorNamingIt) {
     FAIL();
   } catch (const std::runtime_error& error) {
     EXPECT_THAT(error.what(), HasSubstr("servo.yaml:7: goal.image '"));
-    EXPECT_THAT(error.what(), HasSubstr("blank.png': no pose of target 'four-line-board'"));
+    EXPECT_THAT(error.what(), HasSubstr("blank.png': no pose of target 'four-line-a3'"));
   }
   test::WriteText(dir / "bad.png", "not a png");
   config.goal_image = dir / "bad.png";

@@ -422,6 +422,8 @@ TEST(ServoLoop, AStepAboveTheMaximumStopsBeforeTheRobotMoves) {
 TEST(ServoLoop, ALargeRollInOneMoveConvergesWithoutAPoseJump) {
   for (const double roll_deg : {60.0, -70.0}) {
     ServoAppConfig config = Small(DefaultServoConfig());
+    config.target.name = "near-square-board";
+    config.target.board_width_m = config.target.board_height_m = 2.0;
     config.target.lines = {
         TargetLine{-0.08, -1.0, -0.08, 1.0, 0.028}, TargetLine{-1.0, -0.08, 1.0, -0.08, 0.026},
         TargetLine{0.08, -1.0, 0.08, 1.0, 0.021}, TargetLine{-1.0, 0.08, 1.0, 0.08, 0.023}};
