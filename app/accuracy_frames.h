@@ -27,8 +27,18 @@ struct RenderedFrameOptions {
   double focal_px = 600.0;
   double kdu = 0.33;         ///< cheap wide lens (barrel, k1 ≈ -0.25)
   double noise_sigma = 8.0;  ///< grey levels
+  /// Each frame's noise drawn uniformly in [noise_sigma, noise_max] (from the seed); below
+  /// noise_sigma: every frame noise_sigma.
+  double noise_max = -1.0;
   double blur_sigma_px = 1.0;
+  double blur_max_px = -1.0;  ///< as noise_max, for the blur
   double illumination_gradient = 0.2;
+  /// Images of the surface the board lies on, one after the other from frame to frame (paths);
+  /// empty: the scene's (below), else a uniform grey surface.
+  std::vector<std::string> backgrounds;
+  /// The surface, light, shadow, annotations and clutter (a config's `scene:`); its
+  /// background is used when `backgrounds` is empty.
+  SceneConfig scene;
 
   /// Throws std::invalid_argument naming the command-line option and its range: --frames
   /// [1, 1000000], --kdu (-1, 1) (as `oalservo render`), --noise [0, 100], --blur [0, 20],
@@ -36,8 +46,33 @@ struct RenderedFrameOptions {
   void Check() const;
 };
 
-/// The renderer's options for `options`: a centred camera with focal_px and kdu, noise, blur.
+/// The renderer's options for `options`: a centred camera with focal_px and kdu, noise, blur,
+/// and the scene (without its background).
 RenderOptions MakeRenderOptions(const RenderedFrameOptions& options);
+
+/// The renderers of an evaluation, one per background (or one), and each frame's effects.
+class EvaluationScenes {
+ public:
+  /// Reads the backgrounds; throws std::runtime_error naming an unreadable one.
+  EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options);
+  /// The renderer of frame `frame` (backgrounds in turn).
+  const SceneRenderer& For(int frame) const;
+  /// Frame `frame`'s noise and blur (FrameEffects), drawn from `seed` and the frame.
+  FrameEffects EffectsFor(int frame) const;
+  /// "Klimt.pgm" etc., or "uniform grey", for frame `frame`.
+  std::string BackgroundName(int frame) const;
+
+ private:
+  RenderedFrameOptions options_;
+  std::vector<SceneRenderer> renderers_;
+  std::vector<std::string> names_;
+};
+
+/// The photographs of Debian's visp-images-data used as benches by default for the sheet
+/// targets (a painting, a desk with a printed sheet, a crowd outdoors, a cluttered lab, a
+/// dark room, a comic-strip collage, a room with a cube): paths that exist when the package is
+/// installed. Throws std::runtime_error saying so when it is not.
+std::vector<std::string> DefaultBenchPhotos();
 
 /// Adds --seed, described by `help`, with its default shown: an integer >= 0; a negative one
 /// is a usage error (CLI11 alone would turn -1 into 2^64 - 1). For every command with a seed.
@@ -49,6 +84,39 @@ void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
 
 /// `options` as JSON, the start of a report's "options" object (each command adds its own).
 nlohmann::json RenderedFrameJson(const RenderedFrameOptions& options);
+
+/// Whether the YAML file at `path` (read before, without error) has a top-level `section`.
+bool ConfigHasSection(const std::string& path, const std::string& section);
+
+/// The bench a sheet target is evaluated on unless a config's `scene:` says otherwise: the
+/// sheet printed with its annotations, its texture and soft shadow, two printed text sheets
+/// and four tools around it, light falling off towards the corners (the photographs under it
+/// are DefaultBenchPhotos()).
+SceneConfig BenchScene();
+
+/// The target of an accuracy command: the config's `target:` section when it has one (and
+/// `target_given` is false: both is an error naming them), else the built-in `target_name`
+/// (an unknown one is an error naming --target). `config_path` may be empty (no config).
+LineTarget AccuracyTarget(const std::string& target_name, bool target_given,
+                          const std::string& config_path, const AppConfig& config);
+
+/// Whether `target` is a sheet (both sides at most 1 m) rather than the paper's 2 m board.
+bool IsSheet(const LineTarget& target);
+
+/// A sheet from the near to the far end of its range (A3 0.3-0.85 m, A4 and letter
+/// 0.25-0.6 m, another sheet scaled from A3 by its width): tilt up to 30 deg, any roll, the
+/// four crossings 10 px inside the image, the optical axis within 0.1 m of the sheet's
+/// centre (so that the sheet is often partly out of view).
+PoseSampling SheetSampling(const LineTarget& target);
+
+/// The conditions a sheet target is evaluated in, where the command line (`cli`, after
+/// parsing) leaves them open: SheetSampling (but for --min-distance, --max-distance,
+/// --max-tilt-deg, --max-offset, --crossings-margin given), a cheap lens corrected with its
+/// camera file (kdu 0.15), noise 2-8 and blur 0.5-1.5 px drawn per frame, BenchScene()
+/// unless `scene_given` (a config's scene:), on DefaultBenchPhotos() unless a background is
+/// given. Nothing for the board.
+void ApplySheetDefaults(const CLI::App& cli, const LineTarget& target, bool scene_given,
+                        RenderedFrameOptions* options, PoseSampling* sampling);
 
 /// LoadConfig(path), and an error for any section of the file not in `used`: `command` would
 /// silently ignore it (target:, camera:...), so it is rejected with

@@ -146,12 +146,19 @@ cv::Mat AnnotateLines(const cv::Mat& frame, const std::vector<DetectedLine>& lin
 // (x red, y green, z blue, kAxisLengthM long) when the pose is ok, and the status.
 cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines,
                      const PoseResult& pose, const vpCameraParameters& camera,
-                     const std::optional<vpCameraParameters>& undistorted_by) {
+                     const std::optional<vpCameraParameters>& undistorted_by,
+                     const std::vector<Point2d>& region) {
   static const cv::Scalar kLineColours[4] = {
       {0, 200, 255}, {255, 0, 200}, {255, 255, 0}, {0, 128, 255}};
   cv::Mat image;
   cv::cvtColor(gray, image, cv::COLOR_GRAY2BGR);
   const int w = gray.cols, h = gray.rows;
+  if (region.size() >= 3) {  // the outermost border scanned, thin
+    std::vector<cv::Point2d> outline;
+    for (const Point2d& p : region) outline.emplace_back(p.u, p.v);
+    const std::vector<std::vector<cv::Point>> polygon = {Fixed(outline)};
+    cv::polylines(image, polygon, true, cv::Scalar(120, 200, 120), 1, cv::LINE_AA, kShift);
+  }
   for (int k = 0; k < 4; ++k) {
     const int index = pose.line_index[k];
     if (index < 0 || index >= static_cast<int>(lines.size())) continue;

@@ -31,6 +31,7 @@ cv::Mat AnnotateLines(const cv::Mat& frame, const std::vector<DetectedLine>& lin
 /// was estimated from (pose.line_index indexes them).
 cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines,
                      const PoseResult& pose, const vpCameraParameters& camera,
-                     const std::optional<vpCameraParameters>& undistorted_by);
+                     const std::optional<vpCameraParameters>& undistorted_by,
+                     const std::vector<Point2d>& region = {});
 
 }  // namespace oal

@@ -19,6 +19,8 @@
 #include <utility>
 #include <vector>
 
+#include "app/image_source.h"
+
 namespace oal {
 namespace {
 
@@ -789,6 +791,133 @@ void ReadTargetPoseSection(const YAML::Node& section, const std::string& file, A
   config->target_wMo = ReadPose(Value{section, file, "target_pose"});
 }
 
+// ------------------------------------------------------------------------------------------
+// `tracking:`: TargetTrackerOptions, with the sheet finder's options as `tracking.finder`.
+
+const std::vector<Field<SheetFinderOptions>>& FinderFields() {
+  using O = SheetFinderOptions;
+  static const std::vector<Field<O>> fields = {
+      IntField("cell_px", &O::cell_px),
+      DoubleField("min_area_fraction", &O::min_area_fraction),
+      IntField("min_contrast", &O::min_contrast),
+      IntField("max_candidates", &O::max_candidates),
+  };
+  return fields;
+}
+
+const std::vector<Field<TargetTrackerOptions>>& TrackingFields() {
+  using O = TargetTrackerOptions;
+  static const std::vector<Field<O>> fields = {
+      {"scan",
+       [](const Value& value, O* options) {
+         options->scan = value.Choice(&ScanModeFromString, "target, image");
+       }},
+      IntField("borders", &O::borders),
+      IntField("tracked_borders", &O::tracked_borders),
+      IntField("max_candidates", &O::max_candidates),
+      BoolField("image_fallback", &O::image_fallback),
+      IntField("min_line_support", &O::min_line_support),
+      DoubleField("min_stripe_agreement", &O::min_stripe_agreement),
+      IntField("min_stripe_contrast", &O::min_stripe_contrast),
+      DoubleField("max_jump_m", &O::max_jump_m),
+      DoubleField("max_jump_deg", &O::max_jump_deg),
+      {"finder",
+       [](const Value& value, O* options) {
+         if (!value.node.IsMap()) value.Fail("'" + value.key + "' must be a map of keys");
+         ReadCheckedSection(value.node, value.file, "tracking.finder", FinderFields(),
+                            &options->finder);
+       }},
+  };
+  return fields;
+}
+
+void ReadTrackingSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  ReadCheckedSection(section, file, "tracking", TrackingFields(), &config->tracking);
+}
+
+// ------------------------------------------------------------------------------------------
+// `scene:`: SceneConfig.
+
+const std::vector<Field<SceneConfig>>& SceneFields() {
+  using O = SceneConfig;
+  static const std::vector<Field<O>> fields = {
+      {"background",
+       [](const Value& value, O* scene) {
+         scene->background = PathNextTo(value.file, value);
+         scene->background_origin = value.file + ":" + std::to_string(value.node.Mark().line + 1);
+       }},
+      DoubleField("background_texel_m", &O::background_texel_m),
+      IntField("background_grey", &O::background_grey),
+      DoubleField("background_gain", &O::background_gain),
+      DoubleField("background_offset", &O::background_offset),
+      DoubleField("gradient", &O::gradient),
+      DoubleField("gradient_angle_deg", &O::gradient_angle_deg),
+      DoubleField("vignetting", &O::vignetting),
+      DoubleField("hot_spot_gain", &O::hot_spot_gain),
+      DoubleField("hot_spot_u", &O::hot_spot_u),
+      DoubleField("hot_spot_v", &O::hot_spot_v),
+      DoubleField("hot_spot_sigma", &O::hot_spot_sigma),
+      DoubleField("shadow_darkness", &O::shadow_darkness),
+      DoubleField("shadow_offset_m", &O::shadow_offset_m),
+      DoubleField("shadow_angle_deg", &O::shadow_angle_deg),
+      DoubleField("shadow_softness_m", &O::shadow_softness_m),
+      DoubleField("paper_texture_grey", &O::paper_texture_grey),
+      BoolField("annotations", &O::annotations),
+      IntField("clutter_sheets", &O::clutter_sheets),
+      IntField("clutter_objects", &O::clutter_objects),
+      DoubleField("clutter_reach_m", &O::clutter_reach_m),
+      IntField("seed", &O::seed),
+  };
+  return fields;
+}
+
+// The scene's values are checked by RenderOptions::Check(): through a render of its own,
+// named by the keys (RenderOptions' fields are the keys but for the units at the edge).
+struct SceneCheck {
+  const SceneConfig& scene;
+  void Check() const {
+    if (scene.seed < 0) {
+      throw std::invalid_argument("SceneConfig::seed = " + std::to_string(scene.seed) +
+                                  ". Violated constraint: seed >= 0");
+    }
+    RequireOption(scene.background_gain >= 0.0 && scene.background_gain <= 4.0,
+                  "SceneConfig::background_gain", scene.background_gain,
+                  "0 <= background_gain <= 4");
+    RequireOption(std::fabs(scene.background_offset) <= 255.0, "SceneConfig::background_offset",
+                  scene.background_offset, "-255 <= background_offset <= 255");
+    RenderOptions render;
+    SceneConfig without_image = scene;
+    without_image.background.clear();  // read when used, with its own message
+    without_image.ApplyTo(&render);
+    try {
+      render.Check();
+    } catch (const std::invalid_argument& error) {
+      std::string message = error.what();
+      // "RenderOptions::shadow_angle_rad = ..." -> the key the user wrote.
+      const std::string prefix = "RenderOptions::";
+      if (message.rfind(prefix, 0) == 0) message = "SceneConfig::" + message.substr(prefix.size());
+      for (const auto& [field, key] :
+           {std::pair<const char*, const char*>{"illumination_gradient", "gradient"},
+            {"gradient_angle_rad", "gradient_angle_deg"},
+            {"shadow_angle_rad", "shadow_angle_deg"},
+            {"scene_seed", "seed"}}) {
+        const std::string from = std::string("SceneConfig::") + field + " ";
+        if (message.rfind(from, 0) == 0)
+          message = std::string("SceneConfig::") + key + message.substr(from.size() - 1);
+      }
+      throw std::invalid_argument(message);
+    }
+  }
+};
+
+void ReadSceneSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
+  Lines lines;
+  SceneConfig scene = config->scene;
+  ReadFields(section, file, "scene", SceneFields(), "", &scene, &lines);
+  CheckAt(SceneCheck{scene}, file, "scene", lines);
+  config->scene = std::move(scene);
+}
+
 struct Section {
   const char* name;
   void (*read)(const YAML::Node& section, const std::string& file, AppConfig* config);
@@ -800,6 +929,7 @@ constexpr Section kSections[] = {
     {"robot", &ReadRobotSection},       {"servo", &ReadServoSection},
     {"goal", &ReadGoalSection},         {"target_pose", &ReadTargetPoseSection},
     {"source", &ReadSourceSection},     {"output", &ReadOutputSection},
+    {"tracking", &ReadTrackingSection}, {"scene", &ReadSceneSection},
 };
 
 // Sections later versions will read: rejected with a message that says so.
@@ -938,6 +1068,49 @@ std::string OutsideWorkspace(const SafetyOptions& safety, const vpTranslationVec
   return "";
 }
 
+void SceneConfig::ApplyTo(RenderOptions* render) const {
+  constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+  render->background_texel_m = background_texel_m;
+  render->background_grey = background_grey;
+  render->illumination_gradient = gradient;
+  render->gradient_angle_rad = gradient_angle_deg * kRadPerDeg;
+  render->vignetting = vignetting;
+  render->hot_spot_gain = hot_spot_gain;
+  render->hot_spot_u = hot_spot_u;
+  render->hot_spot_v = hot_spot_v;
+  render->hot_spot_sigma = hot_spot_sigma;
+  render->shadow_darkness = shadow_darkness;
+  render->shadow_offset_m = shadow_offset_m;
+  render->shadow_angle_rad = shadow_angle_deg * kRadPerDeg;
+  render->shadow_softness_m = shadow_softness_m;
+  render->paper_texture_grey = paper_texture_grey;
+  render->annotations = annotations;
+  render->clutter_sheets = clutter_sheets;
+  render->clutter_objects = clutter_objects;
+  render->clutter_reach_m = clutter_reach_m;
+  render->scene_seed = static_cast<std::uint64_t>(seed);
+  render->background.reset();
+  if (background.empty()) return;
+  const std::string where = (background_origin.empty() ? "" : background_origin + ": ") +
+                            "scene.background '" + background + "'";
+  try {
+    render->background = Surface(ReadGrayImage(background));
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(where + ": " + error.what());
+  }
+}
+
+std::shared_ptr<const vpImage<unsigned char>> SceneConfig::Surface(
+    std::shared_ptr<const vpImage<unsigned char>> photo) const {
+  if (background_gain == 1.0 && background_offset == 0.0) return photo;
+  auto surface = std::make_shared<vpImage<unsigned char>>(*photo);
+  for (unsigned int i = 0; i < surface->getSize(); ++i) {
+    const long grey = std::lround(background_gain * surface->bitmap[i] + background_offset);
+    surface->bitmap[i] = static_cast<unsigned char>(std::clamp(grey, 0L, 255L));
+  }
+  return surface;
+}
+
 vpCameraParameters CameraConfig::Camera() const {
   vpCameraParameters camera;
   if (kdu != 0.0) {
@@ -1022,6 +1195,31 @@ void ServoLoopOptions::Check() const {
   if (!(max_step_deg > 0.0 && max_step_deg <= 180.0)) {
     Violated("ServoLoopOptions::max_step_deg", Num(max_step_deg), "0 < max_step_deg <= 180");
   }
+}
+
+std::string TargetYaml(const LineTarget& target) {
+  auto number = [](double value) {
+    std::ostringstream text;
+    text.precision(17);
+    text << value;
+    return text.str();
+  };
+  std::ostringstream yaml;
+  yaml << "# The target of this data set, as `oalservo render` drew it (a config's target:\n"
+          "# section; config/four-line-board.yaml documents the keys).\n"
+       << "target:\n"
+       << "  name: \"" << target.name << "\"\n"
+       << "  board_width_m: " << number(target.board_width_m) << "\n"
+       << "  board_height_m: " << number(target.board_height_m) << "\n"
+       << "  board_grey: " << target.board_grey << "\n"
+       << "  line_grey: " << target.line_grey << "\n"
+       << "  lines:" << (target.lines.empty() ? " []" : "") << "\n";
+  for (const TargetLine& line : target.lines) {
+    yaml << "    - {from: [" << number(line.x1_m) << ", " << number(line.y1_m) << "], to: ["
+         << number(line.x2_m) << ", " << number(line.y2_m) << "], width: " << number(line.width_m)
+         << "}\n";
+  }
+  return yaml.str();
 }
 
 AppConfig ParseConfig(const std::string& yaml_text, const std::string& file_name,

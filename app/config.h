@@ -56,6 +56,7 @@
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 
@@ -143,12 +144,57 @@ struct OutputConfig {
   void Check() const;
 };
 
+/// `scene:` the world a rendered camera sees around the target (the simulated camera of
+/// `servo`, and `render`, `demo` and the accuracy commands given --config): the surface the
+/// sheet lies on, its light, its shadow, what is printed beside the target and what else lies
+/// on the bench (scene/scene.h RenderOptions states each effect).
+struct SceneConfig {
+  /// An image of the surface (relative paths: relative to the config file); empty: a uniform
+  /// grey surface of background_grey.
+  std::string background;
+  std::string background_origin;      ///< "FILE:LINE" of scene.background, for messages
+  double background_texel_m = 0.002;  ///< one background pixel on the plane, m, (0, 1]
+  int background_grey = 90;           ///< [0, 255]
+  /// The background image's greys become background_gain * grey + background_offset (clipped
+  /// to [0, 255]): a darker, paler or flatter surface from the same photograph.
+  double background_gain = 1.0;     ///< [0, 4]
+  double background_offset = 0.0;   ///< grey levels, [-255, 255]
+  double gradient = 0.0;            ///< light falls linearly by this across the image, [0, 0.9]
+  double gradient_angle_deg = 0.0;  ///< its direction, degrees, finite
+  double vignetting = 0.0;          ///< radial fall-off, [0, 0.9]
+  double hot_spot_gain = 0.0;       ///< [0, 2]
+  double hot_spot_u = 0.5, hot_spot_v = 0.5;  ///< fractions of width, height, [-2, 3]
+  double hot_spot_sigma = 0.4;                ///< fraction of the diagonal, [0.01, 10]
+  double shadow_darkness = 0.0;               ///< [0, 0.95]
+  double shadow_offset_m = 0.006;             ///< [0, 0.1]
+  double shadow_angle_deg = 45.0;             ///< finite
+  double shadow_softness_m = 0.003;           ///< [0, 0.05]
+  double paper_texture_grey = 0.0;            ///< [0, 20]
+  bool annotations = false;                   ///< the target's printed marks
+  int clutter_sheets = 0;                     ///< [0, 10]
+  int clutter_objects = 0;                    ///< [0, 50]
+  double clutter_reach_m = 0.3;               ///< (0, 10]
+  int seed = 1;                               ///< the clutter's layout, >= 0
+
+  /// Copies the effects into `render` and reads the background image. Throws
+  /// std::runtime_error "FILE:LINE: scene.background ..." when it cannot be read, and
+  /// std::invalid_argument for values RenderOptions::Check() rejects.
+  void ApplyTo(RenderOptions* render) const;
+  /// `photo` with background_gain and background_offset applied (itself when they are 1, 0).
+  std::shared_ptr<const vpImage<unsigned char>> Surface(
+      std::shared_ptr<const vpImage<unsigned char>> photo) const;
+};
+
 /// Everything a configuration file can set. A new section is a member here plus one row in
 /// config.cpp's section table.
 struct AppConfig {
   DetectorOptions detector;
-  LineTarget target = FourLineTarget();  ///< the planar target (pose, render, `oalservo target`)
-  PoseOptions pose;        ///< `pose:`; its camera, lines_undistorted and image size stay as given
+  /// The planar target (pose, render, servo, `oalservo target`): the A3 sheet by default.
+  LineTarget target = FourLineA3Target();
+  PoseOptions pose;  ///< `pose:`; its camera, lines_undistorted and image size stay as given
+  /// `tracking:` where the target is looked for in each frame (servo/target_tracker.h).
+  TargetTrackerOptions tracking;
+  SceneConfig scene;       ///< `scene:`
   CameraConfig camera;     ///< `camera:`
   RobotConfig robot;       ///< `robot:`
   ServoLoopOptions servo;  ///< `servo:`
@@ -183,6 +229,10 @@ using ServoAppConfig = AppConfig;
 /// std::runtime_error "FILE:LINE: ..." for a missing or malformed file, an unknown section
 /// or key, a value of the wrong type, and a value that fails the Options' Check().
 AppConfig LoadConfig(const std::string& path, const AppConfig& base = AppConfig());
+
+/// `target` as a configuration's `target:` section (LoadConfig reads it back exactly: numbers
+/// with 17 significant digits).
+std::string TargetYaml(const LineTarget& target);
 
 /// As LoadConfig, from YAML text; `file_name` stands for the file in messages.
 AppConfig ParseConfig(const std::string& yaml_text, const std::string& file_name,

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "detector/detector.h"
+#include "detector/image_view.h"
 
 namespace oal {
 namespace {
@@ -105,6 +107,8 @@ void AccuracyOptions::Check() const {
                                 std::to_string(max_offset_px) + ")");
   }
   detector.Check();
+  tracking.Check();
+  target.Check();
 }
 
 double Quantile(std::vector<double> values, double q) {
@@ -119,7 +123,7 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
                                         const std::function<void(int, int)>& progress) {
   options.Check();
   const RenderOptions render = MakeRenderOptions(options);
-  const SceneRenderer renderer(TargetByName(options.target), render);
+  const EvaluationScenes scenes(options.target, options);
   const PointUndistorter undistorter(render.camera);
 
   auto named = [](const char* name, const char* reference) {
@@ -138,12 +142,23 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
   ours.push_back({named("paper's algorithm (as published)", "distorted fit"),
                   OalDetector(DetectorOptions::Paper()), false});
   MethodAccuracy opencv = named("OpenCV HoughLines (Otsu binary)", "distorted fit");
+  // The tracker's pose is not needed: only its lines are scored.
+  std::optional<TargetPoseTracker> tracker;
+  MethodAccuracy tracked =
+      named("oal, target tracker (borders on the target; time with the pose)", "ideal");
+  if (options.target.lines.size() == 4) {
+    PoseOptions pose;
+    pose.compute_covariance = false;
+    tracker.emplace(options.target, render.camera, options.detector, pose, options.tracking);
+  }
 
   std::uint64_t state = options.seed;
   std::vector<LineParams> lines;
   for (int frame = 0; frame < options.frames; ++frame) {
+    const SceneRenderer& renderer = scenes.For(frame);
     const vpHomogeneousMatrix cMo = SamplePose(renderer, options.sampling, &state);
-    const RenderedFrame rendered = renderer.Render(cMo, options.seed * 1000003ULL + frame);
+    const RenderedFrame rendered =
+        renderer.Render(cMo, options.seed * 1000003ULL + frame, scenes.EffectsFor(frame));
     for (OalMethod& method : ours) {
       const auto start = std::chrono::steady_clock::now();
       const auto& detected = method.detector.Detect(rendered.image);
@@ -159,6 +174,17 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
     const auto stop = std::chrono::steady_clock::now();
     opencv.time_us.push_back(std::chrono::duration<double, std::micro>(stop - start).count());
     Score(lines, rendered, false, undistorter, options, frame, &opencv);
+    if (tracker) {
+      tracker->Reset();
+      const auto tracker_start = std::chrono::steady_clock::now();
+      tracker->Track(ViewOf(rendered.image));
+      tracked.time_us.push_back(std::chrono::duration<double, std::micro>(
+                                    std::chrono::steady_clock::now() - tracker_start)
+                                    .count());
+      lines.clear();
+      for (const DetectedLine& line : tracker->lines()) lines.push_back(line.line);
+      Score(lines, rendered, true, undistorter, options, frame, &tracked);
+    }
     if (progress) progress(frame + 1, options.frames);
   }
 
@@ -166,6 +192,7 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
   report.options = options;
   for (OalMethod& method : ours) report.methods.push_back(std::move(method.result));
   report.methods.push_back(std::move(opencv));
+  if (tracker) report.methods.push_back(std::move(tracked));
   return report;
 }
 

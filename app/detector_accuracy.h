@@ -10,18 +10,23 @@
 #include "app/accuracy_frames.h"
 #include "detector/options.h"
 #include "scene/scene.h"
+#include "servo/pose.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 
 /// RenderedFrameOptions (frames, seed, camera, degradations) and what this evaluation adds.
 struct AccuracyOptions : RenderedFrameOptions {
-  std::string target = "four-line";
+  LineTarget target = FourLineTarget();
   /// A target line fails when its best match among the first N detected lines (N = number
   /// of target lines) is further than either bound.
   double max_angle_deg = 1.0;
   double max_offset_px = 2.0;
   PoseSampling sampling = DefaultSampling();
   DetectorOptions detector;
+  /// A '#' target is also found by the target tracker (servo/target_tracker.h, a config's
+  /// `tracking:`), each frame on its own: the lines of the borders it scanned on the target.
+  TargetTrackerOptions tracking;
 
   static PoseSampling DefaultSampling() {
     PoseSampling sampling;

@@ -35,7 +35,7 @@ nlohmann::json ToJson(const AccuracyReport& report) {
   const AccuracyOptions& o = report.options;
   nlohmann::json json;
   json["options"] = RenderedFrameJson(o);
-  json["options"]["target"] = o.target;
+  json["options"]["target"] = o.target.name;
   json["options"]["max_angle_deg"] = o.max_angle_deg;
   json["options"]["max_offset_px"] = o.max_offset_px;
   json["options"]["min_visible_length_px"] = o.sampling.min_visible_length_px;
@@ -66,8 +66,20 @@ int RunDetectAccuracy(int argc, char** argv) {
       "largest distance of the true visible chord's ends from the detected line).",
       "oalservo detect-accuracy"};
   AccuracyOptions options;
-  std::string config_path, out_path;
-  cli.add_option("--target", options.target, "two-line or four-line")->capture_default_str();
+  std::string config_path, out_path, target_name = "four-line-board";
+  CLI::Option* target = cli.add_option(
+                               "--target", target_name,
+                               "a built-in target: " +
+                                   [] {
+                                     std::string list;
+                                     for (const std::string& name : TargetNames()) {
+                                       list += (list.empty() ? "" : ", ") + name;
+                                     }
+                                     return list;
+                                   }() +
+                                   " (a sheet: on photographs of a bench, as "
+                                   "pose-accuracy)")
+                            ->capture_default_str();
   AddRenderedFrameOptions(cli, &options, "lens distortion (ViSP kdu; 0.33 = cheap wide lens)");
   cli.add_option("--gradient", options.illumination_gradient, "illumination fall-off, 0..0.9")
       ->capture_default_str();
@@ -80,21 +92,31 @@ int RunDetectAccuracy(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--max-offset-px", options.max_offset_px, "failure bound on offset")
       ->capture_default_str();
+  cli.add_option("--max-offset", options.sampling.max_offset_m,
+                 "the optical axis meets the target at most this far from its centre, metres");
+  cli.add_option("--crossings-margin", options.sampling.crossings_margin_px,
+                 "a sheet's four crossings at least this far inside the image, pixels");
   cli.add_option("--config", config_path,
-                 "YAML config for our detector: its 'detector:' section, the only one read "
+                 "YAML config: its 'detector:', 'target:', 'tracking:' and 'scene:' sections "
                  "(another section is an error)")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
   // Everything that can fail before the evaluation's minutes of work.
+  AppConfig config;
   if (!config_path.empty()) {
-    options.detector = LoadAccuracyConfig(config_path, "detect-accuracy", {"detector"},
-                                          "the target is chosen with --target")
-                           .detector;
+    config = LoadAccuracyConfig(
+        config_path, "detect-accuracy", {"detector", "target", "tracking", "scene"},
+        "it renders the target with the camera of its command-line options");
+    options.detector = config.detector;
+    options.tracking = config.tracking;
+    options.scene = config.scene;
   }
+  const bool scene_given = !config_path.empty() && ConfigHasSection(config_path, "scene");
+  options.target = AccuracyTarget(target_name, target->count() > 0, config_path, config);
+  ApplySheetDefaults(cli, options.target, scene_given, &options, &options.sampling);
   options.Check();
-  TargetByName(options.target);  // throws for an unknown name
   CheckReportFile(out_path);
   const AccuracyReport report = EvaluateDetectorAccuracy(options, TerminalFrameProgress());
   PrintAccuracyReport(Table(report), ToJson(report), out_path);

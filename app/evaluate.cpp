@@ -32,6 +32,7 @@
 #include "app/compare.h"
 #include "app/config.h"
 #include "app/detector_accuracy.h"
+#include "app/frame_command.h"
 #include "app/image_source.h"
 #include "app/report.h"
 #include "app/truth_file.h"
@@ -1386,7 +1387,12 @@ EvaluateResult Evaluate(const EvaluateOptions& options,
                         const std::function<void(int, int)>& progress) {
   options.Check();
   RunContext run{options, AppConfig(), std::nullopt, LoadChartJs(), 4};
-  if (!options.config_path.empty()) run.config = LoadConfig(options.config_path, run.config);
+  if (!options.config_path.empty()) {
+    run.config = LoadConfig(options.config_path, run.config);
+  } else if (const std::optional<std::string> target =
+                 CompanionFile(options.inputs, "target.yaml")) {
+    run.config = LoadConfig(*target, run.config);  // the target `oalservo render` drew
+  }
   run.config.detector.Check();
   if (!options.camera_path.empty()) run.camera = LoadCameraFile(options.camera_path);
   run.target_lines = options.target_lines > 0

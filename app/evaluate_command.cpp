@@ -25,7 +25,8 @@ int RunEvaluate(int argc, char** argv) {
       ->required();
   cli.add_option("--out", options.out_dir, "output directory (created if missing)")->required();
   cli.add_option("--config", options.config_path,
-                 "YAML configuration: detector, target and pose sections");
+                 "YAML configuration: detector, target and pose sections (default: the "
+                 "target.yaml `oalservo render` writes next to its frames, else the A3 sheet)");
   cli.add_option("--camera", options.camera_path,
                  "ViSP camera XML for every input (default: camera.xml next to each input; "
                  "without a camera there is no pose)");

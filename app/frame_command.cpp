@@ -6,6 +6,22 @@
 
 namespace oal {
 
+std::string CompanionDirectory(const std::vector<std::string>& inputs) {
+  if (inputs.empty()) return ".";
+  const std::filesystem::path first = inputs.front();
+  const std::filesystem::path dir =
+      std::filesystem::is_directory(first) ? first : first.parent_path();
+  return dir.empty() ? std::string(".") : dir.string();
+}
+
+std::optional<std::string> CompanionFile(const std::vector<std::string>& inputs,
+                                         const std::string& name) {
+  if (inputs.empty()) return std::nullopt;
+  const std::filesystem::path candidate = std::filesystem::path(CompanionDirectory(inputs)) / name;
+  if (!std::filesystem::is_regular_file(candidate)) return std::nullopt;
+  return candidate.string();
+}
+
 std::vector<std::unique_ptr<ImageSource>> OpenInputs(const FrameCommandOptions& options,
                                                      std::vector<std::string>* warnings) {
   std::vector<std::unique_ptr<ImageSource>> sources;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,14 @@ struct FrameCommandOptions {
   /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
   int max_frames = 0;
 };
+
+/// The folder where `oalservo render` leaves its companion files for `inputs`: the first
+/// input if it is a directory, else the first input's directory ("." for a bare name).
+std::string CompanionDirectory(const std::vector<std::string>& inputs);
+/// The file `name` (e.g. "camera.xml", "target.yaml") in CompanionDirectory(inputs), if it
+/// exists.
+std::optional<std::string> CompanionFile(const std::vector<std::string>& inputs,
+                                         const std::string& name);
 
 /// Opens every input of `options` in order; files skipped in a directory go to `warnings`.
 std::vector<std::unique_ptr<ImageSource>> OpenInputs(const FrameCommandOptions& options,

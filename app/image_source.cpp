@@ -364,6 +364,20 @@ Pattern ParsePattern(const std::string& text) {
 
 }  // namespace
 
+cv::Mat ReadGrayImageFile(const std::string& path) {
+  return DecodeGray(path);
+}
+
+std::shared_ptr<const vpImage<unsigned char>> ReadGrayImage(const std::string& path) {
+  const cv::Mat gray = DecodeGray(path);
+  auto image = std::make_shared<vpImage<unsigned char>>(static_cast<unsigned>(gray.rows),
+                                                        static_cast<unsigned>(gray.cols));
+  for (int r = 0; r < gray.rows; ++r) {
+    std::copy_n(gray.ptr<unsigned char>(r), gray.cols, (*image)[r]);
+  }
+  return image;
+}
+
 bool HasImageExtension(const std::string& path) {
   return OneOf(LowerExtension(path),
                {".png", ".pgm", ".ppm",  ".pnm",  ".pbm", ".pam", ".jpg", ".jpeg", ".jpe", ".bmp",
@@ -377,7 +391,8 @@ bool IsCompanionFile(const std::string& path) {
     return name.size() >= end.size() &&
            name.compare(name.size() - end.size(), end.size(), end) == 0;
   };
-  return name == "camera.xml" || LowerExtension(path) == ".json" || ends_with(".truth.csv");
+  return name == "camera.xml" || name == "target.yaml" || LowerExtension(path) == ".json" ||
+         ends_with(".truth.csv");
 }
 
 bool HasVideoExtension(const std::string& path) {

@@ -14,6 +14,8 @@
 // Frames come out as 8-bit grey cv::Mat, viewed by the detector without a copy.
 #pragma once
 
+#include <visp3/core/vpImage.h>
+
 #include <memory>
 #include <opencv2/core/mat.hpp>
 #include <string>
@@ -71,10 +73,16 @@ struct V4l2Settings {
 std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
                                             const V4l2Settings& settings = V4l2Settings());
 
+/// One image file decoded to 8-bit grey as the sources decode it. Throws std::runtime_error
+/// naming the file when it is missing, cut short or not an image.
+cv::Mat ReadGrayImageFile(const std::string& path);
+/// The same as a shared vpImage (e.g. a renderer's background, scene/scene.h).
+std::shared_ptr<const vpImage<unsigned char>> ReadGrayImage(const std::string& path);
+
 /// True if `path` has the extension of an image format OpenCV reads (case-insensitive).
 bool HasImageExtension(const std::string& path);
 /// True if `path` names a file expected next to images or videos that is no frame: a
-/// camera.xml, a JSON file (`oalservo render`'s frame truth and sequence.json) or a
+/// camera.xml, target.yaml, a JSON file (`oalservo render`'s frame truth and sequence.json) or a
 /// <video>.truth.csv. Directories skip these without a warning.
 bool IsCompanionFile(const std::string& path);
 /// True if `path` has the extension of a video container.

@@ -7,8 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "detector/detector.h"
-#include "servo/pose.h"
+#include "detector/lens.h"
 
 namespace oal {
 namespace {
@@ -25,65 +24,116 @@ double RollDeg(const vpHomogeneousMatrix& cMo) {
   return vpMath::deg(vpRzyxVector(cRo)[0]);
 }
 
-// options.pose with what the evaluation sets: the rendered camera, the detector's
-// undistortion and the image size.
-PoseOptions PoseOptionsFor(const PoseAccuracyOptions& options, const RenderOptions& render,
-                           bool lines_undistorted) {
-  PoseOptions pose = options.pose;
-  pose.camera = render.camera;
-  pose.lines_undistorted = lines_undistorted;
-  pose.image_width = options.width;
-  pose.image_height = options.height;
-  return pose;
+// Whether every visible target line has a line of `lines` within the bounds: its angle to the
+// projected centre line, and the larger distance of the visible chord's (undistorted) ends.
+bool AllLinesFound(const std::vector<DetectedLine>& lines, const RenderedFrame& frame,
+                   const PointUndistorter& undistorter, bool undistorted,
+                   const PoseAccuracyOptions& options) {
+  for (const TruthLine& truth : frame.truth) {
+    if (!truth.visible) continue;
+    const LineParams& reference = undistorted ? truth.ideal : truth.distorted_fit;
+    const Point2d a = undistorted ? undistorter.Undistort(truth.end_a) : truth.end_a;
+    const Point2d b = undistorted ? undistorter.Undistort(truth.end_b) : truth.end_b;
+    bool found = false;
+    for (const DetectedLine& line : lines) {
+      const double angle = vpMath::deg(AngleBetween(line.line, reference));
+      const double offset = std::max(std::fabs(line.line.SignedDistance(a.u, a.v)),
+                                     std::fabs(line.line.SignedDistance(b.u, b.v)));
+      if (angle <= options.line_angle_deg && offset <= options.line_offset_px) {
+        found = true;
+        break;
+      }
+    }
+    if (!found) return false;
+  }
+  return true;
 }
 
 }  // namespace
 
+int PoseAccuracyReport::posed() const {
+  const auto ok = status_counts.find(ToString(TargetStatus::kOk));
+  return ok == status_counts.end() ? 0 : ok->second;
+}
+
+PoseSampling PoseAccuracyOptions::BoardSampling() {
+  PoseSampling sampling;
+  sampling.min_distance_m = 0.3;
+  sampling.max_distance_m = 1.0;
+  sampling.max_tilt_deg = 40.0;
+  sampling.min_visible_length_px = 150.0;
+  return sampling;
+}
+
 void PoseAccuracyOptions::Check() const {
   RenderedFrameOptions::Check();
   detector.Check();
-  PoseOptionsFor(*this, MakeRenderOptions(*this), true).Check();
+  tracking.Check();
+  sampling.Check();
+  PoseOptions check = pose;
+  check.camera = MakeRenderOptions(*this).camera;
+  check.Check();
+  IdentifyTargetLines({}, target, check);  // throws unless the target is a '#'
 }
 
 PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
                                         const std::function<void(int, int)>& progress) {
   options.Check();
-  const RenderOptions render = MakeRenderOptions(options);
-  const SceneRenderer renderer(FourLineTarget(), render);
-
-  OalDetector detector(options.detector, render.camera);
-  const PoseOptions pose_options = PoseOptionsFor(options, render, detector.Undistorts());
+  const EvaluationScenes scenes(options.target, options);
+  const vpCameraParameters camera = scenes.For(0).options().camera;
+  TargetPoseTracker tracker(options.target, camera, options.detector, options.pose,
+                            options.tracking);
+  const PointUndistorter undistorter(camera);
+  const bool undistorted = tracker.detector().Undistorts();
 
   PoseAccuracyReport report;
   report.options = options;
+  // Every status, so that the report's keys do not depend on what happened.
+  for (const TargetStatus status : {TargetStatus::kOk, TargetStatus::kNotFound,
+                                    TargetStatus::kModelMismatch, TargetStatus::kJump}) {
+    report.status_counts[ToString(status)] = 0;
+  }
   std::uint64_t state = options.seed;
   for (int frame = 0; frame < options.frames; ++frame) {
+    const SceneRenderer& renderer = scenes.For(frame);
     const vpHomogeneousMatrix cMo_true = SamplePose(renderer, options.sampling, &state);
-    const RenderedFrame rendered = renderer.Render(cMo_true, options.seed * 7919ULL + frame);
+    const RenderedFrame rendered =
+        renderer.Render(cMo_true, options.seed * 7919ULL + frame, scenes.EffectsFor(frame));
 
-    auto start = std::chrono::steady_clock::now();
-    const std::vector<DetectedLine>& lines = detector.Detect(rendered.image);
-    report.detect_time_us.push_back(MicrosecondsSince(start));
-    start = std::chrono::steady_clock::now();
-    const PoseResult pose = EstimatePose(lines, renderer.target(), pose_options);
-    report.pose_time_us.push_back(MicrosecondsSince(start));
+    tracker.Reset();  // each frame on its own
+    const auto start = std::chrono::steady_clock::now();
+    const TargetFrame& result = tracker.Track(ViewOf(rendered.image));
+    report.total_time_us.push_back(MicrosecondsSince(start));
+    report.find_time_us.push_back(result.find_us);
+    report.detect_time_us.push_back(result.detect_us);
+    report.pose_time_us.push_back(result.pose_us);
 
     ++report.frames;
-    ++report.status_counts[static_cast<std::size_t>(pose.status)];
-    if (pose.status != PoseStatus::kOk) {
+    ++report.status_counts[ToString(result.status)];
+    report.lines_found +=
+        AllLinesFound(tracker.lines(), rendered, undistorter, undistorted, options);
+    if (result.status != TargetStatus::kOk) {
+      ++report.pose_status_counts[ToString(result.pose.status)];
       report.failed_frames.push_back(frame);
     } else {
+      ++report.source_counts[ToString(result.source)];
+      const vpHomogeneousMatrix& cMo = result.pose.cMo;
       const vpTranslationVector error_t =
-          pose.cMo.getTranslationVector() - cMo_true.getTranslationVector();
-      report.translation_error_pct.push_back(100.0 * error_t.frobeniusNorm() /
-                                             cMo_true.getTranslationVector().frobeniusNorm());
-      const vpThetaUVector error_r((pose.cMo * cMo_true.inverse()).getRotationMatrix());
-      report.rotation_error_deg.push_back(vpMath::deg(error_r.getTheta()));
-      double roll_error = std::fabs(RollDeg(pose.cMo) - RollDeg(cMo_true));
+          cMo.getTranslationVector() - cMo_true.getTranslationVector();
+      const double t_pct =
+          100.0 * error_t.frobeniusNorm() / cMo_true.getTranslationVector().frobeniusNorm();
+      const double r_deg =
+          vpMath::deg(vpThetaUVector((cMo * cMo_true.inverse()).getRotationMatrix()).getTheta());
+      report.translation_error_pct.push_back(t_pct);
+      report.rotation_error_deg.push_back(r_deg);
+      double roll_error = std::fabs(RollDeg(cMo) - RollDeg(cMo_true));
       roll_error = std::fmod(roll_error, 360.0);
       roll_error = std::min(roll_error, 360.0 - roll_error);
       report.roll_error_deg.push_back(roll_error);
       report.roll_flips += roll_error > 45.0;
+      if (t_pct > options.wrong_translation_pct || r_deg > options.wrong_rotation_deg) {
+        report.wrong_frames.push_back(frame);
+      }
     }
     if (progress) progress(frame + 1, options.frames);
   }

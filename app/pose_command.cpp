@@ -22,6 +22,7 @@
 #include "detector/detector.h"
 #include "scene/scene.h"
 #include "servo/pose.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {
@@ -32,16 +33,14 @@ namespace fs = std::filesystem;
 // (in the first input if it is a directory, else in the first input's directory).
 std::string FindCameraPath(const PoseCommandOptions& options, PoseSummary* summary) {
   if (!options.camera_path.empty()) return options.camera_path;
-  const fs::path first = options.inputs.front();
-  const fs::path dir = fs::is_directory(first) ? first : first.parent_path();
-  const fs::path candidate = dir / "camera.xml";
-  if (!fs::is_regular_file(candidate)) {
+  const std::optional<std::string> found = CompanionFile(options.inputs, "camera.xml");
+  if (!found) {
     throw std::runtime_error(
         "pose needs the camera intrinsics: give --camera FILE (no camera.xml in '" +
-        (dir.empty() ? std::string(".") : dir.string()) + "')");
+        CompanionDirectory(options.inputs) + "')");
   }
-  summary->warnings.push_back("no --camera: using the camera in '" + candidate.string() + "'");
-  return candidate.string();
+  summary->warnings.push_back("no --camera: using the camera in '" + *found + "'");
+  return *found;
 }
 
 // Everything one run needs, opened before any output is started so that a bad input or
@@ -49,14 +48,23 @@ std::string FindCameraPath(const PoseCommandOptions& options, PoseSummary* summa
 struct PoseRun {
   AppConfig config;
   CameraFile camera;
-  OalDetector detector;
+  TargetPoseTracker tracker;
   std::vector<std::unique_ptr<ImageSource>> sources;
   std::optional<vpCameraParameters> undistorted_by;  ///< set when lines are undistorted
 };
 
-AppConfig LoadPoseConfig(const PoseCommandOptions& options) {
+// The configuration: --config, else the target.yaml `oalservo render` writes next to its
+// frames (its target), else the defaults (the A3 sheet).
+AppConfig LoadPoseConfig(const PoseCommandOptions& options, PoseSummary* summary) {
   AppConfig config;
-  if (!options.config_path.empty()) config = LoadConfig(options.config_path, config);
+  if (!options.config_path.empty()) {
+    config = LoadConfig(options.config_path, config);
+  } else if (const std::optional<std::string> target =
+                 CompanionFile(options.inputs, "target.yaml")) {
+    config = LoadConfig(*target, config);
+    summary->warnings.push_back("no --config: using the target in '" + *target + "' ('" +
+                                config.target.name + "')");
+  }
   config.detector.Check();
   return config;
 }
@@ -65,9 +73,20 @@ Json Vector3(double x, double y, double z) {
   return Json::array({x, y, z});
 }
 
-Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult& pose,
-               double detect_us, double pose_us) {
-  const bool ok = pose.status == PoseStatus::kOk;
+Json ScanJson(const TargetFrame& result, ScanMode mode) {
+  Json region = Json::array();
+  for (const Point2d& p : result.region) region.push_back(PointJson(p));
+  return Json{{"mode", ToString(mode)},
+              {"source", ToString(result.source)},
+              {"borders", result.borders},
+              {"candidates", result.candidates},
+              {"region", std::move(region)}};
+}
+
+Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFrame& result,
+               ScanMode mode) {
+  const PoseResult& pose = result.pose;
+  const bool ok = result.status == TargetStatus::kOk;
   const bool identified = pose.line_index[0] >= 0 && pose.line_index[1] >= 0 &&
                           pose.line_index[2] >= 0 && pose.line_index[3] >= 0;
   Json cMo;  // null unless ok
@@ -97,8 +116,9 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult
       {"source", frame.source},
       {"width", frame.gray.cols},
       {"height", frame.gray.rows},
-      {"status", ToString(pose.status)},
-      {"message", pose.message},
+      {"status", ToString(result.status)},
+      {"message", result.message},
+      {"pose_status", ToString(pose.status)},
       {"cMo", std::move(cMo)},
       {"roll_deg", if_ok(pose.roll_deg)},
       {"pitch_deg", if_ok(pose.pitch_deg)},
@@ -113,7 +133,11 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult
                              pose.line_index[3]})},
       {"coordinates", undistorted ? "undistorted" : "image"},
       {"corners_px", std::move(corners)},
-      {"time_us", Json{{"detect", detect_us}, {"pose", pose_us}}},
+      {"scan", ScanJson(result, mode)},
+      {"stripe_agreement",
+       result.pose.status == PoseStatus::kOk ? Json(result.agreement.Worst()) : Json()},
+      {"time_us",
+       Json{{"find", result.find_us}, {"detect", result.detect_us}, {"pose", result.pose_us}}},
   };
 }
 
@@ -121,13 +145,10 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const PoseResult
 // sources end or max_frames is reached.
 void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream& sink,
                    bool flush_each, PoseSummary* summary) {
-  const bool undistorted = run->detector.Undistorts();
-  PoseOptions pose_options = run->config.pose;
-  pose_options.camera = run->camera.camera;
-  pose_options.lines_undistorted = undistorted;
+  const bool undistorted = run->tracker.detector().Undistorts();
   Frame frame;
   for (auto& source : run->sources) {
-    std::optional<vpHomogeneousMatrix> previous_cMo;  // a sequence is one source
+    run->tracker.Reset();  // a sequence is one source
     while (options.max_frames == 0 || summary->frames < options.max_frames) {
       if (!source->Next(&frame)) break;
       if (summary->frames == 0) {
@@ -136,27 +157,20 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
           summary->warnings.push_back(*warning + ": the poses will be wrong");
         }
       }
-      pose_options.image_width = frame.gray.cols;
-      pose_options.image_height = frame.gray.rows;
-      const auto start = std::chrono::steady_clock::now();
-      const std::vector<DetectedLine>& lines = run->detector.Detect(frame.view());
-      const auto detected = std::chrono::steady_clock::now();
-      const PoseResult pose = EstimatePose(lines, run->config.target, pose_options, previous_cMo);
-      const auto stop = std::chrono::steady_clock::now();
-      const double detect_us = std::chrono::duration<double, std::micro>(detected - start).count();
-      const double pose_us = std::chrono::duration<double, std::micro>(stop - detected).count();
-      WriteJsonLine(sink, FrameJson(summary->frames, frame, undistorted, pose, detect_us, pose_us),
-                    flush_each);
+      if (options.independent) run->tracker.Reset();
+      const TargetFrame& result = run->tracker.Track(frame.view());
+      WriteJsonLine(
+          sink, FrameJson(summary->frames, frame, undistorted, result, run->tracker.options().scan),
+          flush_each);
       if (!options.annotate_dir.empty()) {
+        // A refused pose is not drawn as one: the lines and the region alone.
+        PoseResult drawn = result.pose;
+        if (result.status != TargetStatus::kOk) drawn.status = PoseStatus::kDegenerate;
         WritePng(AnnotationPath(options, "pose", summary->frames),
-                 AnnotatePose(frame.gray, lines, pose, run->camera.camera, run->undistorted_by));
+                 AnnotatePose(frame.gray, run->tracker.lines(), drawn, run->camera.camera,
+                              run->undistorted_by, result.region));
       }
-      if (pose.status == PoseStatus::kOk) {
-        previous_cMo = pose.cMo;
-        ++summary->ok;
-      } else {
-        previous_cMo.reset();
-      }
+      if (result.status == TargetStatus::kOk) ++summary->ok;
       ++summary->frames;
     }
   }
@@ -171,19 +185,14 @@ void PoseCommandOptions::Check() const {
 PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) {
   options.Check();
   PoseSummary summary;
-  AppConfig config = LoadPoseConfig(options);
+  AppConfig config = LoadPoseConfig(options, &summary);
   summary.camera_path = FindCameraPath(options, &summary);
   CameraFile camera = LoadCameraFile(summary.camera_path, options.camera_name);
-  {
-    // The target and the options with the camera, before any frame: a bad one fails here.
-    PoseOptions check = config.pose;
-    check.camera = camera.camera;
-    check.Check();
-    IdentifyTargetLines({}, config.target, check);  // throws if the target is not a '#'
-  }
-  OalDetector detector(config.detector, camera.camera);
-  PoseRun run{std::move(config), std::move(camera), std::move(detector), {}, {}};
-  if (run.detector.Undistorts()) run.undistorted_by = run.camera.camera;
+  // The target and the options with the camera, before any frame: a bad one fails here.
+  TargetPoseTracker tracker(config.target, camera.camera, config.detector, config.pose,
+                            config.tracking);
+  PoseRun run{std::move(config), std::move(camera), std::move(tracker), {}, {}};
+  if (run.tracker.detector().Undistorts()) run.undistorted_by = run.camera.camera;
   run.sources = OpenInputs(options, &summary.warnings);
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
@@ -194,23 +203,33 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
 int RunPose(int argc, char** argv) {
   PoseCommandOptions options;
   CLI::App cli(
-      "Camera pose from the four-line target (or the config's target) in every frame. Prints "
-      "one JSON object per frame (JSON Lines) to stdout, or writes them to --out.",
+      "Camera pose from the four-line target (the A3 sheet, or the config's target, or the "
+      "target.yaml next to rendered frames) in every frame: the target is looked for in each "
+      "frame (its middle cell, then the borders around it on its own plane), followed from "
+      "frame to frame, and a pose the image does not show is refused. Prints one JSON object "
+      "per frame (JSON Lines) to stdout, or writes them to --out.",
       "oalservo pose");
   AddInputsArgument(cli, &options);
   cli.add_option("--config", options.config_path,
-                 "YAML configuration: detector, target and pose sections (see config/pose.yaml)");
+                 "YAML configuration: detector, target, pose and tracking sections (see "
+                 "config/pose.yaml); default: the target.yaml next to rendered frames, else the "
+                 "A3 sheet");
   cli.add_option("--camera", options.camera_path,
                  "ViSP camera XML (required unless the first input's directory has a "
                  "camera.xml, as `oalservo render` writes)");
   cli.add_option("--camera-name", options.camera_name,
                  "camera to read from the camera file (default: the first in the file)");
+  cli.add_flag("--independent", options.independent,
+               "estimate each frame on its own (a rendered data set of random poses); by default "
+               "the frames of one input are a sequence, the target followed from one to the next "
+               "and a pose that jumps away from the last one held until the next frame agrees");
   AddOutputOptions(cli, &options,
                    "directory for one PNG per frame with lines 1-4 and the target's axes drawn "
                    "(created if missing)");
   cli.footer(
       "Examples:\n"
-      "  oalservo render --count 20 --out data/ && oalservo pose data/ --out poses.jsonl\n"
+      "  oalservo render --count 20 --out data/ && oalservo pose data/ --independent --out "
+      "poses.jsonl\n"
       "  oalservo pose frames/ --camera camera.xml --config config/pose.yaml --annotate ann/\n"
       "  oalservo pose /dev/video0 --camera camera.xml --max-frames 100");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;

@@ -38,6 +38,9 @@ struct PoseCommandOptions : FrameCommandOptions {
   std::string config_path;
   /// ViSP camera XML; empty: camera.xml in the first input's directory, else an error.
   std::string camera_path;
+  /// Each frame on its own (e.g. a rendered data set of random poses); false: the frames of
+  /// one input are a sequence, the target followed from one to the next.
+  bool independent = false;
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;

@@ -34,15 +34,22 @@ std::string FrameName(int index, const char* extension) {
   return "frame_" + number + extension;
 }
 
-RenderOptions ToRenderOptions(const RenderCommandOptions& options) {
+// The render of the options: the config's scene (if any), then the command line's camera,
+// noise, blur and light; --background replaces the scene's surface.
+RenderOptions ToRenderOptions(const RenderCommandOptions& options, const SceneConfig& scene) {
   RenderOptions render;
+  SceneConfig surface = scene;
+  if (!options.background_image.empty()) {
+    surface.background = options.background_image;
+    surface.background_origin = "--background";
+  }
+  surface.ApplyTo(&render);
   render.width = options.width;
   render.height = options.height;
   render.camera = RenderCamera(options.width, options.height, options.fx_px, options.kdu);
   render.noise_sigma = options.noise_sigma;
   render.blur_sigma_px = options.blur_sigma_px;
-  render.illumination_gradient = options.gradient;
-  render.background_image = options.background_image;
+  if (options.gradient > 0.0) render.illumination_gradient = options.gradient;
   return render;
 }
 
@@ -51,7 +58,10 @@ PoseSampling ToPoseSampling(const RenderCommandOptions& options) {
   sampling.min_distance_m = options.min_distance_m;
   sampling.max_distance_m = options.max_distance_m;
   sampling.max_tilt_deg = options.max_tilt_deg;
+  sampling.max_offset_m = options.max_offset_m;
   sampling.min_visible_length_px = options.min_visible_px;
+  sampling.crossings_in_view = options.crossings_margin_px >= 0.0;
+  sampling.crossings_margin_px = std::max(0.0, options.crossings_margin_px);
   return sampling;
 }
 
@@ -60,7 +70,7 @@ PoseSampling ToPoseSampling(const RenderCommandOptions& options) {
 bool IsRendererFile(const fs::directory_entry& entry) {
   if (!entry.is_regular_file()) return false;
   const std::string name = entry.path().filename().string();
-  if (name == "camera.xml" || name == "sequence.json") return true;
+  if (name == "camera.xml" || name == "sequence.json" || name == "target.yaml") return true;
   const std::string stem = entry.path().stem().string();
   const std::string extension = entry.path().extension().string();
   return (extension == ".png" || extension == ".json") && stem.size() > 6 &&
@@ -237,9 +247,13 @@ std::string TargetNameList() {
   return list;
 }
 
-// The target to render: the config's `target:` section if a config is given, else by name.
-LineTarget TargetOf(const RenderCommandOptions& options) {
-  return options.config.empty() ? TargetByName(options.target) : LoadConfig(options.config).target;
+// The target and scene to render: the config's `target:` and `scene:` sections if a config
+// is given, else the target by name on a plain surface.
+AppConfig ConfigOf(const RenderCommandOptions& options) {
+  if (!options.config.empty()) return LoadConfig(options.config);
+  AppConfig config;
+  config.target = TargetByName(options.target);
+  return config;
 }
 
 // Renders the sequence's frames, camera.xml and sequence.json into `dir`.
@@ -279,9 +293,10 @@ void RenderSequenceDataset(const RenderCommandOptions& options, const LineTarget
 }
 
 // Renders independent random poses, their truth and camera.xml into `dir`.
-void RenderRandomDataset(const RenderCommandOptions& options, const LineTarget& target,
+void RenderRandomDataset(const RenderCommandOptions& options, const AppConfig& config,
                          const fs::path& dir) {
-  const SceneRenderer renderer(target, ToRenderOptions(options));
+  const LineTarget& target = config.target;
+  const SceneRenderer renderer(target, ToRenderOptions(options, config.scene));
   const PoseSampling sampling = ToPoseSampling(options);
   const vpCameraParameters& camera = renderer.options().camera;
   SaveCameraFile((dir / "camera.xml").string(), camera, kCameraName,
@@ -333,6 +348,10 @@ void RenderCommandOptions::Check() const {
   RequireOption(max_tilt_deg >= 0.0 && max_tilt_deg <= 80.0, "--max-tilt-deg", max_tilt_deg,
                 "0 <= --max-tilt-deg <= 80");
   RequireOption(min_visible_px >= 0.0, "--min-visible-px", min_visible_px, "--min-visible-px >= 0");
+  RequireOption(max_offset_m >= 0.0 && max_offset_m <= 100.0, "--max-offset", max_offset_m,
+                "0 <= --max-offset <= 100");
+  RequireOption(crossings_margin_px >= -1.0 && crossings_margin_px <= 1000.0, "--crossings-margin",
+                crossings_margin_px, "-1 <= --crossings-margin <= 1000");
   if (!background_image.empty() && !fs::is_regular_file(background_image)) {
     throw std::invalid_argument("--background image '" + background_image + "' does not exist");
   }
@@ -344,13 +363,14 @@ vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu)
 
 int RenderDataset(const RenderCommandOptions& options) {
   options.Check();
-  const LineTarget target = TargetOf(options);
+  const AppConfig config = ConfigOf(options);
   StagedDataset staged(options.out_dir, options.overwrite);
   if (options.sequence.empty()) {
-    RenderRandomDataset(options, target, staged.dir());
+    RenderRandomDataset(options, config, staged.dir());
   } else {
-    RenderSequenceDataset(options, target, staged.dir());
+    RenderSequenceDataset(options, config.target, staged.dir());
   }
+  WriteFileAtomically(staged.dir() / "target.yaml", TargetYaml(config.target));
   staged.Commit();
   return options.count;
 }
@@ -359,7 +379,7 @@ int RunRender(int argc, char** argv) {
   RenderCommandOptions options;
   CLI::App cli(
       "Render a synthetic data set of a line target with ground truth: DIR/frame_NNNN.png, "
-      "DIR/frame_NNNN.json and DIR/camera.xml.",
+      "DIR/frame_NNNN.json, DIR/camera.xml and DIR/target.yaml.",
       "oalservo render");
   CLI::Option* sequence = cli.add_option(
       "--sequence", options.sequence,
@@ -370,7 +390,8 @@ int RunRender(int argc, char** argv) {
                                            " (four-line is an older name of four-line-board)")
                             ->capture_default_str();
   cli.add_option("--config", options.config,
-                 "YAML file whose 'target:' section gives the target (instead of --target)")
+                 "YAML file whose 'target:' section gives the target (instead of --target) and "
+                 "whose 'scene:' section the surface, light, shadow and clutter")
       ->excludes(target);
   CLI::Option* count = cli.add_option("--count", options.count,
                                       "number of frames (default with --sequence: " +
@@ -400,7 +421,17 @@ int RunRender(int argc, char** argv) {
       cli.add_option("--gradient", options.gradient,
                      "illumination fall-off across the image, [0, 0.9]")
           ->capture_default_str(),
-      cli.add_option("--background", options.background_image, "grey image shown around the board"),
+      cli.add_option("--background", options.background_image,
+                     "image of the surface the board lies on (replaces the config's "
+                     "scene.background)"),
+      cli.add_option("--max-offset", options.max_offset_m,
+                     "where the optical axis meets the board, at most this far from its centre, "
+                     "metres (larger: the board often partly out of view)")
+          ->capture_default_str(),
+      cli.add_option("--crossings-margin", options.crossings_margin_px,
+                     "a '#' target's four crossings at least this far inside the image, pixels; "
+                     "-1: not required")
+          ->capture_default_str(),
       cli.add_option("--min-distance", options.min_distance_m, "camera to board, metres")
           ->capture_default_str(),
       cli.add_option("--max-distance", options.max_distance_m, "camera to board, metres")

@@ -4,6 +4,8 @@
 //   DIR/frame_0000.png    8-bit grey frame
 //   DIR/frame_0000.json   ground truth: pose cMo, camera, one entry per target line
 //   DIR/camera.xml        ViSP camera file, camera "oal-render", perspectiveProjWithDistortion
+//   DIR/target.yaml       the target rendered, as a config's `target:` section (`oalservo pose
+//                         DIR` and `evaluate DIR` read it when no --config is given)
 //
 // With a sequence (`--sequence KIND`, scene/sequence.h) the frames are a reproducible camera
 // motion with per-frame effects instead of independent random poses, and two more things are
@@ -33,27 +35,35 @@ struct RenderCommandOptions {
   std::string sequence;
   /// A built-in target: one of TargetNames() (scene/scene.h), or "four-line", an older name
   /// of "four-line-board".
-  std::string target = "four-line";
-  /// YAML file whose `target:` section gives the target instead of `target` (app/config.h);
-  /// empty: use `target`. The data set's JSON then names the config's target.
+  std::string target = "four-line-a3";
+  /// YAML file whose `target:` section gives the target instead of `target`, and whose
+  /// `scene:` section the surface, light, shadow and clutter (app/config.h); empty: use
+  /// `target` and a plain grey surface. The data set's JSON then names the config's target.
   std::string config;
   int count = 10;          ///< frames, [1, 100000]
   std::uint64_t seed = 1;  ///< poses and noise are a function of it
   std::string out_dir;     ///< created if missing; required
   /// Replace the renderer files already in out_dir; false: such a folder is an error.
   bool overwrite = false;
-  int width = 640;               ///< pixels, [16, 8192]
-  int height = 480;              ///< pixels, [16, 8192]
-  double fx_px = 600.0;          ///< focal length, pixels (fy = fx), > 0
-  double kdu = 0.0;              ///< ViSP distortion, distorted -> undistorted; 0: none
-  double noise_sigma = 0.0;      ///< Gaussian noise, grey levels, [0, 100]
-  double blur_sigma_px = 0.0;    ///< Gaussian blur, pixels, [0, 20]
-  double gradient = 0.0;         ///< illumination fall-off across the image, [0, 0.9]
-  std::string background_image;  ///< grey image around the board; empty: uniform
-  double min_distance_m = 0.4;   ///< camera to board, metres, > 0
-  double max_distance_m = 0.9;   ///< metres, >= min_distance_m
-  double max_tilt_deg = 30.0;    ///< optical axis to board normal, degrees, [0, 80]
-  double min_visible_px = 0.0;   ///< each line's visible length at least this, pixels
+  int width = 640;             ///< pixels, [16, 8192]
+  int height = 480;            ///< pixels, [16, 8192]
+  double fx_px = 600.0;        ///< focal length, pixels (fy = fx), > 0
+  double kdu = 0.0;            ///< ViSP distortion, distorted -> undistorted; 0: none
+  double noise_sigma = 0.0;    ///< Gaussian noise, grey levels, [0, 100]
+  double blur_sigma_px = 0.0;  ///< Gaussian blur, pixels, [0, 20]
+  double gradient = 0.0;       ///< illumination fall-off across the image, [0, 0.9]
+  /// Grey image of the surface around the board (replaces the config's scene.background);
+  /// empty: the config's, else uniform.
+  std::string background_image;
+  double min_distance_m = 0.4;  ///< camera to board, metres, > 0
+  double max_distance_m = 0.9;  ///< metres, >= min_distance_m
+  double max_tilt_deg = 30.0;   ///< optical axis to board normal, degrees, [0, 80]
+  double min_visible_px = 0.0;  ///< each line's visible length at least this, pixels
+  /// Where the optical axis meets the board, at most this far from its centre, metres, >= 0.
+  double max_offset_m = 0.05;
+  /// A '#' target's four crossings (each square where two stripes cross) at least this far
+  /// inside the image, pixels; < 0: not required. [-1, 1000].
+  double crossings_margin_px = 10.0;
 
   /// Throws std::invalid_argument naming the command-line option (`--fx`), its value and
   /// the violated constraint.

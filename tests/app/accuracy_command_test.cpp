@@ -57,7 +57,7 @@ TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const json report = json::parse(test::ReadText(dir / "report.json"));
   EXPECT_EQ(report.at("status_counts"),
-            json({{"ok", 3}, {"not-enough-lines", 0}, {"not-identifiable", 0}, {"degenerate", 0}}));
+            json({{"ok", 3}, {"not-found", 0}, {"model-mismatch", 0}, {"jump", 0}}));
   EXPECT_EQ(report.at("posed"), 3);
   ASSERT_TRUE(report.contains("roll_error_deg_median"));
   EXPECT_LE(report.at("roll_error_deg_median").get<double>(),
@@ -69,22 +69,23 @@ TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
 // A section the command would ignore is an error naming the file, the line and the section.
 TEST(AccuracyCommands, ConfigSectionsTheyDoNotReadAreRejected) {
   test::TestDir dir;
-  const std::string config = dir / "with-target.yaml";
-  test::WriteText(config, "detector:\n  step_px: 5\ntarget: {name: two-line}\n");
+  const std::string config = dir / "with-camera.yaml";
+  test::WriteText(config, "detector:\n  step_px: 5\ncamera: {px: 500, py: 500}\n");
   const test::OalservoRun pose =
       test::RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'");
   EXPECT_EQ(pose.exit_code, 1);
-  EXPECT_THAT(pose.err,
-              HasSubstr(config + ":3: section 'target' is not used by oalservo pose-accuracy "
-                                 "(it reads: detector, pose)"));
+  EXPECT_THAT(pose.err, HasSubstr(config + ":3: section 'camera' is not used by oalservo "
+                                           "pose-accuracy (it reads: target, detector, pose, "
+                                           "tracking, scene)"));
   EXPECT_TRUE(pose.out.empty());
   const test::OalservoRun detect =
       test::RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'");
   EXPECT_EQ(detect.exit_code, 1);
   EXPECT_THAT(detect.err,
-              HasSubstr(config + ":3: section 'target' is not used by oalservo "
-                                 "detect-accuracy (it reads: detector); the target is chosen "
-                                 "with --target"));
+              HasSubstr(config + ":3: section 'camera' is not used by oalservo "
+                                 "detect-accuracy (it reads: detector, target, tracking, scene); "
+                                 "it renders the target with the camera of its command-line "
+                                 "options"));
   test::WriteText(config, "pose:\n  max_residual_px: 1.0\n");
   EXPECT_THAT(test::RunOalservo(dir, "detect-accuracy --frames 1 --config '" + config + "'").err,
               HasSubstr(":1: section 'pose' is not used by oalservo detect-accuracy"));
@@ -92,6 +93,14 @@ TEST(AccuracyCommands, ConfigSectionsTheyDoNotReadAreRejected) {
   test::WriteText(config, "pose:\n  max_residual: 1.0\n");
   EXPECT_THAT(test::RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'").err,
               HasSubstr(config + ":2:"));
+  // The target: a two-line one has no pose; the config's and --target together are refused.
+  test::WriteText(config, "target: {name: two-line}\n");
+  EXPECT_THAT(test::RunOalservo(dir, "pose-accuracy --frames 1 --config '" + config + "'").err,
+              HasSubstr("'two-line': 2 lines, a '#' target needs 4"));
+  const test::OalservoRun both = test::RunOalservo(
+      dir, "pose-accuracy --frames 1 --target four-line-a4 --config '" + config + "'");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_THAT(both.err, HasSubstr("--target four-line-a4 and the target: section of"));
 }
 
 // --out is checked before the evaluation: an error, and no table printed (it used to come

@@ -20,10 +20,12 @@
 namespace oal::test {
 
 /// Options rendering `count` frames of `width`x`height` into `out_dir` from `seed`, with fx
-/// scaled from 600 px at 640x480 (the full-size field of view); the rest as RenderCommandOptions.
+/// scaled from 600 px at 640x480 (the full-size field of view), of the 2 m four-line board;
+/// the rest as RenderCommandOptions.
 inline RenderCommandOptions ScaledRender(const std::string& out_dir, int count, std::uint64_t seed,
                                          int width, int height) {
   RenderCommandOptions options;
+  options.target = "four-line-board";  // the paper's condition: lines traverse the image
   options.out_dir = out_dir;
   options.count = count;
   options.seed = seed;
@@ -37,6 +39,7 @@ inline RenderCommandOptions ScaledRender(const std::string& out_dir, int count, 
 inline RenderCommandOptions SequenceRender(const std::string& out_dir, const std::string& sequence,
                                            int count, std::uint64_t seed) {
   RenderCommandOptions options;
+  options.target = "four-line-board";
   options.out_dir = out_dir;
   options.sequence = sequence;
   options.count = count;

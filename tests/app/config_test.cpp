@@ -152,11 +152,11 @@ TEST(Config, OutOfRangeValueNamesFileLineAndField) {
 TEST(Config, SectionsOtherThanTheKnownOnesAreRejected) {
   EXPECT_EQ(ErrorOf("detector: {}\ndetectr:\n  step_px: 5\n"),
             "cfg.yaml:2: section 'detectr' is unknown (known: detector, target, pose, camera, "
-            "robot, servo, goal, target_pose, source, output)");
+            "robot, servo, goal, target_pose, source, output, tracking, scene)");
   EXPECT_EQ(ErrorOf("render:\n  gain: 0.5\n"),
             "cfg.yaml:1: section 'render' is not supported by this version of oalservo "
             "(supported: detector, target, pose, camera, robot, servo, goal, target_pose, source, "
-            "output)");
+            "output, tracking, scene)");
   EXPECT_THAT(ErrorOf("- detector\n"), HasSubstr("cfg.yaml:1: the top level must be a map"));
   EXPECT_THAT(ErrorOf("detector: 5\n"), HasSubstr("cfg.yaml:1: section 'detector' must be a map"));
 }
@@ -213,9 +213,9 @@ void ExpectSameTarget(const LineTarget& a, const LineTarget& b) {
   }
 }
 
-TEST(ConfigTarget, DefaultIsTheFourLineTargetAndSectionsReplaceIt) {
-  ExpectSameTarget(ParseConfig("", "cfg.yaml").target, FourLineTarget());
-  ExpectSameTarget(ParseConfig("target:\n", "cfg.yaml").target, FourLineTarget());
+TEST(ConfigTarget, DefaultIsTheA3SheetAndSectionsReplaceIt) {
+  ExpectSameTarget(ParseConfig("", "cfg.yaml").target, FourLineA3Target());
+  ExpectSameTarget(ParseConfig("target:\n", "cfg.yaml").target, FourLineA3Target());
   ExpectSameTarget(ParseConfig("target: {name: two-line}\n", "cfg.yaml").target, TwoLineTarget());
   ExpectSameTarget(ParseConfig("target:\n  name: four-line\n", "cfg.yaml").target,
                    FourLineTarget());

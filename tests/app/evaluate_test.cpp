@@ -94,8 +94,10 @@ std::string VideoDir(const test::TestDir& dir, const std::string& frames_dir,
                      const std::string& name, const std::vector<std::string>& videos) {
   const fs::path videos_dir = dir / name;
   fs::create_directories(videos_dir);
-  fs::copy_file(frames_dir + "/camera.xml", videos_dir / "camera.xml",
-                fs::copy_options::overwrite_existing);
+  for (const char* companion : {"camera.xml", "target.yaml"}) {
+    fs::copy_file(frames_dir + "/" + companion, videos_dir / companion,
+                  fs::copy_options::overwrite_existing);
+  }
   for (const std::string& video : videos)
     WriteVideo(frames_dir, kFrames, (videos_dir / video).string());
   return videos_dir.string();
