@@ -6,7 +6,7 @@
 //     paper: true        # start from DetectorOptions::Paper() instead of the defaults
 //     step_px: 5
 //
-//   target: {name: four-line}   # a shipped target (scene/scene.h TargetByName), or in full:
+//   target: {name: four-line-a3}   # a shipped target (scene/scene.h TargetNames), or in full:
 //   target:              # oal::LineTarget (config/four-line-board.yaml documents the keys)
 //     name: my-board     # required
 //     board_width_m: 0.4 # required, > 0; the board is centred on the object origin
@@ -21,6 +21,10 @@
 //   pose:                # oal::PoseOptions' tunables (config/pose.yaml documents the keys);
 //     max_residual_px: 2.0   # the camera, lines_undistorted and the image size come from the
 //                            # command (--camera, the detector, the frame), not from here
+//
+//   tracking: {scan: image}  # oal::TargetTrackerOptions (config/pose.yaml documents the keys)
+//   scene:                   # SceneConfig: what a rendered camera sees around the target
+//     background: bench.png  # (config/servo-sim.yaml, config/scene-dark-table.yaml)
 //
 // The servo app's sections (config/servo-sim.yaml documents every key):
 //

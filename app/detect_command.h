@@ -2,14 +2,16 @@
 // a V4L2 camera, one JSON object per frame (JSON Lines).
 //
 //   {"frame":0,"source":"x.png","width":640,"height":480,"time_us":312.5,
-//    "coordinates":"image","lines":[{"rho":..,"theta":..,"votes":..,"count":..,"borders":..,
+//    "coordinates":"image","scan":{"mode":"image","region":[]},
+//    "lines":[{"rho":..,"theta":..,"votes":..,"count":..,"borders":..,
 //    "support":..,"width":..,"end_a":[u,v],"end_b":[u,v]}, ...]}
 //
 // `frame` is the frame's position in the run, from 0, counted over all inputs in order (not
 // the number in the file name, which `compare` and `edge-reference` use: match by `source`,
 // the image path or "<video>#<index>"). `coordinates` is "undistorted" when a camera with
 // distortion (kdu != 0) was given: the lines are then those an ideal pinhole camera would see
-// (detector.h).
+// (detector.h). `scan` is always the paper's scan of the whole image's concentric borders
+// (`oalservo pose` writes where it looked for the target in the same key).
 #pragma once
 
 #include <iosfwd>

@@ -1,25 +1,36 @@
 // `oalservo pose`: the camera pose from the four-line target (servo/pose.h) in every frame of
-// the same inputs as `oalservo detect`, one JSON object per frame (JSON Lines):
+// the same inputs as `oalservo detect`, found by the target tracker (servo/target_tracker.h),
+// one JSON object per frame (JSON Lines):
 //
 //   {"frame":0,"source":"x.png","width":640,"height":480,"status":"ok","message":"",
-//    "cMo":{"t_m":[x,y,z],"thetau_rad":[tux,tuy,tuz]},
+//    "pose_status":"ok","cMo":{"t_m":[x,y,z],"thetau_rad":[tux,tuy,tuz]},
 //    "roll_deg":..,"pitch_deg":..,"yaw_deg":..,"line1_roll_deg":..,
-//    "plane_angles_deg":[a1,a2],"residual_px":..,"method":"lagrange","from_previous":false,
+//    "plane_angles_deg":[a1,a2],"residual_px":..,"covariance":[[..6..],..6 rows..],
+//    "method":"lagrange","from_previous":false,
 //    "lines":[i1,i2,i3,i4],"coordinates":"image","corners_px":[[u,v],[u,v],[u,v],[u,v]],
-//    "time_us":{"detect":..,"pose":..}}
+//    "scan":{"mode":"target","source":"middle-cell","borders":16,"candidates":1,
+//            "region":[[u,v],...]},
+//    "stripe_agreement":..,"time_us":{"find":..,"detect":..,"pose":..}}
 //
-// status is PoseStatus's ToString() ("ok", "not-enough-lines", "not-identifiable",
-// "degenerate") and message its reason ("" when ok). Every object has every key: cMo,
-// roll_deg ... from_previous are null unless the status is ok; lines[k] is the index, in the
-// detector's lines of that frame, of target line k + 1 (-1 when not identified); corners_px
-// (corner k = line k+1 ∩ line k+2, in `coordinates`: "undistorted" when the detector corrects
-// distortion, else "image") is null until the lines are identified. Angles are PoseResult's.
+// status is TargetStatus's ToString() ("ok", "not-found", "model-mismatch", "jump") and
+// message its reason ("" when ok); pose_status is the last estimate's PoseStatus ("ok",
+// "not-enough-lines", "not-identifiable", "degenerate"). Every object has every key: cMo,
+// roll_deg ... from_previous (covariance included) are null unless the status is ok;
+// lines[k] is the index, in the detector's lines of that frame, of target line k + 1 (-1 when
+// not identified); corners_px (corner k = line k+1 ∩ line k+2, in `coordinates`:
+// "undistorted" when the detector corrects distortion, else "image") is null until the lines
+// are identified. Angles are PoseResult's. scan says where the target was looked for
+// (ScanJson, app/json_io.h: mode "target" or "image"; source "prior", "middle-cell", "image"
+// or "none"; region the outermost border scanned, empty for the whole image);
+// stripe_agreement is the model check's worst fraction over lines 1-4 (null when no pose was
+// estimated).
 //
 // The pose needs the camera's intrinsics: --camera FILE, or, without it, the camera.xml that
 // `oalservo render` writes next to the frames (the directory of the first input), which is
 // then used with a warning saying so. Without either the command fails before any output.
-// Within one input the previous frame's pose, when its status was ok, seeds the next frame's
-// (so a sequence does not flip between the two poses of a planar target).
+// Within one input the last accepted pose is the tracker's prior for the next frame (the
+// borders it scans, the lines it seeds, the jump check; so a sequence does not flip between
+// the two poses of a planar target); with `independent` every frame is found on its own.
 #pragma once
 
 #include <iosfwd>
@@ -33,8 +44,9 @@ namespace oal {
 /// FrameCommandOptions: inputs; camera_name from the camera file; out_path (empty: the
 /// stream passed to EstimatePoses()); annotate_dir (pose_0000.png...); max_frames.
 struct PoseCommandOptions : FrameCommandOptions {
-  /// YAML configuration: `detector:`, `target:` (default four-line) and `pose:` sections
-  /// (config/detector.yaml, config/four-line-board.yaml, config/pose.yaml); empty: none.
+  /// YAML configuration: `detector:`, `target:`, `pose:` and `tracking:` sections
+  /// (config/detector.yaml, config/four-line-a3.yaml, config/pose.yaml); empty: the
+  /// target.yaml `oalservo render` writes next to the frames, else the defaults (the A3 sheet).
   std::string config_path;
   /// ViSP camera XML; empty: camera.xml in the first input's directory, else an error.
   std::string camera_path;

@@ -11,11 +11,13 @@
 // One iteration:
 //   1. stop (interrupted) if the interrupt flag is set, (time-limit) past servo.max_time_s;
 //   2. render the frame from the true cMo (camera intrinsics, kdu, noise and blur from the
-//      config), detect (OalDetector with the camera: undistorted lines; its accumulator list
-//      seeded with the target's lines projected from the odometry prediction of step 4),
-//      EstimatePose seeded by that prediction (after a move: the previous estimate carried by
-//      the motion, so that a move that rolls the camera far keeps the lines' identities);
-//   3. stop (target-lost) when the pose status is not ok;
+//      config, the scene around the target from `scene:`), find the target and its pose with
+//      the TargetPoseTracker (servo/target_tracker.h, config `tracking:`) given the odometry
+//      prediction of step 4 as its prior: the borders it scans on the target's plane, the
+//      lines it seeds in the accumulator list and the pose's starting point (after a move:
+//      the previous estimate carried by the motion, so that a move that rolls the camera far
+//      keeps the lines' identities);
+//   3. stop (target-lost) when the tracker has no pose, or refuses one (model check);
 //   4. stop (pose-jump) when the estimate disagrees with the previous estimate carried by the
 //      robot's own motion (odometry: predicted cMo = wMc⁻¹·wMc_prev·cMo_prev) by more than
 //      servo.max_pose_jump_m or max_pose_jump_deg;

@@ -52,8 +52,8 @@ struct DetectorOptions {
   int min_contrast = 40;
   /// Runs narrower than this (along the border) are noise or dead pixels, pixels. Range (0, 1000].
   double min_width_px = 2.0;
-  /// Widest line, measured across the line, pixels (the four-line target's 30 mm line is
-  /// 60 px wide at 0.3 m). Range [min_width_px, 1000].
+  /// Widest line, measured across the line, pixels (the 2 m board's 30 mm line is 60 px wide
+  /// at 0.3 m, the A3 sheet's 24 mm line 48 px). Range [min_width_px, 1000].
   double max_width_px = 80.0;
   /// A line crossing a border at angle a gives a run of width / sin(a): runs up to
   /// max_width_px / sin(min_crossing_angle_deg) are kept (NOTES 2). 90 keeps the paper's

@@ -3,9 +3,10 @@
 // a pure function of (kind, frame count, seed).
 //
 // Every sequence uses a 640x480 camera with px = py = 600 and the principal point at the
-// centre, Gaussian noise sigma = 5 grey levels and blur sigma = 1 px, and by default the
-// four-line target (FourLineTarget(): the scenarios are designed around its '#', in
-// particular which line leaves the image in leave-reenter and where the occluder passes).
+// centre, Gaussian noise sigma = 5 grey levels and blur sigma = 1 px, and by default the 2 m
+// four-line board (FourLineTarget(), "four-line-board": the scenarios are designed around its
+// '#', in particular which line leaves the image in leave-reenter and where the occluder
+// passes; another target, e.g. a sheet, is seen from the same camera poses).
 // Motion is given per frame, not per second: speeds in pixels per frame do not depend on the
 // frame count, while one-off events (the occluder's pass, the illumination change, the pan
 // out and back) are placed relative to the frame count. Scenarios (see MakeSequence for the

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Issue 3's comparison: renders the six tracking sequences and ViSP's real line/ sequence's
-# reference, runs `oalservo compare` on each and gathers the tables in out/compare/.
+# Issue 3's comparison: renders the six tracking sequences on the 2 m four-line board (the
+# target they are made for; render's default is the A3 sheet) and ViSP's real line/
+# sequence's reference, runs `oalservo compare` on each and gathers the tables in out/compare/.
 #   scripts/compare-sequences.sh [FRAMES] [SEED]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,7 +13,8 @@ mkdir -p "$out"
 summary="$out/summary.md"
 : > "$summary.tmp"
 for kind in slow fast occlusion illumination leave-reenter distortion; do
-  "$oal" render --sequence "$kind" --count "$frames" --seed "$seed" --out "$out/$kind/frames" --overwrite > /dev/null
+  "$oal" render --sequence "$kind" --target four-line-board --count "$frames" --seed "$seed" \
+    --out "$out/$kind/frames" --overwrite > /dev/null
   camera=()
   [ "$kind" = distortion ] && camera=(--camera "$out/$kind/frames/camera.xml")
   "$oal" compare "$out/$kind/frames" "${camera[@]}" --out "$out/$kind" > /dev/null

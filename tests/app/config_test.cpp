@@ -332,8 +332,9 @@ TEST(ConfigTarget, MalformedLinesNameFileLineAndKey) {
 
 TEST(ConfigTarget, MalformedBoardNamesFileLineAndKey) {
   EXPECT_EQ(ErrorOf("target: {name: five-line}\n"),
-            "cfg.yaml:1: 'target.name' = 'five-line' is not a shipped target (two-line, "
-            "four-line); describe it in full with board_width_m, board_height_m and lines");
+            "cfg.yaml:1: 'target.name' = 'five-line' is not a shipped target (four-line-a3, "
+            "four-line-a4, four-line-letter, four-line-board, two-line); describe it in full "
+            "with board_width_m, board_height_m and lines");
   EXPECT_THAT(ErrorOf("target:\n  name: four-line\n  board_grey: 200\n"),
               HasSubstr("cfg.yaml:3: key 'target.board_grey' needs a full target description"));
   EXPECT_THAT(ErrorOf("target:\n  board_width_m: 1\n"),
