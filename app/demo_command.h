@@ -1,6 +1,9 @@
-// `oalservo demo`: one frame of a cheap camera (wide lens, noise, blur, uneven light)
-// rendered, detected with point undistortion and compared with the truth. Writes
-// DIR/frame.png (raw), DIR/demo.png (lines drawn), DIR/lines.json and prints a table.
+// `oalservo demo`: one rendered frame, its lines detected and compared with the truth. By
+// default an A3 sheet lying on a photograph of a bench among other sheets and tools, found
+// with the target tracker (the sheet's middle cell, borders on its plane) and its pose
+// estimated; `--target four-line-board` is the paper's condition, the 2 m board filling the
+// view of a cheap wide lens, scanned on the image's borders. Writes DIR/frame.png (raw),
+// DIR/demo.png (lines drawn), DIR/lines.json and prints a table.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +16,7 @@ namespace oal {
 struct DemoCommandOptions {
   std::string out_dir = "out/demo";  ///< created if missing
   std::uint64_t seed = 1;            ///< pose and noise
+  std::string target = "four-line-a3";  ///< one of TargetNames() (scene/scene.h)
 
   void Check() const;
 };
@@ -31,6 +35,9 @@ struct DemoReport {
   int detected = 0;  ///< lines the detector returned
   double time_us = 0.0;
   std::vector<DemoMatch> matches;  ///< one per visible target line
+  /// The target tracker's status ("ok", "not-found" ...) for a four-line target; empty for
+  /// the two-line board (detected on the image's borders, no pose).
+  std::string pose_status;
 };
 
 /// Renders, detects, compares and writes the files; prints the table to `out` (target lines

@@ -56,6 +56,9 @@ Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,
               {"height", frame.gray.rows},
               {"time_us", time_us},
               {"coordinates", undistorted ? "undistorted" : "image"},
+              // detect scans the paper's concentric borders of the whole image (as `pose`
+              // writes it: an empty region is the whole image); `pose` scans the target's.
+              {"scan", Json{{"mode", "image"}, {"region", Json::array()}}},
               {"lines", std::move(json_lines)}};
 }
 

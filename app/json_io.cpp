@@ -73,4 +73,14 @@ void WriteText(std::ostream& sink, const std::string& text) {
   if (!sink) throw std::runtime_error("cannot write the output");
 }
 
+Json ScanJson(const TargetFrame& result, ScanMode mode) {
+  Json region = Json::array();
+  for (const Point2d& p : result.region) region.push_back(PointJson(p));
+  return Json{{"mode", ToString(mode)},
+              {"source", ToString(result.source)},
+              {"borders", result.borders},
+              {"candidates", result.candidates},
+              {"region", std::move(region)}};
+}
+
 }  // namespace oal

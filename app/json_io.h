@@ -11,6 +11,7 @@
 
 #include "detector/detector.h"
 #include "scene/scene.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 
@@ -29,6 +30,9 @@ Json TruthLineJson(const TruthLine& line);
 Json PoseJson(const vpHomogeneousMatrix& cMo);
 /// {model, px, py, u0, v0, kud, kdu, width, height}
 Json CameraJson(const vpCameraParameters& camera, int width, int height);
+/// Where the target tracker looked for the frame's target: {mode, source, borders,
+/// candidates, region (the outermost border scanned, image pixels; empty: the whole image)}.
+Json ScanJson(const TargetFrame& result, ScanMode mode);
 
 /// Writes `record` as one line of JSON Lines; flushes when asked; throws
 /// std::runtime_error if the stream failed (disk full, closed pipe).

@@ -73,16 +73,6 @@ Json Vector3(double x, double y, double z) {
   return Json::array({x, y, z});
 }
 
-Json ScanJson(const TargetFrame& result, ScanMode mode) {
-  Json region = Json::array();
-  for (const Point2d& p : result.region) region.push_back(PointJson(p));
-  return Json{{"mode", ToString(mode)},
-              {"source", ToString(result.source)},
-              {"borders", result.borders},
-              {"candidates", result.candidates},
-              {"region", std::move(region)}};
-}
-
 Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFrame& result,
                ScanMode mode) {
   const PoseResult& pose = result.pose;

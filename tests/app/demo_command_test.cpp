@@ -34,10 +34,52 @@ TEST(Demo, WritesThePicturesTheJsonAndATable) {
   const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
   EXPECT_EQ(json.at("truth").size(), 4u);
   EXPECT_EQ(json.at("detected").size(), static_cast<std::size_t>(report.detected));
-  EXPECT_EQ(json.at("camera").at("kdu"), 0.33);
+  EXPECT_EQ(json.at("camera").at("kdu"), 0.15);
+  EXPECT_EQ(json.at("target"), "four-line-a3");
   EXPECT_THAT(out.str(), HasSubstr("angle err(deg)"));
   EXPECT_THAT(out.str(), HasSubstr("target lines found"));
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// The default scene is the A3 sheet on a bench, found without a prior and posed; the JSON says
+// which region was scanned.
+TEST(Demo, FindsTheSheetAndItsPose) {
+  test::TestDir dir;
+  DemoCommandOptions options;
+  options.out_dir = dir / "demo";
+  std::ostringstream out;
+  const DemoReport report = RunDemoScene(options, out);
+  EXPECT_EQ(report.pose_status, "ok") << out.str();
+  for (const DemoMatch& match : report.matches) EXPECT_GE(match.detected_index, 0);
+  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(json.at("scan").at("mode"), "target");
+  EXPECT_EQ(json.at("scan").at("region").size() >= 4, true);
+  EXPECT_THAT(out.str(), HasSubstr("from the truth"));
+}
+
+// The paper's condition stays available: the 2 m board through a cheap wide lens.
+TEST(Demo, TheBoardThroughACheapLens) {
+  test::TestDir dir;
+  DemoCommandOptions options;
+  options.out_dir = dir / "demo";
+  options.target = "four-line-board";
+  std::ostringstream out;
+  const DemoReport report = RunDemoScene(options, out);
+  EXPECT_EQ(report.matches.size(), 4u);
+  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(json.at("camera").at("kdu"), 0.33);
+  EXPECT_EQ(json.at("target"), "four-line-board");
+}
+
+TEST(Demo, AnUnknownTargetIsAnErrorNamingTheOption) {
+  test::TestDir dir;
+  DemoCommandOptions options;
+  options.out_dir = dir / "demo";
+  options.target = "four-line-a5";
+  std::ostringstream out;
+  EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>([&] { RunDemoScene(options, out); }),
+              HasSubstr("--target"));
+  EXPECT_FALSE(fs::exists(dir / "demo"));
 }
 
 // The table numbers the target's lines 1-4, as the docs and `oalservo target` do.

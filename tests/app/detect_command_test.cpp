@@ -40,6 +40,9 @@ void ExpectWellFormedFrame(const json& frame, int index, int width, int height,
   EXPECT_EQ(frame.at("height").get<int>(), height);
   EXPECT_GE(frame.at("time_us").get<double>(), 0.0);
   EXPECT_EQ(frame.at("coordinates"), coordinates);
+  // detect scans the whole image (the paper's borders); the JSON says so.
+  EXPECT_EQ(frame.at("scan").at("mode"), "image");
+  EXPECT_TRUE(frame.at("scan").at("region").empty());
   ASSERT_TRUE(frame.at("lines").is_array());
   for (const json& line : frame.at("lines")) {
     for (const char* key : {"rho", "theta", "votes", "count", "borders", "support", "width"}) {
