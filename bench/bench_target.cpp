@@ -1,0 +1,181 @@
+// Detect + pose of a printed A3 sheet (four-line-a3) on a bench, through TargetPoseTracker:
+// a first frame (no prior: the sheet finder, its candidates' borders, the pose, the model
+// check) and tracked frames (borders from the last pose). 640x480, px = 600, kdu 0.15
+// corrected, noise 2-8, blur 0.5-1.5, vignetting, the sheet's shadow and printed marks,
+// clutter, on photographs of Debian's visp-images-data (uniform grey when it is missing).
+// Frames are rendered once, outside the timed loops.
+//   build/bench/bench_target --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+#include <visp3/core/vpImageConvert.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+#include "servo/pbvs.h"
+#include "servo/target_tracker.h"
+
+namespace oal {
+namespace {
+
+constexpr int kFrames = 32;
+
+// Three of the photographs the accuracy commands use as benches (app/accuracy_frames.cpp).
+std::vector<std::shared_ptr<const vpImage<unsigned char>>> BenchPhotos() {
+  const std::string root = "/usr/share/visp-images-data/ViSP-images";
+  std::vector<std::shared_ptr<const vpImage<unsigned char>>> photos;
+  for (const char* name : {"Klimt/Klimt.pgm", "mire-2/image.0001.pgm", "cube/image.0000.pgm"}) {
+    const std::string path = root + "/" + name;
+    if (!std::filesystem::is_regular_file(path)) continue;
+    const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (grey.empty()) continue;
+    auto photo = std::make_shared<vpImage<unsigned char>>();
+    vpImageConvert::convert(grey, *photo);
+    photos.push_back(std::move(photo));
+  }
+  if (photos.empty()) photos.push_back(nullptr);  // a uniform grey surface
+  return photos;
+}
+
+RenderOptions BenchRender(std::shared_ptr<const vpImage<unsigned char>> photo, int index) {
+  RenderOptions render;
+  render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  render.background = std::move(photo);
+  render.vignetting = 0.3;
+  render.shadow_darkness = 0.3;
+  render.paper_texture_grey = 3.0;
+  render.annotations = true;
+  render.clutter_sheets = 2;
+  render.clutter_objects = 4;
+  render.clutter_reach_m = 0.25;
+  render.scene_seed = 1 + static_cast<std::uint64_t>(index);
+  return render;
+}
+
+FrameEffects EffectsOf(int frame) {
+  FrameEffects effects;
+  effects.noise_sigma = 2.0 + 6.0 * ((frame * 37) % kFrames) / (kFrames - 1.0);
+  effects.blur_sigma_px = 0.5 + ((frame * 11) % kFrames) / (kFrames - 1.0);
+  return effects;
+}
+
+struct TargetInputs {
+  vpCameraParameters camera;
+  std::vector<RenderedFrame> still;   ///< random poses, each frame on its own
+  std::vector<RenderedFrame> moving;  ///< a smooth sweep between two random poses
+};
+
+const TargetInputs& Inputs() {
+  static const TargetInputs inputs = [] {
+    TargetInputs built;
+    const LineTarget target = FourLineA3Target();
+    std::vector<SceneRenderer> renderers;
+    int index = 0;
+    for (auto& photo : BenchPhotos()) renderers.emplace_back(target, BenchRender(photo, index++));
+    built.camera = renderers.front().options().camera;
+    PoseSampling sampling;
+    sampling.min_distance_m = 0.3;
+    sampling.max_distance_m = 0.85;
+    sampling.max_tilt_deg = 30.0;
+    sampling.max_offset_m = 0.1;
+    sampling.crossings_in_view = true;
+    std::uint64_t state = 1;
+    for (int frame = 0; frame < kFrames; ++frame) {
+      const SceneRenderer& renderer = renderers[frame % renderers.size()];
+      built.still.push_back(
+          renderer.Render(SamplePose(renderer, sampling, &state), frame, EffectsOf(frame)));
+    }
+    // About 3 mm and 0.3 deg a frame: a camera on an arm moving at a walking hand's pace.
+    sampling.min_distance_m = 0.45;
+    sampling.max_distance_m = 0.6;
+    sampling.max_tilt_deg = 15.0;
+    const SceneRenderer& renderer = renderers.front();
+    const vpHomogeneousMatrix from = SamplePose(renderer, sampling, &state);
+    const vpHomogeneousMatrix to =
+        vpHomogeneousMatrix(0.05, -0.03, 0.04, 0.05, -0.05, 0.15) * from;
+    const vpColVector xi = Se3Log(to * from.inverse());
+    for (int frame = 0; frame < kFrames; ++frame) {
+      const vpHomogeneousMatrix cMo = Se3Exp(xi * (frame / (kFrames - 1.0))) * from;
+      built.moving.push_back(renderer.Render(cMo, 100 + frame, EffectsOf(frame)));
+    }
+    return built;
+  }();
+  return inputs;
+}
+
+TargetPoseTracker MakeTracker(const TargetInputs& inputs) {
+  DetectorOptions detector;
+  PoseOptions pose;
+  pose.camera = inputs.camera;
+  pose.image_width = 640;
+  pose.image_height = 480;
+  pose.compute_covariance = false;
+  return TargetPoseTracker(FourLineA3Target(), inputs.camera, detector, pose);
+}
+
+void Report(benchmark::State& state, int ok, double find_us, double detect_us, double pose_us) {
+  const double n = static_cast<double>(state.iterations());
+  state.counters["ok_fraction"] = ok / n;
+  state.counters["find_us"] = find_us / n;
+  state.counters["detect_us"] = detect_us / n;
+  state.counters["pose_us"] = pose_us / n;
+}
+
+// A frame with no prior: what `oalservo pose` does on one image.
+void TargetFirstFrame(benchmark::State& state) {
+  const TargetInputs& inputs = Inputs();
+  TargetPoseTracker tracker = MakeTracker(inputs);
+  std::size_t frame = 0;
+  int ok = 0;
+  double find_us = 0, detect_us = 0, pose_us = 0;
+  for (auto _ : state) {
+    tracker.Reset();
+    const TargetFrame& result = tracker.Track(ViewOf(inputs.still[frame].image));
+    ok += result.status == TargetStatus::kOk;
+    find_us += result.find_us;
+    detect_us += result.detect_us;
+    pose_us += result.pose_us;
+    benchmark::DoNotOptimize(result.pose.cMo.data);
+    frame = (frame + 1) % inputs.still.size();
+  }
+  Report(state, ok, find_us, detect_us, pose_us);
+}
+
+// Frames of a moving camera, each tracked from the last pose; the sequence's first frame (found
+// afresh) is not timed.
+void TargetTracked(benchmark::State& state) {
+  const TargetInputs& inputs = Inputs();
+  TargetPoseTracker tracker = MakeTracker(inputs);
+  tracker.Track(ViewOf(inputs.moving.front().image));
+  std::size_t frame = 1;
+  int ok = 0;
+  double find_us = 0, detect_us = 0, pose_us = 0;
+  for (auto _ : state) {
+    const TargetFrame& result = tracker.Track(ViewOf(inputs.moving[frame].image));
+    ok += result.status == TargetStatus::kOk;
+    find_us += result.find_us;
+    detect_us += result.detect_us;
+    pose_us += result.pose_us;
+    benchmark::DoNotOptimize(result.pose.cMo.data);
+    if (++frame == inputs.moving.size()) {
+      state.PauseTiming();
+      tracker.Reset();
+      tracker.Track(ViewOf(inputs.moving.front().image));
+      frame = 1;
+      state.ResumeTiming();
+    }
+  }
+  Report(state, ok, find_us, detect_us, pose_us);
+}
+
+BENCHMARK(TargetFirstFrame)->Unit(benchmark::kMicrosecond);
+BENCHMARK(TargetTracked)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace oal
+
+BENCHMARK_MAIN();
