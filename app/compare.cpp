@@ -22,7 +22,9 @@
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
 #include "app/config.h"
+#include "app/accuracy_frames.h"  // ConfigHasSection
 #include "app/detector_accuracy.h"
+#include "app/frame_command.h"     // CompanionFile
 #include "app/image_source.h"
 #include "app/truth_file.h"
 #include "detector/detector.h"
@@ -30,6 +32,7 @@
 #include "detector/options.h"  // RequireOption
 #include "detector/tracker.h"
 #include "scene/scene.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {
@@ -203,6 +206,46 @@ class OalMethod : public LineMethod {
  private:
   OalDetector detector_;
   const std::vector<DetectedLine>* last_ = nullptr;
+};
+
+// The target tracker (servo/target_tracker.h): the four lines of the pose it accepts, in the
+// order of the target's lines; nothing in a frame without an accepted pose (a wrong pose is
+// refused, not scored). Its failures are the frames without a pose.
+class OalTargetMethod : public LineMethod {
+ public:
+  OalTargetMethod(const AppConfig& config, const vpCameraParameters& camera, int width,
+                  int height)
+      : tracker_(config.target, camera, config.detector, PoseOf(config, camera, width, height),
+                 config.tracking) {}
+  std::string Name() const override { return "oal-target"; }
+  bool Undistorted() const override { return tracker_.detector().Undistorts(); }
+  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
+    const TargetFrame& frame = tracker_.Track(ViewOf(image));
+    lines->clear();
+    if (frame.status != TargetStatus::kOk) {
+      ++failures_;
+      return;
+    }
+    for (const int index : frame.pose.line_index) {
+      lines->push_back(tracker_.lines()[static_cast<std::size_t>(index)].line);
+    }
+  }
+  int failures() const override { return failures_; }
+  int reinitialisations() const override { return 0; }
+
+ private:
+  static PoseOptions PoseOf(const AppConfig& config, const vpCameraParameters& camera, int width,
+                            int height) {
+    PoseOptions pose = config.pose;
+    pose.camera = camera;
+    pose.image_width = width;
+    pose.image_height = height;
+    pose.compute_covariance = false;
+    return pose;
+  }
+
+  TargetPoseTracker tracker_;
+  int failures_ = 0;
 };
 
 // Our temporal tracker: the lines it holds in each frame (lost ones excluded), best
@@ -832,6 +875,36 @@ std::vector<TargetLineTruth> LoadTruthJson(const std::string& path) {
   return lines;
 }
 
+namespace {
+
+// The oal-target method when the frames show a known four-line target: the config's `target:`
+// section, else the target.yaml `oalservo render` writes next to its frames; it needs the
+// camera (--camera) for the pose. None otherwise (a warning says why when a target is known).
+std::unique_ptr<LineMethod> TargetMethod(const CompareOptions& options, AppConfig config,
+                                         const std::optional<CameraFile>& camera,
+                                         const Frame& first, std::vector<std::string>* warnings) {
+  std::string origin;
+  if (!options.config_path.empty() && ConfigHasSection(options.config_path, "target")) {
+    origin = options.config_path;
+  } else if (const auto companion = CompanionFile({options.input}, "target.yaml")) {
+    config.target = LoadConfig(*companion, AppConfig()).target;
+    origin = *companion;
+  } else {
+    return nullptr;
+  }
+  if (config.target.lines.size() != 4) return nullptr;
+  if (!camera) {
+    warnings->push_back("the target of " + origin +
+                        " is not tracked (oal-target): give the camera file (--camera) for "
+                        "its pose");
+    return nullptr;
+  }
+  return std::make_unique<OalTargetMethod>(config, camera->camera, first.gray.cols,
+                                           first.gray.rows);
+}
+
+}  // namespace
+
 CompareReport RunComparison(const CompareOptions& options,
                             std::vector<std::unique_ptr<LineMethod>> extra_methods) {
   options.Check();
@@ -934,6 +1007,9 @@ CompareReport RunComparison(const CompareOptions& options,
   for (Kind kind : {Kind::kHoughCanny, Kind::kHoughOtsu, Kind::kHoughP, Kind::kLsd, Kind::kFld}) {
     methods.push_back(std::make_unique<OpenCvMethod>(kind, stripes, config.detector.polarity,
                                                      report.max_stripe_width_px, config.detector));
+  }
+  if (auto target = TargetMethod(options, config, camera, frame, &report.warnings)) {
+    methods.push_back(std::move(target));
   }
   for (auto& extra : extra_methods) methods.push_back(std::move(extra));
   for (const auto& method : methods) {

@@ -14,6 +14,10 @@
 //   HoughLinesP       OpenCV: the same Canny edges, HoughLinesP, segments merged into lines
 //   LSD               OpenCV createLineSegmentDetector(LSD_REFINE_STD), segments merged
 //   FLD               OpenCV contrib ximgproc::createFastLineDetector() (defaults), merged
+//   oal-target        our target tracker (servo/target_tracker.h), when the frames show a
+//                     four-line target (the config's target:, else the target.yaml `oalservo
+//                     render` writes beside them) and --camera is given: the four lines of
+//                     each accepted pose, none in a frame without one (its failures)
 //
 // Segments -> lines: segments are taken longest first; a segment joins the first line whose
 // angle is within 1.5 deg and from which both its ends are within 1.5 px (the line is then

@@ -256,12 +256,33 @@ AppConfig ConfigOf(const RenderCommandOptions& options) {
   return config;
 }
 
+// A sequence's render: its camera, noise, blur and light, on the config's scene (surface,
+// fall-off, shadow, marks, clutter) or --background; the scene's gradient, when it sets one,
+// replaces the sequence's.
+RenderOptions SequenceRenderOptions(const RenderCommandOptions& options, const Sequence& sequence,
+                                    const SceneConfig& scene) {
+  RenderOptions render = sequence.options;
+  SceneConfig surface = scene;
+  if (!options.background_image.empty()) {
+    surface.background = options.background_image;
+    surface.background_origin = "--background";
+  }
+  surface.ApplyTo(&render);
+  if (scene.gradient == 0.0) {
+    render.illumination_gradient = sequence.options.illumination_gradient;
+    render.gradient_angle_rad = sequence.options.gradient_angle_rad;
+  }
+  return render;
+}
+
 // Renders the sequence's frames, camera.xml and sequence.json into `dir`.
-void RenderSequenceDataset(const RenderCommandOptions& options, const LineTarget& target,
+void RenderSequenceDataset(const RenderCommandOptions& options, const AppConfig& config,
                            const fs::path& dir) {
+  const LineTarget& target = config.target;
   const Sequence sequence =
       MakeSequence(SequenceKindFromString(options.sequence), options.count, options.seed, target);
-  const SceneRenderer renderer(sequence.target, sequence.options);
+  const SceneRenderer renderer(sequence.target,
+                               SequenceRenderOptions(options, sequence, config.scene));
   const RenderOptions& render = renderer.options();
   SaveCameraFile((dir / "camera.xml").string(), render.camera, kCameraName,
                  static_cast<unsigned int>(render.width), static_cast<unsigned int>(render.height));
@@ -368,7 +389,7 @@ int RenderDataset(const RenderCommandOptions& options) {
   if (options.sequence.empty()) {
     RenderRandomDataset(options, config, staged.dir());
   } else {
-    RenderSequenceDataset(options, config.target, staged.dir());
+    RenderSequenceDataset(options, config, staged.dir());
   }
   WriteFileAtomically(staged.dir() / "target.yaml", TargetYaml(config.target));
   staged.Commit();
@@ -405,6 +426,9 @@ int RunRender(int argc, char** argv) {
   cli.add_flag("--overwrite", options.overwrite,
                "replace the data set already in --out: its frame_NNNN.png/json, camera.xml and "
                "sequence.json are removed; other files in the folder are kept");
+  cli.add_option("--background", options.background_image,
+                 "image of the surface the board lies on (replaces the config's "
+                 "scene.background)");
   // Options that a sequence sets itself.
   const std::vector<CLI::Option*> random_pose_options = {
       cli.add_option("--width", options.width, "image width, pixels")->capture_default_str(),
@@ -421,9 +445,6 @@ int RunRender(int argc, char** argv) {
       cli.add_option("--gradient", options.gradient,
                      "illumination fall-off across the image, [0, 0.9]")
           ->capture_default_str(),
-      cli.add_option("--background", options.background_image,
-                     "image of the surface the board lies on (replaces the config's "
-                     "scene.background)"),
       cli.add_option("--max-offset", options.max_offset_m,
                      "where the optical axis meets the board, at most this far from its centre, "
                      "metres (larger: the board often partly out of view)")

@@ -45,6 +45,11 @@ std::string RenderShort(const test::TestDir& dir) {
   return test::RenderChecked(render);
 }
 
+bool AnyContains(const std::vector<std::string>& texts, const std::string& part) {
+  return std::any_of(texts.begin(), texts.end(),
+                     [&](const std::string& text) { return text.find(part) != std::string::npos; });
+}
+
 // The message RunComparison throws with, or "" if it succeeds.
 std::string CompareError(const CompareOptions& options) {
   return test::ErrorMessageOf([&] { RunComparison(options); });
@@ -110,6 +115,41 @@ TEST(Compare, RenderedSequenceGivesOneRowPerMethod) {
   ASSERT_FALSE(report.figures.empty());
   for (const std::string& figure : report.figures) EXPECT_TRUE(fs::is_regular_file(figure));
   EXPECT_TRUE(test::TempFilesIn(options.out_dir).empty());
+}
+
+// A sheet on a bench moving in front of the camera: the target tracker's row comes after the
+// detectors' (the target is the target.yaml render writes, the camera its camera.xml) and
+// holds the sheet's four lines, in the target's order, in every frame.
+TEST(Compare, ASheetSequenceAddsTheTargetTrackersRow) {
+  test::TestDir dir;
+  RenderCommandOptions render = test::SequenceRender(dir / "sheet", "slow", 5, 2);
+  render.target = "four-line-a3";
+  render.background_image = "/usr/share/visp-images-data/ViSP-images/Klimt/Klimt.pgm";
+  if (!fs::is_regular_file(render.background_image)) {
+    GTEST_SKIP() << "Debian's visp-images-data is not installed";
+  }
+  CompareOptions options;
+  options.input = test::RenderChecked(render);
+  options.camera_path = dir / "sheet/camera.xml";
+  const CompareReport report = RunComparison(options);
+  ASSERT_EQ(report.methods.size(), std::size(kMethods) + 1);
+  const MethodResult& target = report.methods.back();
+  EXPECT_EQ(target.name, "oal-target");
+  EXPECT_EQ(target.reference, report.methods.front().reference);  // as our detector's
+  EXPECT_EQ(target.failures, 0);
+  EXPECT_EQ(target.frames_all_found, 5);
+  EXPECT_EQ(target.spurious_lines, 0);
+}
+
+// Without the camera the target is not tracked, and a warning says what to give.
+TEST(Compare, ATargetWithoutACameraIsWarnedAbout) {
+  test::TestDir dir;
+  CompareOptions options;
+  options.input = RenderShort(dir);
+  const CompareReport report = RunComparison(options);
+  EXPECT_EQ(report.methods.size(), std::size(kMethods));
+  EXPECT_TRUE(AnyContains(report.warnings, "give the camera file (--camera)"))
+      << ::testing::PrintToString(report.warnings);
 }
 
 TEST(Compare, CsvTruthIsReadAndScored) {
@@ -209,11 +249,6 @@ std::string WriteEdgeImages(const fs::path& dir, int count, int width, int heigh
     EXPECT_TRUE(cv::imwrite((dir / name).string(), image));
   }
   return dir.string();
-}
-
-bool AnyContains(const std::vector<std::string>& texts, const std::string& part) {
-  return std::any_of(texts.begin(), texts.end(),
-                     [&](const std::string& text) { return text.find(part) != std::string::npos; });
 }
 
 TEST(Compare, CsvTruthMatchingNoFrameIsAnError) {

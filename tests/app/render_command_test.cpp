@@ -326,6 +326,32 @@ TEST(RenderSequence, SameSeedSameFilesAndDistortionCamera) {
   EXPECT_NEAR(camera.camera.get_kdu(), 0.47, 1e-12);
 }
 
+// A sequence lies on the surface it is given (--background): the frames change only where the
+// surface shows, the truth not at all.
+TEST(RenderSequence, TakesTheSurfaceFromBackground) {
+  test::TestDir dir;
+  const std::string photo = dir / "bench.png";
+  cv::Mat bench(200, 300, CV_8UC1);
+  cv::randu(bench, 0, 255);
+  ASSERT_TRUE(cv::imwrite(photo, bench));
+  RenderCommandOptions plain = test::SequenceRender(dir / "plain", "slow", 1, 3);
+  plain.target = "four-line-a3";
+  RenderCommandOptions textured = plain;
+  textured.out_dir = dir / "textured";
+  textured.background_image = photo;
+  RenderDataset(plain);
+  RenderDataset(textured);
+  const cv::Mat a = cv::imread(plain.out_dir + "/frame_0000.png", cv::IMREAD_UNCHANGED);
+  const cv::Mat b = cv::imread(textured.out_dir + "/frame_0000.png", cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
+  EXPECT_GT(cv::countNonZero(a != b), a.total() / 10) << "the surface around the sheet";
+  EXPECT_LT(cv::countNonZero(a != b), a.total() * 9 / 10) << "the sheet itself";
+  const json truth_a = json::parse(test::ReadText(plain.out_dir + "/frame_0000.json"));
+  const json truth_b = json::parse(test::ReadText(textured.out_dir + "/frame_0000.json"));
+  EXPECT_EQ(truth_a.at("lines"), truth_b.at("lines"));
+}
+
 TEST(RenderSequence, UnknownSequenceNamesTheValidOnes) {
   test::TestDir dir;
   RenderCommandOptions options;
