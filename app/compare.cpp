@@ -18,13 +18,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/accuracy_frames.h"  // ConfigHasSection
 #include "app/annotate.h"
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
 #include "app/config.h"
-#include "app/accuracy_frames.h"  // ConfigHasSection
 #include "app/detector_accuracy.h"
-#include "app/frame_command.h"     // CompanionFile
+#include "app/frame_command.h"  // CompanionFile
 #include "app/image_source.h"
 #include "app/truth_file.h"
 #include "detector/detector.h"
@@ -213,8 +213,7 @@ class OalMethod : public LineMethod {
 // refused, not scored). Its failures are the frames without a pose.
 class OalTargetMethod : public LineMethod {
  public:
-  OalTargetMethod(const AppConfig& config, const vpCameraParameters& camera, int width,
-                  int height)
+  OalTargetMethod(const AppConfig& config, const vpCameraParameters& camera, int width, int height)
       : tracker_(config.target, camera, config.detector, PoseOf(config, camera, width, height),
                  config.tracking) {}
   std::string Name() const override { return "oal-target"; }

@@ -95,8 +95,7 @@ const TargetInputs& Inputs() {
     sampling.max_tilt_deg = 15.0;
     const SceneRenderer& renderer = renderers.front();
     const vpHomogeneousMatrix from = SamplePose(renderer, sampling, &state);
-    const vpHomogeneousMatrix to =
-        vpHomogeneousMatrix(0.05, -0.03, 0.04, 0.05, -0.05, 0.15) * from;
+    const vpHomogeneousMatrix to = vpHomogeneousMatrix(0.05, -0.03, 0.04, 0.05, -0.05, 0.15) * from;
     const vpColVector xi = Se3Log(to * from.inverse());
     for (int frame = 0; frame < kFrames; ++frame) {
       const vpHomogeneousMatrix cMo = Se3Exp(xi * (frame / (kFrames - 1.0))) * from;

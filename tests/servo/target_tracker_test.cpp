@@ -91,7 +91,8 @@ TEST(TargetPoseTracker, FindsA3AndA4SheetsAtEveryRollWithoutAPrior) {
     LineTarget target;
     double near_m, far_m;
   };
-  for (const Case& sheet : {Case{FourLineA3Target(), 0.3, 0.85}, Case{FourLineA4Target(), 0.25, 0.6}}) {
+  for (const Case& sheet :
+       {Case{FourLineA3Target(), 0.3, 0.85}, Case{FourLineA4Target(), 0.25, 0.6}}) {
     const SceneRenderer renderer(sheet.target, BenchRender(3));
     TargetPoseTracker tracker = TrackerFor(renderer);
     const PoseSampling sampling = SheetSampling(sheet.near_m, sheet.far_m);
