@@ -1,5 +1,7 @@
 #include "app/demo_command.h"
 
+#include <visp3/core/vpThetaUVector.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -10,8 +12,6 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
-
-#include <visp3/core/vpThetaUVector.h>
 
 #include "app/accuracy_frames.h"
 #include "app/annotate.h"
@@ -216,9 +216,8 @@ Detection DetectTarget(const LineTarget& target, const RenderOptions& render,
   TargetPoseTracker tracker(target, render.camera, DetectorOptions(), pose);
   const auto start = std::chrono::steady_clock::now();
   const TargetFrame& result = tracker.Track(ViewOf(frame.image));
-  detection.time_us = std::chrono::duration<double, std::micro>(
-                          std::chrono::steady_clock::now() - start)
-                          .count();
+  detection.time_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   detection.lines = tracker.lines();
   detection.target = result;
   return detection;
@@ -229,9 +228,8 @@ Detection DetectImage(const RenderOptions& render, const RenderedFrame& frame) {
   OalDetector detector(DetectorOptions(), render.camera);
   const auto start = std::chrono::steady_clock::now();
   detection.lines = detector.Detect(frame.image);
-  detection.time_us = std::chrono::duration<double, std::micro>(
-                          std::chrono::steady_clock::now() - start)
-                          .count();
+  detection.time_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   return detection;
 }
 
@@ -332,6 +330,12 @@ int RunDemo(int argc, char** argv) {
                      " (a sheet lies on a photograph of a bench; the board fills the view)")
       ->capture_default_str();
   AddSeedOption(cli, &options.seed, "seed of the pose and the noise, >= 0");
+  cli.footer(
+      "Examples:\n"
+      "  oalservo demo --out out/demo\n"
+      "      an A3 sheet on a bench: the lines, the pose and its error against the truth\n"
+      "  oalservo demo --target four-line-board --seed 3 --out out/demo-board\n"
+      "      the paper's 2 m board through a cheap wide lens");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   RunDemoScene(options, std::cout);
   return kExitOk;

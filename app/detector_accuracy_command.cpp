@@ -101,6 +101,12 @@ int RunDetectAccuracy(int argc, char** argv) {
                  "(another section is an error)")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
+  cli.footer(
+      "Examples:\n"
+      "  oalservo detect-accuracy --frames 1000 --seed 1 --out out/detect-accuracy.json\n"
+      "      the 2 m board through a cheap wide lens (the paper's condition)\n"
+      "  oalservo detect-accuracy --target four-line-a3 --frames 1000 --seed 1\n"
+      "      an A3 sheet on the bench photographs of Debian's visp-images-data");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
   // Everything that can fail before the evaluation's minutes of work.

@@ -28,6 +28,12 @@ int RunEdgeReference(int argc, char** argv) {
                  "last frame number (0: up to the last consecutive file that exists)")
       ->capture_default_str();
   cli.add_option("--out", out_path, "the truth CSV to write")->required();
+  cli.footer(
+      "Example:\n"
+      "  oalservo edge-reference '/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm' "
+      "--out out/line-truth.csv\n"
+      "  oalservo compare '/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm' "
+      "--truth out/line-truth.csv --config config/visp_line_edges.yaml");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
   // The frames: a pattern with one %d (not a single image, not a directory), a valid range.

@@ -46,7 +46,25 @@ TEST(Oalservo, HelpListsTheCommandsAndEachHasItsOwnHelp) {
     EXPECT_EQ(sub.exit_code, 0) << command << ": " << sub.err;
     EXPECT_THAT(sub.out, HasSubstr("oalservo " + command)) << command;
     EXPECT_THAT(sub.out, HasSubstr("--help")) << command;
+    // A runnable example, so that nobody has to guess the first command line.
+    EXPECT_THAT(sub.out, ::testing::ContainsRegex("Examples?:\n")) << command;
+    EXPECT_THAT(sub.out, HasSubstr("\n  oalservo " + command + " ")) << command;
   }
+}
+
+// evaluate's warnings (here: nearly nothing detected) reach the console, not only summary.json.
+TEST(Oalservo, EvaluateSaysOnTheConsoleWhatItsSummaryWarnsAbout) {
+  const std::string pattern = "/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm";
+  if (!std::filesystem::exists("/usr/share/visp-images-data/ViSP-images/line/image.0001.pgm")) {
+    GTEST_SKIP() << "Debian's visp-images-data is not installed";
+  }
+  test::TestDir dir;
+  const test::OalservoRun run = test::RunOalservo(
+      dir, "evaluate '" + pattern + "' --no-video --max-frames 3 --out '" + dir / "out" + "'");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_THAT(run.err, ::testing::ContainsRegex("oalservo evaluate: warning: [^:]+: the target's "
+                                                "[0-9]+ lines were found in only 0 of 3 frames"));
+  EXPECT_THAT(run.err, HasSubstr("config/visp_line_edges.yaml"));
 }
 
 TEST(Oalservo, Version) {
