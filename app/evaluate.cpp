@@ -1148,6 +1148,23 @@ class InputEvaluation {
     return out;
   }
 
+  // Nearly nothing detected: what the detector looked for, and what to try.
+  std::string LowDetectionHint(const Tally& t) const {
+    const DetectorOptions& detector = run_.config.detector;
+    std::string looked_for =
+        detector.polarity == Polarity::kEdges
+            ? "straight light/dark edges"
+            : std::string(detector.polarity == Polarity::kLightLines ? "light" : "dark") +
+                  " stripes " + std::to_string(static_cast<int>(detector.min_width_px)) + "-" +
+                  std::to_string(static_cast<int>(detector.max_width_px)) + " px wide";
+    return "the target's " + std::to_string(run_.target_lines) + " lines were found in only " +
+           std::to_string(t.detected) + " of " + std::to_string(t.readable) +
+           " frames; the detector looked for " + looked_for +
+           " (the config's detector: section). A single edge, as in ViSP's line/ sequence, "
+           "needs polarity: edges (config/visp_line_edges.yaml); another number of lines, "
+           "--lines N";
+  }
+
   Json Summary(const ImageSource* source, const DecodeStats& decode) const {
     const Tally& t = tally_;
     const int expected = source->ExpectedFrames();
@@ -1163,6 +1180,7 @@ class InputEvaluation {
                          " could be read (truncated or corrupt)");
     }
     if (!decode.stop_reason.empty()) warnings.push_back(decode.stop_reason);
+    if (t.readable > 0 && t.detected < 0.1 * t.readable) warnings.push_back(LowDetectionHint(t));
     Json pose;
     if (camera_) {
       Json by_status = Json::object();

@@ -81,6 +81,14 @@ int RunEvaluate(int argc, char** argv) {
       Warn("evaluate", "input '" + input.input + "' failed: " + input.error);
     }
     resumed += input.status == "resumed";
+    // What summary.json warns about (a video cut short, nearly nothing detected) is said here
+    // too: a user reads the console first.
+    if (input.status == "complete" && input.summary.is_object() &&
+        input.summary.contains("warnings")) {
+      for (const Json& warning : input.summary.at("warnings")) {
+        Warn("evaluate", input.name + ": " + warning.get<std::string>());
+      }
+    }
   }
   for (const std::string& skipped : result.skipped) Warn("evaluate", "skipped " + skipped);
   std::cerr << "oalservo evaluate: " << result.inputs.size() << " input(s), " << result.frames

@@ -364,6 +364,26 @@ TEST(Evaluate, TruncatedVideoAndNonVideoFilesAreListedNotFatal) {
   EXPECT_THAT(test::ReadText(dir / "out/truncated/report.html"), HasSubstr("announces"));
 }
 
+// ViSP's line/ sequence shows one edge, not the dark stripes the default detector looks for:
+// the summary (and the console) says what was looked for and what to try.
+TEST(Evaluate, NearlyNothingDetectedSaysWhatToTry) {
+  const std::string pattern = "/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm";
+  if (!fs::exists("/usr/share/visp-images-data/ViSP-images/line/image.0001.pgm")) {
+    GTEST_SKIP() << "Debian's visp-images-data is not installed";
+  }
+  test::TestDir dir;
+  EvaluateOptions options = Options({pattern}, dir / "out");
+  options.write_video = false;
+  options.max_frames = 5;
+  const EvaluateResult result = Evaluate(options);
+  ASSERT_EQ(result.inputs.size(), 1u);
+  ASSERT_EQ(result.inputs[0].status, "complete") << result.inputs[0].error;
+  const std::string warnings = result.inputs[0].summary.at("warnings").dump();
+  EXPECT_THAT(warnings, HasSubstr("found in only 0 of 5 frames"));
+  EXPECT_THAT(warnings, HasSubstr("looked for dark stripes"));
+  EXPECT_THAT(warnings, HasSubstr("config/visp_line_edges.yaml"));
+}
+
 TEST(Evaluate, UndecodableImageIsSkippedCountedAndListed) {
   test::TestDir dir;
   const std::string frames = RenderFrames(dir, "frames", 4);
