@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -1178,11 +1179,17 @@ void OutputConfig::Check() const {
   }
 }
 
+int ServoLoopOptions::IterationLimit(bool replay) const {
+  if (max_iterations > 0) return max_iterations;
+  if (replay) return std::numeric_limits<int>::max();
+  return law.mode == ServoMode::kVelocity ? 300 : 30;
+}
+
 void ServoLoopOptions::Check() const {
   law.Check();
-  if (max_iterations < 1 || max_iterations > 1000000) {
+  if (max_iterations < 0 || max_iterations > 1000000) {
     Violated("ServoLoopOptions::max_iterations", Num(max_iterations),
-             "1 <= max_iterations <= 1000000");
+             "0 <= max_iterations <= 1000000 (0: the law's own limit)");
   }
   if (!(max_time_s > 0.0) || !std::isfinite(max_time_s)) {
     Violated("ServoLoopOptions::max_time_s", Num(max_time_s), "max_time_s > 0");

@@ -1,12 +1,16 @@
 #include "app/servo_command.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <thread>
+#include <vector>
 
 #include "app/atomic_file.h"
 #include "app/command_line.h"
@@ -80,6 +84,21 @@ ServoAppConfig LoadServoConfig(const ServoCommandOptions& options) {
 
 namespace {
 
+// Folders the output checks made for a run: removed again (when still empty) unless the run
+// began, on every way out, so that a run that cannot start leaves nothing behind.
+struct FoldersMadeForARun {
+  std::vector<fs::path> folders;  ///< innermost first
+  bool keep = false;
+  FoldersMadeForARun() = default;
+  FoldersMadeForARun(const FoldersMadeForARun&) = delete;
+  FoldersMadeForARun& operator=(const FoldersMadeForARun&) = delete;
+  ~FoldersMadeForARun() {
+    if (keep) return;
+    std::error_code ignored;  // fs::remove leaves a folder that is not empty
+    for (const fs::path& folder : folders) fs::remove(folder, ignored);
+  }
+};
+
 // The window or the annotated frames, fed by the loop's on_frame hook.
 class FrameOutput {
  public:
@@ -147,13 +166,41 @@ class FrameOutput {
 
 }  // namespace
 
+std::optional<std::string> TrueErrorLine(const ServoRunReport& report, const ServoOptions& law) {
+  const auto last = std::find_if(
+      report.iterations.rbegin(), report.iterations.rend(),
+      [](const ServoIteration& row) { return std::isfinite(row.true_translation_error_mm); });
+  if (last == report.iterations.rend()) return std::nullopt;
+  char text[160];
+  std::snprintf(text, sizeof(text), "true error (simulation): %.3f mm, %.4f deg",
+                last->true_translation_error_mm, last->true_rotation_error_deg);
+  std::string line = text;
+  const double tolerance_mm = law.translation_tolerance_m * 1e3;
+  const bool far =
+      last->true_translation_error_mm > std::max(2.0 * tolerance_mm, tolerance_mm + 1.0) ||
+      last->true_rotation_error_deg > 2.0 * law.rotation_tolerance_deg;
+  if (report.status == ServoRunStatus::kConverged && far) {
+    line +=
+        "; WARNING: the estimate says converged but the camera is this far from the goal: "
+        "the pose is biased (does the camera model match the lens?)";
+  }
+  return line;
+}
+
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks) {
   const ServoAppConfig config = LoadServoConfig(options);
   const fs::path dir = config.output.directory;
   const fs::path csv = dir / "servo.csv", plot = dir / "servo-error.png";
   // Everything the outputs need is checked before the source and the robot are opened; what
-  // an earlier run wrote is replaced only once this one has begun.
+  // an earlier run wrote is replaced only once this one has begun, and the folders the checks
+  // create are removed again when it does not begin.
+  const bool dir_existed = dir.empty() || fs::exists(dir);
+  FoldersMadeForARun made;
+  if (!dir_existed)
+    made.folders = {dir / "frames", dir};
+  else if (!fs::exists(dir / "frames"))
+    made.folders = {dir / "frames"};
   if (!dir.empty()) {
     CheckWritableDirectory(dir, options.out_dir.empty() ? "output directory (output.directory)"
                                                         : "output directory (--out)");
@@ -168,6 +215,7 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
 
   ServoRunHooks run_hooks = hooks;
   run_hooks.on_started = [&] {
+    made.keep = true;
     frames.Prepare();
     if (hooks.on_started) hooks.on_started();
   };
@@ -184,10 +232,14 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
   }
   const ServoRunReport report = RunServo(config, out, run_hooks);
   out << "oalservo servo: " << ToString(report.status) << ": " << report.message << '\n';
+  if (const std::optional<std::string> truth = TrueErrorLine(report, config.servo.law)) {
+    out << "oalservo servo: " << *truth << '\n';
+  }
   if (!report.link_summary.empty()) out << "oalservo servo: " << report.link_summary << '\n';
   if (!dir.empty() && !report.started) {
-    out << "oalservo servo: nothing written: the run did not begin (" << dir.string()
-        << " keeps what an earlier run wrote)\n";
+    out << "oalservo servo: nothing written: the run did not begin ("
+        << (dir_existed ? dir.string() + " keeps what an earlier run wrote" : "no folder made")
+        << ")\n";
   } else if (!dir.empty()) {
     AtomicFile file(csv);
     WriteServoCsv(report, file.stream());

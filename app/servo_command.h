@@ -18,6 +18,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 #include <string>
 
 #include "app/command_line.h"
@@ -50,6 +51,12 @@ void StopRobotOnSignal();
 /// unregisters it and returns once no handler is still using it). `signals` must outlive
 /// the run.
 ServoRunHooks StopSignalHooks(const StopSignalScope& signals);
+
+/// In a simulation (the rows know the true error), the console's line on where the camera truly
+/// ended, with a plain warning when the estimate says converged while the truth lies well
+/// outside the law's tolerances (a biased pose: e.g. a camera model that does not match the
+/// lens); nullopt without a truth.
+std::optional<std::string> TrueErrorLine(const ServoRunReport& report, const ServoOptions& law);
 
 /// Loads the configuration, runs the loop (rows to `out`) and writes the outputs.
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,

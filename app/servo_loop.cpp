@@ -83,19 +83,40 @@ std::string Fixed(double value, int digits) {
 }
 
 // The table's header and rows; `yaw`: with the yaw column (not for the 5-axis Scorbot).
-void LogHeader(bool yaw, std::ostream& log) {
-  log << "iter     X mm     Y mm     Z mm    pitch     roll" << (yaw ? "      yaw" : "")
-      << "   err mm   err deg  status\n";
+// The console's table: one row per frame (Table 3's columns); the estimated error to the goal
+// and, in a simulation, the true one beside it; "-" where a value is unknown (no pose, or the
+// row after a stop, which has no frame).
+struct TableColumns {
+  bool yaw = true;    ///< a yaw column (not for the 5-axis Scorbot)
+  bool truth = true;  ///< true error columns (the simulated camera knows it)
+};
+
+void LogHeader(const TableColumns& columns, std::ostream& log) {
+  log << "frame     X mm     Y mm     Z mm pitch deg  roll deg" << (columns.yaw ? "   yaw deg" : "")
+      << "    est mm   est deg" << (columns.truth ? "   true mm  true deg" : "") << "  status\n";
 }
 
-void LogRow(const ServoIteration& row, bool yaw, std::ostream& log) {
-  log << std::setw(4) << row.iteration << std::fixed << std::setprecision(1) << std::setw(9)
-      << row.x_mm << std::setw(9) << row.y_mm << std::setw(9) << row.z_mm << std::setprecision(2)
-      << std::setw(9) << row.pitch_deg << std::setw(9) << row.roll_deg;
-  if (yaw) log << std::setw(9) << row.yaw_deg;
-  log << std::setprecision(3) << std::setw(11) << row.translation_error_mm << std::setw(10)
-      << row.rotation_error_deg << "  " << row.status << '\n'
-      << std::defaultfloat;
+void LogValue(double value, int width, int precision, std::ostream& log) {
+  if (std::isfinite(value)) {
+    log << std::setw(width) << std::setprecision(precision) << value;
+  } else {
+    log << std::setw(width) << "-";
+  }
+}
+
+void LogRow(const ServoIteration& row, const TableColumns& columns, std::ostream& log) {
+  log << std::setw(5) << row.iteration << std::fixed;
+  for (const double mm : {row.x_mm, row.y_mm, row.z_mm}) LogValue(mm, 9, 1, log);
+  LogValue(row.pitch_deg, 10, 2, log);
+  LogValue(row.roll_deg, 10, 2, log);
+  if (columns.yaw) LogValue(row.yaw_deg, 10, 2, log);
+  LogValue(row.translation_error_mm, 10, 3, log);
+  LogValue(row.rotation_error_deg, 10, 3, log);
+  if (columns.truth) {
+    LogValue(row.true_translation_error_mm, 10, 3, log);
+    LogValue(row.true_rotation_error_deg, 10, 3, log);
+  }
+  log << "  " << row.status << '\n' << std::defaultfloat;
 }
 
 ServoRunStatus StatusOfRefusal(const RobotResult& result, const SafeRobot& robot) {
@@ -337,9 +358,14 @@ std::string Number(double value) {
   return text.str();
 }
 
+// "1 move", "3 moves".
+std::string Counted(int count, const std::string& noun) {
+  return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
+}
+
 // Step 1 (after the operator's stop): the time and the iteration limits. A recording that
 // ends where the iteration limit does was played to its end: end-of-input.
-std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int iteration,
+std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int iteration,
                                  std::chrono::steady_clock::time_point start, LoopCamera& frames) {
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -348,16 +374,16 @@ std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int iteration,
                 "time limit reached: servo.max_time_s = " + Number(loop.max_time_s) + " s (" +
                     Fixed(elapsed_s, 3) + " s elapsed) without converging"};
   }
-  if (iteration >= loop.max_iterations) {
+  if (iteration >= limit) {
+    const std::string setting = "servo.max_iterations = " + std::to_string(limit) +
+                                (loop.max_iterations == 0 ? ", the law's own" : "");
     if (frames.AtEnd()) {
-      return Stop{ServoRunStatus::kEndOfInput,
-                  "end of " + frames.Name() + " after " + std::to_string(iteration) +
-                      " frames (servo.max_iterations = " + std::to_string(loop.max_iterations) +
-                      ")"};
+      return Stop{ServoRunStatus::kEndOfInput, "end of " + frames.Name() + " after " +
+                                                   std::to_string(iteration) + " frames (" +
+                                                   setting + ")"};
     }
     return Stop{ServoRunStatus::kIterationLimit,
-                "iteration limit reached: servo.max_iterations = " +
-                    std::to_string(loop.max_iterations) + " frames without converging"};
+                "iteration limit reached: " + setting + " frames without converging"};
   }
   return std::nullopt;
 }
@@ -620,7 +646,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   if (!moves_robot) {
     log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
   }
-  const bool yaw_column = config.robot.type != "scorbot";
+  const TableColumns columns{config.robot.type != "scorbot", config.source.type == "simulated"};
   std::optional<StopGuard> guard;  // from Connect() on
   bool moved_since_row = false;    // a motion was commanded after it
   auto finish = [&](Stop stop) {
@@ -638,7 +664,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
           ServoIteration row = RowAt(config, report.iterations.back().iteration + 1, where.pose,
                                      where.pose.inverse() * config.target_wMo, report.cdMo);
           row.status = "stopped";
-          LogRow(row, yaw_column, log);
+          LogRow(row, columns, log);
           report.iterations.push_back(row);
         }
       } else if (moved_since_row) {
@@ -668,12 +694,16 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
 
   const ServoLoopOptions& loop = config.servo;
   const auto start = std::chrono::steady_clock::now();
+  const int iteration_limit = loop.IterationLimit(!moves_robot);
   std::optional<vpHomogeneousMatrix> previous_cMo;
   vpHomogeneousMatrix previous_wMc;
   // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
   bool confirmed = !moves_robot;
   cv::Mat gray;
-  LogHeader(yaw_column, log);
+  log << "frame 0 finds the target; frame 1, the robot still, confirms it; then each frame "
+         "commands one move. Errors to the goal: est by the estimated pose"
+      << (columns.truth ? ", true by the simulation's truth" : "") << ".\n";
+  LogHeader(columns, log);
   for (int iteration = 0;; ++iteration) {
     const bool interrupted =
         (hooks.interrupt != nullptr && hooks.interrupt->load()) || robot.EmergencyStopRequested();
@@ -683,7 +713,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
                                                        " after " + std::to_string(iteration) +
                                                        " iterations"});
     }
-    if (std::optional<Stop> stop = LimitReached(loop, iteration, start, *frames)) {
+    if (std::optional<Stop> stop = LimitReached(loop, iteration_limit, iteration, start, *frames)) {
       return finish(*stop);
     }
 
@@ -730,13 +760,14 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);
-    LogRow(current, yaw_column, log);
+    LogRow(current, columns, log);
     if (stop) return finish(*stop);
     previous_cMo = pose.cMo;
     previous_wMc = wMc;
     if (step->status == ServoStatus::kConverged) {
       return finish({ServoRunStatus::kConverged,
-                     "converged in " + std::to_string(report.moves) + " moves: estimated error " +
+                     "within the tolerances after " + Counted(report.moves, "move") + " (" +
+                         Counted(iteration + 1, "frame") + "): estimated error " +
                          Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
                          Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"});
     }

@@ -64,6 +64,13 @@ std::string Fixed(double value, int digits) {
   return text.str();
 }
 
+// Frames the run took (the row after a stop has no frame).
+int FramesOf(const ServoRunReport& report) {
+  return static_cast<int>(
+      std::count_if(report.iterations.begin(), report.iterations.end(),
+                    [](const ServoIteration& row) { return row.status != "stopped"; }));
+}
+
 }  // namespace
 
 std::string ServoPlotScript(const ServoRunReport& report, const ServoOptions& law,
@@ -84,9 +91,11 @@ std::string ServoPlotScript(const ServoRunReport& report, const ServoOptions& la
      << "set output " << GnuplotQuoted(png.string()) << "\n"
      << "set multiplot layout 2,1 title "
      << GnuplotQuoted("oalservo servo: " + ToString(law.mode) + " law, " + ToString(report.status) +
-                      " after " + std::to_string(report.iterations.size()) + " frames")
+                      " after " + std::to_string(report.moves) +
+                      (report.moves == 1 ? " move (" : " moves (") +
+                      std::to_string(FramesOf(report)) + " frames)")
      << "\n"
-     << "set logscale y\nset grid\nset key top right\nset xlabel 'iteration'\n"
+     << "set logscale y\nset grid\nset key top right\nset xlabel 'frame'\n"
      << "set xtics 1\nset xrange [-0.3:" << std::max<std::size_t>(report.iterations.size(), 2) - 0.7
      << "]\n";
   const auto panel = [&](const char* label, int estimated, int true_column, double tolerance) {

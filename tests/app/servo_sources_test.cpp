@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <opencv2/imgcodecs.hpp>
@@ -77,7 +78,9 @@ ServoAppConfig ReplayOfStillFrames(const test::TestDir& dir, int count) {
   ServoAppConfig config = Small(DefaultServoConfig());
   const vpHomogeneousMatrix start_cMo = config.robot.start_wMc.inverse() * config.target_wMo;
   for (int i = 0; i < count; ++i) {
-    WriteView(config, start_cMo, 7 + i, dir / ("frame_000" + std::to_string(i) + ".png"));
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%04d.png", i);
+    WriteView(config, start_cMo, 7 + i, dir / name);
   }
   config.source.type = "replay";
   config.source.path = dir / "frame_%04d.png";
@@ -109,6 +112,18 @@ TEST(ServoSources, ReplayRunsOpenLoopToTheEndWithoutMovingTheRobot) {
   EXPECT_EQ(RunServo(config, gap_log).iterations.size(), 1u);
   EXPECT_THAT(gap_log.str(), HasSubstr("warning: pattern '" + config.source.path +
                                        "': the sequence ends at the missing file"));
+}
+
+// With the default config (no servo.max_iterations) a replay is played to its end, however
+// long: end-of-input, exit 0, as the README says.
+TEST(ServoSources, AReplayLongerThanTheLawsLimitRunsToItsEnd) {
+  const test::TestDir dir;
+  const ServoAppConfig config = ReplayOfStillFrames(dir, 35);
+  ASSERT_EQ(config.servo.max_iterations, 0);
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kEndOfInput) << report.message;
+  EXPECT_EQ(report.iterations.size(), 35u);
 }
 
 // A recording exactly servo.max_iterations frames long was played to its end: end-of-input
@@ -362,6 +377,32 @@ TEST(ServoOutput, ARunThatCannotBeginKeepsTheEarlierResults) {
   EXPECT_EQ(test::ReadText(out / "servo.csv"), "earlier run");
   EXPECT_EQ(test::ReadText(out / "servo-error.png"), "earlier plot");
   EXPECT_EQ(test::ReadText(out / "frames" / "iter_0000.png"), "earlier frame");
+}
+
+// A run that cannot start in a fresh --out leaves no folder behind (it says nothing was written).
+TEST(ServoOutput, ARunThatCannotStartLeavesNoFolder) {
+  const test::TestDir dir;
+  test::WriteText(dir / "port.yaml",
+                  "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n"
+                  "output: {display: off}\n"
+                  "robot:\n  type: scorbot\n  scorbot:\n    port: /dev/ttyOAL-missing\n");
+  test::WriteText(dir / "replay.yaml",
+                  "output: {display: off}\n"
+                  "source: {type: replay, path: missing.avi}\n");
+  for (const char* config : {"port.yaml", "replay.yaml"}) {
+    ServoCommandOptions options;
+    options.out_dir = dir / "fresh";
+    options.config_path = dir / config;
+    std::ostringstream log;
+    try {
+      const ServoRunReport report = RunServoCommand(options, log);
+      EXPECT_FALSE(report.started) << config;
+      EXPECT_THAT(log.str(), HasSubstr("nothing written")) << config;
+    } catch (const std::runtime_error&) {
+      // a bad source is an error before the run: the folder goes too
+    }
+    EXPECT_FALSE(fs::exists(dir / "fresh")) << config;
+  }
 }
 
 TEST(ServoOutput, AnOutputDirectoryThatCannotBeWrittenFailsBeforeTheRobotMoves) {

@@ -114,7 +114,7 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
             "servo.yaml:3: key 'servo.deltaa' is unknown");
   EXPECT_THAT(ErrorOf("servo:\n  mode: exponential\n  delta: 1.5\n"),
               HasSubstr("servo.yaml:3: 'servo.delta' is invalid"));
-  EXPECT_THAT(ErrorOf("servo:\n  max_iterations: 0\n"),
+  EXPECT_THAT(ErrorOf("servo:\n  max_iterations: -1\n"),
               HasSubstr("servo.yaml:2: 'servo.max_iterations' is invalid"));
   EXPECT_THAT(
       ErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
@@ -260,6 +260,26 @@ TEST(ServoLoop, Table3WithDistortionUncorrectedMissesTheTrueGoal) {
   EXPECT_GT(report.iterations.back().true_translation_error_mm, 5.0) << report.message;
 }
 
+// ... and the console says so when the estimate claims convergence far from the true goal.
+TEST(ServoCommand, AConvergedEstimateFarFromTheTruthIsAWarning) {
+  ServoRunReport report;
+  report.status = ServoRunStatus::kConverged;
+  ServoIteration row;
+  row.true_translation_error_mm = 21.6;
+  row.true_rotation_error_deg = 0.78;
+  report.iterations.push_back(row);
+  const ServoOptions law;
+  std::optional<std::string> line = TrueErrorLine(report, law);
+  ASSERT_TRUE(line.has_value());
+  EXPECT_THAT(*line, HasSubstr("true error (simulation): 21.600 mm"));
+  EXPECT_THAT(*line, HasSubstr("WARNING: the estimate says converged"));
+  report.iterations.back().true_translation_error_mm = 0.6;
+  report.iterations.back().true_rotation_error_deg = 0.05;
+  EXPECT_THAT(*TrueErrorLine(report, law), ::testing::Not(HasSubstr("WARNING")));
+  report.iterations.back().true_translation_error_mm = std::nan("");
+  EXPECT_FALSE(TrueErrorLine(report, law).has_value());  // not a simulation
+}
+
 TEST(ServoLoop, TargetOutOfViewStopsWithTargetLost) {
   ServoAppConfig config = Small(DefaultServoConfig());
   // Looking up, away from the table.
@@ -292,12 +312,13 @@ TEST(ServoLoop, GoalBeyondTheWorkspaceStopsWithLimit) {
   EXPECT_EQ(report.moves, 0);  // a refused command is not a move
 }
 
+// Every law converges on the default config within its own iteration limit (the velocity law
+// takes about 140 periods, beyond the position laws' 30 frames).
 TEST(ServoLoop, PointAndGoAndVelocityLawsConvergeToo) {
   for (const ServoMode mode : {ServoMode::kPointAndGo, ServoMode::kVelocity}) {
     ServoAppConfig config = Small(DefaultServoConfig());
     config.servo.law.mode = mode;
-    config.servo.law.gain = 2.0;
-    config.servo.max_iterations = 400;
+    ASSERT_EQ(config.servo.max_iterations, 0) << "the default config leaves the limit to the law";
     std::ostringstream log;
     const ServoRunReport report = RunServo(config, log);
     EXPECT_EQ(report.status, ServoRunStatus::kConverged)
@@ -308,6 +329,20 @@ TEST(ServoLoop, PointAndGoAndVelocityLawsConvergeToo) {
     }
     EXPECT_LT(report.iterations.back().true_translation_error_mm, 5.0) << ToString(mode);
   }
+}
+
+TEST(ServoLoopOptions, EachLawHasItsOwnIterationLimit) {
+  ServoLoopOptions loop;
+  loop.law.mode = ServoMode::kExponential;
+  EXPECT_EQ(loop.IterationLimit(false), 30);
+  loop.law.mode = ServoMode::kPointAndGo;
+  EXPECT_EQ(loop.IterationLimit(false), 30);
+  loop.law.mode = ServoMode::kVelocity;
+  EXPECT_EQ(loop.IterationLimit(false), 300);
+  EXPECT_GT(loop.IterationLimit(true), 1000000) << "a replay runs to its end";
+  loop.max_iterations = 7;
+  EXPECT_EQ(loop.IterationLimit(false), 7);
+  EXPECT_EQ(loop.IterationLimit(true), 7);
 }
 
 // The frame after a move disagrees with the odometry: the image slid by 40 px (~65 mm at 0.5 m).
@@ -674,6 +709,27 @@ TEST(ServoCommand, WritesTheCsvAtomically) {
   const std::string csv = ReadText((dir / "out" / "servo.csv").string());
   EXPECT_THAT(csv, HasSubstr("iteration,x_mm,y_mm,z_mm,pitch_deg,roll_deg"));
   EXPECT_THAT(csv, HasSubstr(",converged\n"));
+  std::filesystem::remove_all(dir);
+}
+
+// The console table explains its first frames once, names its units, shows the simulation's
+// true error beside the estimate, and its last line says where the camera truly ended.
+TEST(ServoCommand, TheTableShowsUnitsAndTheTrueErrorBesideTheEstimate) {
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "oal_servo_table_test";
+  std::filesystem::remove_all(dir);
+  ServoCommandOptions options;
+  options.out_dir = (dir / "out").string();
+  options.display = "off";
+  std::ostringstream out;
+  const ServoRunReport report = RunServoCommand(options, out);
+  EXPECT_EQ(report.status, ServoRunStatus::kConverged) << out.str();
+  EXPECT_THAT(out.str(), HasSubstr("frame 1, the robot still, confirms it"));
+  EXPECT_THAT(out.str(), HasSubstr("pitch deg  roll deg   yaw deg    est mm   est deg   true mm"));
+  EXPECT_THAT(out.str(), HasSubstr("within the tolerances after "));
+  EXPECT_THAT(out.str(), HasSubstr("oalservo servo: true error (simulation): "));
+  EXPECT_THAT(out.str(), ::testing::Not(HasSubstr("WARNING")));
+  EXPECT_THAT(out.str(), ::testing::Not(HasSubstr("nan")));
   std::filesystem::remove_all(dir);
 }
 
