@@ -209,6 +209,7 @@ bool ConfigHasSection(const std::string& path, const std::string& section) {
   return root.IsMap() && root[section].IsDefined();
 }
 
+// scene/bench_scene.h's DressAsBench() as a config (the benchmarks and tests render it so).
 SceneConfig BenchScene() {
   SceneConfig scene;
   scene.vignetting = 0.3;

@@ -42,8 +42,8 @@ Json PoseJson(const vpHomogeneousMatrix& cMo) {
   const vpTranslationVector t = cMo.getTranslationVector();
   const vpThetaUVector tu = cMo.getThetaUVector();
   return Json{{"matrix", matrix},
-              {"translation_m", Json::array({t[0], t[1], t[2]})},
-              {"theta_u_rad", Json::array({tu[0], tu[1], tu[2]})}};
+              {"t_m", Json::array({t[0], t[1], t[2]})},
+              {"thetau_rad", Json::array({tu[0], tu[1], tu[2]})}};
 }
 
 Json CameraJson(const vpCameraParameters& camera, int width, int height) {

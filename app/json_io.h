@@ -26,7 +26,8 @@ Json LineJson(const LineParams& line);
 Json DetectedLineJson(const DetectedLine& line);
 /// {index, visible, ideal, distorted_fit, end_a, end_b, visible_length_px, width_px}
 Json TruthLineJson(const TruthLine& line);
-/// {matrix: 4x4 rows, translation_m: [x,y,z], theta_u_rad: [tux,tuy,tuz]}
+/// The one form of a pose in every JSON the product writes (render's truth, pose, demo):
+/// {matrix: 4x4 rows, t_m: [x,y,z] metres, thetau_rad: [tux,tuy,tuz] (theta-u, radians)}
 Json PoseJson(const vpHomogeneousMatrix& cMo);
 /// {model, px, py, u0, v0, kud, kdu, width, height}
 Json CameraJson(const vpCameraParameters& camera, int width, int height);

@@ -69,22 +69,13 @@ AppConfig LoadPoseConfig(const PoseCommandOptions& options, PoseSummary* summary
   return config;
 }
 
-Json Vector3(double x, double y, double z) {
-  return Json::array({x, y, z});
-}
-
 Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFrame& result,
                ScanMode mode) {
   const PoseResult& pose = result.pose;
   const bool ok = result.status == TargetStatus::kOk;
   const bool identified = pose.line_index[0] >= 0 && pose.line_index[1] >= 0 &&
                           pose.line_index[2] >= 0 && pose.line_index[3] >= 0;
-  Json cMo;  // null unless ok
-  if (ok) {
-    const vpTranslationVector t = pose.cMo.getTranslationVector();
-    const vpThetaUVector tu = pose.cMo.getThetaUVector();
-    cMo = Json{{"t_m", Vector3(t[0], t[1], t[2])}, {"thetau_rad", Vector3(tu[0], tu[1], tu[2])}};
-  }
+  const Json cMo = ok ? PoseJson(pose.cMo) : Json();  // null unless ok
   auto if_ok = [ok](const Json& value) { return ok ? value : Json(); };
   // The pose covariance (vpPose, 6 x 6, translation then theta-u), row by row.
   Json covariance;

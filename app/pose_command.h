@@ -3,7 +3,7 @@
 // one JSON object per frame (JSON Lines):
 //
 //   {"frame":0,"source":"x.png","width":640,"height":480,"status":"ok","message":"",
-//    "pose_status":"ok","cMo":{"t_m":[x,y,z],"thetau_rad":[tux,tuy,tuz]},
+//    "pose_status":"ok","cMo":{"matrix":[[...],...],"t_m":[x,y,z],"thetau_rad":[tux,tuy,tuz]},
 //    "roll_deg":..,"pitch_deg":..,"yaw_deg":..,"line1_roll_deg":..,
 //    "plane_angles_deg":[a1,a2],"residual_px":..,"covariance":[[..6..],..6 rows..],
 //    "method":"lagrange","from_previous":false,

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/bench_scene.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/target_tracker.h"
@@ -45,14 +46,7 @@ RenderOptions BenchRender(std::shared_ptr<const vpImage<unsigned char>> photo, i
   RenderOptions render;
   render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
   render.background = std::move(photo);
-  render.vignetting = 0.3;
-  render.shadow_darkness = 0.3;
-  render.paper_texture_grey = 3.0;
-  render.annotations = true;
-  render.clutter_sheets = 2;
-  render.clutter_objects = 4;
-  render.clutter_reach_m = 0.25;
-  render.scene_seed = 1 + static_cast<std::uint64_t>(index);
+  DressAsBench(&render, 1 + static_cast<std::uint64_t>(index));
   return render;
 }
 

@@ -82,8 +82,8 @@ void WriteShiftedTruthCsv(const std::string& frames_dir, int count, const std::s
           << line.at("distorted_fit").at("rho").get<double>() + kRhoShiftPx << ","
           << line.at("distorted_fit").at("theta").get<double>() << "\n";
     }
-    const std::vector<double> t = truth.at("cMo").at("translation_m");
-    const std::vector<double> tu = truth.at("cMo").at("theta_u_rad");
+    const std::vector<double> t = truth.at("cMo").at("t_m");
+    const std::vector<double> tu = truth.at("cMo").at("thetau_rad");
     out << i << ",pose," << t[0] + kShiftTxM << "," << t[1] << "," << t[2] << "," << tu[0] << ","
         << tu[1] << "," << tu[2] << "\n";
   }

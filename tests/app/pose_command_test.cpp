@@ -51,13 +51,14 @@ void ExpectPoseNearTruth(const json& frame, const std::string& truth_path) {
   ASSERT_EQ(frame.at("status"), "ok") << frame.at("message");
   EXPECT_EQ(frame.at("message"), "");
   const json truth = json::parse(test::ReadText(truth_path));
-  const std::vector<double> t_true = truth.at("cMo").at("translation_m");
+  const std::vector<double> t_true = truth.at("cMo").at("t_m");
   const std::vector<double> t = frame.at("cMo").at("t_m");
   ASSERT_EQ(t.size(), 3u);
   const double norm = std::hypot(t_true[0], t_true[1], t_true[2]);
   const double error = std::hypot(t[0] - t_true[0], t[1] - t_true[1], t[2] - t_true[2]);
   EXPECT_LT(error, kTranslationTolerance * norm) << truth_path;
   EXPECT_EQ(frame.at("cMo").at("thetau_rad").size(), 3u);
+  EXPECT_EQ(frame.at("cMo").at("matrix").size(), 4u);  // the same form as render's truth
   for (const char* key : {"roll_deg", "pitch_deg", "yaw_deg", "line1_roll_deg", "residual_px"}) {
     EXPECT_TRUE(frame.at(key).is_number()) << key;
   }

@@ -47,8 +47,8 @@ TEST(Render, WritesFramesTruthAndCamera) {
     EXPECT_EQ(truth.at("image"), "frame_000" + std::to_string(i) + ".png");
     EXPECT_EQ(truth.at("cMo").at("matrix").size(), 4u);
     EXPECT_EQ(truth.at("cMo").at("matrix")[3], json::array({0.0, 0.0, 0.0, 1.0}));
-    EXPECT_EQ(truth.at("cMo").at("translation_m").size(), 3u);
-    EXPECT_EQ(truth.at("cMo").at("theta_u_rad").size(), 3u);
+    EXPECT_EQ(truth.at("cMo").at("t_m").size(), 3u);
+    EXPECT_EQ(truth.at("cMo").at("thetau_rad").size(), 3u);
     EXPECT_EQ(truth.at("camera").at("kdu"), 0.2);
     EXPECT_EQ(truth.at("camera").at("u0"), 79.5);
     ASSERT_EQ(truth.at("lines").size(), 4u);  // the four-line target

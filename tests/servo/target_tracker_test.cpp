@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "scene/bench_scene.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"  // Se3Exp, Se3Log
 #include "tests/scene/scene_image_util.h"
@@ -37,14 +38,7 @@ RenderOptions BenchRender(std::uint64_t scene_seed) {
   render.noise_sigma = 4.0;
   render.blur_sigma_px = 1.0;
   render.background = Bench();
-  render.vignetting = 0.3;
-  render.shadow_darkness = 0.3;
-  render.paper_texture_grey = 3.0;
-  render.annotations = true;
-  render.clutter_sheets = 2;
-  render.clutter_objects = 4;
-  render.clutter_reach_m = 0.25;
-  render.scene_seed = scene_seed;
+  DressAsBench(&render, scene_seed);
   return render;
 }
 
