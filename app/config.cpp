@@ -154,6 +154,26 @@ std::vector<std::string> FieldKeys(std::string field) {
   return keys;
 }
 
+// A Check() message "Options::field = VALUE. Violated constraint: C" in the user's words:
+// "VALUE (needs C)", with "section.field = " first when the key is not named already; other
+// messages as they are.
+std::string InUserWords(const std::string& message, const std::string& section, bool key_named) {
+  const std::string violated = ". Violated constraint: ";
+  const std::size_t equals = message.find(" = ");
+  const std::size_t because = message.rfind(violated);
+  if (equals == std::string::npos || because == std::string::npos || because < equals) {
+    return message;
+  }
+  std::string field = message.substr(0, equals);
+  const std::size_t scope = field.find_last_of(":.");
+  if (scope != std::string::npos) field = field.substr(scope + 1);
+  const std::string value = message.substr(equals + 3, because - equals - 3);
+  const std::string constraint = message.substr(because + violated.size());
+  // A field with an index ("workspace_min_m/workspace_max_m [x]") keeps its name for the index.
+  const bool name_it = !key_named || field.find('[') != std::string::npos;
+  return (name_it ? section + "." + field + " = " : "") + value + " (needs " + constraint + ")";
+}
+
 // Check() names the field as "DetectorOptions::<field> = ..."; point at the line that set it
 // (else at the section's line, when given).
 template <typename Options>
@@ -176,12 +196,13 @@ void CheckAt(const Options& options, const std::string& file, const std::string&
         const auto line = lines.find(field);
         if (line != lines.end()) {
           throw std::runtime_error(file + ":" + std::to_string(line->second) + ": '" + name + "." +
-                                   field + "' is invalid: " + message);
+                                   field + "' is invalid: " + InUserWords(message, name, true));
         }
       }
     }
     const std::string at = section_line > 0 ? ":" + std::to_string(section_line) : "";
-    throw std::runtime_error(file + at + ": section '" + name + "' is invalid: " + message);
+    throw std::runtime_error(file + at + ": section '" + name +
+                             "' is invalid: " + InUserWords(message, name, false));
   }
 }
 

@@ -61,9 +61,9 @@ TEST(ServoConfigSections, SourceOutputAndGoalImageAreReadAndChecked) {
   EXPECT_THAT(ErrorOf("source: {type: webcam}\n"),
               HasSubstr("dir/servo.yaml:1: 'source.type' is invalid"));
   EXPECT_THAT(ErrorOf("source: {type: v4l2, fps: 30}\n"),
-              HasSubstr("'source.fps' is invalid: SourceConfig::fps = 30"));
+              HasSubstr("'source.fps' is invalid: 30 (needs"));
   EXPECT_THAT(ErrorOf("source: {type: replay}\n"),
-              HasSubstr("dir/servo.yaml:1: section 'source' is invalid: SourceConfig::path"));
+              HasSubstr("dir/servo.yaml:1: section 'source' is invalid: source.path = '' (needs"));
   EXPECT_THAT(ErrorOf("output:\n  display: maybe\n"),
               HasSubstr("dir/servo.yaml:2: 'output.display' is invalid"));
   EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.5], rxyz_deg: [0, 0, 0]}\n"

@@ -116,10 +116,8 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
               HasSubstr("servo.yaml:3: 'servo.delta' is invalid"));
   EXPECT_THAT(ErrorOf("servo:\n  max_iterations: -1\n"),
               HasSubstr("servo.yaml:2: 'servo.max_iterations' is invalid"));
-  EXPECT_THAT(
-      ErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
-      HasSubstr("servo.yaml:3: 'servo.max_step_m' is invalid: ServoLoopOptions::max_step_m = "
-                "0. Violated constraint: max_step_m > 0"));
+  EXPECT_THAT(ErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
+              HasSubstr("servo.yaml:3: 'servo.max_step_m' is invalid: 0 (needs max_step_m > 0)"));
   EXPECT_THAT(ErrorOf("servo:\n  max_step_deg: 200\n"),
               HasSubstr("servo.yaml:2: 'servo.max_step_deg' is invalid"));
   EXPECT_THAT(ErrorOf("servo:\n  max_step_m: fast\n"),
@@ -163,7 +161,8 @@ TEST(ServoConfig, AWorkspaceBoxWithMinAboveMaxNamesTheKeyAndLine) {
   EXPECT_THAT(ErrorOf("robot:\n  workspace_enabled: true\n  workspace_min_m: [1, -1, -1]\n"
                       "  workspace_max_m: [0, 1, 1]\n"),
               HasSubstr("servo.yaml:3: 'robot.workspace_min_m' is invalid: "
-                        "SafetyOptions::workspace_min_m/workspace_max_m [x] = 1 / 0"));
+                        "robot.workspace_min_m/workspace_max_m [x] = 1 / 0 (needs finite and min < "
+                        "max)"));
   // Only the max in this file: its line.
   EXPECT_THAT(ErrorOf("robot:\n  workspace_max_m: [1, 1, -2]\n"),
               HasSubstr("servo.yaml:2: 'robot.workspace_max_m' is invalid"));
