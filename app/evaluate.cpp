@@ -70,9 +70,10 @@ double Us(Clock::duration d) {
   return std::chrono::duration<double, std::micro>(d).count();
 }
 
+// The options are named as the user gives them, on evaluate's command line.
 template <typename T>
-void Require(bool ok, const char* field, const T& value, const char* constraint) {
-  RequireOption(ok, std::string("EvaluateOptions::") + field, value, constraint);
+void Require(bool ok, const char* option, const T& value, const char* constraint) {
+  RequireOption(ok, option, value, constraint);
 }
 
 // {count, mean, median, p95, max}; nulls for no values.
@@ -1323,20 +1324,23 @@ std::string NoInputsMessage(const std::vector<std::string>& inputs, const InputP
 // ---------------------------------------------------------------------------------------
 
 void EvaluateOptions::Check() const {
-  if (inputs.empty()) throw std::invalid_argument("EvaluateOptions::inputs is empty");
-  Require(!out_dir.empty(), "out_dir", "''", "an output directory is given");
-  Require(jobs >= 1 && jobs <= 64, "jobs", jobs, "1 <= jobs <= 64");
-  Require(shard_count >= 1, "shard_count", shard_count, "shard_count >= 1");
-  Require(shard_index >= 0 && shard_index < shard_count, "shard_index", shard_index,
-          "0 <= shard_index < shard_count");
-  Require(max_frames >= 0, "max_frames", max_frames, "max_frames >= 0");
-  Require(video_scale >= 0.1 && video_scale <= 1.0, "video_scale", video_scale,
-          "0.1 <= video_scale <= 1");
-  Require(video_codec == "xvid" || video_codec == "mjpg", "video_codec", video_codec,
-          "\"xvid\" or \"mjpg\"");
-  Require(thumbnails >= 0 && thumbnails <= 50, "thumbnails", thumbnails, "0 <= thumbnails <= 50");
-  Require(target_lines >= 0 && target_lines <= 64, "target_lines", target_lines,
-          "0 <= target_lines <= 64");
+  if (inputs.empty()) throw std::invalid_argument("no INPUT given (videos, directories, patterns)");
+  Require(!out_dir.empty(), "--out", "''", "an output directory is given");
+  Require(jobs >= 1 && jobs <= 64, "--jobs", jobs, "1 <= --jobs <= 64");
+  Require(shard_count >= 1, "--shard",
+          std::to_string(shard_index) + "/" + std::to_string(shard_count),
+          "--shard I/N with N >= 1");
+  Require(shard_index >= 0 && shard_index < shard_count, "--shard",
+          std::to_string(shard_index) + "/" + std::to_string(shard_count),
+          "--shard I/N with 0 <= I < N");
+  Require(max_frames >= 0, "--max-frames", max_frames, "--max-frames >= 0");
+  Require(video_scale >= 0.1 && video_scale <= 1.0, "--video-scale", video_scale,
+          "0.1 <= --video-scale <= 1");
+  Require(video_codec == "xvid" || video_codec == "mjpg", "--video-codec", video_codec,
+          "xvid or mjpg");
+  Require(thumbnails >= 0 && thumbnails <= 50, "--thumbnails", thumbnails,
+          "0 <= --thumbnails <= 50");
+  Require(target_lines >= 0 && target_lines <= 64, "--lines", target_lines, "0 <= --lines <= 64");
   if (fs::exists(out_dir) && !fs::is_directory(out_dir)) {
     throw std::invalid_argument("output '" + out_dir + "' is not a directory");
   }

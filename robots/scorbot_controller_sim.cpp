@@ -95,7 +95,7 @@ void ScorbotControllerSim::Start() {
   int master = -1, slave = -1;
   char name[256] = {0};
   if (::openpty(&master, &slave, name, nullptr, nullptr) != 0) {
-    throw std::runtime_error(std::string("ScorbotControllerSim: openpty failed: ") +
+    throw std::runtime_error(std::string("the Scorbot controller simulator: openpty failed: ") +
                              std::strerror(errno));
   }
   termios tio{};
@@ -113,7 +113,7 @@ void ScorbotControllerSim::Start() {
       if (!S_ISLNK(st.st_mode)) {
         ::close(master);
         ::close(slave);
-        throw std::runtime_error("ScorbotControllerSim: " + options_.link_path +
+        throw std::runtime_error("the Scorbot controller simulator: " + options_.link_path +
                                  " exists and is not a symlink");
       }
       ::unlink(options_.link_path.c_str());
@@ -122,7 +122,7 @@ void ScorbotControllerSim::Start() {
       const std::string why = std::strerror(errno);
       ::close(master);
       ::close(slave);
-      throw std::runtime_error("ScorbotControllerSim: cannot create the link " +
+      throw std::runtime_error("the Scorbot controller simulator: cannot create the link " +
                                options_.link_path + ": " + why);
     }
   }
