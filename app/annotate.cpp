@@ -110,6 +110,73 @@ void DrawText(cv::Mat& image, const std::string& text, const cv::Point& origin,
   cv::putText(image, text, origin, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
 }
 
+// Where the labels of lines 1-4 keep away from: the target's crossings, as their centre and
+// the radius that holds them (else the image's centre, and no radius).
+struct LabelAnchor {
+  cv::Point2d centre;
+  double radius_px = 0.0;
+};
+
+LabelAnchor AnchorOf(const PoseResult& pose, const vpCameraParameters& camera, int width,
+                     int height) {
+  std::vector<cv::Point2d> corners;
+  for (const vpColVector& corner : pose.corners_m) {
+    if (corner.size() < 2) continue;
+    const cv::Point2d p = FramePixel(camera, corner[0], corner[1]);
+    if (std::isfinite(p.x) && std::isfinite(p.y)) corners.push_back(p);
+  }
+  if (corners.size() != 4) return {cv::Point2d(0.5 * (width - 1), 0.5 * (height - 1)), 0.0};
+  LabelAnchor anchor{(corners[0] + corners[1] + corners[2] + corners[3]) / 4.0, 0.0};
+  for (const cv::Point2d& p : corners) {
+    anchor.radius_px = std::max(anchor.radius_px, cv::norm(p - anchor.centre));
+  }
+  return anchor;
+}
+
+// A point of the drawn line for its label: along it from where it passes nearest the
+// crossings' centre, past the crossings (beyond the anchor's radius, not on them), inside the
+// image and clear of the status text at its top and bottom edges.
+cv::Point2d LabelPoint(const std::vector<cv::Point2d>& drawn, const LabelAnchor& anchor, int width,
+                       int height) {
+  const double label_offset_px = anchor.radius_px + 25.0;
+  // A straight line is drawn from its two ends: points every few pixels to walk along.
+  std::vector<cv::Point2d> run = {drawn.front()};
+  for (std::size_t i = 1; i < drawn.size(); ++i) {
+    const int steps = std::max(1, static_cast<int>(cv::norm(drawn[i] - drawn[i - 1]) / 4.0));
+    for (int j = 1; j <= steps; ++j) {
+      run.push_back(drawn[i - 1] + (drawn[i] - drawn[i - 1]) * (static_cast<double>(j) / steps));
+    }
+  }
+  constexpr double kTopPx = 28.0, kBottomPx = 34.0, kSidePx = 12.0;
+  const auto usable = [&](const cv::Point2d& p) {
+    return p.x >= kSidePx && p.x <= width - 1 - kSidePx - 10.0 && p.y >= kTopPx &&
+           p.y <= height - 1 - kBottomPx;
+  };
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < run.size(); ++i) {
+    if (cv::norm(run[i] - anchor.centre) < cv::norm(run[nearest] - anchor.centre)) nearest = i;
+  }
+  // Walk both ways from the nearest point; the first side to reach the offset inside the
+  // usable part of the image wins, else the farthest usable point seen.
+  cv::Point2d best = run[nearest];
+  double best_walked = -1.0;
+  for (const int step : {1, -1}) {
+    double walked = 0.0;
+    for (std::size_t i = nearest; i + step < run.size() && (step > 0 || i > 0);) {
+      const std::size_t next = static_cast<std::size_t>(static_cast<long>(i) + step);
+      walked += cv::norm(run[next] - run[i]);
+      i = next;
+      if (!usable(run[i])) break;
+      if (walked > best_walked) {
+        best = run[i];
+        best_walked = walked;
+      }
+      if (walked >= label_offset_px) return run[i];
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 std::vector<std::vector<cv::Point2d>> LineInFrame(
@@ -142,14 +209,15 @@ cv::Mat AnnotateLines(const cv::Mat& frame, const std::vector<DetectedLine>& lin
   return image;
 }
 
+// Target lines 1-4, in every drawing of them (BGR).
+const cv::Scalar kLineColours[4] = {{0, 200, 255}, {255, 0, 200}, {255, 255, 0}, {0, 128, 255}};
+
 // The frame with the identified lines labelled 1-4, the corners, the target frame's axes
 // (x red, y green, z blue, kAxisLengthM long) when the pose is ok, and the status.
 cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines,
                      const PoseResult& pose, const vpCameraParameters& camera,
                      const std::optional<vpCameraParameters>& undistorted_by,
                      const std::vector<Point2d>& region) {
-  static const cv::Scalar kLineColours[4] = {
-      {0, 200, 255}, {255, 0, 200}, {255, 255, 0}, {0, 128, 255}};
   cv::Mat image;
   cv::cvtColor(gray, image, cv::COLOR_GRAY2BGR);
   const int w = gray.cols, h = gray.rows;
@@ -169,10 +237,9 @@ cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines
       }
     }
     if (runs.empty() || runs.front().empty()) continue;
-    const auto& run = runs.front();
-    const cv::Point2d at = run[run.size() / 3];
-    DrawText(image, std::to_string(k + 1), cv::Point(cvRound(at.x) + 4, cvRound(at.y) - 4),
-             kLineColours[k], 0.5);
+    const cv::Point2d at = LabelPoint(runs.front(), AnchorOf(pose, camera, w, h), w, h);
+    DrawText(image, std::to_string(k + 1), cv::Point(cvRound(at.x) + 5, cvRound(at.y) - 5),
+             kLineColours[k], 0.6);
   }
   const bool ok = pose.status == PoseStatus::kOk;
   if (ok) {
@@ -202,6 +269,37 @@ cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines
   DrawText(image, ToString(pose.status), cv::Point(4, 16),
            ok ? cv::Scalar(0, 220, 0) : cv::Scalar(0, 0, 255), 0.45);
   return image;
+}
+
+void DrawGoalLines(cv::Mat* image, const LineTarget& target, const vpHomogeneousMatrix& cdMo,
+                   const vpCameraParameters& camera) {
+  constexpr double kDashPx = 8.0;
+  for (std::size_t k = 0; k < target.lines.size() && k < 4; ++k) {
+    const TargetLine& line = target.lines[k];
+    // The printed centre line seen from the goal, through the lens, in short steps: dashes.
+    auto pixel_at = [&](double t) {
+      vpColVector o(4);
+      o[0] = line.x1_m + t * (line.x2_m - line.x1_m);
+      o[1] = line.y1_m + t * (line.y2_m - line.y1_m);
+      o[2] = 0.0;
+      o[3] = 1.0;
+      const vpColVector c = cdMo * o;
+      if (!(c[2] > 1e-6)) return cv::Point2d(NAN, NAN);
+      const Point2d p = DistortedPixel(camera, c[0] / c[2], c[1] / c[2]);
+      return cv::Point2d(p.u, p.v);
+    };
+    const cv::Point2d a = pixel_at(0.0), b = pixel_at(1.0);
+    if (!std::isfinite(a.x) || !std::isfinite(b.x)) continue;
+    const int steps = std::clamp(static_cast<int>(cv::norm(b - a) / kDashPx), 2, 2000);
+    cv::Point2d previous = a;
+    for (int i = 1; i <= steps; ++i) {
+      const cv::Point2d next = pixel_at(static_cast<double>(i) / steps);
+      if (i % 2 == 1 && std::isfinite(next.x) && std::isfinite(previous.x)) {
+        cv::line(*image, previous, next, kLineColours[k], 1, cv::LINE_AA);
+      }
+      previous = next;
+    }
+  }
 }
 
 }  // namespace oal

@@ -2,12 +2,14 @@
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <opencv2/core/mat.hpp>
 #include <optional>
 #include <vector>
 
 #include "detector/detector.h"
+#include "scene/scene.h"
 #include "servo/pose.h"
 
 namespace oal {
@@ -33,5 +35,10 @@ cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines
                      const PoseResult& pose, const vpCameraParameters& camera,
                      const std::optional<vpCameraParameters>& undistorted_by,
                      const std::vector<Point2d>& region = {});
+
+/// Lines 1-4 of `target` where the camera sees them at the goal `cdMo` (through `camera`'s lens),
+/// dashed and thin, in the colours AnnotatePose gives them: what the servo loop steers towards.
+void DrawGoalLines(cv::Mat* image, const LineTarget& target, const vpHomogeneousMatrix& cdMo,
+                   const vpCameraParameters& camera);
 
 }  // namespace oal

@@ -756,7 +756,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     if (hooks.on_frame) {
       hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, model.camera,
-                                tracker.detector().Undistorts()});
+                                config.target, report.cdMo, tracker.detector().Undistorts()});
     }
     std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);

@@ -146,6 +146,8 @@ struct ServoFrame {
   const TargetFrame& tracked;  ///< what the tracker did: status, region scanned
   const ServoIteration& row;
   const vpCameraParameters& camera;  ///< the camera model the detector and pose used
+  const LineTarget& target;          ///< the target the loop servos on
+  const vpHomogeneousMatrix& cdMo;   ///< the goal: where the lines should end up
   bool lines_undistorted = false;    ///< the lines are in undistorted pixels
 };
 

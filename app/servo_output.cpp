@@ -146,8 +146,13 @@ cv::Mat AnnotateServoFrame(const ServoFrame& frame) {
       frame.lines_undistorted ? std::optional<vpCameraParameters>(frame.camera) : std::nullopt;
   cv::Mat image = AnnotatePose(frame.gray, frame.lines, frame.pose, frame.camera, undistorted_by,
                                frame.tracked.region);
+  DrawGoalLines(&image, frame.target, frame.cdMo, frame.camera);
+  cv::putText(image, "dashed: at the goal", cv::Point(image.cols - 160, 16),
+              cv::FONT_HERSHEY_SIMPLEX, 0.45, kBlack, 3, cv::LINE_AA);
+  cv::putText(image, "dashed: at the goal", cv::Point(image.cols - 160, 16),
+              cv::FONT_HERSHEY_SIMPLEX, 0.45, kWhite, 1, cv::LINE_AA);
   const ServoIteration& row = frame.row;
-  std::string caption = "iteration " + std::to_string(row.iteration) + "  " + row.status;
+  std::string caption = "frame " + std::to_string(row.iteration) + "  " + row.status;
   if (std::isfinite(row.translation_error_mm)) {
     caption += "  error " + Fixed(row.translation_error_mm, 2) + " mm " +
                Fixed(row.rotation_error_deg, 3) + " deg";

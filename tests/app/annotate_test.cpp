@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core.hpp>
 
 #include "detector/lens.h"
+#include "scene/scene.h"
 
 namespace oal {
 namespace {
@@ -56,6 +58,33 @@ TEST(AnnotateLines, DrawsInColourOnACopy) {
   EXPECT_NE(on, cv::Vec3b(128, 128, 128));
   EXPECT_EQ(off, cv::Vec3b(128, 128, 128));
   EXPECT_EQ(gray.at<unsigned char>(60, 80), 128);
+}
+
+// The goal lines are drawn dashed where the camera at the goal sees the target's centre lines,
+// in lines 1-4's colours, and nowhere else.
+TEST(DrawGoalLines, DashedAlongTheGoalsProjectionOfEachLine) {
+  const LineTarget target = FourLineA3Target();
+  const vpCameraParameters camera(600.0, 600.0, 319.5, 239.5);
+  const vpHomogeneousMatrix cdMo(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);  // fronto-parallel, 0.5 m
+  cv::Mat image(480, 640, CV_8UC3, cv::Scalar(0, 0, 0));
+  DrawGoalLines(&image, target, cdMo, camera);
+  int drawn_on_lines = 0, samples = 0;
+  for (const TargetLine& line : target.lines) {
+    for (int i = 1; i < 100; ++i) {
+      const double t = i / 100.0;
+      const double x = line.x1_m + t * (line.x2_m - line.x1_m);
+      const double y = line.y1_m + t * (line.y2_m - line.y1_m);
+      const int u = cvRound(319.5 + 600.0 * x / 0.5), v = cvRound(239.5 + 600.0 * y / 0.5);
+      ++samples;
+      drawn_on_lines += image.at<cv::Vec3b>(v, u) != cv::Vec3b(0, 0, 0);
+    }
+  }
+  // Dashes: about half of the samples lie on a drawn piece, none on the other half's gaps.
+  EXPECT_GT(drawn_on_lines, samples / 4);
+  EXPECT_LT(drawn_on_lines, samples * 9 / 10);
+  // Away from every line (the middle of the middle cell, and a corner) nothing is drawn.
+  EXPECT_EQ(image.at<cv::Vec3b>(240, 320), cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(image.at<cv::Vec3b>(5, 5), cv::Vec3b(0, 0, 0));
 }
 
 }  // namespace
