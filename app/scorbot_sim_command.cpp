@@ -6,10 +6,13 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
 #include "app/command_line.h"
+#include "app/servo_command.h"
+#include "app/servo_loop.h"
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/scorbot_robot.h"
@@ -19,8 +22,21 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The simulator: at HOME, or (--config) as the servo loop starts it, at the configuration's
+// robot.start; the command line's pacing and link on top.
 ScorbotSimOptions SimOptions(const ScorbotSimCommandOptions& options) {
   ScorbotSimOptions sim;
+  if (!options.config_path.empty()) {
+    ServoCommandOptions servo;
+    servo.config_path = options.config_path;
+    const ServoAppConfig config = LoadServoConfig(servo);
+    if (config.robot.type != "scorbot") {
+      throw std::invalid_argument("--config " + options.config_path + ": robot.type is '" +
+                                  config.robot.type +
+                                  "', not scorbot: it has no Scorbot start to take");
+    }
+    sim = ControllerSimOptions(config);
+  }
   sim.time_scale = options.time_scale;
   sim.throttle_to_baud = options.throttle;
   sim.baud = options.baud;
@@ -32,10 +48,22 @@ ScorbotSimOptions SimOptions(const ScorbotSimCommandOptions& options) {
 
 int RunScorbotSimServer(const ScorbotSimCommandOptions& options, std::ostream& out,
                         const std::atomic<bool>* interrupt) {
-  ScorbotControllerSim sim(SimOptions(options));
+  const ScorbotSimOptions started = SimOptions(options);
+  ScorbotControllerSim sim(started);
   sim.Start();
   out << "oalservo scorbot-sim: Controller-A simulator on " << sim.DevicePath();
   if (!options.port_link.empty()) out << " (link " << options.port_link << ")";
+  out << "\noalservo scorbot-sim: the arm starts at "
+      << (options.config_path.empty() ? std::string("HOME")
+                                      : "robot.start of " + options.config_path)
+      << " (joints";
+  std::ostringstream joints;
+  joints << std::fixed << std::setprecision(1);
+  for (const double joint : started.start_deg) joints << ' ' << joint;
+  out << joints.str() << " deg)";
+  if (options.config_path.empty()) {
+    out << "; --config config/scorbot-sim.yaml starts it where that file's camera sees the target";
+  }
   out << "\noalservo scorbot-sim: connect at " << options.baud << " baud 8N1, e.g. "
       << "robot: {type: scorbot, scorbot: {port: " << sim.ConnectPath() << "}}"
       << "\noalservo scorbot-sim: time scale " << options.time_scale << ", "
@@ -149,6 +177,10 @@ int RunScorbotSim(int argc, char** argv) {
       "oalservo scorbot-sim");
   cli.add_option("--port-link", options.port_link,
                  "also create this symlink to the pty slave (a stable path for configs)");
+  cli.add_option("--config", options.config_path,
+                 "start the arm at this servo configuration's robot.start (e.g. "
+                 "config/scorbot-sim.yaml; default: at HOME)")
+      ->check(CLI::ExistingFile);
   cli.add_option("--time-scale", options.time_scale,
                  "simulated seconds per wall-clock second (motion only; the link is real time)")
       ->capture_default_str()
@@ -174,6 +206,7 @@ int RunScorbotSim(int argc, char** argv) {
   cli.footer(
       "Examples:\n"
       "  oalservo scorbot-sim --port-link /tmp/scorbot\n"
+      "  oalservo scorbot-sim --config config/scorbot-sim.yaml --port-link /tmp/scorbot\n"
       "  oalservo scorbot-sim --measure 20\n"
       "  oalservo scorbot-sim --measure 20 --noecho");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;

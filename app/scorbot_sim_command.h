@@ -20,7 +20,10 @@
 namespace oal {
 
 struct ScorbotSimCommandOptions {
-  std::string port_link;       ///< symlink to the pty slave; empty: none
+  std::string port_link;  ///< symlink to the pty slave; empty: none
+  /// A servo configuration whose robot.start the arm starts at (e.g. config/scorbot-sim.yaml,
+  /// so that its camera sees the target); empty: the arm starts at HOME.
+  std::string config_path;
   double time_scale = 1.0;     ///< simulated s per wall s; [0.01, 1000]
   bool throttle = true;        ///< pace bytes at the baud rate (10 bits per byte)
   int baud = 9600;             ///< for the pacing and the driver in --measure

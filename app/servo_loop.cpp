@@ -243,8 +243,8 @@ struct RobotRig {
   std::unique_ptr<Robot> driver;
 };
 
-// The simulated controller's start: the arm's joints for the nearest reachable pose to the
-// configured camera start.
+}  // namespace
+
 ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
   ScorbotSimOptions sim = config.robot.simulator;
   const ScorbotGeometry& geometry = config.robot.scorbot.geometry;
@@ -257,6 +257,8 @@ ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
   for (std::size_t i = 0; i < 5; ++i) sim.start_deg[i] = vpMath::deg(start.q[i]);
   return sim;
 }
+
+namespace {
 
 RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll) {
   RobotRig rig;
@@ -534,7 +536,7 @@ void WarnIfOutsideWorkspace(SafeRobot& robot, std::ostream& log) {
   if (!at.result.ok()) return;  // the loop's first read reports it
   const std::string why = OutsideWorkspace(safety, at.pose.getTranslationVector());
   if (why.empty()) return;
-  log << "warning: the robot starts outside the workspace box: the "
+  log << "oalservo servo: warning: the robot starts outside the workspace box: the "
       << ToString(safety.workspace_frame) << "'s " << why
       << " (robot.workspace_min_m / workspace_max_m); every move is still checked against the "
          "box and may be refused: bring the arm into the box or widen it\n";

@@ -4,15 +4,22 @@
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "app/config.h"
+#include "app/scorbot_sim_command.h"
 #include "app/servo_loop.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/scorbot_kinematics.h"
 #include "servo_test_util.h"
+#include "tests/app/command_test_util.h"
+#include "tests/app/test_util.h"
 
 namespace oal {
 namespace {
@@ -51,6 +58,38 @@ TEST(ServoScorbot, Table3ThroughTheDriverAndTheControllerSimulatorConverges) {
   }
 }
 
+// `oalservo scorbot-sim --config config/scorbot-sim.yaml` starts the arm where that file's
+// camera sees the target, so the loop, connected to it as to a real controller, converges
+// (at HOME it saw nothing).
+TEST(ScorbotSimCommand, StartsTheArmAtTheConfigsStartForTheLoopToConverge) {
+  const test::TestDir dir;
+  ScorbotSimCommandOptions sim;
+  sim.config_path = std::string(OAL_SOURCE_DIR) + "/config/scorbot-sim.yaml";
+  sim.port_link = dir / "scorbot";
+  sim.throttle = false;
+  sim.time_scale = 20.0;
+  std::atomic<bool> stop{false};
+  std::ostringstream sim_out;
+  std::thread server([&] { RunScorbotSimServer(sim, sim_out, &stop); });
+  for (int i = 0; i < 500 && !std::filesystem::exists(sim.port_link); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ServoAppConfig config = FastScorbot();
+  config.robot.scorbot.port = sim.port_link;
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  stop = true;
+  server.join();
+  EXPECT_EQ(report.status, ServoRunStatus::kConverged) << log.str() << report.message;
+  EXPECT_THAT(sim_out.str(), HasSubstr("the arm starts at robot.start of "));
+
+  sim.config_path = std::string(OAL_SOURCE_DIR) + "/config/servo-sim.yaml";
+  std::ostringstream out;
+  EXPECT_THAT(
+      test::ErrorMessageOf<std::invalid_argument>([&] { RunScorbotSimServer(sim, out, &stop); }),
+      HasSubstr("robot.type is 'simulated', not scorbot"));
+}
+
 // A Controller-A simulator the test holds (to pull its cable, to make it hit something), with
 // the arm at the configured start; the loop connects to it as to a real arm.
 class HeldController {
@@ -64,13 +103,7 @@ class HeldController {
 
  private:
   static ScorbotSimOptions Options(const ServoAppConfig& config) {
-    ScorbotSimOptions options = config.robot.simulator;
-    options.geometry = config.robot.scorbot.geometry;
-    const ScorbotReach start =
-        NearestReachable(options.geometry, config.robot.start_wMc, config.camera.eMc);
-    EXPECT_TRUE(start.ok) << start.why;
-    for (std::size_t i = 0; i < 5; ++i) options.start_deg[i] = vpMath::deg(start.q[i]);
-    return options;
+    return ControllerSimOptions(config);  // as the loop starts its own
   }
 
   ScorbotControllerSim sim_;
