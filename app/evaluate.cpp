@@ -54,7 +54,6 @@ constexpr double kMatchOffsetPx = 10.0;
 constexpr std::size_t kQueueFrames = 8;         // decoded frames waiting for the tracker
 constexpr int kMaxConsecutiveUnreadable = 50;   // then the input is given up as ended
 constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
-constexpr int kThumbnailSpacing = 10;           // worst frames at least this many frames apart
 constexpr int kThumbnailWidth = 320;
 constexpr double kVideoFps = 25.0;
 constexpr double kVideoQuality = 75.0;      // JPEG quality of the annotated video, [0, 100]
@@ -377,7 +376,7 @@ struct TrackedFrame {
   std::string why;
 };
 
-// The `capacity` worst frames, at least kThumbnailSpacing frames apart, chosen as frames
+// The `capacity` worst frames, at least kThumbnailSpacingFrames frames apart, chosen as frames
 // stream by: the same frames in the same order give the same choice.
 class WorstFrames {
  public:
@@ -387,7 +386,7 @@ class WorstFrames {
     if (capacity_ == 0 || badness <= 0.0) return false;
     double near = -1.0;
     for (const Thumbnail& kept : kept_) {
-      if (std::abs(kept.frame - frame) < kThumbnailSpacing) {
+      if (std::abs(kept.frame - frame) < kThumbnailSpacingFrames) {
         near = std::max(near, badness_.at(kept.frame));
       }
     }
@@ -398,7 +397,7 @@ class WorstFrames {
     const int frame = thumbnail.frame;
     kept_.erase(std::remove_if(kept_.begin(), kept_.end(),
                                [&](const Thumbnail& kept) {
-                                 return std::abs(kept.frame - frame) < kThumbnailSpacing;
+                                 return std::abs(kept.frame - frame) < kThumbnailSpacingFrames;
                                }),
                 kept_.end());
     if (kept_.size() >= capacity_) {
@@ -512,8 +511,13 @@ cv::Mat Annotate(const TrackedFrame& frame, const std::optional<CameraFile>& cam
                 cv::Point(cvRound(at.x) + 3, cvRound(at.y) + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4,
                 colour, 1, cv::LINE_AA);
   }
-  cv::putText(image, "frame " + std::to_string(frame.index), cv::Point(4, image.rows - 6),
-              cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  // White on a black outline: readable on a bright frame as on a dark one.
+  const cv::Point caption(4, image.rows - 6);
+  const std::string text = "frame " + std::to_string(frame.index);
+  cv::putText(image, text, caption, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3,
+              cv::LINE_AA);
+  cv::putText(image, text, caption, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
   return image;
 }
 

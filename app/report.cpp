@@ -93,13 +93,21 @@ chart('chart-status', {type: 'line', data: {labels: frames, datasets: [
     series(s.held, 'lines held', 1, {yAxisID: 'y2', stepped: true})]},
   options: (function() {
     const o = axes('frame', 'status', 'lines held');
-    Object.assign(o.scales.y, {min: -1, max: 3, ticks: {stepSize: 1}});
+    // Half a step of room above 3 (pose) and below -1: the trace is not hidden on the frame.
+    Object.assign(o.scales.y, {min: -1.5, max: 3.5,
+                               ticks: {stepSize: 0.5, callback: v => Math.abs(v - Math.round(v)) < 1e-6
+                                                                 ? Math.round(v) : null}});
     Object.assign(o.scales.y2, {min: 0, ticks: {stepSize: 1}});
     return o;
   })()});
-function perKey(obj, prefix) {
-  return Object.keys(obj).map((k, i) => series(obj[k], prefix + k, i));
+function perKey(obj, prefix, name) {
+  return Object.keys(obj).map((k, i) => series(obj[k], prefix + (name ? name(k) : k), i));
 }
+// A rendered data set's truth lines are the target's lines, numbered 1-4 as everywhere else;
+// a CSV's keep the CSV's own line numbers.
+const targetTruth = data.summary.truth && data.summary.truth.kind === 'json';
+const truthLine = targetTruth ? 'target line ' : 'truth line ';
+const truthName = targetTruth ? (k => String(Number(k) + 1)) : null;
 chart('chart-rho', {type: 'line', data: {labels: frames, datasets: perKey(s.rho, 'track #')},
   options: axes('frame', 'rho (px)')});
 chart('chart-theta', {type: 'line',
@@ -107,8 +115,8 @@ chart('chart-theta', {type: 'line',
   options: axes('frame', 'theta (deg)')});
 if (document.getElementById('chart-line-errors')) {
   chart('chart-line-errors', {type: 'line',
-    data: {labels: frames, datasets: perKey(s.offset_px, 'offset, truth line ')
-        .concat(perKey(s.angle_deg, 'angle, truth line ').map(d =>
+    data: {labels: frames, datasets: perKey(s.offset_px, 'offset, ' + truthLine, truthName)
+        .concat(perKey(s.angle_deg, 'angle, ' + truthLine, truthName).map(d =>
             Object.assign(d, {yAxisID: 'y2', borderDash: [4, 3]})))},
     options: axes('frame', 'offset (px)', 'angle (deg)')});
 }
@@ -361,6 +369,11 @@ std::string InputReportHtml(const Json& summary, const Json& series, const Json&
   if (thumbnails.empty()) {
     html += "<p>None (no frame lost a line, missed its pose or erred against the truth).</p>\n";
   } else {
+    html +=
+        "<p>Frames with a problem, worst first: up to <code>--thumbnails</code> of them, at "
+        "least " +
+        std::to_string(kThumbnailSpacingFrames) +
+        " frames apart (fewer when fewer frames had one).</p>\n";
     html += "<div class=\"thumbs\">\n";
     for (const Thumbnail& thumbnail : thumbnails) {
       html += "<figure><img alt=\"frame " + std::to_string(thumbnail.frame) +
@@ -391,7 +404,8 @@ std::string IndexHtml(const Json& run, const std::vector<Json>& timing,
       "<h2>Inputs</h2>\n<table>\n<tr><th class=\"l\">input</th><th>frames</th>"
       "<th>unreadable</th><th>detection rate</th><th>lost episodes</th>"
       "<th>pose availability</th><th>line offset mean (px)</th>"
-      "<th>pose error mean (mm)</th><th>wall / over decoding</th></tr>\n";
+      "<th>pose error mean (mm)</th><th title=\"the input's wall-clock time, and how much longer "
+      "it took than decoding its frames alone\">time (s) / over decoding alone</th></tr>\n";
   std::string failed;
   std::size_t i = 0;
   for (const Json& input : run["inputs"]) {

@@ -27,6 +27,9 @@ std::string ChartJsPath();
 /// install when it is missing.
 std::string LoadChartJs();
 
+/// The worst frames shown are at least this many frames apart (one bad stretch, one thumbnail).
+constexpr int kThumbnailSpacingFrames = 10;
+
 /// A worst frame's thumbnail for the report.
 struct Thumbnail {
   int frame = 0;

@@ -510,7 +510,13 @@ TEST(EvaluateReport, IsOneSelfContainedPageWithPlotsAndThumbnails) {
   EXPECT_THAT(html, HasSubstr("id=\"oal-data\""));
   EXPECT_THAT(html, HasSubstr("id=\"oal-timing\""));
   EXPECT_THAT(html, HasSubstr("data:image/jpeg;base64,/9j/"));  // a JPEG thumbnail
-  EXPECT_THAT(test::ReadText(out + "/index.html"), HasSubstr("frames/report.html"));
+  // Why fewer thumbnails than --thumbnails can show, said where they are.
+  EXPECT_THAT(html, HasSubstr("up to <code>--thumbnails</code> of them, at least 10 frames apart"));
+  // A rendered data set's truth lines are named as the target's lines 1-4.
+  EXPECT_THAT(html, HasSubstr("'target line '"));
+  const std::string index = test::ReadText(out + "/index.html");
+  EXPECT_THAT(index, HasSubstr("frames/report.html"));
+  EXPECT_THAT(index, HasSubstr("time (s) / over decoding alone"));
 }
 
 // Runs Debian's chromium headless on `page`; returns the dumped DOM, `log` gets stderr.
