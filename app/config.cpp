@@ -1054,8 +1054,14 @@ YAML::Node LoadYaml(const std::string& text, const std::string& file) {
   try {
     return YAML::Load(text);
   } catch (const YAML::ParserException& error) {
-    throw std::runtime_error(file + ":" + std::to_string(error.mark.line + 1) +
-                             ": YAML syntax error: " + error.msg);
+    // An unclosed bracket or quote is found at the end of the text, past its last line: the
+    // last line is where the user looks.
+    const int lines = static_cast<int>(std::count(text.begin(), text.end(), '\n')) +
+                      (!text.empty() && text.back() != '\n' ? 1 : 0);
+    const bool past_the_end = error.mark.line + 1 > lines && lines > 0;
+    const int line = past_the_end ? lines : error.mark.line + 1;
+    throw std::runtime_error(file + ":" + std::to_string(line) + ": YAML syntax error: " +
+                             error.msg + (past_the_end ? " (at the end of the file)" : ""));
   }
 }
 

@@ -167,9 +167,14 @@ TEST(Config, RepeatedKeysAreRejected) {
 }
 
 TEST(Config, SyntaxErrorNamesFileAndLine) {
-  EXPECT_THAT(ErrorOf("detector:\n  step_px: 5\n  polarity: [dark\n"), HasSubstr("cfg.yaml:"));
+  // An unclosed bracket on the last line: that line, not the one past the end of the file.
   EXPECT_THAT(ErrorOf("detector:\n  step_px: 5\n  polarity: [dark\n"),
-              HasSubstr("YAML syntax error"));
+              HasSubstr("cfg.yaml:3: YAML syntax error"));
+  EXPECT_THAT(ErrorOf("detector:\n  step_px: 5\n  polarity: [dark\n"),
+              HasSubstr("(at the end of the file)"));
+  // A bad indentation inside the file: its own line.
+  EXPECT_THAT(ErrorOf("detector:\n  step_px: 5\n polarity: dark\n"),
+              HasSubstr("cfg.yaml:3: YAML syntax error"));
 }
 
 TEST(Config, LoadConfigNamesTheFile) {
