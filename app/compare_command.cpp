@@ -25,7 +25,8 @@ int RunCompare(int argc, char** argv) {
   cli.add_option("--truth", options.truth,
                  "truth: a directory of frame_NNNN.json files, or a CSV with rows "
                  "frame,line,rho,theta (default: the .json next to each image)");
-  cli.add_option("--config", options.config_path, "YAML configuration of our detector");
+  cli.add_option("--config", options.config_path, "YAML configuration of our detector")
+      ->check(CLI::ExistingFile);
   cli.add_option("--camera", options.camera_path,
                  "ViSP camera XML: our detector undistorts its points and is scored against the "
                  "truth's ideal lines");

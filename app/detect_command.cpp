@@ -126,7 +126,8 @@ int RunDetect(int argc, char** argv) {
       "name instead (image.0001.pgm is frame 1); match them by \"source\".",
       "oalservo detect");
   AddInputsArgument(cli, &options);
-  cli.add_option("--config", options.config_path, "YAML configuration (see config/detector.yaml)");
+  cli.add_option("--config", options.config_path, "YAML configuration (see config/detector.yaml)")
+      ->check(CLI::ExistingFile);
   cli.add_flag("--paper", options.paper,
                "start from the paper's algorithm (every remedy off); --config still overrides");
   CLI::Option* camera =

@@ -26,7 +26,8 @@ int RunEvaluate(int argc, char** argv) {
   cli.add_option("--out", options.out_dir, "output directory (created if missing)")->required();
   cli.add_option("--config", options.config_path,
                  "YAML configuration: detector, target and pose sections (default: the "
-                 "target.yaml `oalservo render` writes next to its frames, else the A3 sheet)");
+                 "target.yaml `oalservo render` writes next to its frames, else the A3 sheet)")
+      ->check(CLI::ExistingFile);
   cli.add_option("--camera", options.camera_path,
                  "ViSP camera XML for every input (default: camera.xml next to each input; "
                  "without a camera there is no pose)");

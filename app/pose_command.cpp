@@ -194,7 +194,8 @@ int RunPose(int argc, char** argv) {
   cli.add_option("--config", options.config_path,
                  "YAML configuration: detector, target, pose and tracking sections (see "
                  "config/pose.yaml); default: the target.yaml next to rendered frames, else the "
-                 "A3 sheet");
+                 "A3 sheet")
+      ->check(CLI::ExistingFile);
   cli.add_option("--camera", options.camera_path,
                  "ViSP camera XML (required unless the first input's directory has a "
                  "camera.xml, as `oalservo render` writes)");

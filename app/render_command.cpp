@@ -413,7 +413,8 @@ int RunRender(int argc, char** argv) {
   cli.add_option("--config", options.config,
                  "YAML file whose 'target:' section gives the target (instead of --target) and "
                  "whose 'scene:' section the surface, light, shadow and clutter")
-      ->excludes(target);
+      ->excludes(target)
+      ->check(CLI::ExistingFile);
   CLI::Option* count = cli.add_option("--count", options.count,
                                       "number of frames (default with --sequence: " +
                                           std::to_string(kDefaultSequenceFrames) + ")")

@@ -270,7 +270,8 @@ int RunServoMain(int argc, char** argv) {
       "oalservo servo");
   cli.add_option("--config", options.config_path,
                  "YAML configuration: camera, robot, servo, goal, target_pose (and detector, "
-                 "target, pose) sections; default: the built-in config/servo-sim.yaml");
+                 "target, pose) sections; default: the built-in config/servo-sim.yaml")
+      ->check(CLI::ExistingFile);
   cli.add_option("--out", options.out_dir,
                  "output directory (overrides output.directory; default out/servo): servo.csv, "
                  "servo-error.png, frames/");

@@ -798,7 +798,8 @@ int RunTarget(int argc, char** argv) {
   cli.add_option("--config", options.config,
                  "YAML file whose 'target:' section gives the target (config/four-line-a3.yaml "
                  "and the other config/four-line-*.yaml are the built-ins written out)")
-      ->excludes(target);
+      ->excludes(target)
+      ->check(CLI::ExistingFile);
   cli.add_option("--page", options.page,
                  "a4 (210 x 297 mm), a3 (297 x 420 mm), letter (215.9 x 279.4 mm), or full: the "
                  "board at its full size with 10 mm around it, for a plotter or a print shop")

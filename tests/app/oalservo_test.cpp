@@ -49,6 +49,10 @@ TEST(Oalservo, HelpListsTheCommandsAndEachHasItsOwnHelp) {
     // A runnable example, so that nobody has to guess the first command line.
     EXPECT_THAT(sub.out, ::testing::ContainsRegex("Examples?:\n")) << command;
     EXPECT_THAT(sub.out, HasSubstr("\n  oalservo " + command + " ")) << command;
+    // One type for --config in every command that has it: a file that must exist.
+    if (sub.out.find("  --config ") != std::string::npos) {
+      EXPECT_THAT(sub.out, HasSubstr("--config TEXT:FILE")) << command;
+    }
   }
 }
 
