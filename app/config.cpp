@@ -1159,8 +1159,9 @@ void CameraConfig::Check() const {
   if (!(py > 0.0) || !std::isfinite(py)) Violated("CameraConfig::py", Num(py), "py > 0");
   if (!std::isfinite(u0)) Violated("CameraConfig::u0", Num(u0), "finite");
   if (!std::isfinite(v0)) Violated("CameraConfig::v0", Num(v0), "finite");
-  if (!std::isfinite(kdu) || std::fabs(kdu) > 10.0) {
-    Violated("CameraConfig::kdu", Num(kdu), "|kdu| <= 10");
+  // The same range as every command line's --kdu.
+  if (!(kdu > -1.0 && kdu < 1.0)) {
+    Violated("CameraConfig::kdu", Num(kdu), "-1 < kdu < 1");
   }
   if (width < 16 || width > 8192)
     Violated("CameraConfig::width", Num(width), "16 <= width <= 8192");

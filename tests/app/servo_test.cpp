@@ -114,6 +114,9 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
             "servo.yaml:3: key 'servo.deltaa' is unknown");
   EXPECT_THAT(ErrorOf("servo:\n  mode: exponential\n  delta: 1.5\n"),
               HasSubstr("servo.yaml:3: 'servo.delta' is invalid"));
+  // The camera's kdu: the range every command line's --kdu has.
+  EXPECT_THAT(ErrorOf("camera:\n  kdu: 1.5\n"),
+              HasSubstr("servo.yaml:2: 'camera.kdu' is invalid: 1.5 (needs -1 < kdu < 1)"));
   EXPECT_THAT(ErrorOf("servo:\n  max_iterations: -1\n"),
               HasSubstr("servo.yaml:2: 'servo.max_iterations' is invalid"));
   EXPECT_THAT(ErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
