@@ -25,6 +25,7 @@
 #include <thread>
 #include <tuple>
 
+#include "app/accuracy_frames.h"  // IsSheet
 #include "app/annotate.h"
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
@@ -40,6 +41,7 @@
 #include "detector/options.h"
 #include "detector/tracker.h"
 #include "servo/pose.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {
@@ -856,6 +858,18 @@ class InputEvaluation {
       pose_options.camera = camera_->camera;
       pose_options.lines_undistorted = undistorts_;
     }
+    // A printed sheet's pose comes from the target tracker (borders on the target's plane, the
+    // model check), as `pose` finds it: the line tracker's image borders cross a sheet's
+    // stripes only where they reach far enough. The 2 m board's lines traverse the image, the
+    // paper's condition the tracks are made for: its pose stays on them, as does any pose
+    // with `tracking: {scan: image}`. The tracks stay the detection's measure either way.
+    if (camera_ && IsSheet(run_.config.target) && run_.config.target.lines.size() == 4 &&
+        run_.config.tracking.scan == ScanMode::kTarget) {
+      PoseOptions target_pose = pose_options;
+      target_pose.compute_covariance = false;
+      target_tracker_.emplace(run_.config.target, camera_->camera, run_.config.detector,
+                              target_pose, run_.config.tracking);
+    }
 
     AtomicFile frames_file(dir_ / "frames.jsonl");
     AtomicFile timing_file(dir_ / "timing.jsonl");
@@ -961,6 +975,44 @@ class InputEvaluation {
     series_.pose_us.push_back(nullptr);
   }
 
+  // The target tracker's pose of the frame, its lines 1-4 given as the held tracks' lines they
+  // are (-1: no track holds it), so that the tracks' identities, jumps and drawings read it as
+  // they read EstimatePose's. A frame the tracker refuses has a non-ok status and its reason.
+  PoseResult TargetPose(const vpImage<unsigned char>& image,
+                        const std::vector<DetectedLine>& held) {
+    const TargetFrame& found = target_tracker_->Track(ViewOf(image));
+    PoseResult pose = found.pose;
+    if (found.status != TargetStatus::kOk) {
+      if (pose.status == PoseStatus::kOk) pose.status = PoseStatus::kDegenerate;
+      pose.message = ToString(found.status) + ": " + found.message;
+    }
+    const std::vector<DetectedLine>& lines = target_tracker_->lines();
+    for (int& index : pose.line_index) {
+      if (index < 0 || index >= static_cast<int>(lines.size())) {
+        index = -1;
+        continue;
+      }
+      const LineParams& line = lines[static_cast<std::size_t>(index)].line;
+      index = -1;
+      // The point of the line nearest the image's centre: a held line through it, at about
+      // its angle, is the same line.
+      const double centre_u = 0.5 * (image.getWidth() - 1.0);
+      const double centre_v = 0.5 * (image.getHeight() - 1.0);
+      const double off = line.SignedDistance(centre_u, centre_v);
+      const double foot_u = centre_u - off * std::cos(line.theta_rad);
+      const double foot_v = centre_v - off * std::sin(line.theta_rad);
+      for (std::size_t i = 0; i < held.size(); ++i) {
+        const bool same = AngleBetween(held[i].line, line) < vpMath::rad(1.0) &&
+                          std::fabs(held[i].line.SignedDistance(foot_u, foot_v)) < 3.0;
+        if (same) {
+          index = static_cast<int>(i);
+          break;
+        }
+      }
+    }
+    return pose;
+  }
+
   TrackedFrame Process(DecodedFrame& frame, OalLineTracker* tracker, PoseOptions pose_options,
                        std::ostream& frames, std::ostream& timing, std::vector<double>* track_times,
                        std::vector<double>* pose_times) {
@@ -1005,7 +1057,8 @@ class InputEvaluation {
       // never becomes the seed.
       std::optional<vpHomogeneousMatrix> seed;
       if (trusted_ && frame.index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
-      out.pose = EstimatePose(out.held, run_.config.target, pose_options, seed);
+      out.pose = target_tracker_ ? TargetPose(image, out.held)
+                                 : EstimatePose(out.held, run_.config.target, pose_options, seed);
       if (out.pose->status == PoseStatus::kOk) {
         const std::array<int, 4> identified = IdentifiedTracks(*out.pose, out.ids);
         jump = JumpFrom(trusted_, frame.index, out.pose->cMo, identified);
@@ -1269,7 +1322,8 @@ class InputEvaluation {
   std::optional<PointUndistorter> undistorter_;
   std::vector<std::string> warnings_;
   Tally tally_;
-  std::optional<TrustedPose> trusted_;  ///< the last trusted pose (JumpFrom)
+  std::optional<TrustedPose> trusted_;               ///< the last trusted pose (JumpFrom)
+  std::optional<TargetPoseTracker> target_tracker_;  ///< the pose of a '#' target
   Series series_;
   std::vector<double> decode_us_;
 };

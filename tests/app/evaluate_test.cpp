@@ -384,6 +384,27 @@ TEST(Evaluate, NearlyNothingDetectedSaysWhatToTry) {
   EXPECT_THAT(warnings, HasSubstr("config/visp_line_edges.yaml"));
 }
 
+// A printed sheet among clutter: the pose comes from the target tracker, in every frame, where
+// the line tracker's tracks alone give it in about half of them.
+TEST(Evaluate, ASheetsPoseComesFromTheTargetTracker) {
+  const std::string bench = "/usr/share/visp-images-data/ViSP-images/Klimt/Klimt.pgm";
+  if (!fs::exists(bench)) GTEST_SKIP() << "Debian's visp-images-data is not installed";
+  test::TestDir dir;
+  RenderCommandOptions render = test::SequenceRender(dir / "sheet", "slow", 8, 1);
+  render.target = "four-line-a3";
+  render.background_image = bench;
+  const std::string frames = test::RenderChecked(render);
+  EvaluateOptions options = Options({frames}, dir / "out");
+  options.camera_path = frames + "/camera.xml";
+  options.write_video = false;
+  const EvaluateResult result = Evaluate(options);
+  ASSERT_EQ(result.inputs.size(), 1u);
+  ASSERT_EQ(result.inputs[0].status, "complete") << result.inputs[0].error;
+  const json& summary = result.inputs[0].summary;
+  EXPECT_EQ(summary.at("pose").at("frames_ok"), 8) << summary.dump(2);
+  EXPECT_LT(summary.at("truth").at("pose_translation_mm").at("max").get<double>(), 2.0);
+}
+
 TEST(Evaluate, UndecodableImageIsSkippedCountedAndListed) {
   test::TestDir dir;
   const std::string frames = RenderFrames(dir, "frames", 4);
