@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/config.h"
+#include "scene/bench_scene.h"  // IsSheet, SheetSampling
 #include "scene/scene.h"
 
 namespace CLI {
@@ -99,15 +100,6 @@ SceneConfig BenchScene();
 /// (an unknown one is an error naming --target). `config_path` may be empty (no config).
 LineTarget AccuracyTarget(const std::string& target_name, bool target_given,
                           const std::string& config_path, const AppConfig& config);
-
-/// Whether `target` is a sheet (both sides at most 1 m) rather than the paper's 2 m board.
-bool IsSheet(const LineTarget& target);
-
-/// A sheet from the near to the far end of its range (A3 0.3-0.85 m, A4 and letter
-/// 0.25-0.6 m, another sheet scaled from A3 by its width): tilt up to 30 deg, any roll, the
-/// four crossings 10 px inside the image, the optical axis within 0.1 m of the sheet's
-/// centre (so that the sheet is often partly out of view).
-PoseSampling SheetSampling(const LineTarget& target);
 
 /// The conditions a sheet target is evaluated in, where the command line (`cli`, after
 /// parsing) leaves them open: SheetSampling (but for --min-distance, --max-distance,

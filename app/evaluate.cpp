@@ -25,7 +25,6 @@
 #include <thread>
 #include <tuple>
 
-#include "app/accuracy_frames.h"  // IsSheet
 #include "app/annotate.h"
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
@@ -40,6 +39,7 @@
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "detector/tracker.h"
+#include "scene/bench_scene.h"  // IsSheet
 #include "servo/pose.h"
 #include "servo/target_tracker.h"
 

@@ -12,6 +12,7 @@
 
 #include "app/accuracy_frames.h"
 #include "detector/options.h"
+#include "scene/bench_scene.h"  // SheetSampling
 #include "scene/scene.h"
 #include "servo/pose.h"
 #include "servo/target_tracker.h"
