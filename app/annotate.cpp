@@ -227,6 +227,7 @@ cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines
     const std::vector<std::vector<cv::Point>> polygon = {Fixed(outline)};
     cv::polylines(image, polygon, true, cv::Scalar(120, 200, 120), 1, cv::LINE_AA, kShift);
   }
+  const LabelAnchor anchor = AnchorOf(pose, camera, w, h);
   for (int k = 0; k < 4; ++k) {
     const int index = pose.line_index[k];
     if (index < 0 || index >= static_cast<int>(lines.size())) continue;
@@ -237,7 +238,7 @@ cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines
       }
     }
     if (runs.empty() || runs.front().empty()) continue;
-    const cv::Point2d at = LabelPoint(runs.front(), AnchorOf(pose, camera, w, h), w, h);
+    const cv::Point2d at = LabelPoint(runs.front(), anchor, w, h);
     DrawText(image, std::to_string(k + 1), cv::Point(cvRound(at.x) + 5, cvRound(at.y) - 5),
              kLineColours[k], 0.6);
   }
@@ -285,8 +286,7 @@ void DrawGoalLines(cv::Mat* image, const LineTarget& target, const vpHomogeneous
       o[3] = 1.0;
       const vpColVector c = cdMo * o;
       if (!(c[2] > 1e-6)) return cv::Point2d(NAN, NAN);
-      const Point2d p = DistortedPixel(camera, c[0] / c[2], c[1] / c[2]);
-      return cv::Point2d(p.u, p.v);
+      return FramePixel(camera, c[0] / c[2], c[1] / c[2]);
     };
     const cv::Point2d a = pixel_at(0.0), b = pixel_at(1.0);
     if (!std::isfinite(a.x) || !std::isfinite(b.x)) continue;

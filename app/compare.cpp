@@ -213,9 +213,8 @@ class OalMethod : public LineMethod {
 // refused, not scored). Its failures are the frames without a pose.
 class OalTargetMethod : public LineMethod {
  public:
-  OalTargetMethod(const AppConfig& config, const vpCameraParameters& camera, int width, int height)
-      : tracker_(config.target, camera, config.detector, PoseOf(config, camera, width, height),
-                 config.tracking) {}
+  OalTargetMethod(const AppConfig& config, const vpCameraParameters& camera)
+      : tracker_(config.target, camera, config.detector, PoseOf(config), config.tracking) {}
   std::string Name() const override { return "oal-target"; }
   bool Undistorted() const override { return tracker_.detector().Undistorts(); }
   void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
@@ -233,12 +232,9 @@ class OalTargetMethod : public LineMethod {
   int reinitialisations() const override { return 0; }
 
  private:
-  static PoseOptions PoseOf(const AppConfig& config, const vpCameraParameters& camera, int width,
-                            int height) {
+  // The tracker sets the camera and each frame's size itself; scoring needs no covariance.
+  static PoseOptions PoseOf(const AppConfig& config) {
     PoseOptions pose = config.pose;
-    pose.camera = camera;
-    pose.image_width = width;
-    pose.image_height = height;
     pose.compute_covariance = false;
     return pose;
   }
@@ -881,7 +877,7 @@ namespace {
 // camera (--camera) for the pose. None otherwise (a warning says why when a target is known).
 std::unique_ptr<LineMethod> TargetMethod(const CompareOptions& options, AppConfig config,
                                          const std::optional<CameraFile>& camera,
-                                         const Frame& first, std::vector<std::string>* warnings) {
+                                         std::vector<std::string>* warnings) {
   std::string origin;
   if (!options.config_path.empty() && ConfigHasSection(options.config_path, "target")) {
     origin = options.config_path;
@@ -898,8 +894,7 @@ std::unique_ptr<LineMethod> TargetMethod(const CompareOptions& options, AppConfi
                         "its pose");
     return nullptr;
   }
-  return std::make_unique<OalTargetMethod>(config, camera->camera, first.gray.cols,
-                                           first.gray.rows);
+  return std::make_unique<OalTargetMethod>(config, camera->camera);
 }
 
 }  // namespace
@@ -1007,7 +1002,7 @@ CompareReport RunComparison(const CompareOptions& options,
     methods.push_back(std::make_unique<OpenCvMethod>(kind, stripes, config.detector.polarity,
                                                      report.max_stripe_width_px, config.detector));
   }
-  if (auto target = TargetMethod(options, config, camera, frame, &report.warnings)) {
+  if (auto target = TargetMethod(options, config, camera, &report.warnings)) {
     methods.push_back(std::move(target));
   }
   for (auto& extra : extra_methods) methods.push_back(std::move(extra));

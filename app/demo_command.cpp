@@ -209,11 +209,8 @@ struct Detection {
 Detection DetectTarget(const LineTarget& target, const RenderOptions& render,
                        const RenderedFrame& frame) {
   Detection detection;
-  PoseOptions pose;
-  pose.camera = render.camera;
-  pose.image_width = render.width;
-  pose.image_height = render.height;
-  TargetPoseTracker tracker(target, render.camera, DetectorOptions(), pose);
+  // The tracker sets the pose's camera and the frame's size itself.
+  TargetPoseTracker tracker(target, render.camera, DetectorOptions(), PoseOptions());
   const auto start = std::chrono::steady_clock::now();
   const TargetFrame& result = tracker.Track(ViewOf(frame.image));
   detection.time_us =
