@@ -149,9 +149,8 @@ CLI::Option* AddSeedOption(CLI::App& cli, std::uint64_t* seed, const std::string
 
 void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
                              const std::string& kdu_help) {
-  cli.add_option("--frames", options->frames, "number of rendered frames")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
+  cli.add_option("--frames", options->frames, "number of rendered frames, [1, 1000000]")
+      ->capture_default_str();
   AddSeedOption(cli, &options->seed, "seed of poses and noise, >= 0");
   // The defaults depend on the target (ApplySheetDefaults): said in words, not shown.
   cli.add_option("--kdu", options->kdu,

@@ -13,6 +13,7 @@
 #include "app/command_line.h"
 #include "app/servo_command.h"
 #include "app/servo_loop.h"
+#include "detector/options.h"  // RequireOption
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/scorbot_robot.h"
@@ -45,6 +46,18 @@ ScorbotSimOptions SimOptions(const ScorbotSimCommandOptions& options) {
 }
 
 }  // namespace
+
+void ScorbotSimCommandOptions::Check() const {
+  RequireOption(time_scale >= 0.01 && time_scale <= 1000.0, "--time-scale", time_scale,
+                "0.01 <= --time-scale <= 1000");
+  RequireOption(measure_iterations >= 0 && measure_iterations <= 100000, "--measure",
+                measure_iterations, "0 <= --measure <= 100000 (0: serve)");
+  RequireOption(step_mm >= 0.0 && step_mm <= 50.0, "--step-mm", step_mm, "0 <= --step-mm <= 50");
+  RequireOption(step_deg >= 0.0 && step_deg <= 10.0, "--step-deg", step_deg,
+                "0 <= --step-deg <= 10");
+  RequireOption(speed_percent >= 1 && speed_percent <= 100, "--speed", speed_percent,
+                "1 <= --speed <= 100");
+}
 
 int RunScorbotSimServer(const ScorbotSimCommandOptions& options, std::ostream& out,
                         const std::atomic<bool>* interrupt) {
@@ -182,27 +195,25 @@ int RunScorbotSim(int argc, char** argv) {
                  "config/scorbot-sim.yaml; default: at HOME)")
       ->check(CLI::ExistingFile);
   cli.add_option("--time-scale", options.time_scale,
-                 "simulated seconds per wall-clock second (motion only; the link is real time)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.01, 1000.0));
+                 "simulated seconds per wall-clock second (motion only; the link is real time), "
+                 "[0.01, 1000]")
+      ->capture_default_str();
   cli.add_flag("!--no-throttle", options.throttle,
                "do not pace the bytes at the baud rate (instant replies)");
   cli.add_option("--baud", options.baud, "baud rate for the pacing (and --measure's driver)")
       ->capture_default_str()
       ->check(CLI::IsMember({1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200}));
   cli.add_option("--measure", options.measure_iterations,
-                 "measure the link budget over N servo iterations of a position move, then exit")
-      ->check(CLI::Range(1, 100000));
-  cli.add_option("--step-mm", options.step_mm, "--measure: camera step per iteration, mm")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 50.0));
-  cli.add_option("--step-deg", options.step_deg, "--measure: camera rotation per iteration, deg")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+                 "measure the link budget over N servo iterations of a position move, then exit, "
+                 "[1, 100000]");
+  cli.add_option("--step-mm", options.step_mm, "--measure: camera step per iteration, mm, [0, 50]")
+      ->capture_default_str();
+  cli.add_option("--step-deg", options.step_deg,
+                 "--measure: camera rotation per iteration, deg, [0, 10]")
+      ->capture_default_str();
   cli.add_flag("!--noecho", options.echo, "--measure: switch the controller's echo off");
-  cli.add_option("--speed", options.speed_percent, "--measure: SPEED, %")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100));
+  cli.add_option("--speed", options.speed_percent, "--measure: SPEED, %, [1, 100]")
+      ->capture_default_str();
   cli.footer(
       "Examples:\n"
       "  oalservo scorbot-sim --port-link /tmp/scorbot\n"
@@ -210,6 +221,7 @@ int RunScorbotSim(int argc, char** argv) {
       "  oalservo scorbot-sim --measure 20\n"
       "  oalservo scorbot-sim --measure 20 --noecho");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  options.Check();
   if (options.measure_iterations > 0) {
     MeasureScorbotLink(options, std::cout);
     return kExitOk;

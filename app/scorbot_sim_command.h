@@ -32,6 +32,9 @@ struct ScorbotSimCommandOptions {
   double step_deg = 0.5;       ///< --measure: camera rotation step per iteration, deg
   bool echo = true;            ///< --measure: controller echo on (false: NOECHO)
   int speed_percent = 50;      ///< --measure: SPEED
+
+  /// Throws std::invalid_argument naming the command-line option out of range.
+  void Check() const;
 };
 
 /// Figures of --measure, per servo iteration (means over the iterations).

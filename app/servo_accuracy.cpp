@@ -17,19 +17,15 @@ int ServoAccuracyLaw::converged() const {
 }
 
 void ServoAccuracyOptions::Check() const {
-  const auto fail = [](const std::string& field, double value, const std::string& constraint) {
-    RequireOption(false, "ServoAccuracyOptions::" + field, value, constraint);
-  };
-  if (starts < 1) fail("starts", starts, "starts >= 1");
-  if (!(min_distance_m > 0.0)) fail("min_distance_m", min_distance_m, "min_distance_m > 0");
-  if (!(max_distance_m >= min_distance_m)) {
-    fail("max_distance_m", max_distance_m, "max_distance_m >= min_distance_m");
-  }
-  if (!(max_off_deg >= 0.0 && max_off_deg <= 80.0)) {
-    fail("max_off_deg", max_off_deg, "0 <= max_off_deg <= 80");
-  }
-  if (max_iterations < 0) fail("max_iterations", max_iterations, "max_iterations >= 0");
-  if (modes.empty()) throw std::invalid_argument("ServoAccuracyOptions::modes is empty");
+  // Named as the command line gives them: these options come from nowhere else.
+  RequireOption(starts >= 1 && starts <= 1000000, "--starts", starts, "1 <= --starts <= 1000000");
+  RequireOption(min_distance_m > 0.0, "--min-distance", min_distance_m, "--min-distance > 0");
+  RequireOption(max_distance_m >= min_distance_m, "--max-distance", max_distance_m,
+                "--max-distance >= --min-distance");
+  RequireOption(max_off_deg >= 0.0 && max_off_deg <= 80.0, "--max-off-deg", max_off_deg,
+                "0 <= --max-off-deg <= 80");
+  RequireOption(max_iterations >= 0, "--max-iterations", max_iterations, "--max-iterations >= 0");
+  if (modes.empty()) throw std::invalid_argument("--laws: no law to run");
 }
 
 std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoAppConfig& config,

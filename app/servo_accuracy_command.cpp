@@ -113,9 +113,8 @@ int RunServoAccuracy(int argc, char** argv) {
   cli.add_option("--background", background,
                  "image of the surface the target lies on, instead of the configuration's "
                  "scene.background");
-  cli.add_option("--starts", options.starts, "random start poses per law")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
+  cli.add_option("--starts", options.starts, "random start poses per law, [1, 1000000]")
+      ->capture_default_str();
   cli.add_option("--seed", options.seed, "seed of the start poses")->capture_default_str();
   cli.add_option("--min-distance", options.min_distance_m, "metres")->capture_default_str();
   cli.add_option("--max-distance", options.max_distance_m, "metres")->capture_default_str();

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tests/app/command_test_util.h"
@@ -19,6 +20,7 @@ namespace oal {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // The command names listed by `oalservo --help`, so new commands are covered automatically.
 std::vector<std::string> ListedCommands(const std::string& help) {
@@ -100,6 +102,28 @@ TEST(Oalservo, BadInputExitsWithOneAndSaysWhy) {
   EXPECT_THAT(result.err, HasSubstr("oalservo detect: error: no such file or directory '"));
   EXPECT_TRUE(result.out.empty());
   EXPECT_FALSE(std::filesystem::exists(dir / "lines.jsonl"));
+}
+
+// A number out of its range is bad input, not a bad command line, in every command alike: exit
+// 1, "--option = value. Violated constraint: <the range>", nothing run.
+TEST(Oalservo, ANumberOutOfRangeGetsOneStyleOfError) {
+  test::TestDir dir;
+  const std::pair<std::string, std::string> cases[] = {
+      {"render --out '" + dir / "r" + "' --count 0",
+       "--count = 0. Violated constraint: 1 <= --count"},
+      {"servo-accuracy --starts 0", "--starts = 0. Violated constraint: 1 <= --starts <= 1000000"},
+      {"servo-accuracy --max-off-deg 90", "--max-off-deg = 90. Violated constraint: 0 <="},
+      {"pose-accuracy --frames 0", "--frames = 0. Violated constraint: 1 <= --frames"},
+      {"scorbot-sim --speed 0", "--speed = 0. Violated constraint: 1 <= --speed <= 100"},
+      {"scorbot-sim --time-scale 0", "--time-scale = 0. Violated constraint: 0.01 <="},
+  };
+  for (const auto& [command, message] : cases) {
+    const test::OalservoRun run = test::RunOalservo(dir, command);
+    EXPECT_EQ(run.exit_code, 1) << command << ": " << run.err;
+    EXPECT_THAT(run.err, HasSubstr(message)) << command;
+    EXPECT_THAT(run.err, Not(HasSubstr("Options::"))) << command;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "r"));
 }
 
 TEST(Oalservo, CameraNameWithoutCameraIsAUsageError) {
