@@ -145,12 +145,47 @@ vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo) {
 
 bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,
                        const Point2d& plane, Point2d* pixel) {
-  const vpHomography& h = plane_to_image;
-  const double w = h[2][0] * plane.u + h[2][1] * plane.v + h[2][2];
+  return PlaneProjector(plane_to_image, camera).Project(plane, pixel);
+}
+
+PlaneProjector::PlaneProjector(const vpHomography& plane_to_image, const vpCameraParameters& camera)
+    : px_(camera.get_px()),
+      py_(camera.get_py()),
+      u0_(camera.get_u0()),
+      v0_(camera.get_v0()),
+      kdu_(camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
+               ? camera.get_kdu()
+               : 0.0) {
+  for (unsigned int r = 0; r < 3; ++r) {
+    for (unsigned int c = 0; c < 3; ++c) h_[r][c] = plane_to_image[r][c];
+  }
+}
+
+bool PlaneProjector::Project(const Point2d& plane, Point2d* pixel) const {
+  const double w = h_[2][0] * plane.u + h_[2][1] * plane.v + h_[2][2];
   if (!(w > 1e-9)) return false;
-  const double x = (h[0][0] * plane.u + h[0][1] * plane.v + h[0][2]) / w;
-  const double y = (h[1][0] * plane.u + h[1][1] * plane.v + h[1][2]) / w;
-  *pixel = DistortedPixel(camera, x, y);
+  const double x = (h_[0][0] * plane.u + h_[0][1] * plane.v + h_[0][2]) / w;
+  const double y = (h_[1][0] * plane.u + h_[1][1] * plane.v + h_[1][2]) / w;
+  double scale = 1.0;  // distorted over ideal normalised radius
+  const double rho2 = x * x + y * y;
+  if (kdu_ != 0.0 && rho2 > 0.0) {
+    // ViSP's kdu model: rho = r (1 + kdu r^2) for the distorted radius r, solved by Newton
+    // from the inverse's series r = rho (1 - kdu rho^2 + 3 kdu^2 rho^4 - ...), which is
+    // within 1e-3 of it where kdu rho^2 < 0.1, so that two steps usually do. Beyond the
+    // turning point (kdu < 0) no r exists.
+    const double rho = std::sqrt(rho2);
+    if (kdu_ < 0.0 && rho > (2.0 / 3.0) / std::sqrt(-3.0 * kdu_)) return false;
+    const double e = kdu_ * rho2;
+    double r = std::fabs(e) < 0.1 ? rho * (1.0 - e + 3.0 * e * e) : rho / (1.0 + e);
+    for (int i = 0; i < 50; ++i) {
+      const double step = (kdu_ * r * r * r + r - rho) / (3.0 * kdu_ * r * r + 1.0);
+      r -= step;
+      if (std::fabs(step) <= 1e-12 * (1.0 + r)) break;
+    }
+    scale = r / rho;
+  }
+  pixel->u = u0_ + px_ * x * scale;
+  pixel->v = v0_ + py_ * y * scale;
   return std::isfinite(pixel->u) && std::isfinite(pixel->v) && std::fabs(pixel->u) < kFarPx &&
          std::fabs(pixel->v) < kFarPx;
 }
@@ -165,6 +200,7 @@ ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_
 void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
                    const vpCameraParameters& camera, int count, ScanBorders* out) {
   std::vector<std::vector<Point2d>>& polygons = out->polygons;
+  const PlaneProjector projector(plane_to_image, camera);
   std::size_t used = 0;
   auto lerp = [](const Interval& from, const Interval& to, double f) {
     return Interval{from.lo + f * (to.lo - from.lo), from.hi + f * (to.hi - from.hi)};
@@ -180,8 +216,7 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
     polygon.resize(4);
     bool ok = true;
     for (int c = 0; c < 4 && ok; ++c) {
-      ok = ProjectPlanePoint(plane_to_image, camera, corners[c],
-                             &polygon[static_cast<std::size_t>(c)]);
+      ok = projector.Project(corners[c], &polygon[static_cast<std::size_t>(c)]);
     }
     // The lens can fold a quadrilateral seen near the edge of its reach: keep convex ones.
     if (!ok || !IsConvexQuadrilateral(polygon)) continue;

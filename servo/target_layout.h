@@ -97,4 +97,17 @@ std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, con
 bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,
                        const Point2d& plane, Point2d* pixel);
 
+/// ProjectPlanePoint for many points of one view: the homography and the lens are read once
+/// (the model check projects a few hundred points a frame), and the lens is inverted to
+/// 1e-12 of the radius, far below a pixel, rather than to the renderer's last bit.
+class PlaneProjector {
+ public:
+  PlaneProjector(const vpHomography& plane_to_image, const vpCameraParameters& camera);
+  bool Project(const Point2d& plane, Point2d* pixel) const;
+
+ private:
+  double h_[3][3];
+  double px_, py_, u0_, v0_, kdu_;
+};
+
 }  // namespace oal

@@ -126,23 +126,21 @@ namespace {
 // Whether the point `across` metres off stripe k's centre line at `along` is in view, and its
 // grey level.
 bool StripeGrey(const GrayImageView& image, const TargetLayout& layout,
-                const vpHomography& plane_to_image, const vpCameraParameters& camera, int k,
-                double along, double across, int* grey) {
+                const PlaneProjector& projector, int k, double along, double across, int* grey) {
   Point2d pixel;
-  return ProjectPlanePoint(plane_to_image, camera, layout.OnStripe(k, along, across), &pixel) &&
-         GreyAt(image, pixel, grey);
+  return projector.Project(layout.OnStripe(k, along, across), &pixel) && GreyAt(image, pixel, grey);
 }
 
 // The part of stripe k's span whose centre line is in view, to kCoarseSteps of the span
 // (the whole span when both ends and the middle are; empty when no step is): a board's
 // stripe seen from near shows a tenth of its length, where evenly spread samples would miss.
 Interval StripeInView(const GrayImageView& image, const TargetLayout& layout,
-                      const vpHomography& plane_to_image, const vpCameraParameters& camera, int k) {
+                      const PlaneProjector& projector, int k) {
   constexpr int kCoarseSteps = 64;
   const Interval span = layout.stripes[static_cast<std::size_t>(k)].along;
   int grey = 0;
   auto seen = [&](double along) {
-    return StripeGrey(image, layout, plane_to_image, camera, k, along, 0.0, &grey);
+    return StripeGrey(image, layout, projector, k, along, 0.0, &grey);
   };
   if (seen(span.lo) && seen(span.hi) && seen(0.5 * (span.lo + span.hi))) return span;
   const double step = (span.hi - span.lo) / kCoarseSteps;
@@ -162,7 +160,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
                              const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
                              int min_contrast) {
   StripeAgreement agreement;
-  const vpHomography plane_to_image = PlaneToImage(cMo);
+  const PlaneProjector projector(PlaneToImage(cMo), camera);
   for (int k = 0; k < 4; ++k) {
     const StripeSpan& stripe = layout.stripes[static_cast<std::size_t>(k)];
     const double width = 2.0 * stripe.half;
@@ -178,7 +176,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
       }
       return false;
     };
-    const Interval in_view = StripeInView(image, layout, plane_to_image, camera, k);
+    const Interval in_view = StripeInView(image, layout, projector, k);
     if (!(in_view.hi > in_view.lo)) continue;
     // Across the stripe: beside, inside, centre, inside, beside.
     const double across[5] = {-beside, -kInsideFraction * width, 0.0, kInsideFraction * width,
@@ -189,7 +187,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
       int grey[5] = {};
       bool seen = true;
       for (int j = 0; j < 5 && seen; ++j) {
-        seen = StripeGrey(image, layout, plane_to_image, camera, k, along, across[j], &grey[j]);
+        seen = StripeGrey(image, layout, projector, k, along, across[j], &grey[j]);
       }
       if (!seen) continue;
       ++agreement.samples[static_cast<std::size_t>(k)];
