@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -13,6 +14,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 
 #include "app/atomic_file.h"
 
@@ -31,6 +33,45 @@ std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv) {
     throw UsageError(std::string(error.what()) + " (run with --help for usage)");
   }
   return std::nullopt;
+}
+
+namespace {
+
+// `text` with every whole-word occurrence of `word` replaced by `by` (a word: not preceded
+// or followed by a letter, digit, '_' or ':').
+std::string ReplaceWord(std::string text, const std::string& word, const std::string& by) {
+  auto part_of_word = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == ':';
+  };
+  for (std::size_t at = text.find(word); at != std::string::npos; at = text.find(word, at)) {
+    const std::size_t end = at + word.size();
+    if ((at > 0 && part_of_word(text[at - 1])) || (end < text.size() && part_of_word(text[end]))) {
+      at = end;
+      continue;
+    }
+    text.replace(at, word.size(), by);
+    at += by.size();
+  }
+  return text;
+}
+
+}  // namespace
+
+void CheckInOptionWords(const std::function<void()>& check,
+                        const std::vector<std::pair<std::string, std::string>>& fields) {
+  try {
+    check();
+  } catch (const std::invalid_argument& error) {
+    std::string message = error.what();
+    for (const auto& [qualified, option] : fields) {
+      message = ReplaceWord(message, qualified, option);
+      const std::size_t scope = qualified.rfind("::");
+      if (scope != std::string::npos) {
+        message = ReplaceWord(message, qualified.substr(scope + 2), option);
+      }
+    }
+    throw std::invalid_argument(message);
+  }
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace CLI {
@@ -39,6 +40,12 @@ class UsageError : public std::runtime_error {
 /// Parses argv into `cli`. Returns an exit code when the command should stop here (--help
 /// was printed: kExitOk), std::nullopt to go on. Throws UsageError on a bad command line.
 std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv);
+
+/// Runs `check` (a library Options' Check()) and, when it throws std::invalid_argument,
+/// throws the same message in the command line's words: each {"Options::field", "--option"}
+/// pair's qualified field, and its bare name in the constraint, become the option that set it.
+void CheckInOptionWords(const std::function<void()>& check,
+                        const std::vector<std::pair<std::string, std::string>>& fields);
 
 /// "frame N / total, R frames/s, ETA m:ss" on stderr, redrawn in place (at most 5 times a
 /// second, and at the end), when stderr is a terminal; nothing otherwise (logs stay clean).

@@ -58,6 +58,12 @@ int RunCompare(int argc, char** argv) {
       "--config config/visp_line_edges.yaml --truth line_reference.csv");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   options.target_kind = TargetKindFromString(target_kind);
+  CheckInOptionWords([&] { options.Check(); }, {{"CompareOptions::lines", "--lines"},
+                                                {"CompareOptions::max_frames", "--max-frames"},
+                                                {"CompareOptions::figures", "--figures"},
+                                                {"VpMeLineOptions::range_px", "--me-range"},
+                                                {"VpMeLineOptions::threshold", "--me-threshold"},
+                                                {"VpMeLineOptions::sample_step_px", "--me-step"}});
   CompareReport report;
   {
     std::optional<QuietStderr> quiet;

@@ -116,6 +116,10 @@ TEST(Oalservo, ANumberOutOfRangeGetsOneStyleOfError) {
       {"pose-accuracy --frames 0", "--frames = 0. Violated constraint: 1 <= --frames"},
       {"scorbot-sim --speed 0", "--speed = 0. Violated constraint: 1 <= --speed <= 100"},
       {"scorbot-sim --time-scale 0", "--time-scale = 0. Violated constraint: 0.01 <="},
+      {"compare '" + dir.path().string() + "' --me-range 0",
+       "--me-range = 0. Violated constraint: 1 <= --me-range <= 100"},
+      {"compare '" + dir.path().string() + "' --lines 200",
+       "--lines = 200. Violated constraint: 0 <= --lines <= 100"},
   };
   for (const auto& [command, message] : cases) {
     const test::OalservoRun run = test::RunOalservo(dir, command);
