@@ -76,7 +76,7 @@ struct TargetTrackerOptions {
   int borders = 16;
   /// ... and when it is tracked from a prior pose, whose seeded lines need fewer votes to
   /// stand out. Range [2, 64].
-  int tracked_borders = 12;
+  int tracked_borders = 8;
   SheetFinderOptions finder;
   /// Middle-cell candidates scanned per frame at most. Range [1, 16].
   int max_candidates = 3;
