@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <sstream>
 
 #include "robots/check_option.h"
@@ -60,13 +61,36 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
-// The number after "AXIS" in an upper-cased line, 0 if none.
-int AxisOf(const std::string& upper) {
+// The number of 1 to `max_digits` digits at s[i..] (no sign) and where it ends; nothing when
+// there is no digit there or the run is longer (a number std::atoi would wrap).
+std::optional<int> BoundedNumber(const std::string& s, std::size_t i, std::size_t max_digits,
+                                 std::size_t* end = nullptr) {
+  std::size_t j = i;
+  int value = 0;
+  while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) {
+    if (j - i == max_digits) return std::nullopt;
+    value = 10 * value + (s[j] - '0');
+    ++j;
+  }
+  if (j == i) return std::nullopt;
+  if (end != nullptr) *end = j;
+  return value;
+}
+
+// The axis after "AXIS" in an upper-cased line: 0 when the line names none; when it names
+// one that is not 1..5 (signed, too long, out of range), nothing, and *problem says why.
+std::optional<int> AxisOf(const std::string& upper, std::string* problem) {
   const std::size_t at = upper.find("AXIS");
   if (at == std::string::npos) return 0;
   std::size_t i = at + 4;
   while (i < upper.size() && (upper[i] == ' ' || upper[i] == ':')) ++i;
-  return std::atoi(upper.c_str() + i);
+  if (i == upper.size()) return 0;
+  const std::optional<int> axis = BoundedNumber(upper, i, 1);
+  if (axis && *axis >= 1 && *axis <= 5) return axis;
+  std::size_t end = i;
+  while (end < upper.size() && upper[end] != ' ') ++end;
+  *problem = "axis '" + upper.substr(i, std::min<std::size_t>(end - i, 24)) + "' is not 1..5";
+  return std::nullopt;
 }
 
 // Position of the first '>' that starts a line in s[from..], npos if none.
@@ -159,6 +183,8 @@ std::string ToString(AclErrorKind kind) {
       return "numbered";
     case AclErrorKind::kOther:
       return "other";
+    case AclErrorKind::kMalformed:
+      return "malformed";
   }
   return "unknown";
 }
@@ -199,27 +225,39 @@ std::vector<AclError> ParseAclErrors(const std::string& text) {
     const bool numbered = digits > 0 && digits < up.size() && up[digits] == ' ' &&
                           digits + 1 < up.size() &&
                           std::isupper(static_cast<unsigned char>(up[digits + 1]));
+    std::optional<int> axis = 0;
     if (up.find("IMPACT PROTECTION") != std::string::npos) {
       e.kind = AclErrorKind::kImpact;
-      e.axis = AxisOf(up);
+      axis = AxisOf(up, &e.problem);
     } else if (up.find("OUT OF RANGE") != std::string::npos) {
       e.kind = AclErrorKind::kOutOfRange;
-      e.axis = AxisOf(up);
+      axis = AxisOf(up, &e.problem);
     } else if (up.find("HOME FAILURE") != std::string::npos) {
       e.kind = AclErrorKind::kHomeFailure;
-      e.axis = AxisOf(up);
+      axis = AxisOf(up, &e.problem);
     } else if (up.find("CONTROL DISABLED") != std::string::npos) {
       e.kind = AclErrorKind::kControlDisabled;
     } else if (numbered) {
-      e.code = std::atoi(up.c_str());
-      e.kind = e.code == 317   ? AclErrorKind::kBadCartesian
-               : e.code == 312 ? AclErrorKind::kBadCoordinate
-                               : AclErrorKind::kNumbered;
+      // ACL's error codes have three digits; a longer run is noise on the line.
+      const std::optional<int> code = BoundedNumber(up, 0, 4);
+      if (code) {
+        e.code = *code;
+        e.kind = e.code == 317   ? AclErrorKind::kBadCartesian
+                 : e.code == 312 ? AclErrorKind::kBadCoordinate
+                                 : AclErrorKind::kNumbered;
+      } else {
+        e.problem = "error number '" + up.substr(0, std::min<std::size_t>(digits, 24)) +
+                    "' has more than 4 digits";
+      }
     } else if (starred) {
       e.kind = AclErrorKind::kOther;
     } else {
       continue;
     }
+    if (axis) {
+      e.axis = *axis;
+    }
+    if (!e.problem.empty()) e.kind = AclErrorKind::kMalformed;
     errors.push_back(e);
   }
   return errors;
@@ -298,8 +336,11 @@ AclReply AclClient::Finish(AclReply reply, const std::string& async, const std::
   reply.lines = Lines(StripFlowControl(body));
   reply.errors = std::move(errors);
   if (reply.errors.empty()) return reply;
-  std::string texts = reply.errors.front().text;
-  for (std::size_t i = 1; i < reply.errors.size(); ++i) texts += "; " + reply.errors[i].text;
+  auto described = [](const AclError& e) {
+    return e.problem.empty() ? e.text : e.text + " (malformed: " + e.problem + ")";
+  };
+  std::string texts = described(reply.errors.front());
+  for (std::size_t i = 1; i < reply.errors.size(); ++i) texts += "; " + described(reply.errors[i]);
   if (reply.status == AclStatus::kOk) {
     reply.status = AclStatus::kControllerError;
     reply.message = "controller: " + texts;

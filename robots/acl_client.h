@@ -56,17 +56,20 @@ enum class AclErrorKind {
   kBadCoordinate,    ///< "312 BAD POINT COORDINATE"
   kNumbered,         ///< another numbered error "NNN TEXT"
   kOther,            ///< any other "*** TEXT" line
+  kMalformed,        ///< an error line whose number cannot be right (an axis not 1..5, a code
+                     ///< beyond 4 digits): the link is garbled, and the line still an error
 };
 
 /// "impact", "out-of-range", "home-failure", "control-disabled", "bad-cartesian-point",
-/// "bad-point-coordinate", "numbered", "other".
+/// "bad-point-coordinate", "numbered", "other", "malformed".
 std::string ToString(AclErrorKind kind);
 
 struct AclError {
   AclErrorKind kind = AclErrorKind::kOther;
-  int axis = 0;      ///< 1..5 when the message names an axis, else 0
-  int code = 0;      ///< the number of a numbered error, else 0
-  std::string text;  ///< the controller's line, trimmed
+  int axis = 0;         ///< 1..5 when the message names an axis, else 0
+  int code = 0;         ///< the number of a numbered error, else 0
+  std::string text;     ///< the controller's line, trimmed
+  std::string problem;  ///< kMalformed: what is wrong with the line; else empty
 };
 
 /// The error lines of `text` (any line starting, after any prompt '>', with "***",

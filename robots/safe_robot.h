@@ -83,7 +83,9 @@ std::string ToString(SafeRobotState state);
 /// One velocity cycle.
 struct CycleReport {
   RobotResult result;
-  vpColVector twist;       ///< the twist sent to the driver (after saturation); empty if none
+  /// The twist sent to the driver (after saturation); zero when none was sent (a 6-vector
+  /// still: an empty vpColVector copies through memcpy from a null pointer).
+  vpColVector twist = vpColVector(6, 0.0);
   double scale = 1;        ///< saturation factor applied to the request, in (0, 1]
   bool saturated = false;  ///< scale < 1
   int limiting_axis = -1;  ///< 0..5 (vx..wz) that set the scale; -1 when not saturated

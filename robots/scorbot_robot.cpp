@@ -40,6 +40,7 @@ RobotStatus StatusOf(AclErrorKind kind) {
     case AclErrorKind::kHomeFailure:
     case AclErrorKind::kNumbered:
     case AclErrorKind::kOther:
+    case AclErrorKind::kMalformed:
       return RobotStatus::kError;
   }
   return RobotStatus::kError;

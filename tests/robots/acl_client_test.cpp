@@ -99,6 +99,31 @@ TEST(AclParse, EveryErrorKind) {
   EXPECT_EQ(e[7].text, "*** INVALID COMMAND");
 }
 
+// A number that cannot be right is not wrapped into one that looks right (std::atoi read
+// "4294967613" as 317 and "99999999999" as an axis): the line stays an error, marked
+// malformed with the reason, and no axis or code is taken from it.
+TEST(AclParse, NumbersOutOfRangeAreMalformedErrors) {
+  const std::vector<AclError> e = ParseAclErrors(
+      "4294967613 BAD CARTESIAN POINT\r\n"
+      "*** IMPACT PROTECTION axis 99999999999\r\n"
+      "*** OUT OF RANGE axis -7\r\n"
+      "*** HOME FAILURE AXIS 9\r\n"
+      "*** IMPACT PROTECTION axis 5\r\n");
+  ASSERT_EQ(e.size(), 5u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(e[i].kind, AclErrorKind::kMalformed) << e[i].text;
+    EXPECT_EQ(e[i].axis, 0) << e[i].text;
+    EXPECT_EQ(e[i].code, 0) << e[i].text;
+  }
+  EXPECT_EQ(e[0].problem, "error number '4294967613' has more than 4 digits");
+  EXPECT_EQ(e[1].problem, "axis '99999999999' is not 1..5");
+  EXPECT_EQ(e[2].problem, "axis '-7' is not 1..5");
+  EXPECT_EQ(e[3].problem, "axis '9' is not 1..5");
+  EXPECT_EQ(e[4].kind, AclErrorKind::kImpact);
+  EXPECT_EQ(e[4].axis, 5);
+  EXPECT_TRUE(e[4].problem.empty());
+}
+
 TEST(AclClient, EchoPromptAndReply) {
   SimLink link(testing_scorbot::FastSim(), false, 1.0, /*consume_banner=*/false);
   // Let the banner arrive (a prompt of its own): text before our echo is asynchronous output.

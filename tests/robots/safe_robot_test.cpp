@@ -171,6 +171,11 @@ TEST(SafeRobot, VelocityLeavingTheWorkspaceIsRefusedAndTheRobotStaysPutAndStoppe
   EXPECT_EQ(next.result.status, RobotStatus::kStopped);
   EXPECT_NE(next.result.message.find("workspace box"), std::string::npos) << next.result.message;
   EXPECT_TRUE(SamePose(rig.camera->wMc(), before, 0));
+  // Nothing was sent: a zero twist, a 6-vector all the same (copied without a null memcpy).
+  ASSERT_EQ(next.twist.size(), 6u);
+  EXPECT_EQ(next.twist.frobeniusNorm(), 0.0);
+  const CycleReport copy = next;
+  EXPECT_EQ(copy.twist.size(), 6u);
 }
 
 TEST(SafeRobot, MoveTargetOutsideTheWorkspaceIsRefused) {
