@@ -118,16 +118,7 @@ std::vector<unsigned char> ReadBytes(const fs::path& path) {
 
 cv::Mat DecodeGray(const fs::path& path) {
   if (!fs::exists(path)) throw std::runtime_error("no such file " + Quoted(path));
-  const std::vector<unsigned char> bytes = ReadBytes(path);
-  if (const std::string truncation = Truncation(bytes); !truncation.empty()) {
-    throw std::runtime_error("cannot decode image " + Quoted(path) + ": " + truncation);
-  }
-  cv::Mat gray = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
-  if (gray.empty()) {
-    throw std::runtime_error("cannot decode image " + Quoted(path) +
-                             " (not an image, truncated, or a format OpenCV cannot read)");
-  }
-  return gray;
+  return DecodeGrayImage(ReadBytes(path), path.string());
 }
 
 // A list of image files, decoded one at a time.
@@ -242,7 +233,9 @@ cv::Mat ToGray(const cv::Mat& image) {
 class VideoSource : public ImageSource {
  public:
   explicit VideoSource(const std::string& path) : path_(path) {
-    if (!capture_.open(path) || !capture_.isOpened()) {
+    // FFmpeg reads the video containers; naming it spares a file the probe of OpenCV's camera
+    // backends (gPhoto2 scans the USB bus and keeps what it found, GStreamer prints errors).
+    if (!capture_.open(path, cv::CAP_FFMPEG) || !capture_.isOpened()) {
       throw std::runtime_error("cannot open video " + Quoted(path) +
                                " (not a video, or no decoder for it)");
     }
@@ -363,6 +356,18 @@ Pattern ParsePattern(const std::string& text) {
 }
 
 }  // namespace
+
+cv::Mat DecodeGrayImage(const std::vector<unsigned char>& bytes, const std::string& name) {
+  if (const std::string truncation = Truncation(bytes); !truncation.empty()) {
+    throw std::runtime_error("cannot decode image " + Quoted(name) + ": " + truncation);
+  }
+  cv::Mat gray = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  if (gray.empty()) {
+    throw std::runtime_error("cannot decode image " + Quoted(name) +
+                             " (not an image, truncated, or a format OpenCV cannot read)");
+  }
+  return gray;
+}
 
 cv::Mat ReadGrayImageFile(const std::string& path) {
   return DecodeGray(path);

@@ -73,6 +73,9 @@ struct V4l2Settings {
 std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
                                             const V4l2Settings& settings = V4l2Settings());
 
+/// An image file's bytes decoded to 8-bit grey, as every source decodes them (a PNG or JPEG
+/// cut short is refused before the decoder sees it). Throws std::runtime_error naming `name`.
+cv::Mat DecodeGrayImage(const std::vector<unsigned char>& bytes, const std::string& name);
 /// One image file decoded to 8-bit grey as the sources decode it. Throws std::runtime_error
 /// naming the file when it is missing, cut short or not an image.
 cv::Mat ReadGrayImageFile(const std::string& path);

@@ -489,7 +489,7 @@ TEST(ServoAccuracy, EveryLawConvergesFromRandomStarts) {
   }
 }
 
-TEST(ServoAccuracy, BadOptionsNameTheField) {
+TEST(ServoAccuracy, BadOptionsNameTheOption) {
   const ServoAppConfig config = Small(DefaultServoConfig());
   const auto error = [&](ServoAccuracyOptions options) {
     try {
@@ -501,13 +501,15 @@ TEST(ServoAccuracy, BadOptionsNameTheField) {
   };
   ServoAccuracyOptions options;
   options.starts = 0;
-  EXPECT_THAT(error(options), HasSubstr("ServoAccuracyOptions::starts = 0"));
+  EXPECT_THAT(error(options), HasSubstr("--starts = 0. Violated constraint: 1 <= --starts"));
   options = ServoAccuracyOptions();
   options.max_distance_m = 0.2;  // below min_distance_m = 0.3
-  EXPECT_THAT(error(options), HasSubstr("ServoAccuracyOptions::max_distance_m = 0.2"));
+  EXPECT_THAT(error(options),
+              HasSubstr("--max-distance = 0.2. Violated constraint: --max-distance >= "
+                        "--min-distance"));
   options = ServoAccuracyOptions();
   options.modes.clear();
-  EXPECT_THAT(error(options), HasSubstr("ServoAccuracyOptions::modes is empty"));
+  EXPECT_THAT(error(options), HasSubstr("--laws: no law to run"));
 }
 
 TEST(ServoLoopTable3, PointAndGoReachesTheGoalWithinThreeMoves) {
