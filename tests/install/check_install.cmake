@@ -1,6 +1,7 @@
 # ctest's install check: `cmake --install` the build tree into a fresh prefix, then configure,
 # build and run tests/install/consumer against it alone, as another project would.
-# -D BUILD_DIR (this build), WORK_DIR (scratch), CONSUMER_DIR (the consumer's sources).
+# -D BUILD_DIR (this build), WORK_DIR (scratch), CONSUMER_DIR (the consumer's sources),
+# SANITIZE_FLAGS (the build's sanitizer flags, ;-separated; empty: none).
 function(run_step what)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT status EQUAL 0)
@@ -18,7 +19,10 @@ foreach(file bin/oalservo include/oalservo/detector/detector.h share/oalservo/co
   endif()
 endforeach()
 run_step("installed oalservo --version" ${prefix}/bin/oalservo --version)
+# A sanitized library links only into a program built with the same sanitizers.
+string(REPLACE ";" " " sanitize "${SANITIZE_FLAGS}")
 run_step("consumer configure" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build
-         -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+         -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix}
+         "-DCMAKE_CXX_FLAGS=${sanitize}" "-DCMAKE_EXE_LINKER_FLAGS=${sanitize}")
 run_step("consumer build" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run_step("consumer run" ${WORK_DIR}/build/consumer)
