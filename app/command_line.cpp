@@ -118,13 +118,14 @@ std::function<void(int, int)> FrameProgress(const std::string& label, double pla
   return ProgressPrinter(label, terminal, terminal ? 0.2 : plain_every_s, unit);
 }
 
-void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
-                       int max_frames, const std::string& out_path) {
-  const std::string name = options_name;
-  if (inputs.empty()) throw std::invalid_argument(name + "::inputs is empty");
+void CheckFrameCommand(const std::vector<std::string>& inputs, int max_frames,
+                       const std::string& out_path) {
+  if (inputs.empty()) {
+    throw std::invalid_argument("no input: give an image, a directory, a pattern or a video");
+  }
   if (max_frames < 0) {
-    throw std::invalid_argument(name + "::max_frames = " + std::to_string(max_frames) +
-                                ". Violated constraint: max_frames >= 0");
+    throw std::invalid_argument("--max-frames = " + std::to_string(max_frames) +
+                                ". Violated constraint: --max-frames >= 0");
   }
   if (!out_path.empty()) CheckOutputFile(out_path);
 }

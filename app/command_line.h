@@ -58,10 +58,10 @@ std::function<void(int done, int total)> FrameProgress(const std::string& label,
                                                        double plain_every_s = 10.0,
                                                        const std::string& unit = "frames");
 
-/// The checks every command over image sources shares: at least one input, max_frames >= 0
-/// and a writable --out. Throws std::invalid_argument naming `options_name`'s field.
-void CheckFrameCommand(const char* options_name, const std::vector<std::string>& inputs,
-                       int max_frames, const std::string& out_path);
+/// The checks every command over image sources shares: at least one input, --max-frames >= 0
+/// and a writable --out. Throws std::invalid_argument naming the option.
+void CheckFrameCommand(const std::vector<std::string>& inputs, int max_frames,
+                       const std::string& out_path);
 
 /// While one lives, the signals that ask a program to stop — SIGINT (Ctrl-C), SIGTERM (kill,
 /// `systemctl stop`, `timeout`) and SIGHUP (the terminal or the SSH session closed) — set

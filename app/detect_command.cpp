@@ -96,7 +96,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
 }  // namespace
 
 void DetectCommandOptions::Check() const {
-  CheckFrameCommand("DetectCommandOptions", inputs, max_frames, out_path);
+  CheckFrameCommand(inputs, max_frames, out_path);
   if (!camera_name.empty() && camera_path.empty()) {
     throw std::invalid_argument("DetectCommandOptions::camera_name '" + camera_name +
                                 "' needs camera_path (the camera file to read it from)");

@@ -108,6 +108,7 @@ void AccuracyOptions::Check() const {
   }
   detector.Check();
   tracking.Check();
+  sampling.Check();
   target.Check();
 }
 

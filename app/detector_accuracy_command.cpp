@@ -122,7 +122,10 @@ int RunDetectAccuracy(int argc, char** argv) {
   const bool scene_given = !config_path.empty() && ConfigHasSection(config_path, "scene");
   options.target = AccuracyTarget(target_name, target->count() > 0, config_path, config);
   ApplySheetDefaults(cli, options.target, scene_given, &options, &options.sampling);
-  options.Check();
+  CheckInOptionWords([&] { options.Check(); }, {{"PoseSampling::min_distance_m", "--min-distance"},
+                                                {"PoseSampling::max_distance_m", "--max-distance"},
+                                                {"PoseSampling::max_tilt_deg", "--max-tilt-deg"},
+                                                {"PoseSampling::max_offset_m", "--max-offset"}});
   CheckReportFile(out_path);
   const AccuracyReport report = EvaluateDetectorAccuracy(options, TerminalFrameProgress());
   PrintAccuracyReport(Table(report), ToJson(report), out_path);

@@ -180,7 +180,10 @@ int RunPoseAccuracy(int argc, char** argv) {
   const bool scene_given = !config_path.empty() && ConfigHasSection(config_path, "scene");
   options.target = AccuracyTarget(target_name, target->count() > 0, config_path, config);
   ApplyTargetDefaults(cli, scene_given, &options);
-  options.Check();
+  CheckInOptionWords([&] { options.Check(); }, {{"PoseSampling::min_distance_m", "--min-distance"},
+                                                {"PoseSampling::max_distance_m", "--max-distance"},
+                                                {"PoseSampling::max_tilt_deg", "--max-tilt-deg"},
+                                                {"PoseSampling::max_offset_m", "--max-offset"}});
   CheckReportFile(out_path);
   const PoseAccuracyReport report = EvaluatePoseAccuracy(options, TerminalFrameProgress());
   PrintAccuracyReport(Table(report), ToJson(report, config_path), out_path);

@@ -160,7 +160,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
 }  // namespace
 
 void PoseCommandOptions::Check() const {
-  CheckFrameCommand("PoseCommandOptions", inputs, max_frames, out_path);
+  CheckFrameCommand(inputs, max_frames, out_path);
 }
 
 PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) {

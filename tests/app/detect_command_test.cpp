@@ -251,10 +251,10 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Detect, OptionsAreChecked) {
   test::TestDir dir;
   DetectCommandOptions options;
-  EXPECT_THAT(DetectError(options), HasSubstr("inputs is empty"));
+  EXPECT_THAT(DetectError(options), HasSubstr("no input: give an image"));
   options.inputs = {"x.png"};
   options.max_frames = -1;
-  EXPECT_THAT(DetectError(options), HasSubstr("max_frames"));
+  EXPECT_THAT(DetectError(options), HasSubstr("--max-frames = -1. Violated constraint"));
   options.max_frames = 0;
   options.out_path = dir / "no/such/dir/lines.jsonl";
   EXPECT_THAT(DetectError(options), HasSubstr("does not exist"));
