@@ -14,8 +14,8 @@
 namespace oal {
 
 struct DemoCommandOptions {
-  std::string out_dir = "out/demo";  ///< created if missing
-  std::uint64_t seed = 1;            ///< pose and noise
+  std::string out_dir = "out/demo";     ///< created if missing
+  std::uint64_t seed = 1;               ///< pose and noise
   std::string target = "four-line-a3";  ///< one of TargetNames() (scene/scene.h)
 
   void Check() const;
