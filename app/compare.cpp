@@ -40,7 +40,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kRadToDeg = 180.0 / kPi;
-constexpr double kDegToRad = kPi / 180.0;
 
 // ---------------------------------------------------------------------------------------
 // Line geometry helpers (image pixels, detector/line.h convention).
