@@ -38,10 +38,11 @@ std::optional<int> ParseCommandLine(CLI::App& cli, int argc, char** argv) {
 namespace {
 
 // `text` with every whole-word occurrence of `word` replaced by `by` (a word: not preceded
-// or followed by a letter, digit, '_' or ':').
+// or followed by a letter, digit, '_', ':' or '-', so that an option already named, "--lines",
+// is not renamed again).
 std::string ReplaceWord(std::string text, const std::string& word, const std::string& by) {
   auto part_of_word = [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == ':';
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == ':' || c == '-';
   };
   for (std::size_t at = text.find(word); at != std::string::npos; at = text.find(word, at)) {
     const std::size_t end = at + word.size();

@@ -129,7 +129,8 @@ TEST(Oalservo, ANumberOutOfRangeGetsOneStyleOfError) {
   for (const auto& [command, message] : cases) {
     const test::OalservoRun run = test::RunOalservo(dir, command);
     EXPECT_EQ(run.exit_code, 1) << command << ": " << run.err;
-    EXPECT_THAT(run.err, HasSubstr(message)) << command;
+    EXPECT_THAT(run.err, HasSubstr("error: " + message)) << command;
+    EXPECT_THAT(run.err, Not(HasSubstr("---"))) << command;
     EXPECT_THAT(run.err, Not(HasSubstr("Options::"))) << command;
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "r"));
