@@ -34,8 +34,11 @@ for target in "${targets[@]}"; do
   findings=build-fuzz/findings/$target
   mkdir -p "$corpus" "$findings"
   cp -n tests/fuzz/corpus/"$target"/* "$corpus"/ 2>/dev/null || true
+  # The target's own dictionary, else its family's (acl_reply_fuzz, acl_client_fuzz: acl.dict).
   dict=()
-  [ -f tests/fuzz/"$target".dict ] && dict=(-dict=tests/fuzz/"$target".dict)
+  for file in tests/fuzz/"$target".dict tests/fuzz/"${target%%_*}".dict; do
+    if [ -f "$file" ]; then dict=(-dict="$file"); break; fi
+  done
   log=build-fuzz/$target.log
   echo "fuzz.sh: $target for $seconds s" >&2
   if build-fuzz/tests/fuzz/"$target" "$corpus" "${dict[@]}" -max_total_time="$seconds" \
