@@ -13,6 +13,7 @@
 #include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/detector_accuracy.h"  // Quantile
+#include "app/fault_campaign.h"
 #include "app/servo_accuracy.h"
 #include "app/servo_command.h"
 #include "app/servo_output.h"
@@ -127,9 +128,29 @@ int RunServoAccuracy(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::IsMember({"point-and-go", "exponential", "velocity"}));
   cli.add_option("--out", out_path, "write the runs as JSON to this file");
+  FaultCampaignOptions faults;
+  int fault_runs = 0;
+  cli.add_option("--faults", fault_runs,
+                 "instead of convergence, the fault campaign: this many runs of the "
+                 "configuration's servo job, each with one fault at a random moment (the "
+                 "Scorbot's link, the drive, the frames), each checked for the robot stopped, "
+                 "the reason printed, no motion after the stop, whole outputs; [1, 1000000]");
+  cli.add_option("--time-scale", faults.time_scale,
+                 "with --faults: simulated seconds per second of the Scorbot's controller "
+                 "simulator, [0.01, 1000]")
+      ->capture_default_str();
+  cli.add_option("--jobs", faults.jobs,
+                 "with --faults: runs at once (each mostly waits on the link), [1, 64]")
+      ->capture_default_str();
+  cli.add_option("--work-dir", faults.work_dir,
+                 "with --faults: the runs' output folders run_NNNN (replaced); a run that passes "
+                 "is removed, a failed one kept with its console log")
+      ->capture_default_str();
   cli.footer(
       "Examples:\n"
       "  oalservo servo-accuracy --starts 100 --out out/servo-accuracy.json\n"
+      "  oalservo servo-accuracy --config config/scorbot-sim.yaml --faults 1000 --out "
+      "out/faults-scorbot.json\n"
       "  oalservo servo-accuracy --starts 100 --target four-line-board\n"
       "  oalservo servo-accuracy --starts 100 --background "
       "/usr/share/visp-images-data/ViSP-images/Klimt/Klimt.pgm");
@@ -139,6 +160,12 @@ int RunServoAccuracy(int argc, char** argv) {
     const std::filesystem::path parent = std::filesystem::path(out_path).parent_path();
     CheckWritableDirectory(parent.empty() ? "." : parent, "directory of --out");
     CheckOutputFile(out_path);
+  }
+  const bool fault_campaign = cli.count("--faults") > 0;
+  if (fault_campaign) {
+    faults.runs = fault_runs;
+    faults.seed = options.seed;
+    faults.Check();
   }
   if (!laws.empty()) {
     options.modes.clear();
@@ -159,6 +186,13 @@ int RunServoAccuracy(int argc, char** argv) {
     config.scene.background_origin = "--background";
     RenderOptions probe;
     config.scene.ApplyTo(&probe);  // an unreadable image fails now, not in the first run
+  }
+  if (fault_campaign) {
+    const FaultCampaignReport report =
+        RunFaultCampaign(config, faults, FrameProgress("fault run", 30.0, "runs"));
+    std::cout << FaultCampaignTable(report);
+    if (!out_path.empty()) WriteFileAtomically(out_path, FaultCampaignJson(report));
+    return report.failed() == 0 ? kExitOk : kExitError;
   }
   const ServoAccuracyReport report =
       EvaluateServoAccuracy(config, options, FrameProgress("servo run", 30.0, "runs"));

@@ -189,7 +189,16 @@ std::optional<std::string> TrueErrorLine(const ServoRunReport& report, const Ser
 
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks) {
-  const ServoAppConfig config = LoadServoConfig(options);
+  return RunServoWithOutputs(
+      LoadServoConfig(options),
+      options.config_path.empty() ? kDefaultServoConfigName : options.config_path,
+      options.out_dir.empty() ? "output directory (output.directory)" : "output directory (--out)",
+      out, hooks);
+}
+
+ServoRunReport RunServoWithOutputs(const ServoAppConfig& config, const std::string& config_name,
+                                   const std::string& directory_what, std::ostream& out,
+                                   const ServoRunHooks& hooks) {
   const fs::path dir = config.output.directory;
   const fs::path csv = dir / "servo.csv", plot = dir / "servo-error.png";
   // Everything the outputs need is checked before the source and the robot are opened; what
@@ -202,15 +211,12 @@ ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream&
   else if (!fs::exists(dir / "frames"))
     made.folders = {dir / "frames"};
   if (!dir.empty()) {
-    CheckWritableDirectory(dir, options.out_dir.empty() ? "output directory (output.directory)"
-                                                        : "output directory (--out)");
+    CheckWritableDirectory(dir, directory_what);
     CheckOutputFile(csv);
     CheckOutputFile(plot);
   }
   FrameOutput frames(config, dir.empty() ? fs::path() : dir / "frames");
-  out << "oalservo servo: "
-      << (options.config_path.empty() ? kDefaultServoConfigName : options.config_path) << ", "
-      << ToString(config.servo.law.mode) << " law"
+  out << "oalservo servo: " << config_name << ", " << ToString(config.servo.law.mode) << " law"
       << (frames.HasWindow() ? ", live window (click to stop)" : "") << '\n';
 
   ServoRunHooks run_hooks = hooks;

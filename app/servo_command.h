@@ -61,6 +61,12 @@ std::optional<std::string> TrueErrorLine(const ServoRunReport& report, const Ser
 /// Loads the configuration, runs the loop (rows to `out`) and writes the outputs.
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks = ServoRunHooks());
+/// Runs the loop on `config` (rows to `out`, the first line naming `config_name`) and writes
+/// the outputs into config.output.directory; `directory_what` names that setting in errors
+/// (e.g. "output directory (--out)").
+ServoRunReport RunServoWithOutputs(const ServoAppConfig& config, const std::string& config_name,
+                                   const std::string& directory_what, std::ostream& out,
+                                   const ServoRunHooks& hooks = ServoRunHooks());
 
 int RunServoMain(int argc, char** argv);
 

@@ -260,7 +260,7 @@ ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
 
 namespace {
 
-RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll) {
+RobotRig OpenConfiguredRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll) {
   RobotRig rig;
   if (config.robot.type == "scorbot") {
     ScorbotOptions options = config.robot.scorbot;
@@ -282,6 +282,13 @@ RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> o
   options.eMc = config.camera.eMc;
   options.on_poll = std::move(on_poll);
   rig.driver = std::make_unique<SimulatedCamera>(options);
+  return rig;
+}
+
+RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll,
+                   const ServoRunHooks& hooks) {
+  RobotRig rig = OpenConfiguredRobot(config, std::move(on_poll));
+  if (hooks.wrap_driver) rig.driver = hooks.wrap_driver(std::move(rig.driver));
   return rig;
 }
 
@@ -391,8 +398,10 @@ std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int it
 }
 
 // The frame of this iteration, of the camera's size; a stop when there is none.
+// `on_grab` (ServoRunHooks) sees the frame before it is checked.
 std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
-                         const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) {
+                         const vpHomogeneousMatrix& true_cMo, int iteration,
+                         const std::function<void(int, cv::Mat*)>& on_grab, cv::Mat* gray) {
   bool have_frame = false;
   try {
     have_frame = frames.Grab(true_cMo, iteration, gray);
@@ -403,6 +412,12 @@ std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
   if (!have_frame) {
     return Stop{ServoRunStatus::kEndOfInput,
                 "end of " + frames.Name() + " after " + std::to_string(iteration) + " frames"};
+  }
+  if (on_grab) on_grab(iteration, gray);
+  if (gray->empty()) {
+    return Stop{ServoRunStatus::kError, "cannot read the next frame at iteration " +
+                                            std::to_string(iteration) + ": " + frames.Name() +
+                                            " gave an empty frame"};
   }
   if (gray->cols != camera.width || gray->rows != camera.height) {
     return Stop{ServoRunStatus::kError,
@@ -628,9 +643,12 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   const bool moves_robot = config.source.type != "replay";
 
   int move_iteration = -1;  // the iteration whose move runs, for Hooks::on_move_poll
-  const RobotRig rig = OpenRobot(config, [&hooks, &move_iteration](int poll) {
-    if (hooks.on_move_poll) hooks.on_move_poll(move_iteration, poll);
-  });
+  const RobotRig rig = OpenRobot(
+      config,
+      [&hooks, &move_iteration](int poll) {
+        if (hooks.on_move_poll) hooks.on_move_poll(move_iteration, poll);
+      },
+      hooks);
   if (velocity_law && !rig.driver->Capabilities().velocity) {
     throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
                                 rig.driver->Name() +
@@ -726,10 +744,10 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     }
     const vpHomogeneousMatrix wMc = read.pose;
     const vpHomogeneousMatrix true_cMo = wMc.inverse() * config.target_wMo;
-    if (std::optional<Stop> stop = Grab(*frames, config.camera, true_cMo, iteration, &gray)) {
+    if (std::optional<Stop> stop =
+            Grab(*frames, config.camera, true_cMo, iteration, hooks.on_grab, &gray)) {
       return finish(*stop);
     }
-    if (hooks.on_grab) hooks.on_grab(iteration, &gray);
     report.iterations.push_back(RowAt(config, iteration, wMc, true_cMo, report.cdMo));
     moved_since_row = false;
     ServoIteration& current = report.iterations.back();

@@ -68,6 +68,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <opencv2/core/mat.hpp>
 #include <ostream>
 #include <string>
@@ -168,12 +169,16 @@ struct ServoRunHooks {
   /// Called once per frame, after the pose and the law, before the robot moves.
   std::function<void(const ServoFrame&)> on_frame;
   /// Called with each frame before detection; may change it (tests inject occlusions and a
-  /// target leaving the view through it). The frame may be a view of the source's buffer.
+  /// target leaving the view through it; an emptied frame is one that could not be read). The
+  /// frame may be a view of the source's buffer.
   std::function<void(int iteration, cv::Mat* gray)> on_grab;
   /// Tests: called at every poll of a position move of the simulated robot (robot.type
   /// simulated, whose moves take one sampling period per poll), with the iteration that
   /// commanded the move and the poll's number in it (0 first), e.g. to stop it on its way.
   std::function<void(int iteration, int poll)> on_move_poll;
+  /// Tests and the fault campaign: wraps the driver the configuration opened (to watch what
+  /// it is sent, to make it fail); the loop drives the wrapper in its place.
+  std::function<std::unique_ptr<Robot>(std::unique_ptr<Robot>)> wrap_driver;
 };
 
 /// The goal of a taught configuration: the pose of config.target estimated in the image

@@ -494,8 +494,9 @@ AclReply AclClient::Ping() {
 }
 
 AclReply AclClient::Abort() {
-  // Ctrl-A first, on its own: the controller acts on it as it arrives.
-  if (IoResult w = link_.Write(std::string(1, kCtrlA), options_.reply_timeout_s); !w.ok()) {
+  // Ctrl-A first, on its own: the controller acts on it as it arrives. Urgent: a controller
+  // that holds our output with XOFF longer than a reply takes is faulty, and the stop must go.
+  if (IoResult w = link_.WriteUrgent(std::string(1, kCtrlA), options_.reply_timeout_s); !w.ok()) {
     AclReply reply;
     reply.status = StatusOf(w);
     reply.message = "sending Ctrl-A: " + w.message;

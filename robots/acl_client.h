@@ -33,8 +33,9 @@
 // sequence again: no second one is sent, since its output could not be told from the first's.
 // A controller that lost the sequence (bytes lost on the line) therefore stays out of step
 // until a new client (ScorbotRobot::Connect()).
-// Abort() is Ctrl-A (0x01, stops all motion immediately, sent even when out of step) followed
-// by CLRBUF (clears the movement buffer). Not thread-safe.
+// Abort() is Ctrl-A (0x01, stops all motion immediately, sent even when out of step and even
+// while the controller holds our output with XOFF) followed by CLRBUF (clears the movement
+// buffer). Not thread-safe.
 #pragma once
 
 #include <array>

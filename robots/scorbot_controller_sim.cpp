@@ -144,7 +144,9 @@ void ScorbotControllerSim::Start() {
     silent_ = false;
     homing_reply_pending_ = false;
     holding_reply_ = false;
+    cutting_reply_ = false;
     held_.clear();
+    heard_line_.clear();
     Emit("SYSTEM READY!\r\n");
     Prompt();
   }
@@ -186,6 +188,32 @@ void ScorbotControllerSim::InjectImpact(int axis) {
 void ScorbotControllerSim::InjectImpactAfterNextPrompt(int axis) {
   std::lock_guard<std::mutex> lock(mutex_);
   impact_after_prompt_axis_ = std::max(1, std::min(5, axis));
+}
+
+void ScorbotControllerSim::InjectImpactNow(int axis) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const int clamped = std::max(1, std::min(5, axis));
+  if (motion_.active && !motion_.homing) {
+    motion_.impact_at_s = SimTime();
+    motion_.impact_axis = clamped;
+  } else {
+    impact_axis_ = clamped;
+  }
+}
+
+void ScorbotControllerSim::InjectCutReply() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  cut_reply_armed_ = true;
+}
+
+void ScorbotControllerSim::InjectNoise(const std::string& bytes) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Into the middle of what is still to go out, else now.
+  out_.insert(out_.size() / 2, bytes);
+}
+
+std::vector<HeardLine> ScorbotControllerSim::heard() const {
+  return Snapshot(heard_);
 }
 
 void ScorbotControllerSim::InjectLateReply() {
@@ -352,7 +380,20 @@ void ScorbotControllerSim::Prompt() {
   Emit(">");
 }
 
+void ScorbotControllerSim::Hear(char c) {
+  if (!options_.log_input) return;
+  if (c == kCtrlA) {
+    heard_.push_back({std::chrono::steady_clock::now(), "^A"});
+  } else if (c == '\r') {
+    heard_.push_back({std::chrono::steady_clock::now(), heard_line_});
+    heard_line_.clear();
+  } else if (c != '\n' && heard_line_.size() < 256) {
+    heard_line_.push_back(c);
+  }
+}
+
 void ScorbotControllerSim::Receive(char c) {
+  Hear(c);
   if (silent_) return;  // a hung controller: nothing is executed
   if (c == kCtrlA) {
     AbortMotion();
@@ -369,7 +410,17 @@ void ScorbotControllerSim::Receive(char c) {
     if (echo_) Emit("\r\n");
     const std::string line = line_;
     line_.clear();
+    if (cut_reply_armed_ && !holding_reply_) {
+      cut_reply_armed_ = false;
+      cutting_reply_ = holding_reply_ = true;  // the echo went; the reply is held and cut
+    }
     Execute(line);
+    if (cutting_reply_) {
+      cutting_reply_ = holding_reply_ = false;
+      const std::string sent = held_.substr(0, held_.size() / 2);
+      held_.clear();
+      Emit(sent);
+    }
     return;
   }
   if (c == '\b' || c == 0x7f) {

@@ -31,12 +31,14 @@
 //   - Time: simulated time = wall time x time_scale (tests run moves fast). With
 //     throttle_to_baud, every byte in each direction takes 10 bits at the baud rate (8N1), the
 //     two directions independently (full duplex), so link timing is realistic.
-// FAULT INJECTION (thread-safe, for tests): an impact on axis n halfway through the next move;
-// an impact on axis n during the current move right after the next command's prompt (in the
-// same write); silence (a hung controller: input discarded, nothing executed, echoed or
-// answered); a late answer (the next command's reply and prompt held back until the host sends
-// another line); "317 BAD CARTESIAN POINT" for the next MOVE; a home failure on axis n for the
-// next HOME; XOFF / XON sent to the host.
+// FAULT INJECTION (thread-safe, for tests and the fault campaign): an impact on axis n halfway
+// through the next move, or now; an impact on axis n during the current move right after the
+// next command's prompt (in the same write); silence (a hung controller: input discarded,
+// nothing executed, echoed or answered); a late answer (the next command's reply and prompt
+// held back until the host sends another line); a reply cut short (its second half and the
+// prompt lost); line noise (bytes amid the output); "317 BAD CARTESIAN POINT" for the next
+// MOVE; a home failure on axis n for the next HOME; XOFF / XON sent to the host. Stop() is
+// the port closed (the cable pulled). With log_input, heard() is what the host sent, timed.
 #pragma once
 
 #include <array>
@@ -48,6 +50,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "robots/scorbot_kinematics.h"
 
@@ -71,9 +74,18 @@ struct ScorbotSimOptions {
   std::string link_path;
   /// Joint angles at start-up, degrees (default: the home position, encoders at 0).
   std::array<double, 5> start_deg{0.0, 60.0, -90.0, -60.0, 0.0};
+  /// Keep every line received (and each Ctrl-A) with its arrival time, also while silent: a
+  /// tap on the wire for tests and the fault campaign (heard()). Off: nothing is kept.
+  bool log_input = false;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
+};
+
+/// A line the controller received (without its CR), or "^A" for a Ctrl-A, and when it arrived.
+struct HeardLine {
+  std::chrono::steady_clock::time_point at;
+  std::string text;
 };
 
 /// Byte and command counts of a simulator run.
@@ -124,6 +136,15 @@ class ScorbotControllerSim {
   void InjectBadCartesianPoint();
   /// The next HOME fails with "*** HOME FAILURE AXIS n".
   void InjectHomeFailure(int axis);
+  /// The arm hits something now: a move under way stops at once with "*** IMPACT PROTECTION
+  /// axis n" (control goes off); with the arm still, the next move stops halfway.
+  void InjectImpactNow(int axis);
+  /// The next command's reply (after its echo) is cut short: its first half is sent, the rest
+  /// and the prompt are lost.
+  void InjectCutReply();
+  /// Line noise: `bytes` go out now, amid whatever the controller is sending (inside a reply
+  /// still on its way at the baud rate), silence or not.
+  void InjectNoise(const std::string& bytes);
   /// Sends XOFF (0x13) / XON (0x11) to the host: a host with XON/XOFF stops / resumes sending.
   void SendXoff();
   void SendXon();
@@ -137,6 +158,8 @@ class ScorbotControllerSim {
   /// The last command line executed, upper-cased ("" before the first).
   std::string last_command() const;
   ScorbotSimStats stats() const;
+  /// What the host sent, line by line (options log_input; else empty).
+  std::vector<HeardLine> heard() const;
 
  private:
   struct Point {
@@ -166,6 +189,7 @@ class ScorbotControllerSim {
     return member;
   }
   double SimTime() const;  // s
+  void Hear(char c);       // the wire tap (options_.log_input)
   void Receive(char c);
   void Execute(const std::string& line);
   void Emit(const std::string& text);  // reply text, subject to silence
@@ -208,6 +232,10 @@ class ScorbotControllerSim {
   int impact_axis_ = 0;
   int impact_after_prompt_axis_ = 0;
   bool late_reply_armed_ = false;
+  bool cut_reply_armed_ = false;
+  bool cutting_reply_ = false;  // the reply being held is to be cut, not sent late
+  std::string heard_line_;      // the line being received, for heard_
+  std::vector<HeardLine> heard_;
   bool holding_reply_ = false;
   std::string held_;  // output held back by a late reply
   std::string last_command_;

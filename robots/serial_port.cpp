@@ -159,6 +159,20 @@ IoResult SerialPort::Open(const std::string& path, const SerialPortOptions& opti
   return {};
 }
 
+IoResult SerialPort::WriteUrgent(const std::string& bytes, double timeout_s) {
+  termios tio{};
+  const bool ixon = fd_ >= 0 && ::tcgetattr(fd_, &tio) == 0 && (tio.c_iflag & IXON) != 0;
+  if (!ixon) return Write(bytes, timeout_s);
+  // Clearing IXON restarts output that an XOFF stopped (TCOON only undoes TCOOFF); flow
+  // control is back on once the bytes are out.
+  termios without = tio;
+  without.c_iflag &= ~static_cast<tcflag_t>(IXON);
+  ::tcsetattr(fd_, TCSANOW, &without);
+  const IoResult result = Write(bytes, timeout_s);
+  ::tcsetattr(fd_, TCSANOW, &tio);
+  return result;
+}
+
 IoResult SerialPort::Write(const std::string& bytes, double timeout_s) {
   if (fd_ < 0) return {IoStatus::kError, "port not open"};
   const Clock::time_point deadline = Deadline(timeout_s);

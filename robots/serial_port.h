@@ -44,6 +44,11 @@ class ByteLink {
   virtual ~ByteLink() = default;
   /// Writes all of `bytes` within `timeout_s` seconds.
   virtual IoResult Write(const std::string& bytes, double timeout_s) = 0;
+  /// Writes `bytes` even while the other end holds our output with XOFF: an emergency stop
+  /// must not wait for an XON that a faulty controller may never send. Default: Write().
+  virtual IoResult WriteUrgent(const std::string& bytes, double timeout_s) {
+    return Write(bytes, timeout_s);
+  }
   /// Waits up to `timeout_s` for at least one byte, then appends whatever is available to
   /// `*out` without waiting further.
   virtual IoResult ReadSome(std::string* out, double timeout_s) = 0;
@@ -85,6 +90,8 @@ class SerialPort final : public ByteLink {
   const std::string& path() const { return path_; }
 
   IoResult Write(const std::string& bytes, double timeout_s) override;
+  /// Writes with IXON off, which resumes output an XOFF held (then restores it).
+  IoResult WriteUrgent(const std::string& bytes, double timeout_s) override;
   IoResult ReadSome(std::string* out, double timeout_s) override;
   std::string DrainInput() override;
   LinkCounters counters() const override { return counters_; }

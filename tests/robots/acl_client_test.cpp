@@ -270,6 +270,24 @@ TEST(AclClient, XoffHoldsOurOutputUntilXon) {
   EXPECT_EQ(link.sim.speed_percent(), 35);
 }
 
+// A controller that holds our output with XOFF and never releases it must not keep the stop
+// from leaving: Ctrl-A overrides the held output, and the arm stops.
+TEST(AclClient, AbortGoesOutThroughAHeldXoff) {
+  SimLink link(testing_scorbot::FastSim(), /*xonxoff=*/true, 0.3);
+  ASSERT_TRUE(link.client->Command("SPEED 5").ok());
+  ASSERT_TRUE(link.client->Command("DEFP P1").ok());
+  ASSERT_TRUE(link.client->Command("HERE P1").ok());
+  ASSERT_TRUE(link.client->Command("SETPV P1 1 9000").ok());
+  ASSERT_TRUE(link.client->Command("MOVE P1").ok());
+  ASSERT_TRUE(link.sim.moving());
+  link.sim.SendXoff();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the line discipline acts
+  EXPECT_EQ(link.client->Command("SPEED 30").status, AclStatus::kTimeout);  // held
+  const AclReply abort = link.client->Abort();
+  EXPECT_TRUE(abort.ok()) << abort.message;
+  EXPECT_FALSE(link.sim.moving());
+}
+
 TEST(AclClient, FlowControlBytesAreIgnoredWhenFlowControlIsOff) {
   SimLink link;
   ASSERT_TRUE(link.client->Ping().ok());

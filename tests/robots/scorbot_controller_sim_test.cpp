@@ -179,5 +179,50 @@ TEST(ScorbotControllerSim, LateReplyGoesOutWhenTheNextLineArrives) {
   EXPECT_EQ(sim.speed_percent(), 30);
 }
 
+TEST(ScorbotControllerSim, ACutReplyLosesItsSecondHalfAndThePrompt) {
+  ScorbotControllerSim sim(FastSim());
+  sim.Start();
+  SerialPort port;
+  ASSERT_TRUE(port.Open(sim.DevicePath(), SerialPortOptions()).ok());
+  ReadTo(port, ">");
+  sim.InjectCutReply();
+  ASSERT_TRUE(port.Write("LISTPV POSITION\r", 1.0).ok());
+  std::string in;
+  EXPECT_EQ(port.ReadUntil(&in, ">", 0.3).status, IoStatus::kTimeout);
+  // The echo, then half of "Position POSITION\r\n 1:0 2:0 ...\r\n X:... R:0\r\n>".
+  EXPECT_EQ(in.rfind("LISTPV POSITION\r\nPosition POSITION\r\n", 0), 0u) << in;
+  EXPECT_EQ(in.find(" X:"), std::string::npos) << in;
+  ASSERT_TRUE(port.Write("SPEED\r", 1.0).ok());  // the next command is answered in full
+  EXPECT_EQ(ReadTo(port, ">"), "SPEED\r\nSPEED 50\r\n>");
+}
+
+TEST(ScorbotControllerSim, NoiseGoesOutAmidTheOutputAndImpactNowStopsTheMove) {
+  ScorbotSimOptions options = FastSim();
+  options.log_input = true;
+  ScorbotControllerSim sim(options);
+  sim.Start();
+  SerialPort port;
+  ASSERT_TRUE(port.Open(sim.DevicePath(), SerialPortOptions()).ok());
+  ReadTo(port, ">");
+  sim.InjectNoise("#~");
+  EXPECT_EQ(ReadTo(port, "#~"), "#~");
+  for (const char* command : {"SPEED 2", "DEFP P1", "HERE P1", "SETPV P1 1 3000", "MOVE P1"}) {
+    ASSERT_TRUE(port.Write(std::string(command) + "\r", 1.0).ok());
+    ReadTo(port, ">");
+  }
+  ASSERT_TRUE(sim.moving());
+  sim.InjectImpactNow(2);
+  EXPECT_EQ(ReadTo(port, "axis 2\r\n"), "\r\n*** IMPACT PROTECTION axis 2\r\n");
+  EXPECT_FALSE(sim.moving());
+  EXPECT_FALSE(sim.control_enabled());
+  ASSERT_TRUE(port.Write(std::string(1, 0x01), 1.0).ok());
+  ASSERT_TRUE(WaitFor([&] { return sim.heard().size() == 6; }));
+  const std::vector<HeardLine> heard = sim.heard();
+  EXPECT_EQ(heard[0].text, "SPEED 2");
+  EXPECT_EQ(heard[4].text, "MOVE P1");
+  EXPECT_EQ(heard[5].text, "^A");
+  EXPECT_LE(heard[4].at, heard[5].at);
+}
+
 }  // namespace
 }  // namespace oal
