@@ -58,8 +58,9 @@ constexpr int kMaxConsecutiveUnreadable = 50;   // then the input is given up as
 constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
 constexpr int kThumbnailWidth = 320;
 constexpr double kVideoFps = 25.0;
-constexpr double kVideoQuality = 75.0;      // JPEG quality of the annotated video, [0, 100]
-constexpr std::size_t kPlottedTracks = 10;  // the tracks seen longest get a series
+constexpr double kVideoQuality = 75.0;        // JPEG quality of the annotated video, [0, 100]
+constexpr std::size_t kPlottedTracks = 10;    // the tracks seen longest get a series
+constexpr std::size_t kPlottedFrames = 2048;  // frames in the plots: 2048 to 4095 (Series)
 // A pose is flagged as a jump when, against the last trusted pose of at most kJumpFrames
 // frames before, the same four tracks are identified as other target lines, or the rotation
 // exceeds kJumpRotationDeg (docs/EVALUATE.md, frames.jsonl).
@@ -77,19 +78,76 @@ void Require(bool ok, const char* option, const T& value, const char* constraint
   RequireOption(ok, option, value, constraint);
 }
 
+// Count, mean, maximum and quantiles of a non-negative per-frame measure in bounded memory:
+// the first kExactSamples values are kept (a short input reports exact quantiles, by nearest
+// rank), beyond them a histogram of logarithmic bins 1 % wide, whose quantiles are within
+// 0.5 % of the exact ones: an hour of video costs what a minute does.
+class SampleStats {
+ public:
+  void push_back(double value) {
+    ++count_;
+    sum_ += value;
+    max_ = count_ == 1 ? value : std::max(max_, value);
+    if (bins_.empty() && exact_.size() < kExactSamples) {
+      exact_.push_back(value);
+      return;
+    }
+    if (bins_.empty()) {
+      for (const double kept : exact_) Bin(kept);
+      std::vector<double>().swap(exact_);
+    }
+    Bin(value);
+  }
+  std::size_t size() const { return count_; }
+  double mean() const { return sum_ / static_cast<double>(count_); }
+  double max() const { return max_; }
+  double Quantile(double q) const {
+    if (bins_.empty()) return oal::Quantile(exact_, q);
+    const double rank =
+        std::clamp(std::ceil(q * static_cast<double>(count_)), 1.0, static_cast<double>(count_));
+    std::size_t seen = 0;
+    for (std::size_t i = 0; i < bins_.size(); ++i) {
+      seen += bins_[i];
+      if (static_cast<double>(seen) >= rank) {
+        return i == 0 ? 0.0 : std::min(max_, kSmallest * std::pow(kBinGrowth, i - 0.5));
+      }
+    }
+    return max_;
+  }
+
+ private:
+  static constexpr std::size_t kExactSamples = 4096;
+  static constexpr double kSmallest = 1e-6;  // smaller values (and zero) share bin 0
+  static constexpr double kBinGrowth = 1.01;
+  static constexpr std::size_t kMaxBins = 8192;  // up to 1e-6 * 1.01^8192, about 1e29
+
+  void Bin(double value) {
+    std::size_t bin = 0;
+    if (value >= kSmallest) {
+      bin = 1 + static_cast<std::size_t>(
+                    std::min(std::log(value / kSmallest) / std::log(kBinGrowth), kMaxBins - 2.0));
+    }
+    if (bin >= bins_.size()) bins_.resize(bin + 1, 0);
+    ++bins_[bin];
+  }
+
+  std::size_t count_ = 0;
+  double sum_ = 0.0, max_ = 0.0;
+  std::vector<double> exact_;
+  std::vector<std::uint32_t> bins_;
+};
+
 // {count, mean, median, p95, max}; nulls for no values.
-Json Stats(const std::vector<double>& values) {
-  if (values.empty()) {
+Json Stats(const SampleStats& values) {
+  if (values.size() == 0) {
     return Json{
         {"count", 0}, {"mean", nullptr}, {"median", nullptr}, {"p95", nullptr}, {"max", nullptr}};
   }
-  double sum = 0.0;
-  for (double v : values) sum += v;
   return Json{{"count", values.size()},
-              {"mean", sum / static_cast<double>(values.size())},
-              {"median", Quantile(values, 0.5)},
-              {"p95", Quantile(values, 0.95)},
-              {"max", *std::max_element(values.begin(), values.end())}};
+              {"mean", values.mean()},
+              {"median", values.Quantile(0.5)},
+              {"p95", values.Quantile(0.95)},
+              {"max", values.max()}};
 }
 
 // ---------------------------------------------------------------------------------------
@@ -677,37 +735,59 @@ std::optional<CameraFile> CameraFor(const RunContext& run, const PlannedInput& i
   return LoadCameraFile(candidate.string());
 }
 
-// Per-frame values for the plots (report.h), nulls where a value does not exist.
+// Per-frame values for the plots (report.h), nulls where a value does not exist. At most
+// 2 x kPlottedFrames frames are kept: past that, every other one is dropped and from then on
+// only every second frame recorded (then every fourth...), so a long input's plots cost
+// bounded memory; frames.jsonl keeps every frame.
 struct Series {
-  Json frame = Json::array(), status = Json::array(), held = Json::array(), pose_ok = Json::array(),
-       pose_t_mm = Json::array(), pose_r_deg = Json::array();
-  std::map<int, Json> rho, theta_deg;        // per track id
-  std::map<int, Json> offset_px, angle_deg;  // per truth line
-  std::map<int, int> seen;                   // frames each track was held
-  Json decode_us = Json::array(), track_us = Json::array(), pose_us = Json::array();
+  struct Track {
+    int id = 0;
+    double rho_px = 0, theta_deg = 0;
+  };
+  struct TruthLine {
+    int line = 0;
+    std::optional<double> offset_px, angle_deg;
+  };
+  struct Row {
+    int frame = 0;
+    int status = -1;
+    std::optional<double> held, pose_ok, pose_t_mm, pose_r_deg;
+    double decode_us = 0;
+    std::optional<double> track_us, pose_us;
+    std::vector<Track> tracks;
+    std::vector<TruthLine> truth;
+  };
 
-  static void Put(std::map<int, Json>* series, int key, std::size_t frame, const Json& value) {
-    Json& values = (*series)[key];
-    while (values.size() < frame) values.push_back(nullptr);
-    values.push_back(value);
+  std::vector<Row> rows;
+  std::map<int, int> seen;  // frames each track was held, every frame counted
+  std::size_t offered = 0, stride = 1;
+
+  void Add(Row row) {
+    for (const Track& track : row.tracks) ++seen[track.id];
+    if (offered++ % stride != 0) return;
+    rows.push_back(std::move(row));
+    if (rows.size() < 2 * kPlottedFrames) return;
+    for (std::size_t i = 1; 2 * i < rows.size(); ++i) rows[i] = std::move(rows[2 * i]);
+    rows.resize((rows.size() + 1) / 2);
+    stride *= 2;
   }
-  static Json Padded(const std::map<int, Json>& series, std::size_t frames,
-                     const std::vector<int>& keys) {
+
+  static Json Optional(const std::optional<double>& value) { return value ? Json(*value) : Json(); }
+  template <typename Get>
+  Json Column(Get get) const {
+    Json column = Json::array();
+    for (const Row& row : rows) column.push_back(get(row));
+    return column;
+  }
+  // {"key": [value or null per row]} for `keys`, each row's value from `find(row, key)`.
+  template <typename Find>
+  Json Keyed(const std::vector<int>& keys, Find find) const {
     Json out = Json::object();
-    for (int key : keys) {
-      Json values = series.at(key);
-      while (values.size() < frames) values.push_back(nullptr);
-      out[std::to_string(key)] = std::move(values);
-    }
+    for (int key : keys)
+      out[std::to_string(key)] = Column([&](const Row& r) { return find(r, key); });
     return out;
   }
-  static std::vector<int> Keys(const std::map<int, Json>& series) {
-    std::vector<int> keys;
-    for (const auto& entry : series) keys.push_back(entry.first);
-    return keys;
-  }
   Json ToJson() const {
-    const std::size_t frames = frame.size();
     std::vector<std::pair<int, int>> by_seen(seen.begin(), seen.end());  // (id, frames)
     std::stable_sort(by_seen.begin(), by_seen.end(),
                      [](const auto& a, const auto& b) { return a.second > b.second; });
@@ -716,16 +796,42 @@ struct Series {
       tracks.push_back(by_seen[i].first);
     }
     std::sort(tracks.begin(), tracks.end());
-    return Json{{"frame", frame},
-                {"status", status},
-                {"held", held},
-                {"pose_ok", pose_ok},
-                {"rho", Padded(rho, frames, tracks)},
-                {"theta_deg", Padded(theta_deg, frames, tracks)},
-                {"offset_px", Padded(offset_px, frames, Keys(offset_px))},
-                {"angle_deg", Padded(angle_deg, frames, Keys(angle_deg))},
-                {"pose_t_mm", pose_t_mm},
-                {"pose_r_deg", pose_r_deg}};
+    std::set<int> truth_lines;
+    for (const Row& row : rows) {
+      for (const TruthLine& line : row.truth) truth_lines.insert(line.line);
+    }
+    const std::vector<int> lines(truth_lines.begin(), truth_lines.end());
+    const auto track_value = [](double Track::*member) {
+      return [member](const Row& row, int id) {
+        for (const Track& track : row.tracks) {
+          if (track.id == id) return Json(track.*member);
+        }
+        return Json();
+      };
+    };
+    const auto truth_value = [](std::optional<double> TruthLine::*member) {
+      return [member](const Row& row, int line) {
+        for (const TruthLine& truth : row.truth) {
+          if (truth.line == line) return Optional(truth.*member);
+        }
+        return Json();
+      };
+    };
+    return Json{{"frame", Column([](const Row& r) { return Json(r.frame); })},
+                {"status", Column([](const Row& r) { return Json(r.status); })},
+                {"held", Column([](const Row& r) { return Optional(r.held); })},
+                {"pose_ok", Column([](const Row& r) { return Optional(r.pose_ok); })},
+                {"rho", Keyed(tracks, track_value(&Track::rho_px))},
+                {"theta_deg", Keyed(tracks, track_value(&Track::theta_deg))},
+                {"offset_px", Keyed(lines, truth_value(&TruthLine::offset_px))},
+                {"angle_deg", Keyed(lines, truth_value(&TruthLine::angle_deg))},
+                {"pose_t_mm", Column([](const Row& r) { return Optional(r.pose_t_mm); })},
+                {"pose_r_deg", Column([](const Row& r) { return Optional(r.pose_r_deg); })}};
+  }
+  Json TimingJson() const {
+    return Json{{"decode_us", Column([](const Row& r) { return Json(r.decode_us); })},
+                {"track_us", Column([](const Row& r) { return Optional(r.track_us); })},
+                {"pose_us", Column([](const Row& r) { return Optional(r.pose_us); })}};
   }
 };
 
@@ -822,7 +928,7 @@ struct Tally {
   std::vector<Json> unreadable;
   int unreadable_count = 0;
   int truth_frames = 0, truth_lines = 0, found_lines = 0, pose_truth_frames = 0;
-  std::vector<double> angle_deg, offset_px, pose_t_mm, pose_r_deg;
+  SampleStats angle_deg, offset_px, pose_t_mm, pose_r_deg;
   std::set<int> track_ids;
   int pose_jumps = 0;
   std::vector<int> jump_frames;
@@ -887,7 +993,7 @@ class InputEvaluation {
     Joined writer(std::thread(WriteFrames, &tracked, video ? &*video : nullptr,
                               static_cast<std::size_t>(run_.options.thumbnails), std::cref(camera_),
                               std::cref(undistorted_by_), &writer_result));
-    std::vector<double> track_us, pose_us;
+    SampleStats track_us, pose_us;
     try {
       while (std::optional<DecodedFrame> frame = decoded.Pop()) {
         if (!frame->error.empty()) {
@@ -937,9 +1043,7 @@ class InputEvaluation {
              {"overhead_vs_decode",
               decode_stats.total_us > 0 ? wall_us / decode_stats.total_us - 1.0 : 0.0}};
     Json timing_with_series = *timing;
-    timing_with_series["series"] = Json{{"decode_us", series_.decode_us},
-                                        {"track_us", series_.track_us},
-                                        {"pose_us", series_.pose_us}};
+    timing_with_series["series"] = series_.TimingJson();
     WriteFileAtomically(dir_ / "report.html",
                         InputReportHtml(summary, series_.ToJson(), timing_with_series,
                                         writer_result.thumbnails, run_.chart_js));
@@ -964,15 +1068,10 @@ class InputEvaluation {
                   false);
     WriteJsonLine(timing, Json{{"frame", frame.index}, {"decode_us", frame.decode_us}}, false);
     decode_us_.push_back(frame.decode_us);
-    series_.frame.push_back(frame.index);
-    series_.status.push_back(-1);
-    series_.held.push_back(nullptr);
-    series_.pose_ok.push_back(nullptr);
-    series_.pose_t_mm.push_back(nullptr);
-    series_.pose_r_deg.push_back(nullptr);
-    series_.decode_us.push_back(frame.decode_us);
-    series_.track_us.push_back(nullptr);
-    series_.pose_us.push_back(nullptr);
+    Series::Row row;
+    row.frame = frame.index;
+    row.decode_us = frame.decode_us;
+    series_.Add(std::move(row));
   }
 
   // The target tracker's pose of the frame, its lines 1-4 given as the held tracks' lines they
@@ -1014,8 +1113,8 @@ class InputEvaluation {
   }
 
   TrackedFrame Process(DecodedFrame& frame, OalLineTracker* tracker, PoseOptions pose_options,
-                       std::ostream& frames, std::ostream& timing, std::vector<double>* track_times,
-                       std::vector<double>* pose_times) {
+                       std::ostream& frames, std::ostream& timing, SampleStats* track_times,
+                       SampleStats* pose_times) {
     const int w = frame.gray.cols, h = frame.gray.rows;
     if (tally_.readable == 0) tally_.width = w, tally_.height = h;
     // A view of the frame for ViSP, no copy (the decoder's clone is continuous).
@@ -1100,7 +1199,7 @@ class InputEvaluation {
     double worst_offset = 0.0;
     int missed = 0;
     std::optional<std::pair<double, double>> pose_error;
-    const std::size_t f = series_.frame.size();
+    Series::Row row;
     if (truth.known) {
       ++tally_.truth_frames;
       Json lines = Json::array();
@@ -1119,8 +1218,10 @@ class InputEvaluation {
                              {"track", e.track},
                              {"angle_deg", found ? Json(e.angle_deg) : Json()},
                              {"offset_px", found ? Json(e.offset_px) : Json()}});
-        Series::Put(&series_.offset_px, e.line, f, found ? Json(e.offset_px) : Json());
-        Series::Put(&series_.angle_deg, e.line, f, found ? Json(e.angle_deg) : Json());
+        Series::TruthLine plotted;
+        plotted.line = e.line;
+        if (found) plotted.offset_px = e.offset_px, plotted.angle_deg = e.angle_deg;
+        row.truth.push_back(plotted);
       }
       Json pose_error_json;
       if (pose_ok && truth.cMo) {
@@ -1187,20 +1288,19 @@ class InputEvaluation {
                   false);
     decode_us_.push_back(frame.decode_us);
 
-    series_.frame.push_back(frame.index);
-    series_.status.push_back(status);
-    series_.held.push_back(held.size());
-    series_.pose_ok.push_back(camera_ ? Json(pose_ok ? 1 : 0) : Json());
-    series_.pose_t_mm.push_back(pose_error ? Json(pose_error->first) : Json());
-    series_.pose_r_deg.push_back(pose_error ? Json(pose_error->second) : Json());
+    row.frame = frame.index;
+    row.status = status;
+    row.held = static_cast<double>(held.size());
+    if (camera_) row.pose_ok = pose_ok ? 1.0 : 0.0;
+    if (pose_error) row.pose_t_mm = pose_error->first, row.pose_r_deg = pose_error->second;
     for (const TrackedLine* track : held) {
-      ++series_.seen[track->id];
-      Series::Put(&series_.rho, track->id, f, track->line.line.rho_px);
-      Series::Put(&series_.theta_deg, track->id, f, track->line.line.theta_rad * kRadToDeg);
+      row.tracks.push_back(
+          {track->id, track->line.line.rho_px, track->line.line.theta_rad * kRadToDeg});
     }
-    series_.decode_us.push_back(frame.decode_us);
-    series_.track_us.push_back(track_us);
-    series_.pose_us.push_back(camera_ ? Json(pose_us) : Json());
+    row.decode_us = frame.decode_us;
+    row.track_us = track_us;
+    if (camera_) row.pose_us = pose_us;
+    series_.Add(std::move(row));
 
     out.gray = std::move(frame.gray);
     return out;
@@ -1325,7 +1425,7 @@ class InputEvaluation {
   std::optional<TrustedPose> trusted_;               ///< the last trusted pose (JumpFrom)
   std::optional<TargetPoseTracker> target_tracker_;  ///< the pose of a '#' target
   Series series_;
-  std::vector<double> decode_us_;
+  SampleStats decode_us_;
 };
 
 // Removes temporary files a killed run left in `dir` (any pid: that run is gone).

@@ -283,6 +283,66 @@ TEST(Evaluate, VideoWithTruthCsvReportsTheKnownErrors) {
   EXPECT_TRUE(test::TempFilesIn(dir / "out").empty());
 }
 
+// The JSON a report page embeds under `id`.
+json ReportBlock(const std::string& html, const std::string& id) {
+  const std::string open = "id=\"" + id + "\">";
+  const std::size_t from = html.find(open);
+  if (from == std::string::npos) return json();
+  const std::size_t begin = from + open.size();
+  return json::parse(html.substr(begin, html.find("</script>", begin) - begin));
+}
+
+// A long input costs bounded memory: its plots keep 2048 to 4095 of its frames, evenly
+// spread, and its statistics still count every frame.
+TEST(Evaluate, ALongInputsPlotsKeepABoundedNumberOfFrames) {
+  test::TestDir dir;
+  // Small frames: the test is about the frames' count, not their content.
+  RenderCommandOptions render = test::ScaledRender(dir / "frames", kFrames, 5, 160, 120);
+  render.min_visible_px = 30.0;
+  const std::string frames = test::RenderChecked(render);
+  const fs::path videos = dir / "long";
+  fs::create_directories(videos);
+  fs::copy_file(frames + "/camera.xml", videos / "camera.xml");
+  constexpr int kLong = 4200;  // past 4096: the plots' frames were halved once
+  {
+    cv::VideoWriter writer((videos / "loop.avi").string(), cv::CAP_OPENCV_MJPEG,
+                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(160, 120),
+                           true);
+    ASSERT_TRUE(writer.isOpened());
+    std::vector<cv::Mat> images;
+    for (int i = 0; i < kFrames; ++i) {
+      images.push_back(cv::imread(frames + "/" + FrameName(i, ".png"), cv::IMREAD_COLOR));
+    }
+    for (int i = 0; i < kLong; ++i) writer.write(images[static_cast<std::size_t>(i % kFrames)]);
+  }
+  EvaluateOptions options = Options({(videos / "loop.avi").string()}, dir / "out");
+  options.write_video = false;
+  ASSERT_EQ(Evaluate(options).inputs.at(0).status, "complete");
+  const json timing = ReadJson(dir / "out/loop/timing.json");
+  EXPECT_EQ(timing.at("track_us").at("count"), kLong);
+  EXPECT_LE(timing.at("track_us").at("median").get<double>(),
+            timing.at("track_us").at("p95").get<double>());
+  EXPECT_LE(timing.at("track_us").at("p95").get<double>(),
+            timing.at("track_us").at("max").get<double>());
+  const std::string html = test::ReadText(dir / "out/loop/report.html");
+  const json series = ReportBlock(html, "oal-data").at("series");
+  const json& plotted = series.at("frame");
+  ASSERT_GE(plotted.size(), 2048u);
+  ASSERT_LT(plotted.size(), 4096u);
+  EXPECT_EQ(plotted.front(), 0);
+  for (std::size_t i = 1; i < plotted.size(); ++i) {
+    ASSERT_EQ(plotted[i].get<int>() - plotted[i - 1].get<int>(), 2) << i;  // every other
+  }
+  for (const char* column : {"status", "held", "pose_ok"}) {
+    EXPECT_EQ(series.at(column).size(), plotted.size()) << column;
+  }
+  for (const auto& [id, values] : series.at("rho").items()) {
+    EXPECT_EQ(values.size(), plotted.size()) << "track " << id;
+  }
+  const json timing_series = ReportBlock(html, "oal-timing").at("series");
+  EXPECT_EQ(timing_series.at("track_us").size(), plotted.size());
+}
+
 TEST(Evaluate, SmoothSequenceHasNoPoseJump) {
   test::TestDir dir;
   const RenderCommandOptions render = test::SequenceRender(dir / "slow", "slow", 12, 3);
