@@ -653,6 +653,8 @@ const std::vector<Field<RobotConfig>>& ScorbotFields() {
       option("sampling_time_s", &ScorbotOptions::sampling_time_s),
       option("arrive_tolerance_mm", &ScorbotOptions::arrive_tolerance_mm),
       option("arrive_tolerance_deg", &ScorbotOptions::arrive_tolerance_deg),
+      option("position_check_mm", &ScorbotOptions::position_check_mm),
+      option("position_check_deg", &ScorbotOptions::position_check_deg),
       option("point_name", &ScorbotOptions::point_name),
       option("control_off_at_end", &ScorbotOptions::control_off_at_end),
       {"geometry",

@@ -73,6 +73,10 @@ void ScorbotOptions::Check() const {
                      p + "arrive_tolerance_mm", arrive_tolerance_mm, "finite and >= 0.1");
   RequireRobotOption(arrive_tolerance_deg >= 0.1 && std::isfinite(arrive_tolerance_deg),
                      p + "arrive_tolerance_deg", arrive_tolerance_deg, "finite and >= 0.1");
+  RequireRobotOption(position_check_mm >= 0 && std::isfinite(position_check_mm),
+                     p + "position_check_mm", position_check_mm, "finite and >= 0");
+  RequireRobotOption(position_check_deg >= 0 && std::isfinite(position_check_deg),
+                     p + "position_check_deg", position_check_deg, "finite and >= 0");
   bool name_ok = !point_name.empty() && point_name.size() <= 5 &&
                  std::isalpha(static_cast<unsigned char>(point_name[0]));
   for (char c : point_name) name_ok = name_ok && std::isalnum(static_cast<unsigned char>(c));
@@ -270,7 +274,11 @@ RobotResult ScorbotRobot::ReadPosition() {
   const AclReply reply = client_->ListPosition("POSITION", &v);
   if (RobotResult r = FromReply(reply, "LISTPV POSITION"); !r.ok()) return r;
   if (v.has_counts) {
-    q_ = FromCounts(options_.geometry, v.counts);
+    const ScorbotJoints q = FromCounts(options_.geometry, v.counts);
+    if (v.has_cartesian) {
+      if (RobotResult r = CheckReadingAgrees(q, v.cartesian); !r.ok()) return r;
+    }
+    q_ = q;
     wMe_ = ForwardKinematics(options_.geometry, q_);
     pose_ = v.has_cartesian ? v.cartesian : AclPoseOfJoints(options_.geometry, q_);
   } else {
@@ -280,6 +288,33 @@ RobotResult ScorbotRobot::ReadPosition() {
     if (ik.ok || ik.axis != 0) q_ = ik.q;
   }
   return RobotResult::Ok();
+}
+
+RobotResult ScorbotRobot::CheckReadingAgrees(const ScorbotJoints& q, const AclPose& printed) const {
+  const AclPose joints = AclPoseOfJoints(options_.geometry, q);
+  // ACL units: tenths of a millimetre and of a degree; R wraps at 360 deg.
+  const auto off_tenths = [](long a, long b, long wrap) {
+    long d = std::labs(a - b);
+    if (wrap > 0) d = std::min(d, wrap - d % wrap);
+    return d;
+  };
+  const long xyz = std::max({off_tenths(joints.x, printed.x, 0), off_tenths(joints.y, printed.y, 0),
+                             off_tenths(joints.z, printed.z, 0)});
+  const long pr =
+      std::max(off_tenths(joints.p, printed.p, 3600), off_tenths(joints.r, printed.r, 3600));
+  const bool xyz_bad = options_.position_check_mm > 0 && xyz > options_.position_check_mm * 10;
+  const bool pr_bad = options_.position_check_deg > 0 && pr > options_.position_check_deg * 10;
+  if (!xyz_bad && !pr_bad) return RobotResult::Ok();
+  const auto text = [](const AclPose& a) {
+    return "X " + std::to_string(a.x) + " Y " + std::to_string(a.y) + " Z " + std::to_string(a.z) +
+           " P " + std::to_string(a.p) + " R " + std::to_string(a.r);
+  };
+  return RobotResult::Fail(
+      RobotStatus::kError,
+      "scorbot: LISTPV POSITION disagrees with itself: its joint counts put the tool at " +
+          text(joints) + " but it printed " + text(printed) +
+          " (ACL units): a garbled reply, or a geometry that does not match the arm "
+          "(position_check_mm, position_check_deg)");
 }
 
 ScorbotJointReading ScorbotRobot::GetJoints() {

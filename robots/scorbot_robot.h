@@ -14,9 +14,10 @@
 //                 is closed.
 //   Stop()        Ctrl-A, CLRBUF (AclClient::Abort). noexcept, safe in any state.
 //   GetPosition() LISTPV POSITION -> encoder counts -> joints -> wMe (forward kinematics);
-//                 wMc = wMe * eMc. The pose read by the last PollMove() is reused once by the
-//                 next GetPosition() (SafeRobot reads the pose right after every poll), which
-//                 halves the bytes per poll.
+//                 wMc = wMe * eMc; refused when the counts and the X Y Z P R of the same reply
+//                 disagree (position_check_mm, position_check_deg: a garbled reply). The pose read
+//                 by the last PollMove() is reused once by the next GetPosition() (SafeRobot reads
+//                 the pose right after every poll), which halves the bytes per poll.
 //   StartMove()   the target (wMc or wMe) must be reachable by 5 axes up to the ACL resolution
 //                 (use NearestReachable()); IK and joint ranges are checked here before anything
 //                 is sent; then SETPVC P X|Y|Z|P|R value for each coordinate that differs from
@@ -80,6 +81,13 @@ struct ScorbotOptions {
   /// ... and P, R, deg; >= 0.1. With SafeRobot, set SafetyOptions::reach_tolerance_rad to at
   /// least 0.005 (the ACL resolution of 0.1 deg on P and on R, plus the encoders).
   double arrive_tolerance_deg = 0.1;
+  /// LISTPV gives both the joints' encoder counts and X Y Z P R: a reading whose two disagree
+  /// by more than this on X, Y or Z (the counts through the geometry's forward kinematics), mm,
+  /// is refused, since a position read wrong moves the arm wrong (a garbled reply; or a
+  /// geometry that does not match the arm). 0: no check.
+  double position_check_mm = 2.0;
+  /// ... and by more than this on P or R, deg (these follow from the joints alone). 0: no check.
+  double position_check_deg = 0.5;
   /// The ACL position variable used for targets: 1-5 letters and digits, starting with a letter.
   std::string point_name = "OALT";
   /// At the end of a session (Disconnect(), the destructor), after the abort was confirmed:
@@ -154,6 +162,8 @@ class ScorbotRobot final : public Robot {
   RobotResult Send(const std::string& command, double timeout_s = 0);
   RobotResult CheckEnabled() const;
   RobotResult ReadPosition();
+  // The counts and the X Y Z P R of one LISTPV reply agree (position_check_mm, _deg).
+  RobotResult CheckReadingAgrees(const ScorbotJoints& q, const AclPose& printed) const;
 
   ScorbotOptions options_;
   SerialPort port_;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The tests that run threads, built with ThreadSanitizer under build-tsan/: evaluate's
 # pipeline (--jobs), the stop signals and the servo loop's interruption, the Scorbot driver
-# against the controller simulator on a pseudo-terminal (a thread serves the link). No
+# against the controller simulator on a pseudo-terminal (a thread serves the link), the fault
+# campaign (runs in parallel, a timer thread injecting the faults). No
 # recovery: the first race fails the test. Extra arguments go to ctest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,4 +13,4 @@ cmake --build build-tsan -j "$jobs" --target app_tests robots_tests
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1"
 cd build-tsan
 ctest --output-on-failure -j "$jobs" \
-  -R 'Evaluate\.|EvaluateJobs|StopSignalScope|ServoCommand\.|ServoLoop\.Interrupt|ServoScorbot|ScorbotRobot|ScorbotControllerSim|AclClient' "$@"
+  -R 'Evaluate\.|EvaluateJobs|StopSignalScope|ServoCommand\.|ServoLoop\.Interrupt|ServoScorbot|ScorbotRobot|ScorbotControllerSim|AclClient|FaultCampaign' "$@"

@@ -80,6 +80,30 @@ TEST(ScorbotRobot, ReadsThePoseFromTheControllerThroughTheKinematics) {
   EXPECT_EQ(J.getCols(), 5u);
 }
 
+// LISTPV prints the joints' counts and X Y Z P R: a reading whose two disagree (a garbled
+// reply; here an arm whose upper arm is 2 cm longer than the driver believes) is refused, not
+// taken for where the arm is.
+TEST(ScorbotRobot, AReadingWhoseCountsAndCoordinatesDisagreeIsRefused) {
+  ScorbotSimOptions longer_arm = FastSim();
+  longer_arm.geometry.upper_arm_m += 0.02;
+  ScorbotControllerSim sim(longer_arm);
+  sim.Start();
+  ScorbotRobot robot(RobotOptions(sim.ConnectPath()));
+  ASSERT_TRUE(robot.Connect().ok());
+  const RobotPose read = robot.GetPosition(RobotFrame::kEndEffector);
+  EXPECT_EQ(read.result.status, RobotStatus::kError);
+  EXPECT_NE(read.result.message.find("LISTPV POSITION disagrees with itself"), std::string::npos)
+      << read.result.message;
+  EXPECT_NE(read.result.message.find("position_check_mm"), std::string::npos);
+  // Without the check the reading stands (through the driver's geometry).
+  ScorbotOptions unchecked = RobotOptions(sim.ConnectPath());
+  unchecked.position_check_mm = 0;
+  robot.Disconnect();
+  ScorbotRobot trusting(unchecked);
+  ASSERT_TRUE(trusting.Connect().ok());
+  EXPECT_TRUE(trusting.GetPosition(RobotFrame::kEndEffector).result.ok());
+}
+
 TEST(ScorbotRobot, SequenceOfCameraMovesReachesEveryTarget) {
   Rig rig;
   const RobotPose start = rig.safe->GetPosition(RobotFrame::kCamera);
