@@ -60,7 +60,7 @@ FaultCampaignReport RunSmallCampaign(const ServoAppConfig& config, int per_kind,
 TEST(FaultCampaign, TheSimulatedRobotStopsOnEveryFault) {
   const test::TestDir dir;
   ServoAppConfig config = test::Small(DefaultServoConfig());
-  const FaultCampaignReport report = RunSmallCampaign(config, 2, dir);
+  const FaultCampaignReport report = RunSmallCampaign(config, 1, dir);
   for (const FaultRun& run : report.runs) {
     if (!run.reached) continue;
     if (run.kind == FaultKind::kUnreadableFrame) {
