@@ -6,9 +6,9 @@
 #   2. the serial port, then the controller simulator's pty, opened and closed OPENS times
 #      (default 10000): open file descriptors before and after;
 #   3. `oalservo evaluate` on a video of VIDEO_FRAMES frames (default 30000): its resident
-#      memory sampled every half second, after the first fifth of its run against the maximum
-#      after it (its statistics and plots fill their bounded buffers over the first 4096
-#      frames, a fifth of the run at the default length).
+#      memory sampled every half second, the median over the last fifth of its run against
+#      the median over the second (its statistics and plots fill their bounded buffers over
+#      the first 4096 frames, within the first fifth at the default length).
 # Exit 1 when memory grew by more than 1 MB after the warm-up or a descriptor leaked.
 #   scripts/soak.sh                       # the figures
 #   FRAMES=5000 OPENS=200 VIDEO_FRAMES=1000 scripts/soak.sh   # a quick look
@@ -46,15 +46,23 @@ if [ "$count" -lt 10 ]; then
   echo "evaluate: $video_frames frames in $count samples: too short a run to judge (more frames)"
   exit $status
 fi
-warm=${samples[$((count / 5))]}
-max=$warm
+# Medians of the second fifth (warmed up) and of the last fifth: the decoder's and the writer's
+# queues fill and drain by a few frames (a 640x480 frame is 300 kB), which a single sample
+# would take for growth.
+median_of() {  # FROM TO: the median of samples[FROM..TO)
+  printf '%s\n' "${samples[@]:$1:$(($2 - $1))}" | sort -n | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'
+}
+warm=$(median_of $((count / 5)) $((2 * count / 5)))
+last=$(median_of $((4 * count / 5)) "$count")
+low=$warm high=$warm
 for ((i = count / 5; i < count; ++i)); do
-  [ "${samples[$i]}" -gt "$max" ] && max=${samples[$i]}
+  [ "${samples[$i]}" -gt "$high" ] && high=${samples[$i]}
+  [ "${samples[$i]}" -lt "$low" ] && low=${samples[$i]}
 done
-growth=$((max - warm))
+growth=$((last - warm))
 verdict=flat
 if [ "$growth" -gt 1024 ]; then verdict=GROWS; status=1; fi
-echo "evaluate: $video_frames frames, $count samples every 0.5 s; resident $warm kB after the" \
-  "first fifth, at most $max kB after, ${samples[$((count - 1))]} kB at the last sample:" \
-  "growth $growth kB ($verdict, allowed 1024 kB)"
+echo "evaluate: $video_frames frames, $count samples every 0.5 s; resident median $warm kB over" \
+  "the second fifth, $last kB over the last fifth: growth $growth kB ($verdict, allowed 1024" \
+  "kB); samples after the first fifth between $low and $high kB"
 exit $status
