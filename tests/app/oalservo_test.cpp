@@ -113,6 +113,8 @@ TEST(Oalservo, ANumberOutOfRangeGetsOneStyleOfError) {
        "--count = 0. Violated constraint: 1 <= --count"},
       {"servo-accuracy --starts 0", "--starts = 0. Violated constraint: 1 <= --starts <= 1000000"},
       {"servo-accuracy --max-off-deg 90", "--max-off-deg = 90. Violated constraint: 0 <="},
+      {"servo-accuracy --faults 0", "--faults = 0. Violated constraint: 1 <= --faults <= 1000000"},
+      {"servo-accuracy --faults 3 --jobs 0", "--jobs = 0. Violated constraint: 1 <= --jobs <= 64"},
       {"pose-accuracy --frames 0", "--frames = 0. Violated constraint: 1 <= --frames"},
       {"pose-accuracy --frames 1 --min-distance -1",
        "--min-distance = -1. Violated constraint: --min-distance > 0"},
