@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/camera_file.h"
 #include "app/image_source.h"
 
 namespace oal {
@@ -528,21 +529,89 @@ Field<Options> PoseField(const char* key, vpHomogeneousMatrix Options::*member) 
           [member](const Value& value, Options* options) { options->*member = ReadPose(value); }};
 }
 
+// A path in the config file: relative ones are relative to the file's directory.
+std::string PathNextTo(const std::string& file, const Value& value) {
+  const std::string text = value.As<std::string>("a path");
+  if (text.empty()) value.Fail("'" + value.key + "' must not be empty");
+  const std::filesystem::path path(text);
+  if (path.is_absolute() || text.rfind("/dev/", 0) == 0) return text;
+  return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
+}
+
 const std::vector<Field<CameraConfig>>& CameraFields() {
   using O = CameraConfig;
   static const std::vector<Field<O>> fields = {
-      DoubleField("px", &O::px),       DoubleField("py", &O::py),
-      DoubleField("u0", &O::u0),       DoubleField("v0", &O::v0),
-      DoubleField("kdu", &O::kdu),     BoolField("correct_distortion", &O::correct_distortion),
-      IntField("width", &O::width),    IntField("height", &O::height),
-      DoubleField("noise", &O::noise), DoubleField("blur", &O::blur),
+      DoubleField("px", &O::px),
+      DoubleField("py", &O::py),
+      DoubleField("u0", &O::u0),
+      DoubleField("v0", &O::v0),
+      DoubleField("kdu", &O::kdu),
+      BoolField("correct_distortion", &O::correct_distortion),
+      IntField("width", &O::width),
+      IntField("height", &O::height),
+      DoubleField("noise", &O::noise),
+      DoubleField("blur", &O::blur),
       PoseField("eMc", &O::eMc),
+      {"file", [](const Value& value, O* camera) { camera->file = PathNextTo(value.file, value); }},
+      {"name", [](const Value& value,
+                  O* camera) { camera->file_camera = value.As<std::string>("a camera's name"); }},
   };
   return fields;
 }
 
+// camera.file: the intrinsics from the ViSP camera file, and its image size, which inline
+// width and height must then equal (a camera calibrated at one size does not fit another).
+void ApplyCameraFile(const std::string& yaml, const Lines& lines, CameraConfig* camera) {
+  const auto at = [&yaml, &lines](const char* key) {
+    return yaml + ":" + std::to_string(lines.at(key));
+  };
+  for (const char* key : {"px", "py", "u0", "v0", "kdu"}) {
+    if (lines.count(key) == 0) continue;
+    throw std::runtime_error(at(key) + ": 'camera." + key + "' and 'camera.file' (line " +
+                             std::to_string(lines.at("file")) +
+                             ") are both given: the file holds the camera's intrinsics; remove "
+                             "one of them");
+  }
+  CameraFile loaded;
+  try {
+    loaded = LoadCameraFile(camera->file, camera->file_camera);
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(at("file") + ": camera.file: " + error.what());
+  }
+  const vpCameraParameters& read = loaded.camera;
+  camera->px = read.get_px();
+  camera->py = read.get_py();
+  camera->u0 = read.get_u0();
+  camera->v0 = read.get_v0();
+  camera->kdu = read.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
+                    ? read.get_kdu()
+                    : 0.0;
+  if (loaded.width == 0 || loaded.height == 0) return;
+  const int width = static_cast<int>(loaded.width), height = static_cast<int>(loaded.height);
+  for (const char* key : {"width", "height"}) {
+    if (lines.count(key) == 0 || (camera->width == width && camera->height == height)) continue;
+    throw std::runtime_error(
+        at(key) + ": camera.width x camera.height is " + std::to_string(camera->width) + "x" +
+        std::to_string(camera->height) + " but camera.file '" + camera->file + "' (line " +
+        std::to_string(lines.at("file")) + ") was calibrated for " + std::to_string(width) + "x" +
+        std::to_string(height) +
+        " images: calibrate the camera at the size it runs at, or remove width and height");
+  }
+  camera->width = width;
+  camera->height = height;
+}
+
 void ReadCameraSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
-  ReadCheckedSection(section, file, "camera", CameraFields(), &config->camera);
+  CameraConfig& camera = config->camera;
+  Lines lines;
+  ReadFields(section, file, "camera", CameraFields(), "", &camera, &lines);
+  if (lines.count("file") > 0) {
+    ApplyCameraFile(file, lines, &camera);
+  } else if (lines.count("name") > 0) {
+    throw std::runtime_error(file + ":" + std::to_string(lines.at("name")) +
+                             ": 'camera.name' picks a camera of camera.file, which is not given");
+  }
+  CheckAt(camera, file, "camera", lines, section.Mark().line + 1);
 }
 
 template <typename T>
@@ -739,15 +808,6 @@ const std::vector<Field<ServoLoopOptions>>& ServoFields() {
 
 void ReadServoSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
   ReadCheckedSection(section, file, "servo", ServoFields(), &config->servo);
-}
-
-// A path in the config file: relative ones are relative to the file's directory.
-std::string PathNextTo(const std::string& file, const Value& value) {
-  const std::string text = value.As<std::string>("a path");
-  if (text.empty()) value.Fail("'" + value.key + "' must not be empty");
-  const std::filesystem::path path(text);
-  if (path.is_absolute() || text.rfind("/dev/", 0) == 0) return text;
-  return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
 }
 
 struct Goal {

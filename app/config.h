@@ -77,6 +77,11 @@ struct CameraConfig {
   double noise = 0.0;             ///< Gaussian noise of the rendering, grey levels, [0, 100]
   double blur = 0.0;              ///< Gaussian blur of the rendering, pixels, [0, 20]
   vpHomogeneousMatrix eMc;        ///< hand-eye: the camera in the end-effector frame
+  /// `camera.file`: a ViSP camera XML (the canonical form) that gives px, py, u0, v0, kdu and,
+  /// when it has them, width and height; empty: the inline keys. Relative to the config file.
+  std::string file;
+  /// `camera.name`: the camera to read from `file` (empty: its first).
+  std::string file_camera;
 
   /// The vpCameraParameters (with distortion when kdu != 0).
   vpCameraParameters Camera() const;

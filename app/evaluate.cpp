@@ -58,9 +58,8 @@ constexpr int kMaxConsecutiveUnreadable = 50;   // then the input is given up as
 constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
 constexpr int kThumbnailWidth = 320;
 constexpr double kVideoFps = 25.0;
-constexpr double kVideoQuality = 75.0;        // JPEG quality of the annotated video, [0, 100]
-constexpr std::size_t kPlottedTracks = 10;    // the tracks seen longest get a series
-constexpr std::size_t kPlottedFrames = 2048;  // frames in the plots: 2048 to 4095 (Series)
+constexpr double kVideoQuality = 75.0;      // JPEG quality of the annotated video, [0, 100]
+constexpr std::size_t kPlottedTracks = 10;  // the tracks seen longest get a series
 // A pose is flagged as a jump when, against the last trusted pose of at most kJumpFrames
 // frames before, the same four tracks are identified as other target lines, or the rotation
 // exceeds kJumpRotationDeg (docs/EVALUATE.md, frames.jsonl).
@@ -735,10 +734,10 @@ std::optional<CameraFile> CameraFor(const RunContext& run, const PlannedInput& i
   return LoadCameraFile(candidate.string());
 }
 
-// Per-frame values for the plots (report.h), nulls where a value does not exist. At most
-// 2 x kPlottedFrames frames are kept: past that, every other one is dropped and from then on
-// only every second frame recorded (then every fourth...), so a long input's plots cost
-// bounded memory; frames.jsonl keeps every frame.
+// Per-frame values for the plots (report.h), nulls where a value does not exist. Fewer than
+// 2 x `capacity` frames are kept: at that, every other one is dropped and from then on only
+// every second frame recorded (then every fourth...), so a long input's plots cost bounded
+// memory; frames.jsonl keeps every frame.
 struct Series {
   struct Track {
     int id = 0;
@@ -759,14 +758,15 @@ struct Series {
   };
 
   std::vector<Row> rows;
-  std::map<int, int> seen;  // frames each track was held, every frame counted
+  std::map<int, int> seen;      // frames each track was held, every frame counted
+  std::size_t capacity = 2048;  ///< EvaluateOptions::plot_frames
   std::size_t offered = 0, stride = 1;
 
   void Add(Row row) {
     for (const Track& track : row.tracks) ++seen[track.id];
     if (offered++ % stride != 0) return;
     rows.push_back(std::move(row));
-    if (rows.size() < 2 * kPlottedFrames) return;
+    if (rows.size() < 2 * capacity) return;
     for (std::size_t i = 1; 2 * i < rows.size(); ++i) rows[i] = std::move(rows[2 * i]);
     rows.resize((rows.size() + 1) / 2);
     stride *= 2;
@@ -940,6 +940,7 @@ class InputEvaluation {
   InputEvaluation(const RunContext& run, const PlannedInput& input, fs::path dir)
       : run_(run), input_(input), dir_(std::move(dir)), truth_(run.options, input) {
     camera_ = CameraFor(run, input, &camera_path_);
+    series_.capacity = static_cast<std::size_t>(run.options.plot_frames);
   }
 
   void AddWarnings(const std::vector<std::string>& warnings) {
@@ -1498,6 +1499,8 @@ void EvaluateOptions::Check() const {
           "xvid or mjpg");
   Require(thumbnails >= 0 && thumbnails <= 50, "--thumbnails", thumbnails,
           "0 <= --thumbnails <= 50");
+  Require(plot_frames >= 16 && plot_frames <= 1000000, "plot_frames", plot_frames,
+          "16 <= plot_frames <= 1000000");
   Require(target_lines >= 0 && target_lines <= 64, "--lines", target_lines, "0 <= --lines <= 64");
   if (fs::exists(out_dir) && !fs::is_directory(out_dir)) {
     throw std::invalid_argument("output '" + out_dir + "' is not a directory");

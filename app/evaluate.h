@@ -79,6 +79,9 @@ struct EvaluateOptions {
   int max_frames = 0;
   /// Worst frames shown as thumbnails in each report, [0, 50].
   int thumbnails = 6;
+  /// The report's plots keep between this many frames and twice as many, evenly spaced (a
+  /// long input's are thinned out; frames.jsonl keeps every frame). [16, 1000000].
+  int plot_frames = 2048;
   /// Output directory, created if missing; required.
   std::string out_dir;
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "app/camera_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 
@@ -373,6 +374,58 @@ TEST(ConfigTarget, MalformedBoardNamesFileLineAndKey) {
       HasSubstr("'target.board_grey' is invalid"));
   EXPECT_EQ(ErrorOf("target:\n  name: x\n  name: y\n"),
             "cfg.yaml:3: key 'target.name' is repeated (first at line 2)");
+}
+
+}  // namespace
+}  // namespace oal
+
+namespace oal {
+namespace {
+
+using ::testing::HasSubstr;
+
+// camera.file: the ViSP camera XML is the canonical form of the lens; a config names it
+// (relative to the config's folder) instead of the inline keys.
+TEST(ConfigCameraFile, TheFileGivesTheIntrinsicsAndTheImageSize) {
+  const test::TestDir dir;
+  vpCameraParameters lens;
+  lens.initPersProjWithDistortion(812.5, 810.25, 331.0, 244.5, -0.12, 0.13);
+  SaveCameraFile(dir / "lens.xml", lens, "Wide", 800, 600);
+  const AppConfig config =
+      ParseConfig("camera:\n  file: lens.xml\n  name: Wide\n  noise: 1.5\n", dir / "servo.yaml");
+  EXPECT_DOUBLE_EQ(config.camera.px, 812.5);
+  EXPECT_DOUBLE_EQ(config.camera.py, 810.25);
+  EXPECT_DOUBLE_EQ(config.camera.u0, 331.0);
+  EXPECT_DOUBLE_EQ(config.camera.v0, 244.5);
+  EXPECT_DOUBLE_EQ(config.camera.kdu, 0.13);
+  EXPECT_EQ(config.camera.width, 800);
+  EXPECT_EQ(config.camera.height, 600);
+  EXPECT_DOUBLE_EQ(config.camera.noise, 1.5);  // the other keys stay inline
+  EXPECT_EQ(config.camera.file, dir / "lens.xml");
+}
+
+TEST(ConfigCameraFile, ConflictsAndMissingFilesNameTheLine) {
+  const test::TestDir dir;
+  vpCameraParameters lens;
+  lens.initPersProjWithoutDistortion(600, 600, 159.5, 119.5);
+  SaveCameraFile(dir / "lens.xml", lens, "Camera", 320, 240);
+  const std::string yaml = dir / "servo.yaml";
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  file: lens.xml\n  px: 700\n", yaml),
+              HasSubstr("servo.yaml:3: 'camera.px' and 'camera.file' (line 2) are both given"));
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  width: 640\n  file: lens.xml\n", yaml),
+              HasSubstr("servo.yaml:2: camera.width x camera.height is 640x480 but camera.file '" +
+                        dir / "lens.xml" + "' (line 3) was calibrated for 320x240 images"));
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  file: missing.xml\n", yaml),
+              HasSubstr("servo.yaml:2: camera.file: "));
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  file: lens.xml\n  name: Other\n", yaml),
+              HasSubstr("servo.yaml:2: camera.file: "));
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  name: Camera\n", yaml),
+              HasSubstr("servo.yaml:2: 'camera.name' picks a camera of camera.file, which is not "
+                        "given"));
+  // The size the file gives agrees with the inline one: fine.
+  EXPECT_EQ(
+      ParseConfig("camera:\n  file: lens.xml\n  width: 320\n  height: 240\n", yaml).camera.width,
+      320);
 }
 
 }  // namespace

@@ -292,8 +292,8 @@ json ReportBlock(const std::string& html, const std::string& id) {
   return json::parse(html.substr(begin, html.find("</script>", begin) - begin));
 }
 
-// A long input costs bounded memory: its plots keep 2048 to 4095 of its frames, evenly
-// spread, and its statistics still count every frame.
+// A long input costs bounded memory: its plots keep plot_frames to twice as many of its
+// frames, evenly spread, and its statistics still count every frame.
 TEST(Evaluate, ALongInputsPlotsKeepABoundedNumberOfFrames) {
   test::TestDir dir;
   // Small frames: the test is about the frames' count, not their content.
@@ -303,7 +303,8 @@ TEST(Evaluate, ALongInputsPlotsKeepABoundedNumberOfFrames) {
   const fs::path videos = dir / "long";
   fs::create_directories(videos);
   fs::copy_file(frames + "/camera.xml", videos / "camera.xml");
-  constexpr int kLong = 4200;  // past 4096: the plots' frames were halved once
+  constexpr int kPlotFrames = 64;
+  constexpr int kLong = 2 * kPlotFrames + 10;  // the plots' frames were halved once
   {
     cv::VideoWriter writer((videos / "loop.avi").string(), cv::CAP_OPENCV_MJPEG,
                            cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(160, 120),
@@ -317,6 +318,7 @@ TEST(Evaluate, ALongInputsPlotsKeepABoundedNumberOfFrames) {
   }
   EvaluateOptions options = Options({(videos / "loop.avi").string()}, dir / "out");
   options.write_video = false;
+  options.plot_frames = kPlotFrames;
   ASSERT_EQ(Evaluate(options).inputs.at(0).status, "complete");
   const json timing = ReadJson(dir / "out/loop/timing.json");
   EXPECT_EQ(timing.at("track_us").at("count"), kLong);
@@ -327,8 +329,8 @@ TEST(Evaluate, ALongInputsPlotsKeepABoundedNumberOfFrames) {
   const std::string html = test::ReadText(dir / "out/loop/report.html");
   const json series = ReportBlock(html, "oal-data").at("series");
   const json& plotted = series.at("frame");
-  ASSERT_GE(plotted.size(), 2048u);
-  ASSERT_LT(plotted.size(), 4096u);
+  ASSERT_GE(plotted.size(), static_cast<std::size_t>(kPlotFrames));
+  ASSERT_LT(plotted.size(), static_cast<std::size_t>(2 * kPlotFrames));
   EXPECT_EQ(plotted.front(), 0);
   for (std::size_t i = 1; i < plotted.size(); ++i) {
     ASSERT_EQ(plotted[i].get<int>() - plotted[i - 1].get<int>(), 2) << i;  // every other
