@@ -471,12 +471,12 @@ TEST(ServoOutput, PlotScriptHasBothSeriesAndTheTolerances) {
 TEST(ServoAccuracy, EveryLawConvergesFromRandomStarts) {
   const ServoAppConfig config = Small(DefaultServoConfig());
   ServoAccuracyOptions options;
-  options.starts = 4;
+  options.starts = 2;  // the 100-start figures: docs/BENCHMARKS.md
   options.seed = 3;
   const std::vector<vpHomogeneousMatrix> starts = SampleServoStarts(config, options);
-  ASSERT_EQ(starts.size(), 4u);
+  ASSERT_EQ(starts.size(), 2u);
   EXPECT_FALSE(SamePose(starts[0], starts[1]));
-  EXPECT_TRUE(SamePose(SampleServoStarts(config, options)[2], starts[2]));  // deterministic
+  EXPECT_TRUE(SamePose(SampleServoStarts(config, options)[1], starts[1]));  // deterministic
   const ServoAccuracyReport report = EvaluateServoAccuracy(config, options);
   ASSERT_EQ(report.laws.size(), 3u);
   for (const ServoAccuracyLaw& law : report.laws) {
