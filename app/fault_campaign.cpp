@@ -456,6 +456,7 @@ FaultRun Judge(const Outcome& outcome, const FaultPlan& plan, const fs::path& di
     problems.push_back(text.str());
   }
   if (const std::string outputs = CheckOutputs(dir, report); !outputs.empty()) {
+    run.outputs_whole = false;
     problems.push_back(outputs);
   }
   return run;
@@ -638,10 +639,7 @@ std::string FaultCampaignTable(const FaultCampaignReport& report) {
       unconfirmed += run.stop_unconfirmed;
       converged += run.status == ServoRunStatus::kConverged;
       moved += run.moves_after_stop > 0;
-      whole += std::none_of(run.problems.begin(), run.problems.end(), [](const std::string& p) {
-        return p.find("servo.csv") != std::string::npos || p.find("file") != std::string::npos ||
-               p.find("image") != std::string::npos || p.find("folder") != std::string::npos;
-      });
+      whole += run.outputs_whole;
       if (std::isfinite(run.fault_to_stop_ms)) stop_ms.push_back(run.fault_to_stop_ms);
     }
     if (runs == 0) continue;
@@ -680,6 +678,7 @@ std::string FaultCampaignJson(const FaultCampaignReport& report) {
                     {"stop_unconfirmed", run.stop_unconfirmed},
                     {"fault_to_stop_ms", number(run.fault_to_stop_ms)},
                     {"moves_after_stop", run.moves_after_stop},
+                    {"outputs_whole", run.outputs_whole},
                     {"final_true_translation_error_mm", number(run.final_true_translation_mm)},
                     {"final_true_rotation_error_deg", number(run.final_true_rotation_deg)},
                     {"problems", run.problems}});

@@ -80,7 +80,8 @@ struct FaultRun {
   bool stop_unconfirmed = false;  ///< the run says "STOP COULD NOT BE SENT"
   /// From the fault to the first stop command the robot received after it; NaN: none.
   double fault_to_stop_ms = std::numeric_limits<double>::quiet_NaN();
-  int moves_after_stop = 0;  ///< motion commands the robot received after that stop
+  int moves_after_stop = 0;   ///< motion commands the robot received after that stop
+  bool outputs_whole = true;  ///< no temporary file, images decode, one CSV row an iteration
   double final_true_translation_mm = std::numeric_limits<double>::quiet_NaN();
   double final_true_rotation_deg = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::string> problems;  ///< the rules above it broke; empty: it passed
