@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -39,33 +38,63 @@ using Polygon = std::vector<Point>;  // convex, corners in order
 // ------------------------------------------------------------------------------------------
 // Reading the SVG: simple searches on its text, which the command writes one element a line.
 
+bool IsSpace(char c) {
+  return c == ' ' || c == '\n' || c == '\t' || c == '\r';
+}
+
+// The value of attribute `name` in an element's opening tag, or throws. (String searches, not
+// <regex>: std::regex over a whole drawing takes seconds in a sanitizer build.)
+std::string AttributeIn(const std::string& tag, const std::string& name) {
+  const std::string key = name + "=\"";
+  for (std::size_t at = tag.find(key); at != std::string::npos; at = tag.find(key, at + 1)) {
+    if (at == 0 || !IsSpace(tag[at - 1])) continue;
+    const std::size_t first = at + key.size();
+    const std::size_t last = tag.find('"', first);
+    if (last == std::string::npos) break;
+    return tag.substr(first, last - first);
+  }
+  throw std::runtime_error("no " + name + " in " + tag);
+}
+
+// Every opening tag of `element` (such as "line", not "linearGradient"), in document order.
+std::vector<std::string> Tags(const std::string& svg, const std::string& element) {
+  std::vector<std::string> tags;
+  const std::string open = "<" + element;
+  for (std::size_t at = svg.find(open); at != std::string::npos; at = svg.find(open, at + 1)) {
+    const std::size_t after = at + open.size();
+    if (after >= svg.size() || !(IsSpace(svg[after]) || svg[after] == '>')) continue;
+    const std::size_t end = svg.find('>', after);
+    if (end == std::string::npos) break;
+    tags.push_back(svg.substr(at, end + 1 - at));
+  }
+  return tags;
+}
+
 // The value of attribute `name` of the first element starting with `element` (such as
 // `<line id="scale-bar"`), or throws.
 std::string Attribute(const std::string& svg, const std::string& element, const std::string& name) {
   const std::size_t begin = svg.find(element);
   if (begin == std::string::npos) throw std::runtime_error("no element " + element);
   const std::size_t end = svg.find('>', begin);
-  const std::string tag = svg.substr(begin, end - begin);
-  const std::regex pattern("\\s" + name + "=\"([^\"]*)\"");
-  std::smatch match;
-  if (!std::regex_search(tag, match, pattern)) {
-    throw std::runtime_error("no " + name + " in " + tag);
-  }
-  return match[1];
+  return AttributeIn(svg.substr(begin, end - begin), name);
 }
 
 double Number(const std::string& svg, const std::string& element, const std::string& name) {
   return std::stod(Attribute(svg, element, name));
 }
 
+bool IsLineId(const std::string& id) {
+  return id.size() > 5 && id.compare(0, 5, "line-") == 0 &&
+         std::all_of(id.begin() + 5, id.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
 // The `points` of every stripe polygon, in document order.
 std::vector<Polygon> StripePolygons(const std::string& svg) {
   std::vector<Polygon> polygons;
-  const std::regex pattern("<polygon class=\"stripe\" id=\"line-\\d+\" points=\"([^\"]*)\"");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), pattern);
-       it != std::sregex_iterator(); ++it) {
+  for (const std::string& tag : Tags(svg, "polygon")) {
+    if (AttributeIn(tag, "class") != "stripe" || !IsLineId(AttributeIn(tag, "id"))) continue;
     Polygon polygon;
-    std::istringstream in((*it)[1].str());
+    std::istringstream in(AttributeIn(tag, "points"));
     std::string pair;
     while (in >> pair) {
       const std::size_t comma = pair.find(',');
@@ -77,12 +106,7 @@ std::vector<Polygon> StripePolygons(const std::string& svg) {
 }
 
 double AttributeOf(const std::string& tag, const std::string& name) {
-  const std::regex pattern("\\s" + name + "=\"([^\"]*)\"");
-  std::smatch match;
-  if (!std::regex_search(tag, match, pattern)) {
-    throw std::runtime_error("no " + name + " in " + tag);
-  }
-  return std::stod(match[1]);
+  return std::stod(AttributeIn(tag, name));
 }
 
 struct Text {
@@ -95,21 +119,28 @@ struct Text {
 
 std::vector<Text> Texts(const std::string& svg) {
   std::vector<Text> texts;
-  const std::regex pattern("(<text[^>]*>)([^<]*)</text>");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), pattern);
-       it != std::sregex_iterator(); ++it) {
+  std::size_t from = 0;
+  for (const std::string& tag : Tags(svg, "text")) {
     Text text;
-    text.tag = (*it)[1];
-    text.content = (*it)[2];
+    text.tag = tag;
+    const std::size_t begin = svg.find(tag, from) + tag.size();
+    const std::size_t end = svg.find("</text>", begin);
+    if (end == std::string::npos) throw std::runtime_error("unclosed " + tag);
+    from = end;
+    text.content = svg.substr(begin, end - begin);
     text.at = {AttributeOf(text.tag, "x"), AttributeOf(text.tag, "y")};
     text.size_mm = AttributeOf(text.tag, "font-size");
-    std::smatch rotate;
-    if (std::regex_search(
-            text.tag, rotate,
-            std::regex("transform=\"rotate\\(([-0-9.e]+) ([-0-9.e]+) ([-0-9.e]+)\\)\""))) {
-      text.angle_deg = std::stod(rotate[1]);
-      EXPECT_NEAR(std::stod(rotate[2]), text.at.x, 1e-9) << text.tag;  // about its own anchor
-      EXPECT_NEAR(std::stod(rotate[3]), text.at.y, 1e-9) << text.tag;
+    if (text.tag.find(" transform=\"") != std::string::npos) {
+      const std::string transform = AttributeIn(text.tag, "transform");
+      const std::size_t open = transform.find("rotate("), close = transform.find(')');
+      if (open == std::string::npos || close == std::string::npos) {
+        throw std::runtime_error("not a rotation: " + text.tag);
+      }
+      std::istringstream in(transform.substr(open + 7, close - open - 7));
+      double x = 0.0, y = 0.0;
+      if (!(in >> text.angle_deg >> x >> y)) throw std::runtime_error("bad rotate in " + text.tag);
+      EXPECT_NEAR(x, text.at.x, 1e-9) << text.tag;  // about its own anchor
+      EXPECT_NEAR(y, text.at.y, 1e-9) << text.tag;
     }
     texts.push_back(text);
   }
@@ -124,11 +155,9 @@ struct Line {
 
 std::vector<Line> Lines(const std::string& svg) {
   std::vector<Line> lines;
-  const std::regex pattern("<line[^>]*>");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), pattern);
-       it != std::sregex_iterator(); ++it) {
+  for (const std::string& tag : Tags(svg, "line")) {
     Line line;
-    line.tag = (*it)[0];
+    line.tag = tag;
     line.a = {AttributeOf(line.tag, "x1"), AttributeOf(line.tag, "y1")};
     line.b = {AttributeOf(line.tag, "x2"), AttributeOf(line.tag, "y2")};
     line.stroke_mm = AttributeOf(line.tag, "stroke-width");
