@@ -10,6 +10,7 @@
 #include <opencv2/core/utils/logger.hpp>
 #include <string>
 
+#include "app/calibrate_command.h"
 #include "app/command_line.h"
 #include "app/compare_command.h"
 #include "app/demo_command.h"
@@ -50,6 +51,8 @@ constexpr oal::Command kCommands[] = {
     {"evaluate", &oal::RunEvaluate,
      "evaluate the tracker and the pose on recorded videos: JSON, annotated video, HTML report"},
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
+    {"calibrate", &oal::RunCalibrate,
+     "camera intrinsics and distortion from chessboard views, as a ViSP camera file"},
     {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
     {"scorbot-sim", &oal::RunScorbotSim,
      "Scorbot ER-VII controller simulator (ACL) on a pseudo-terminal; --measure: link budget"},

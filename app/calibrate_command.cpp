@@ -1,0 +1,171 @@
+#include "app/calibrate_command.h"
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/atomic_file.h"
+#include "app/camera_file.h"
+#include "app/command_line.h"
+#include "app/image_source.h"
+#include "calibration/calibrate.h"
+#include "calibration/chessboard.h"
+
+namespace oal {
+namespace {
+
+// "9x6": inner corners along a row and along a column.
+void ParseChessboard(const std::string& text, ChessboardOptions* options) {
+  int columns = 0, rows = 0;
+  char x = 0, rest = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &columns, &x, &rows, &rest) != 3 ||
+      (x != 'x' && x != 'X') || columns < 2 || rows < 2 || columns > 100 || rows > 100) {
+    throw UsageError("--chessboard " + text +
+                     ": expected the inner corners as COLUMNSxROWS, e.g. 9x6 (2 to 100 each)");
+  }
+  options->columns = columns;
+  options->rows = rows;
+}
+
+std::string Fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
+void PrintReport(const CalibrationResult& result) {
+  for (const CalibrationViewReport& view : result.views) {
+    if (view.used) {
+      std::cout << view.name << ": " << view.points << " corners, RMS " << Fixed(view.rms_px, 3)
+                << " px, tilt " << Fixed(view.tilt_deg, 1) << " deg\n";
+    } else {
+      std::cout << view.name << ": not used: " << view.rejected << '\n';
+    }
+  }
+  const vpCameraParameters& camera = result.camera;
+  std::cout << "px " << Fixed(camera.get_px(), 2) << " +- " << Fixed(result.px_sd, 2) << ", py "
+            << Fixed(camera.get_py(), 2) << " +- " << Fixed(result.py_sd, 2) << ", u0 "
+            << Fixed(camera.get_u0(), 2) << " +- " << Fixed(result.u0_sd, 2) << ", v0 "
+            << Fixed(camera.get_v0(), 2) << " +- " << Fixed(result.v0_sd, 2) << " px\n";
+  if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
+    std::cout << "kud " << Fixed(camera.get_kud(), 5) << ", kdu " << Fixed(camera.get_kdu(), 5)
+              << " (OpenCV's k1 " << Fixed(result.lens.k1, 5) << " +- " << Fixed(result.k1_sd, 5)
+              << ", k2 " << Fixed(result.lens.k2, 5) << ")\n";
+  }
+  std::cout << "reprojection RMS " << Fixed(result.rms_px, 3) << " px\n";
+  for (const std::string& advice : result.advice) Warn("calibrate", advice);
+}
+
+}  // namespace
+
+int RunCalibrate(int argc, char** argv) {
+  CLI::App cli{
+      "Calibrates the camera from views of a printed chessboard: px, py, u0, v0 and ViSP's "
+      "radial distortion (kud, kdu), with each view's reprojection RMS and the parameters' "
+      "standard deviations, written as a ViSP camera file (camera.xml) that detect, pose, "
+      "evaluate and servo read.",
+      "oalservo calibrate"};
+  std::vector<std::string> inputs;
+  std::string chessboard_text, out_path, name = "Camera";
+  ChessboardOptions chessboard;
+  bool no_distortion = false;
+  cli.add_option("INPUT", inputs,
+                 "images, directories of images, printf patterns or videos of the chessboard "
+                 "(10-30 views, tilted 20-45 deg in different directions, some near the "
+                 "image's corners)")
+      ->required();
+  cli.add_option("--chessboard", chessboard_text,
+                 "inner corners of the chessboard, COLUMNSxROWS (e.g. 9x6 for a board of 10 x "
+                 "7 squares)")
+      ->required();
+  cli.add_option("--square", chessboard.square_m, "side of a square as printed, metres")
+      ->required();
+  cli.add_option("--out", out_path, "the ViSP camera file to write")->required();
+  cli.add_option("--name", name, "the camera's name in the file")->capture_default_str();
+  cli.add_flag("--no-distortion", no_distortion,
+               "a distortion-free model (perspectiveProjWithoutDistortion)");
+  cli.footer(
+      "Example:\n"
+      "  oalservo calibrate shots/ --chessboard 9x6 --square 0.025 --out camera.xml\n"
+      "Print the chessboard at 100 % and measure a square; hold it flat. Views in which the "
+      "whole board is not found are listed and left out.");
+  if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  ParseChessboard(chessboard_text, &chessboard);
+  CheckInOptionWords([&] { chessboard.Check(); }, {{"ChessboardOptions::square_m", "--square"}});
+
+  // The output before the work: a bad --out fails now, and the file appears only whole.
+  const std::filesystem::path out(out_path);
+  if (out.has_parent_path()) {
+    std::error_code error;
+    std::filesystem::create_directories(out.parent_path(), error);
+    if (error) {
+      throw std::runtime_error("--out " + out_path + ": cannot create directory " +
+                               out.parent_path().string() + ": " + error.message());
+    }
+  }
+  CheckOutputFile(out);
+
+  std::vector<CalibrationView> views;
+  int width = 0, height = 0;
+  for (const std::string& input : inputs) {
+    std::vector<std::string> warnings;
+    const std::unique_ptr<ImageSource> source = OpenImageSource(input, &warnings);
+    for (const std::string& warning : warnings) Warn("calibrate", warning);
+    Frame frame;
+    while (source->Next(&frame)) {
+      if (width == 0) width = frame.gray.cols, height = frame.gray.rows;
+      if (frame.gray.cols != width || frame.gray.rows != height) {
+        throw std::runtime_error(frame.source + ": " + std::to_string(frame.gray.cols) + "x" +
+                                 std::to_string(frame.gray.rows) + " pixels, the first view " +
+                                 std::to_string(width) + "x" + std::to_string(height) +
+                                 ": one calibration is for one image size");
+      }
+      std::optional<CalibrationView> view = FindChessboard(frame.view(), chessboard, frame.source);
+      if (view) {
+        views.push_back(std::move(*view));
+      } else {
+        views.push_back(CalibrationView{frame.source, {}});
+      }
+    }
+  }
+  if (views.empty()) throw std::runtime_error("no image in " + inputs.front());
+
+  CalibrationOptions options;
+  options.width = width;
+  options.height = height;
+  options.estimate_distortion = !no_distortion;
+  options.min_points_per_view = chessboard.columns * chessboard.rows;
+  std::vector<CalibrationView> found;
+  for (CalibrationView& view : views) {
+    if (view.points.empty()) {
+      std::cout << view.name << ": not used: the whole chessboard (" << chessboard.columns << "x"
+                << chessboard.rows << " inner corners) was not found\n";
+    } else {
+      found.push_back(std::move(view));
+    }
+  }
+  if (static_cast<int>(found.size()) < options.min_views) {
+    throw std::runtime_error(std::to_string(found.size()) + " of " + std::to_string(views.size()) +
+                             " images show the whole chessboard, at least " +
+                             std::to_string(options.min_views) + " needed: nothing written to " +
+                             out_path);
+  }
+  CalibrationResult result;
+  try {
+    result = Calibrate(found, options);
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(std::string(error.what()) + "\nnothing written to " + out_path);
+  }
+  PrintReport(result);
+  SaveCameraFile(out_path, result.camera, name, static_cast<unsigned>(width),
+                 static_cast<unsigned>(height));
+  std::cout << "wrote " << out_path << " (camera '" << name << "', " << width << "x" << height
+            << ", " << found.size() << " of " << views.size() << " views)\n";
+  return kExitOk;
+}
+
+}  // namespace oal
