@@ -9,6 +9,7 @@
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include "app/annotate.h"
@@ -117,6 +118,7 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFram
       {"scan", ScanJson(result, mode)},
       {"stripe_agreement",
        result.pose.status == PoseStatus::kOk ? Json(result.agreement.Worst()) : Json()},
+      {"straightness_px", if_ok(result.straightness_px)},
       {"time_us",
        Json{{"find", result.find_us}, {"detect", result.detect_us}, {"pose", result.pose_us}}},
   };
@@ -151,7 +153,10 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
                  AnnotatePose(frame.gray, run->tracker.lines(), drawn, run->camera.camera,
                               run->undistorted_by, result.region));
       }
-      if (result.status == TargetStatus::kOk) ++summary->ok;
+      if (result.status == TargetStatus::kOk) {
+        ++summary->ok;
+        summary->straightness_px.push_back(result.straightness_px);
+      }
       ++summary->frames;
     }
   }
@@ -178,6 +183,17 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
+  const LensCheck lens = CheckLens(summary.straightness_px);
+  if (lens.mismatch) {
+    std::ostringstream message;
+    message.precision(2);
+    message << std::fixed << "lines 1-4 still bend by " << lens.median_px << " px (median of "
+            << lens.frames << " frames; a camera file that matches the lens "
+            << "leaves under 0.1 px) after '" << summary.camera_path
+            << "' corrects them: it does not describe this lens (its distortion, or the "
+               "resolution it was made for). Calibrate the camera: oalservo calibrate";
+    summary.warnings.push_back(message.str());
+  }
   return summary;
 }
 

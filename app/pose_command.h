@@ -63,8 +63,11 @@ struct PoseSummary {
   int ok = 0;  ///< frames with status ok
   /// The camera file used (--camera, or the camera.xml found next to the inputs).
   std::string camera_path;
-  /// For the user (camera found automatically, skipped files, camera size mismatch).
+  /// For the user (camera found automatically, skipped files, camera size mismatch, a camera
+  /// file whose lens model leaves the stripes bent).
   std::vector<std::string> warnings;
+  /// TargetFrame::straightness_px of the frames with a pose, in order.
+  std::vector<double> straightness_px;
 };
 
 /// Estimates the pose in every frame of every input. Output goes to options.out_path

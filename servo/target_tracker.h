@@ -120,6 +120,11 @@ struct TargetFrame {
   int borders = 0;
   int candidates = 0;  ///< middle-cell candidates scanned
   StripeAgreement agreement;
+  /// How straight lines 1-4 came out after the lens model's correction: the second largest
+  /// bend (sagitta, pixels) of their feature points over the stretch seen (0 without a pose).
+  /// Stripes bent by a lens the camera file does not describe (a distortion-free model on a
+  /// wide lens, the wrong resolution) raise it.
+  double straightness_px = 0.0;
   double find_us = 0.0, detect_us = 0.0, pose_us = 0.0;  ///< time spent in each step
 };
 
@@ -172,6 +177,19 @@ class TargetPoseTracker {
   std::optional<vpHomogeneousMatrix> held_cMo_;  ///< a jump, waiting for the next frame
   int frames_since_ok_ = 0;  ///< 1: the last frame's pose was accepted; 0: none ever was
 };
+
+/// The lens check over several frames: whether their lines 1-4, after the camera model's
+/// correction, bend by more than a matching model leaves. A single frame can show a stray
+/// bend (a mark beside a stripe), so the median of at least `min_frames` frames decides:
+/// on the A3 bench scenes a matching camera file gives a median of about 0.05 px, one whose
+/// kdu is off by 0.1 about 0.4 px (docs/BENCHMARKS.md).
+struct LensCheck {
+  int frames = 0;          ///< frames with a pose that were counted
+  double median_px = 0.0;  ///< their median TargetFrame::straightness_px
+  bool mismatch = false;   ///< median above the threshold, over at least min_frames frames
+};
+LensCheck CheckLens(std::vector<double> straightness_px, double threshold_px = 0.2,
+                    int min_frames = 3);
 
 /// The model check alone: how well `image` shows the target of `layout` at cMo. Each stripe
 /// is sampled at 16 points spread over the part of it in view (away from the crossings),

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "app/camera_file.h"
 #include "app/config.h"
 #include "app/render_command.h"
 #include "tests/app/command_test_util.h"
@@ -140,6 +141,41 @@ TEST(Pose, DistortedFramesWithCameraAndAnnotations) {
     EXPECT_EQ(image.cols, 320);
     EXPECT_EQ(image.rows, 240);
   }
+}
+
+// Each frame says how straight its lines came out; a camera file that leaves them bent (here
+// one without the lens's distortion) gets one warning that says what to do.
+TEST(Pose, ACameraFileThatMissesTheLensIsToldOnce) {
+  test::TestDir dir;
+  const std::string data = RenderSmall(dir, "data", 6, 0.25);
+  PoseCommandOptions options;
+  options.inputs = {data};
+  options.independent = true;
+  options.camera_path = data + "/camera.xml";
+  std::ostringstream out;
+  PoseSummary summary = EstimatePoses(options, out);
+  ASSERT_EQ(summary.ok, 6);
+  for (const json& frame : ParseJsonLines(out.str())) {
+    EXPECT_LT(frame.at("straightness_px").get<double>(), 0.2);
+  }
+  auto lens_warnings = [](const PoseSummary& run) {
+    int count = 0;
+    for (const std::string& warning : run.warnings) {
+      count += warning.find("Calibrate the camera") != std::string::npos;
+    }
+    return count;
+  };
+  EXPECT_EQ(lens_warnings(summary), 0);
+
+  const CameraFile right = LoadCameraFile(options.camera_path);
+  vpCameraParameters pinhole;
+  pinhole.initPersProjWithoutDistortion(right.camera.get_px(), right.camera.get_py(),
+                                        right.camera.get_u0(), right.camera.get_v0());
+  options.camera_path = dir / "pinhole.xml";
+  SaveCameraFile(options.camera_path, pinhole, "Camera", right.width, right.height);
+  out.str("");
+  summary = EstimatePoses(options, out);
+  EXPECT_EQ(lens_warnings(summary), 1);
 }
 
 // Frames without the four lines (two lines, a blank image) are rows with their status; the

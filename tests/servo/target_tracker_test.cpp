@@ -111,6 +111,43 @@ TEST(TargetPoseTracker, FollowsAMovingSheetFromItsLastPose) {
   }
 }
 
+// The straightness of lines 1-4 after the lens correction tells a camera file that matches
+// the lens (kdu 0.15) from ones whose distortion is off by 0.1 or missing, over every run of
+// five frames; a single frame may show a stray bend, never the median of five.
+TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
+  const SceneRenderer renderer(FourLineA3Target(), BenchRender(13));
+  const PoseSampling sampling = SheetSampling(renderer.target());
+  std::uint64_t random = 21;
+  std::vector<vpImage<unsigned char>> frames;
+  for (int k = 0; k < 40; ++k) {
+    frames.push_back(renderer.Render(SamplePose(renderer, sampling, &random), 300 + k).image);
+  }
+  for (const double kdu : {0.15, 0.05, 0.25, 0.0}) {
+    const bool right = kdu == 0.15;
+    const vpCameraParameters camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, kdu, 640, 480);
+    PoseOptions pose;
+    pose.camera = camera;
+    pose.image_width = 640;
+    pose.image_height = 480;
+    TargetPoseTracker tracker(renderer.target(), camera, DetectorOptions(), pose);
+    std::vector<double> values;
+    for (const vpImage<unsigned char>& frame : frames) {
+      tracker.Reset();
+      const TargetFrame& result = tracker.Track(ViewOf(frame));
+      if (result.status == TargetStatus::kOk) values.push_back(result.straightness_px);
+    }
+    ASSERT_GE(values.size(), 35u) << "kdu " << kdu;
+    for (std::size_t first = 0; first + 5 <= values.size(); first += 5) {
+      const LensCheck check =
+          CheckLens(std::vector<double>(values.begin() + first, values.begin() + first + 5));
+      EXPECT_EQ(check.mismatch, !right)
+          << "kdu " << kdu << ", frames from " << first << ": median " << check.median_px << " px";
+    }
+  }
+  EXPECT_FALSE(CheckLens({0.9, 0.8}).mismatch) << "two frames are too few to judge";
+  EXPECT_EQ(CheckLens({}).frames, 0);
+}
+
 // The sheet slides out of view (no pose, never a wrong one) and comes back (found again).
 TEST(TargetPoseTracker, LosesTheSheetOutOfViewAndFindsItAgain) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(7));
