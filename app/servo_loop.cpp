@@ -719,6 +719,10 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   vpHomogeneousMatrix previous_wMc;
   // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
   bool confirmed = !moves_robot;
+  // The lens check over the first frames with a pose, said once: a camera file that misses
+  // the lens biases every pose, which the loop cannot see otherwise.
+  constexpr std::size_t kLensCheckFrames = 5;
+  std::vector<double> straightness;
   cv::Mat gray;
   log << "frame 0 finds the target; frame 1, the robot still, confirms it; then each frame "
          "commands one move. Errors to the goal: est by the estimated pose"
@@ -767,6 +771,17 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     const TargetFrame& tracked =
         tracker.Track(ViewOf(gray), confirming ? std::nullopt : predicted_cMo);
     const PoseResult& pose = tracked.pose;
+    if (tracked.status == TargetStatus::kOk && straightness.size() < kLensCheckFrames) {
+      straightness.push_back(tracked.straightness_px);
+      const LensCheck lens = CheckLens(straightness, 0.2, static_cast<int>(kLensCheckFrames));
+      if (lens.mismatch) {
+        log << "oalservo servo: warning: lines 1-4 still bend by " << Fixed(lens.median_px, 2)
+            << " px (median of " << lens.frames
+            << " frames; a camera file that matches the lens leaves under 0.1 px) after the "
+               "camera model's correction: it does not describe this lens, and every pose is "
+               "biased. Calibrate the camera: oalservo calibrate\n";
+      }
+    }
     std::optional<ServoStep> step;
     if (tracked.status == TargetStatus::kOk) {
       step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);

@@ -219,6 +219,7 @@ TEST(ServoLoop, DefaultConfigConvergesWithTheImageInTheLoop) {
   // Truth, not the estimate: a few mm on 320x240 noisy images.
   EXPECT_LT(report.iterations.back().true_translation_error_mm, 5.0);
   EXPECT_LT(report.iterations.back().true_rotation_error_deg, 0.5);
+  EXPECT_THAT(log.str(), ::testing::Not(HasSubstr("Calibrate the camera")));
 }
 
 TEST(ServoLoop, Table3ConvergesWithin10IterationsWithDelta08) {
@@ -243,6 +244,7 @@ TEST(ServoLoop, Table3WithDistortionCorrectedConverges) {
   ASSERT_TRUE(config.camera.correct_distortion);
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
+  EXPECT_THAT(log.str(), ::testing::Not(HasSubstr("Calibrate the camera")));
   ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
   EXPECT_LE(report.moves, 10);
   EXPECT_LE(report.iterations.back().true_translation_error_mm, kTolTranslationMm);
@@ -260,6 +262,7 @@ TEST(ServoLoop, Table3WithDistortionUncorrectedMissesTheTrueGoal) {
   EXPECT_FALSE(report.message.empty());
   ASSERT_FALSE(report.iterations.empty());
   EXPECT_GT(report.iterations.back().true_translation_error_mm, 5.0) << report.message;
+  EXPECT_THAT(log.str(), HasSubstr("Calibrate the camera")) << "the lens check says why";
 }
 
 // ... and the console says so when the estimate claims convergence far from the true goal.
