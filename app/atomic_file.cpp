@@ -79,4 +79,16 @@ void CheckOutputFile(const std::filesystem::path& target) {
   }
 }
 
+void PrepareOutputFile(const std::filesystem::path& target, const std::string& option) {
+  if (target.has_parent_path()) {
+    std::error_code error;
+    std::filesystem::create_directories(target.parent_path(), error);
+    if (error) {
+      throw std::runtime_error(option + " " + target.string() + ": cannot create directory " +
+                               target.parent_path().string() + ": " + error.message());
+    }
+  }
+  CheckOutputFile(target);
+}
+
 }  // namespace oal

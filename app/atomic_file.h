@@ -58,6 +58,11 @@ void WriteToFileOrConsole(const std::string& target, std::ostream& console, Writ
 /// not exist, or it is itself a directory. Call before any work, so nothing is half done.
 void CheckOutputFile(const std::filesystem::path& target);
 
+/// Creates the directories above `target`, an output file the user named with `option`
+/// (e.g. "--out"), then CheckOutputFile(target). Throws std::runtime_error naming the option
+/// when a directory cannot be created.
+void PrepareOutputFile(const std::filesystem::path& target, const std::string& option);
+
 /// Writes `bytes` to `target` atomically.
 void WriteFileAtomically(const std::filesystem::path& target, const std::string& bytes);
 void WriteFileAtomically(const std::filesystem::path& target,

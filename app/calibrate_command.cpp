@@ -99,15 +99,7 @@ int RunCalibrate(int argc, char** argv) {
 
   // The output before the work: a bad --out fails now, and the file appears only whole.
   const std::filesystem::path out(out_path);
-  if (out.has_parent_path()) {
-    std::error_code error;
-    std::filesystem::create_directories(out.parent_path(), error);
-    if (error) {
-      throw std::runtime_error("--out " + out_path + ": cannot create directory " +
-                               out.parent_path().string() + ": " + error.message());
-    }
-  }
-  CheckOutputFile(out);
+  PrepareOutputFile(out, "--out");
 
   std::vector<CalibrationView> views;
   int width = 0, height = 0;
