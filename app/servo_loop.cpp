@@ -773,7 +773,8 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     const PoseResult& pose = tracked.pose;
     if (tracked.status == TargetStatus::kOk && straightness.size() < kLensCheckFrames) {
       straightness.push_back(tracked.straightness_px);
-      const LensCheck lens = CheckLens(straightness, 0.2, static_cast<int>(kLensCheckFrames));
+      const LensCheck lens =
+          CheckLens(straightness, kLensMismatchPx, static_cast<int>(kLensCheckFrames));
       if (lens.mismatch) {
         log << "oalservo servo: warning: lines 1-4 still bend by " << Fixed(lens.median_px, 2)
             << " px (median of " << lens.frames

@@ -383,7 +383,6 @@ void OalDetector::ReadOff(int width, int height, bool in_region) {
     line.borders = stats.borders;
     line.support = stats.points;
     line.width_px = stats.width_px;
-    line.residual_px = stats.rms_px;
     line.support_a = stats.first;
     line.support_b = stats.last;
     candidates_.push_back(line);

@@ -60,10 +60,6 @@ struct DetectedLine {
   int borders = 0;        ///< borders with at least one feature point on the line
   int support = 0;        ///< feature points of all borders within support_tolerance_px
   double width_px = 0.0;  ///< mean line thickness across the line (0 for edges)
-  /// RMS distance of the supporting feature points to the line, pixels (undistorted ones
-  /// when correcting): a straight stripe seen through a lens the camera model describes
-  /// gives the points' own noise, a few tenths of a pixel; a bent one more.
-  double residual_px = 0.0;
   /// Where the line meets the image border, or the region's outline when a region was
   /// scanned (the undistorted one when correcting).
   Point2d end_a, end_b;

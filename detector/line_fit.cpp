@@ -49,14 +49,12 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
   const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
   SupportStats stats;
   int last_border = -1, width_n = 0;
-  double width_sum = 0.0, squares = 0.0;
+  double width_sum = 0.0;
   // Positions along the line's direction (-s, c).
   double t_min = HUGE_VAL, t_max = -HUGE_VAL;
   for (const FramePoint& point : points) {
-    const double distance = point.p.u * c + point.p.v * s - line.rho_px;
-    if (std::fabs(distance) > tolerance_px) continue;
+    if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) > tolerance_px) continue;
     ++stats.points;
-    squares += distance * distance;
     const double t = -point.p.u * s + point.p.v * c;
     t_min = std::min(t_min, t);
     t_max = std::max(t_max, t);
@@ -71,7 +69,6 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
     }
   }
   stats.width_px = width_n > 0 ? width_sum / width_n : 0.0;
-  stats.rms_px = stats.points >= 2 ? std::sqrt(squares / stats.points) : 0.0;
   if (stats.points == 0) t_min = t_max = 0.0;
   const Point2d foot{line.rho_px * c, line.rho_px * s};
   stats.first = Point2d{foot.u - t_min * s, foot.v + t_min * c};

@@ -25,9 +25,6 @@ struct SupportStats {
   int points = 0;         ///< feature points within the tolerance
   int borders = 0;        ///< distinct borders among them
   double width_px = 0.0;  ///< mean line width across the line (0 if unknown)
-  /// Root mean square of their distances to the line, pixels: how straight the feature is
-  /// (0 with fewer than two points).
-  double rms_px = 0.0;
   /// The extreme points among them along the line, projected onto it (the foot of the line's
   /// normal from the origin when there are none).
   Point2d first, last;

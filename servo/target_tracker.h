@@ -188,7 +188,9 @@ struct LensCheck {
   double median_px = 0.0;  ///< their median TargetFrame::straightness_px
   bool mismatch = false;   ///< median above the threshold, over at least min_frames frames
 };
-LensCheck CheckLens(std::vector<double> straightness_px, double threshold_px = 0.2,
+/// The bend above which a median says the camera model misses the lens, pixels.
+inline constexpr double kLensMismatchPx = 0.2;
+LensCheck CheckLens(std::vector<double> straightness_px, double threshold_px = kLensMismatchPx,
                     int min_frames = 3);
 
 /// The model check alone: how well `image` shows the target of `layout` at cMo. Each stripe
