@@ -301,6 +301,32 @@ CycleReport SafeRobot::SetVelocity(RobotFrame frame, const vpColVector& v) {
   return finish(r);
 }
 
+RobotPose SafeRobot::PlanMove(RobotFrame frame, const vpHomogeneousMatrix& target) {
+  RobotPose reach = robot_.NearestReachable(frame, target);
+  if (!reach.result.ok()) return reach;
+  if (RobotResult r = CheckInBox(BoxFramePose(frame, reach.pose), "the move target"); !r.ok()) {
+    reach.result = r;
+    return reach;
+  }
+  // The path too, as the driver will execute it (a joint-interpolated arm swings out on an
+  // arc), before anything is sent.
+  if (options_.workspace_enabled) {
+    const RobotPose from = robot_.GetPosition(frame);
+    if (!from.result.ok()) return {from.result, reach.pose};
+    if (RobotResult r = CheckPathInBox(frame, from.pose, reach.pose); !r.ok()) {
+      reach.result = r;
+    }
+  }
+  return reach;
+}
+
+RobotPose SafeRobot::CheckMove(RobotFrame frame, const vpHomogeneousMatrix& target) {
+  if (state_ == SafeRobotState::kDisconnected) {
+    return {RobotResult::Fail(RobotStatus::kNotReady, "not connected"), vpHomogeneousMatrix()};
+  }
+  return PlanMove(frame, target);
+}
+
 MoveReport SafeRobot::MovePosition(RobotFrame frame, const vpHomogeneousMatrix& target) {
   const Clock::time_point move_start = Clock::now();
   MoveReport report;
@@ -314,19 +340,9 @@ MoveReport SafeRobot::MovePosition(RobotFrame frame, const vpHomogeneousMatrix& 
     report.result = r;
     return report;
   }
-  const RobotPose reach = robot_.NearestReachable(frame, target);
-  if (!reach.result.ok()) return fail(reach.result);
+  const RobotPose reach = PlanMove(frame, target);
   report.target = reach.pose;
-  if (RobotResult r = CheckInBox(BoxFramePose(frame, report.target), "the move target"); !r.ok()) {
-    return fail(r);
-  }
-  // The path too, as the driver will execute it (a joint-interpolated arm swings out on an
-  // arc), before anything is sent.
-  if (options_.workspace_enabled) {
-    const RobotPose from = robot_.GetPosition(frame);
-    if (!from.result.ok()) return fail(from.result);
-    if (RobotResult r = CheckPathInBox(frame, from.pose, report.target); !r.ok()) return fail(r);
-  }
+  if (!reach.result.ok()) return fail(reach.result);
   if (RobotResult r = robot_.StartMove(frame, report.target); !r.ok()) return fail(r);
   const int max_polls = static_cast<int>(std::ceil(options_.move_timeout_s / sampling_time_s_));
   for (;;) {

@@ -139,6 +139,11 @@ class SafeRobot {
   /// driver's StartMove()/PollMove(), every poll a checked cycle.
   MoveReport MovePosition(RobotFrame frame, const vpHomogeneousMatrix& target);
 
+  /// Whether MovePosition(frame, target) would pass the runner's checks from where the robot
+  /// is now: the pose it would move to (NearestReachable()) and ok, or why it would be
+  /// refused. Computes only: nothing is sent, nothing is latched (a plan may try poses).
+  RobotPose CheckMove(RobotFrame frame, const vpHomogeneousMatrix& target);
+
   SafeRobotState state() const { return state_; }
   /// Why the robot is stopped (ok when it is not).
   const RobotResult& stop_reason() const { return stop_reason_; }
@@ -156,6 +161,8 @@ class SafeRobot {
 
   RobotResult CheckMayMove();
   RobotResult Latch(RobotResult why) noexcept;
+  /// NearestReachable(), then the target and the path from here in the box.
+  RobotPose PlanMove(RobotFrame frame, const vpHomogeneousMatrix& target);
   RobotResult CheckInBox(const vpHomogeneousMatrix& wMb, const std::string& what) const;
   /// The path of a move of `frame` from `from` to `target` (Robot::PoseAlongMove()) in the box.
   RobotResult CheckPathInBox(RobotFrame frame, const vpHomogeneousMatrix& from,
