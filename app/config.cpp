@@ -552,6 +552,7 @@ const std::vector<Field<CameraConfig>>& CameraFields() {
       DoubleField("noise", &O::noise),
       DoubleField("blur", &O::blur),
       PoseField("eMc", &O::eMc),
+      {"true_eMc", [](const Value& value, O* camera) { camera->true_eMc = ReadPose(value); }},
       {"file", [](const Value& value, O* camera) { camera->file = PathNextTo(value.file, value); }},
       {"name", [](const Value& value,
                   O* camera) { camera->file_camera = value.As<std::string>("a camera's name"); }},
@@ -1321,6 +1322,16 @@ std::string TargetYaml(const LineTarget& target) {
          << number(line.x2_m) << ", " << number(line.y2_m) << "], width: " << number(line.width_m)
          << "}\n";
   }
+  return yaml.str();
+}
+
+std::string PoseYaml(const vpHomogeneousMatrix& pose) {
+  const vpTranslationVector t = pose.getTranslationVector();
+  const vpRxyzVector r(pose.getRotationMatrix());
+  std::ostringstream yaml;
+  yaml.precision(12);
+  yaml << "{translation_m: [" << t[0] << ", " << t[1] << ", " << t[2] << "], rxyz_deg: ["
+       << vpMath::deg(r[0]) << ", " << vpMath::deg(r[1]) << ", " << vpMath::deg(r[2]) << "]}";
   return yaml.str();
 }
 

@@ -51,6 +51,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <map>
+#include <optional>
 #include <string>
 
 #include "detector/options.h"
@@ -77,6 +78,9 @@ struct CameraConfig {
   double noise = 0.0;             ///< Gaussian noise of the rendering, grey levels, [0, 100]
   double blur = 0.0;              ///< Gaussian blur of the rendering, pixels, [0, 20]
   vpHomogeneousMatrix eMc;        ///< hand-eye: the camera in the end-effector frame
+  /// Simulation (source: simulated): how the rendered camera is really mounted, when eMc is
+  /// only what the loop believes (to try a hand-eye calibration); unset: eMc.
+  std::optional<vpHomogeneousMatrix> true_eMc;
   /// `camera.file`: a ViSP camera XML (the canonical form) that gives px, py, u0, v0, kdu and,
   /// when it has them, width and height; empty: the inline keys. Relative to the config file.
   std::string file;
@@ -249,6 +253,10 @@ AppConfig LoadConfig(const std::string& path, const AppConfig& base = AppConfig(
 /// `target` as a configuration's `target:` section (LoadConfig reads it back exactly: numbers
 /// with 17 significant digits).
 std::string TargetYaml(const LineTarget& target);
+
+/// `pose` in the configuration's form, {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]},
+/// with 12 significant digits (LoadConfig reads it back to far below a micrometre).
+std::string PoseYaml(const vpHomogeneousMatrix& pose);
 
 /// As LoadConfig, from YAML text; `file_name` stands for the file in messages.
 AppConfig ParseConfig(const std::string& yaml_text, const std::string& file_name,

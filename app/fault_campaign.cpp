@@ -26,6 +26,7 @@
 
 #include "app/detector_accuracy.h"  // Quantile
 #include "app/servo_command.h"
+#include "app/servo_rig.h"
 #include "detector/options.h"  // RequireOption
 #include "robots/scorbot_controller_sim.h"
 

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "app/calibrate_command.h"
+#include "app/hand_eye_command.h"
 #include "app/command_line.h"
 #include "app/compare_command.h"
 #include "app/demo_command.h"
@@ -53,6 +54,8 @@ constexpr oal::Command kCommands[] = {
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
     {"calibrate", &oal::RunCalibrate,
      "camera intrinsics and distortion from chessboard views, as a ViSP camera file"},
+    {"hand-eye", &oal::RunHandEye,
+     "the camera's mounting on the arm (eMc): move through stations, or from recorded pairs"},
     {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
     {"scorbot-sim", &oal::RunScorbotSim,
      "Scorbot ER-VII controller simulator (ACL) on a pseudo-terminal; --measure: link budget"},

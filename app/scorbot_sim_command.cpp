@@ -13,6 +13,7 @@
 #include "app/command_line.h"
 #include "app/servo_command.h"
 #include "app/servo_loop.h"
+#include "app/servo_rig.h"
 #include "detector/options.h"  // RequireOption
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"

@@ -75,6 +75,7 @@ ServoAppConfig LoadServoConfig(const ServoCommandOptions& options) {
   ServoAppConfig config = options.config_path.empty()
                               ? DefaultServoConfig()
                               : LoadConfig(options.config_path, DefaultServoConfig());
+  for (const std::string& path : options.more_config_paths) config = LoadConfig(path, config);
   if (!options.out_dir.empty()) config.output.directory = options.out_dir;
   if (!options.mode.empty()) config.servo.law.mode = ServoModeFromString(options.mode);
   if (!options.display.empty()) config.output.display = options.display;
@@ -189,9 +190,11 @@ std::optional<std::string> TrueErrorLine(const ServoRunReport& report, const Ser
 
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks) {
+  std::string config_name =
+      options.config_path.empty() ? kDefaultServoConfigName : options.config_path;
+  for (const std::string& path : options.more_config_paths) config_name += " + " + path;
   return RunServoWithOutputs(
-      LoadServoConfig(options),
-      options.config_path.empty() ? kDefaultServoConfigName : options.config_path,
+      LoadServoConfig(options), config_name,
       options.out_dir.empty() ? "output directory (output.directory)" : "output directory (--out)",
       out, hooks);
 }
@@ -274,9 +277,12 @@ int RunServoMain(int argc, char** argv) {
       "detect, estimate the pose, move the robot; one row per iteration in the form of the "
       "paper's Table 3, and DIR/servo.csv.",
       "oalservo servo");
-  cli.add_option("--config", options.config_path,
+  std::vector<std::string> config_paths;
+  cli.add_option("--config", config_paths,
                  "YAML configuration: camera, robot, servo, goal, target_pose (and detector, "
-                 "target, pose) sections; default: the built-in config/servo-sim.yaml")
+                 "target, pose) sections; default: the built-in config/servo-sim.yaml. Given "
+                 "again, each file applies over the ones before (a hand-eye file after the "
+                 "robot's)")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", options.out_dir,
                  "output directory (overrides output.directory; default out/servo): servo.csv, "
@@ -290,8 +296,13 @@ int RunServoMain(int argc, char** argv) {
       "Examples:\n"
       "  oalservo servo\n"
       "  oalservo servo --config config/table3-sim.yaml --out out/table3\n"
-      "  oalservo servo --config config/table3-sim.yaml --mode point-and-go --display off");
+      "  oalservo servo --config config/table3-sim.yaml --mode point-and-go --display off\n"
+      "  oalservo servo --config config/scorbot-sim.yaml --config out/hand-eye.yaml");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  if (!config_paths.empty()) {
+    options.config_path = config_paths.front();
+    options.more_config_paths.assign(config_paths.begin() + 1, config_paths.end());
+  }
   const StopSignalScope signals(&StopRobotOnSignal);
   const ServoRunReport report = RunServoCommand(options, std::cout, StopSignalHooks(signals));
   const bool ok =

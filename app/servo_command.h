@@ -20,6 +20,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/command_line.h"
 #include "app/config.h"
@@ -29,6 +30,8 @@ namespace oal {
 
 struct ServoCommandOptions {
   std::string config_path;  ///< YAML configuration; empty: the built-in default
+  /// Further files applied after it, in order (e.g. a hand-eye file after the robot's).
+  std::vector<std::string> more_config_paths;
   /// Overrides of the configuration; empty: as configured.
   std::string out_dir;  ///< output.directory (created if missing)
   std::string mode;     ///< servo.mode: point-and-go, exponential, velocity
@@ -37,8 +40,9 @@ struct ServoCommandOptions {
 
 /// The built-in default configuration (config/servo-sim.yaml, embedded at build time).
 ServoAppConfig DefaultServoConfig();
-/// The configuration `options` selects: --config applied over the built-in default (keys and
-/// sections a file leaves out keep the default's values), or the built-in itself,
+/// The configuration `options` selects: each --config applied in turn over the built-in
+/// default (keys and sections a file leaves out keep the values before it), or the built-in
+/// itself,
 /// then the command line's overrides. Throws std::runtime_error / std::invalid_argument for a
 /// bad file or override.
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "app/image_source.h"
+#include "app/servo_rig.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
 #include "robots/scorbot_controller_sim.h"
@@ -32,8 +33,6 @@
 
 namespace oal {
 namespace {
-
-constexpr std::uint64_t kNoiseSeed = 20240605;
 
 // Stops the robot however the loop ends (also on an exception) and unregisters it from the
 // command's signal handler first. Declared after the SafeRobot, so destroyed before it: the
@@ -132,159 +131,7 @@ ServoRunStatus StatusOfRefusal(const RobotResult& result, const SafeRobot& robot
   return ServoRunStatus::kError;
 }
 
-// What the detector and the pose believe about the lens: the true one, or (the paper's
-// condition, camera.correct_distortion false) a pinhole camera with the same intrinsics.
-struct LoopModel {
-  const ServoAppConfig& config;
-  vpCameraParameters camera;
-
-  explicit LoopModel(const ServoAppConfig& c)
-      : config(c),
-        camera(c.camera.correct_distortion
-                   ? c.camera.Camera()
-                   : vpCameraParameters(c.camera.px, c.camera.py, c.camera.u0, c.camera.v0)) {}
-
-  // The tracker sets the camera, the undistortion and the image size from its own.
-  PoseOptions Pose() const {
-    PoseOptions options = config.pose;
-    options.compute_covariance = false;  // the loop does not use it
-    return options;
-  }
-  TargetPoseTracker Tracker() const {
-    return TargetPoseTracker(config.target, camera, config.detector, Pose(), config.tracking);
-  }
-};
-
-// Where the loop's frames come from (config `source:`).
-class LoopCamera {
- public:
-  virtual ~LoopCamera() = default;
-  /// The frame of iteration `iteration`: seen from `true_cMo` (simulation) or the next one of
-  /// the source; false at the end of a recording. Throws std::runtime_error when a frame cannot
-  /// be read.
-  virtual bool Grab(const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) = 0;
-  /// True when a recording has no frame left (the next Grab() would return false); a camera
-  /// never ends.
-  virtual bool AtEnd() { return false; }
-  virtual std::string Name() const = 0;
-};
-
-// The simulated camera: the target rendered from the true pose with the configured lens,
-// noise and blur.
-class RenderedCamera : public LoopCamera {
- public:
-  explicit RenderedCamera(const ServoAppConfig& config)
-      : renderer_(config.target, RenderOptionsOf(config)) {}
-
-  bool Grab(const vpHomogeneousMatrix& true_cMo, int iteration, cv::Mat* gray) override {
-    frame_ = renderer_.Render(true_cMo, kNoiseSeed + static_cast<std::uint64_t>(iteration));
-    *gray = cv::Mat(static_cast<int>(frame_.image.getHeight()),
-                    static_cast<int>(frame_.image.getWidth()), CV_8UC1, frame_.image.bitmap);
-    return true;
-  }
-  std::string Name() const override { return "the simulated camera"; }
-
- private:
-  // The camera's lens, noise and blur; the scene's surface, light and clutter.
-  static RenderOptions RenderOptionsOf(const ServoAppConfig& config) {
-    const CameraConfig& camera = config.camera;
-    RenderOptions render;
-    config.scene.ApplyTo(&render);
-    render.width = camera.width;
-    render.height = camera.height;
-    render.camera = camera.Camera();
-    render.noise_sigma = camera.noise;
-    render.blur_sigma_px = camera.blur;
-    return render;
-  }
-
-  SceneRenderer renderer_;
-  RenderedFrame frame_;
-};
-
-// A V4L2 camera or a recording (app/image_source.h).
-class SourceCamera : public LoopCamera {
- public:
-  explicit SourceCamera(std::unique_ptr<ImageSource> source) : source_(std::move(source)) {}
-
-  bool Grab(const vpHomogeneousMatrix& /*true_cMo*/, int /*iteration*/, cv::Mat* gray) override {
-    const bool have_frame = peeked_ ? peeked_frame_ : source_->Next(&frame_);
-    peeked_ = false;
-    if (!have_frame) return false;
-    *gray = frame_.gray;
-    return true;
-  }
-  // Reads the next frame ahead (Grab() then hands it out); an unreadable one is not the end.
-  bool AtEnd() override {
-    if (!peeked_) {
-      try {
-        peeked_frame_ = source_->Next(&frame_);
-      } catch (const std::exception&) {
-        return false;  // Grab() reads on past it and reports it
-      }
-      peeked_ = true;
-    }
-    return !peeked_frame_;
-  }
-  std::string Name() const override { return source_->Name(); }
-
- private:
-  std::unique_ptr<ImageSource> source_;
-  Frame frame_;
-  bool peeked_ = false;        // frame_ holds the next frame already (AtEnd())
-  bool peeked_frame_ = false;  // ... and there was one
-};
-
-// The robot the configuration names. For the Scorbot with port "simulator", the Controller-A
-// simulator runs on a pseudo-terminal in this process and the real driver talks to it; it is
-// declared before the driver so that it outlives it.
-struct RobotRig {
-  std::unique_ptr<ScorbotControllerSim> controller;
-  std::unique_ptr<Robot> driver;
-};
-
-}  // namespace
-
-ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
-  ScorbotSimOptions sim = config.robot.simulator;
-  const ScorbotGeometry& geometry = config.robot.scorbot.geometry;
-  sim.geometry = geometry;
-  sim.baud = config.robot.scorbot.baud;
-  const ScorbotReach start = NearestReachable(geometry, config.robot.start_wMc, config.camera.eMc);
-  if (!start.ok) {
-    throw std::invalid_argument("robot.start is out of the Scorbot's reach: " + start.why);
-  }
-  for (std::size_t i = 0; i < 5; ++i) sim.start_deg[i] = vpMath::deg(start.q[i]);
-  return sim;
-}
-
-namespace {
-
-RobotRig OpenConfiguredRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll) {
-  RobotRig rig;
-  if (config.robot.type == "scorbot") {
-    ScorbotOptions options = config.robot.scorbot;
-    options.eMc = config.camera.eMc;
-    if (options.port == "simulator") {
-      rig.controller = std::make_unique<ScorbotControllerSim>(ControllerSimOptions(config));
-      rig.controller->Start();
-      options.port = rig.controller->ConnectPath();
-    }
-    rig.driver = std::make_unique<ScorbotRobot>(options);
-    return rig;
-  }
-  SimulatedCameraOptions options;
-  options.sampling_time_s = config.robot.sampling_time_s;
-  // A move takes time, one sampling period per poll, as on an arm: a stop during it (Ctrl-C,
-  // a limit) leaves the camera on its way.
-  options.move_mode = SimulatedCameraOptions::MoveMode::kIntegrate;
-  options.wMc = config.robot.start_wMc;
-  options.eMc = config.camera.eMc;
-  options.on_poll = std::move(on_poll);
-  rig.driver = std::make_unique<SimulatedCamera>(options);
-  return rig;
-}
-
+// The configured robot, wrapped by the hooks' wrapper.
 RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll,
                    const ServoRunHooks& hooks) {
   RobotRig rig = OpenConfiguredRobot(config, std::move(on_poll));
@@ -307,34 +154,6 @@ std::string LinkSummary(const Robot& driver, int baud, int moves) {
   return summary;
 }
 
-// "FILE:LINE: key" where the configuration set `key`, or "key" when no file set it.
-std::string KeyAt(const ServoAppConfig& config, const std::string& key) {
-  const std::string origin = config.Origin(key);
-  return origin.empty() ? key : origin + ": " + key;
-}
-
-// Files after a printf pattern's gap are reported in `warnings`.
-std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config,
-                                           std::vector<std::string>* warnings) {
-  const SourceConfig& source = config.source;
-  if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
-  const bool v4l2 = source.type == "v4l2";
-  const std::string key = v4l2 ? "source.device" : "source.path";
-  try {
-    if (v4l2) {
-      V4l2Settings settings;
-      settings.width = config.camera.width;
-      settings.height = config.camera.height;
-      settings.fps = source.fps;
-      return std::make_unique<SourceCamera>(OpenV4l2Source(source.device, settings));
-    }
-    return std::make_unique<SourceCamera>(OpenImageSource(source.path, warnings));
-  } catch (const std::runtime_error& error) {
-    throw std::runtime_error(KeyAt(config, key) + " '" + (v4l2 ? source.device : source.path) +
-                             "' cannot be opened: " + error.what());
-  }
-}
-
 // Why the loop ends, for the report.
 struct Stop {
   ServoRunStatus status;
@@ -353,6 +172,11 @@ void CheckServoConfig(const ServoAppConfig& config) {
         "whose motion the camera would not see); to watch a camera without moving anything use "
         "source: {type: replay, path: " +
         config.source.device + "}");
+  }
+  if (config.camera.true_eMc && config.source.type != "simulated") {
+    throw std::invalid_argument(KeyAt(config, "camera.true_eMc") +
+                                " is the mounting of a simulated camera; source.type is " +
+                                config.source.type + ": remove it");
   }
 }
 
@@ -677,7 +501,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (!report.iterations.empty()) report.iterations.back().status = ToString(stop.status);
     if (guard) {
       // Where the robot stopped: after a move since the last frame, one more row says so.
-      const RobotPose where = robot.GetPosition(RobotFrame::kCamera);
+      const RobotPose where = TrueCameraPose(robot, config);
       if (where.result.ok()) {
         report.final_wMc = where.pose;
         if (moved_since_row && !report.iterations.empty()) {
@@ -741,7 +565,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
       return finish(*stop);
     }
 
-    const RobotPose read = robot.GetPosition(RobotFrame::kCamera);
+    const RobotPose read = TrueCameraPose(robot, config);
     if (!read.result.ok()) {
       return finish(
           {ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message});

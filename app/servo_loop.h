@@ -200,10 +200,5 @@ void Table3Columns(const vpHomogeneousMatrix& wMc, double* x_mm, double* y_mm, d
 /// The report as CSV: a header and one row per iteration.
 void WriteServoCsv(const ServoRunReport& report, std::ostream& out);
 
-/// The Controller-A simulator of a Scorbot configuration (robot.simulator, the arm's geometry
-/// and baud rate), its arm started at the joints of the nearest reachable pose to the
-/// configured camera start (robot.start through camera.eMc). Throws std::invalid_argument when
-/// robot.start is out of the arm's reach.
-ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config);
 
 }  // namespace oal

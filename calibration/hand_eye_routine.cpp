@@ -1,9 +1,13 @@
 #include "calibration/hand_eye_routine.h"
 
+#include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpMath.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "detector/options.h"  // RequireOption
 
@@ -22,12 +26,13 @@ bool Interrupted(const std::atomic<bool>* interrupt) {
   return interrupt != nullptr && interrupt->load(std::memory_order_relaxed);
 }
 
-// The target's pose once two successive frames agree (the arm and its camera stand still);
+// The target's pose once `frames_averaged` successive frames agree, each with the one before
+// (the arm and its camera stand still): their mean, which halves the pose's noise from four.
 // nullopt with `why` when no pose is seen or it keeps moving.
 std::optional<vpHomogeneousMatrix> StillPose(const MeasureTarget& measure,
                                              const HandEyeRoutineOptions& options,
                                              const std::atomic<bool>* interrupt, std::string* why) {
-  std::optional<vpHomogeneousMatrix> previous;
+  std::vector<vpHomogeneousMatrix> still;  // successive agreeing poses
   for (int frame = 0; frame < options.max_frames_per_station; ++frame) {
     if (Interrupted(interrupt)) {
       *why = "interrupted";
@@ -35,21 +40,66 @@ std::optional<vpHomogeneousMatrix> StillPose(const MeasureTarget& measure,
     }
     std::optional<vpHomogeneousMatrix> cMo = measure(why);
     if (!cMo) {
-      previous.reset();
+      still.clear();
       continue;
     }
-    if (previous) {
-      const PoseDistance moved = Distance(*previous, *cMo);
-      if (moved.translation_m * 1e3 <= options.still_mm &&
-          vpMath::deg(moved.rotation_rad) <= options.still_deg) {
-        return cMo;
+    if (!still.empty()) {
+      const PoseDistance moved = Distance(still.back(), *cMo);
+      if (moved.translation_m * 1e3 > options.still_mm ||
+          vpMath::deg(moved.rotation_rad) > options.still_deg) {
+        *why = "the target's pose kept changing (by " + Fixed(moved.translation_m * 1e3, 2) +
+               " mm between the last two frames): the arm or the target is not still";
+        still.clear();
       }
-      *why = "the target's pose kept changing (by " + Fixed(moved.translation_m * 1e3, 2) +
-             " mm between the last two frames): the arm or the target is not still";
     }
-    previous = cMo;
+    still.push_back(*cMo);
+    if (static_cast<int>(still.size()) == options.frames_averaged) {
+      return vpHomogeneousMatrix::mean(still);
+    }
+  }
+  if (!still.empty() && why->empty()) {
+    *why = "fewer than " + std::to_string(options.frames_averaged) + " frames showed the target";
   }
   return std::nullopt;
+}
+
+// Why the runner would refuse a move to wMe, or why the target would not be seen there
+// (`in_view` on the target's pose predicted through the guess); empty: neither. The pose the
+// arm would reach is judged, not the one asked: a 5-axis arm cannot turn freely, and what it
+// makes of a station may look elsewhere.
+std::string Refusal(SafeRobot& robot, const vpHomogeneousMatrix& wMe,
+                    const vpHomogeneousMatrix& eMc_guess, const vpHomogeneousMatrix& wMo_seen,
+                    const TargetInView& in_view) {
+  const RobotPose reach = robot.CheckMove(RobotFrame::kEndEffector, wMe);
+  if (!reach.result.ok()) return reach.result.message;
+  if (!in_view) return "";
+  return in_view((reach.pose * eMc_guess).inverse() * wMo_seen);
+}
+
+struct StationPlan {
+  vpHomogeneousMatrix wMe;  // where to send the end effector
+  std::string how;          // how it differs from the plan, for the user ("" as planned)
+  std::string refusal;      // why the station is skipped; "" when it is not
+};
+
+// The station, or when it is refused (out of the box, out of reach: an arm near a joint
+// limit, or the target out of view), the same turn the other way, then half of it either way,
+// along the screw about the target.
+StationPlan PlanStation(SafeRobot& robot, const vpHomogeneousMatrix& start,
+                        const vpHomogeneousMatrix& planned, const vpHomogeneousMatrix& eMc_guess,
+                        const vpHomogeneousMatrix& wMo_seen, const TargetInView& in_view) {
+  StationPlan plan{planned, "", Refusal(robot, planned, eMc_guess, wMo_seen, in_view)};
+  if (plan.refusal.empty()) return plan;
+  const vpColVector screw = vpExponentialMap::inverse(start.inverse() * planned);
+  const std::pair<double, const char*> alternatives[] = {{-1.0, "turned the other way"},
+                                                         {0.5, "at half the turn"},
+                                                         {-0.5, "at half the turn, the other way"}};
+  for (const auto& [fraction, how] : alternatives) {
+    const vpHomogeneousMatrix instead = start * vpExponentialMap::direct(fraction * screw);
+    if (!Refusal(robot, instead, eMc_guess, wMo_seen, in_view).empty()) continue;
+    return {instead, std::string(" ") + how + " (as planned: " + plan.refusal + ")", ""};
+  }
+  return plan;
 }
 
 // Ends the routine early: the arm stopped, the reason kept.
@@ -69,15 +119,19 @@ void HandEyeRoutineOptions::Check() const {
                 "0 < still_mm <= 100");
   RequireOption(still_deg > 0.0 && still_deg <= 10.0, "HandEyeRoutineOptions::still_deg", still_deg,
                 "0 < still_deg <= 10");
-  RequireOption(max_frames_per_station >= 2 && max_frames_per_station <= 1000,
+  RequireOption(frames_averaged >= 2 && frames_averaged <= 100,
+                "HandEyeRoutineOptions::frames_averaged", frames_averaged,
+                "2 <= frames_averaged <= 100");
+  RequireOption(max_frames_per_station >= frames_averaged && max_frames_per_station <= 1000,
                 "HandEyeRoutineOptions::max_frames_per_station", max_frames_per_station,
-                "2 <= max_frames_per_station <= 1000");
+                "frames_averaged <= max_frames_per_station <= 1000");
 }
 
 HandEyeRoutineResult RunHandEyeRoutine(SafeRobot& robot, const vpHomogeneousMatrix& eMc_guess,
                                        const MeasureTarget& measure,
                                        const HandEyeRoutineOptions& options,
                                        const std::function<void(const std::string&)>& progress,
+                                       const TargetInView& in_view,
                                        const std::atomic<bool>* interrupt) {
   options.Check();
   auto say = [&](const std::string& line) {
@@ -93,6 +147,8 @@ HandEyeRoutineResult RunHandEyeRoutine(SafeRobot& robot, const vpHomogeneousMatr
   if (!cMo_start) {
     return StopHere(robot, "no pose of the target where the arm stands: " + why, &result);
   }
+  // The target in the world as the guess places it: to predict where each station sees it.
+  const vpHomogeneousMatrix wMo_seen = start.pose * eMc_guess * *cMo_start;
   const std::vector<vpHomogeneousMatrix> planned =
       HandEyeStations(start.pose, eMc_guess, *cMo_start, options.stations);
   const int count = static_cast<int>(planned.size());
@@ -101,14 +157,16 @@ HandEyeRoutineResult RunHandEyeRoutine(SafeRobot& robot, const vpHomogeneousMatr
     station.wMe_planned = planned[k];
     const std::string name = "station " + std::to_string(k + 1) + "/" + std::to_string(count);
     if (Interrupted(interrupt)) return StopHere(robot, "interrupted at " + name, &result);
-    const RobotPose plan = robot.CheckMove(RobotFrame::kEndEffector, planned[k]);
-    if (!plan.result.ok()) {
-      station.skipped = "skipped before moving: " + plan.result.message;
+    const StationPlan plan =
+        PlanStation(robot, start.pose, planned[k], eMc_guess, wMo_seen, in_view);
+    station.wMe_planned = plan.wMe;
+    if (!plan.refusal.empty()) {
+      station.skipped = "skipped before moving: " + plan.refusal;
       say(name + ": " + station.skipped);
       result.stations.push_back(station);
       continue;
     }
-    const MoveReport move = robot.MovePosition(RobotFrame::kEndEffector, planned[k]);
+    const MoveReport move = robot.MovePosition(RobotFrame::kEndEffector, station.wMe_planned);
     if (!move.result.ok()) {
       result.stations.push_back(station);
       return StopHere(robot, name + ": the move failed: " + move.result.message, &result);
@@ -128,7 +186,7 @@ HandEyeRoutineResult RunHandEyeRoutine(SafeRobot& robot, const vpHomogeneousMatr
       result.pairs.push_back({wMe.pose, *cMo});
     }
     say(name + ": " +
-        (station.taken ? "pair " + std::to_string(result.pairs.size()) + " taken"
+        (station.taken ? "pair " + std::to_string(result.pairs.size()) + " taken" + plan.how
                        : station.skipped));
     result.stations.push_back(station);
   }

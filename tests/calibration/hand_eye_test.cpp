@@ -8,7 +8,9 @@
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -259,44 +261,65 @@ TEST(HandEyeRoutine, TakesAPairAtEveryStationAndReturnsTheArmToItsStart) {
 }
 
 TEST(HandEyeRoutine, SkipsStationsOutsideTheWorkspaceBoxBeforeMovingThere) {
-  // A box 20 cm wide: the stations pivot about the target 0.5 m away, the full tilts (15 deg)
-  // swing the flange about 13 cm, the part ones (9 deg) about 8 cm.
-  Rig rig(BoxAround(0.10));
+  // A box 10 cm wide: the stations pivot about the target 0.5 m away, the full tilts (15 deg)
+  // swing the flange about 13 cm, the part ones (9 deg) about 8 cm; half of a part tilt fits,
+  // half of a full one not.
+  Rig rig(BoxAround(0.05));
   double farthest_m = 0.0;
   const vpTranslationVector start = StartWMe().getTranslationVector();
-  MeasureTarget camera = [&](std::string* why) {
-    const vpTranslationVector at = rig.arm.wMc() * rig.scene.eMc.inverse() * vpTranslationVector();
-    (void)why;
+  MeasureTarget camera = [&](std::string*) {
+    const vpTranslationVector at = (rig.arm.wMc() * rig.scene.eMc.inverse()).getTranslationVector();
     for (unsigned int i = 0; i < 3; ++i) {
       farthest_m = std::max(farthest_m, std::fabs(at[i] - start[i]));
     }
     return std::optional<vpHomogeneousMatrix>(rig.arm.wMc().inverse() * rig.scene.wMo);
   };
+  std::vector<std::string> lines;
   const HandEyeRoutineResult result =
-      RunHandEyeRoutine(rig.robot, TrueMounting(), camera, HandEyeRoutineOptions(), nullptr);
+      RunHandEyeRoutine(rig.robot, TrueMounting(), camera, HandEyeRoutineOptions(),
+                        [&](const std::string& line) { lines.push_back(line); });
   ASSERT_TRUE(result.completed) << result.stopped;
-  int skipped = 0;
+  int skipped = 0, halved = 0;
   for (const HandEyeStation& station : result.stations) {
     if (station.taken) continue;
     ++skipped;
     EXPECT_NE(station.skipped.find("skipped before moving"), std::string::npos) << station.skipped;
+    EXPECT_NE(station.skipped.find("workspace"), std::string::npos) << station.skipped;
   }
+  for (const std::string& line : lines)
+    halved += line.find("at half the turn") != std::string::npos;
   EXPECT_GT(skipped, 0);
-  EXPECT_GT(result.pairs.size(), 0u) << "no station inside the box: the test shows nothing";
+  EXPECT_GT(halved, 0);
   EXPECT_EQ(result.pairs.size() + skipped, 12u);
-  EXPECT_LE(farthest_m, 0.10 + 1e-9);
+  EXPECT_LE(farthest_m, 0.05 + 1e-9);
   EXPECT_EQ(rig.robot.state(), SafeRobotState::kEnabled);  // skipping latches nothing
+}
+
+TEST(HandEyeRoutine, AStationWhereTheTargetWouldLeaveTheViewIsNotVisited) {
+  Rig rig(BoxAround(0.5));
+  int judged = 0;
+  const TargetInView in_view = [&](const vpHomogeneousMatrix&) {
+    ++judged;
+    return std::string("off to the side");
+  };
+  const HandEyeRoutineResult result = RunHandEyeRoutine(rig.robot, TrueMounting(), rig.Camera(),
+                                                        HandEyeRoutineOptions(), nullptr, in_view);
+  EXPECT_EQ(judged, 12 * 4);  // each station, then its three alternatives
+  EXPECT_TRUE(result.pairs.empty());
+  ASSERT_EQ(result.stations.size(), 12u);
+  EXPECT_NE(result.stations[0].skipped.find("off to the side"), std::string::npos);
+  EXPECT_EQ(rig.frames, 4);  // the start's frames only: the arm never left
 }
 
 TEST(HandEyeRoutine, AnInterruptStopsTheArmAndEndsTheRoutine) {
   Rig rig(BoxAround(0.5));
   std::atomic<bool> interrupt{false};
   MeasureTarget camera = [&](std::string*) {
-    if (++rig.frames == 7) interrupt = true;  // during the third station
+    if (++rig.frames == 11) interrupt = true;  // at the second station
     return std::optional<vpHomogeneousMatrix>(rig.arm.wMc().inverse() * rig.scene.wMo);
   };
   const HandEyeRoutineResult result = RunHandEyeRoutine(
-      rig.robot, TrueMounting(), camera, HandEyeRoutineOptions(), nullptr, &interrupt);
+      rig.robot, TrueMounting(), camera, HandEyeRoutineOptions(), nullptr, nullptr, &interrupt);
   EXPECT_FALSE(result.completed);
   EXPECT_NE(result.stopped.find("interrupted"), std::string::npos) << result.stopped;
   EXPECT_EQ(rig.robot.state(), SafeRobotState::kStopped);
@@ -319,9 +342,10 @@ TEST(HandEyeRoutine, NoTargetAtTheStartMovesNothing) {
 TEST(HandEyeRoutine, AStationWithoutATargetIsSkippedWithTheReason) {
   Rig rig(BoxAround(0.5));
   MeasureTarget camera = [&](std::string* why) -> std::optional<vpHomogeneousMatrix> {
-    // Blind while the arm is at the fourth station (frames 1-2 at the start, then 2 a station).
+    // Blind while the arm is at the fourth station (4 frames at the start and at each station,
+    // 12 at most).
     ++rig.frames;
-    if (rig.frames > 8 && rig.frames <= 8 + 10) {
+    if (rig.frames > 16 && rig.frames <= 16 + 12) {
       *why = "the target is not in view";
       return std::nullopt;
     }
