@@ -146,6 +146,21 @@ void TargetTrackerOptions::Check() const {
                 max_jump_deg, "0 <= max_jump_deg <= 180");
 }
 
+std::array<std::vector<Point2d>, 4> TargetPoseTracker::StripePoints(double tolerance_px) const {
+  std::array<std::vector<Point2d>, 4> stripes;
+  if (frame_.status != TargetStatus::kOk) return stripes;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const LineParams& line = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
+    const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
+    for (const FramePoint& point : detector_.feature_points()) {
+      if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) <= tolerance_px) {
+        stripes[k].push_back(point.p);
+      }
+    }
+  }
+  return stripes;
+}
+
 LensCheck CheckLens(std::vector<double> straightness_px, double threshold_px, int min_frames) {
   LensCheck check;
   check.frames = static_cast<int>(straightness_px.size());

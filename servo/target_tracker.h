@@ -28,6 +28,7 @@
 #include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -143,6 +144,10 @@ class TargetPoseTracker {
   const TargetFrame& Track(const GrayImageView& image,
                            const std::optional<vpHomogeneousMatrix>& predicted_cMo = std::nullopt);
 
+  /// The feature points within `tolerance_px` of lines 1-4 of the last frame, when it has a
+  /// pose (else empty), in the detector's pixels (undistorted when it undistorts): the points
+  /// of four straight stripes, to tell a lens by (calibration/plumb_line.h).
+  std::array<std::vector<Point2d>, 4> StripePoints(double tolerance_px) const;
   /// The lines of the last scan that gave the frame's pose (or of the last scan), best first.
   const std::vector<DetectedLine>& lines() const { return lines_; }
   const OalDetector& detector() const { return detector_; }
