@@ -5,8 +5,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
+#include "app/lens_estimate.h"
 #include "detector/lens.h"
 
 namespace oal {
@@ -76,17 +78,67 @@ void PoseAccuracyOptions::Check() const {
   IdentifyTargetLines({}, target, check);  // throws unless the target is a '#'
 }
 
+namespace {
+
+// Frames told apart from the evaluated ones: the lens is estimated on poses of its own.
+constexpr int kLensFrames = 10;
+constexpr int kMaxLensFramesRendered = 100;
+constexpr std::uint64_t kLensSeedOffset = 0x9e3779b97f4a7c15ULL;
+
+// The camera with the kdu the stripes tell, from up to kMaxLensFramesRendered frames tracked
+// by a pinhole camera; the pinhole camera itself, with report->estimate_failed saying why,
+// when they cannot tell it.
+vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
+                                   const PoseAccuracyOptions& options, PoseAccuracyReport* report) {
+  const vpCameraParameters lens = scenes.For(0).options().camera;
+  vpCameraParameters pinhole;
+  pinhole.initPersProjWithoutDistortion(lens.get_px(), lens.get_py(), lens.get_u0(), lens.get_v0());
+  TargetPoseTracker tracker(options.target, pinhole, options.detector, options.pose,
+                            options.tracking);
+  StripeCollector stripes;
+  std::uint64_t state = options.seed + kLensSeedOffset;
+  for (int frame = 0; frame < kMaxLensFramesRendered && stripes.frames() < kLensFrames; ++frame) {
+    const SceneRenderer& renderer = scenes.For(frame);
+    const RenderedFrame rendered =
+        renderer.Render(SamplePose(renderer, options.sampling, &state),
+                        state + static_cast<std::uint64_t>(frame), scenes.EffectsFor(frame));
+    tracker.Reset();
+    tracker.Track(ViewOf(rendered.image));
+    stripes.Add(tracker);
+  }
+  report->estimated_kdu = std::numeric_limits<double>::quiet_NaN();
+  if (stripes.frames() < kLensFrames) {
+    report->estimate_failed = std::to_string(stripes.frames()) + " of " +
+                              std::to_string(kMaxLensFramesRendered) + " frames showed the target";
+    return pinhole;
+  }
+  try {
+    const PlumbLineResult result = stripes.Estimate(pinhole);
+    report->estimated_kdu = result.kdu;
+    report->estimated_kdu_sd = result.kdu_sd;
+  } catch (const std::runtime_error& error) {
+    report->estimate_failed = error.what();
+    return pinhole;
+  }
+  return CameraWithKdu(lens.get_px(), lens.get_py(), lens.get_u0(), lens.get_v0(),
+                       report->estimated_kdu, options.width, options.height);
+}
+
+}  // namespace
+
 PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
                                         const std::function<void(int, int)>& progress) {
   options.Check();
   const EvaluationScenes scenes(options.target, options);
-  const vpCameraParameters camera = scenes.For(0).options().camera;
+  PoseAccuracyReport report;
+  const vpCameraParameters camera = options.estimate_distortion
+                                        ? EstimatedCamera(scenes, options, &report)
+                                        : scenes.For(0).options().camera;
   TargetPoseTracker tracker(options.target, camera, options.detector, options.pose,
                             options.tracking);
   const PointUndistorter undistorter(camera);
   const bool undistorted = tracker.detector().Undistorts();
 
-  PoseAccuracyReport report;
   report.options = options;
   // Every status, so that the report's keys do not depend on what happened.
   for (const TargetStatus status : {TargetStatus::kOk, TargetStatus::kNotFound,

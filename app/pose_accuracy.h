@@ -34,6 +34,10 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
   /// A target line is found when one of the frame's lines is within both of its truth.
   double line_angle_deg = 1.0;
   double line_offset_px = 2.0;
+  /// The tracker is not told the lens: kdu is estimated from the target's stripes in the first
+  /// 10 frames (of poses drawn apart from the evaluated ones) a pinhole tracker finds it in,
+  /// then used for every frame (app/lens_estimate.h).
+  bool estimate_distortion = false;
 
   /// The paper's board (issue 4's evaluation): 0.3-1.0 m, tilt up to 40 deg, any roll, every
   /// line crossing 150 px of the image.
@@ -57,6 +61,10 @@ struct PoseAccuracyReport {
   int lines_found = 0;  ///< frames whose four target lines were all found (line_ bounds)
   std::vector<double> find_time_us, detect_time_us, pose_time_us, total_time_us;
   std::vector<int> failed_frames;  ///< frames without a pose
+  /// With estimate_distortion: the kdu told from the stripes (NaN when it could not be), its
+  /// standard deviation, and why not.
+  double estimated_kdu = 0.0, estimated_kdu_sd = 0.0;
+  std::string estimate_failed;
 
   int posed() const;
 };

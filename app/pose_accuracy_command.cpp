@@ -17,6 +17,12 @@
 namespace oal {
 namespace {
 
+std::string Fixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
 std::string Table(const PoseAccuracyReport& r) {
   std::ostringstream out;
   const auto count = [](const std::map<std::string, int>& counts, const std::string& key) {
@@ -52,6 +58,14 @@ std::string Table(const PoseAccuracyReport& r) {
       << "| roll error median / max (deg) | " << Quantile(r.roll_error_deg, 0.5) << " / "
       << Quantile(r.roll_error_deg, 1.0) << " |\n"
       << "| frames with roll off by > 45 deg | " << r.roll_flips << " |\n";
+  if (r.options.estimate_distortion) {
+    out << "| kdu told from the stripes of 10 frames | "
+        << (r.estimate_failed.empty()
+                ? Fixed(r.estimated_kdu, 4) + " +- " + Fixed(r.estimated_kdu_sd, 4) + " (truth " +
+                      Fixed(r.options.kdu, 4) + ")"
+                : "none: " + r.estimate_failed + "; poses without distortion")
+        << " |\n";
+  }
   std::string sources;
   for (const auto& [source, n] : r.source_counts) {
     sources += (sources.empty() ? "" : ", ") + source + " " + std::to_string(n);
@@ -97,7 +111,10 @@ nlohmann::json ToJson(const PoseAccuracyReport& r, const std::string& config_pat
           {"find_time_us_median", Quantile(r.find_time_us, 0.5)},
           {"detect_time_us_median", Quantile(r.detect_time_us, 0.5)},
           {"pose_time_us_median", Quantile(r.pose_time_us, 0.5)},
-          {"frames_without_pose", r.failed_frames}};
+          {"frames_without_pose", r.failed_frames},
+          {"estimated_kdu", o.estimate_distortion && r.estimate_failed.empty()
+                                ? nlohmann::json(r.estimated_kdu)
+                                : nlohmann::json()}};
 }
 
 // The evaluation conditions a target is made for, where the command line leaves them open:
@@ -158,6 +175,9 @@ int RunPoseAccuracy(int argc, char** argv) {
                  "sections; another section is an error")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
+  cli.add_flag("--estimate-distortion", options.estimate_distortion,
+               "do not tell the tracker the lens: estimate kdu from the target's stripes in 10 "
+               "frames of other poses, then use it");
   cli.footer(
       "Examples:\n"
       "  oalservo pose-accuracy --frames 1000 --seed 1 --out out/pose-a3.json\n"

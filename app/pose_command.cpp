@@ -4,7 +4,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <opencv2/imgproc.hpp>
@@ -20,6 +22,7 @@
 #include "app/frame_command.h"
 #include "app/image_source.h"
 #include "app/json_io.h"
+#include "app/lens_estimate.h"
 #include "detector/detector.h"
 #include "scene/scene.h"
 #include "servo/pose.h"
@@ -124,41 +127,138 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFram
   };
 }
 
+// The frames of the inputs in order, each saying whether it begins a new input; frames held
+// back (read ahead to tell the lens) come first.
+class FrameFeed {
+ public:
+  explicit FrameFeed(std::vector<std::unique_ptr<ImageSource>>* sources) : sources_(*sources) {}
+
+  bool Next(Frame* frame, bool* new_input) {
+    if (!held_.empty()) {
+      *frame = std::move(held_.front().frame);
+      *new_input = held_.front().input != replayed_input_;
+      replayed_input_ = held_.front().input;
+      held_.pop_front();
+      return true;
+    }
+    while (input_ < sources_.size()) {
+      if (sources_[input_]->Next(frame)) {
+        *new_input = input_ != replayed_input_;
+        replayed_input_ = input_;
+        return true;
+      }
+      ++input_;
+    }
+    return false;
+  }
+  /// Reads a frame ahead and holds a copy of it for Next(); false at the end.
+  bool ReadAhead(Frame* frame) {
+    while (input_ < sources_.size()) {
+      if (sources_[input_]->Next(frame)) {
+        held_.push_back({Frame{frame->gray.clone(), frame->source}, input_});
+        return true;
+      }
+      ++input_;
+    }
+    return false;
+  }
+
+ private:
+  struct Held {
+    Frame frame;
+    std::size_t input;
+  };
+  std::vector<std::unique_ptr<ImageSource>>& sources_;
+  std::deque<Held> held_;
+  std::size_t input_ = 0;
+  std::size_t replayed_input_ = static_cast<std::size_t>(-1);
+};
+
+// Frames read ahead at most while looking for the frames with a pose that tell the lens.
+constexpr int kMaxLensFramesRead = 100;
+
+// Reads frames ahead until `frames` of them show the target, estimates kdu from their stripes
+// and, when it succeeds, gives the tracker the camera with it. Says what it did in `summary`.
+void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* run,
+                  PoseSummary* summary) {
+  const vpCameraParameters& pinhole = run->camera.camera;
+  StripeCollector stripes;
+  int read = 0;
+  Frame frame;
+  while (stripes.frames() < options.estimate_frames && read < kMaxLensFramesRead &&
+         (options.max_frames == 0 || read < options.max_frames) && feed->ReadAhead(&frame)) {
+    ++read;
+    run->tracker.Reset();
+    run->tracker.Track(frame.view());
+    stripes.Add(run->tracker);
+  }
+  run->tracker.Reset();
+  std::ostringstream said;
+  said.precision(4);
+  said << std::fixed;
+  if (stripes.frames() < options.estimate_frames) {
+    said << "--estimate-distortion: " << stripes.frames() << " of the first " << read
+         << " frames show the target, " << options.estimate_frames
+         << " needed to tell the lens: the poses are without distortion";
+    summary->warnings.push_back(said.str());
+    return;
+  }
+  PlumbLineResult lens;
+  try {
+    lens = stripes.Estimate(pinhole);
+  } catch (const std::runtime_error& error) {
+    summary->warnings.push_back(std::string("--estimate-distortion: ") + error.what() +
+                                ": the poses are without distortion");
+    return;
+  }
+  summary->estimated_kdu = lens.kdu;
+  run->camera.camera = CameraWithKdu(pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
+                                     pinhole.get_v0(), lens.kdu, frame.gray.cols, frame.gray.rows);
+  run->tracker = TargetPoseTracker(run->config.target, run->camera.camera, run->config.detector,
+                                   run->config.pose, run->config.tracking);
+  run->undistorted_by = run->camera.camera;
+  said << "kdu " << lens.kdu << " +- " << lens.kdu_sd << " from the stripes of " << stripes.frames()
+       << " frames (they bend " << std::setprecision(2) << lens.rms_before_px
+       << " px RMS from straight, " << lens.rms_after_px << " px corrected); every pose uses it";
+  summary->notes.push_back(said.str());
+}
+
 // Runs the detector and the pose over every frame, writing to `sink`; returns when the
 // sources end or max_frames is reached.
 void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream& sink,
                    bool flush_each, PoseSummary* summary) {
+  FrameFeed feed(&run->sources);
+  if (options.estimate_distortion) EstimateLens(options, &feed, run, summary);
   const bool undistorted = run->tracker.detector().Undistorts();
   Frame frame;
-  for (auto& source : run->sources) {
-    run->tracker.Reset();  // a sequence is one source
-    while (options.max_frames == 0 || summary->frames < options.max_frames) {
-      if (!source->Next(&frame)) break;
-      if (summary->frames == 0) {
-        if (auto warning =
-                CameraSizeMismatch(run->camera, frame.gray.cols, frame.gray.rows, frame.source)) {
-          summary->warnings.push_back(*warning + ": the poses will be wrong");
-        }
+  bool new_input = false;
+  while ((options.max_frames == 0 || summary->frames < options.max_frames) &&
+         feed.Next(&frame, &new_input)) {
+    if (new_input) run->tracker.Reset();  // a sequence is one input
+    if (summary->frames == 0) {
+      if (auto warning =
+              CameraSizeMismatch(run->camera, frame.gray.cols, frame.gray.rows, frame.source)) {
+        summary->warnings.push_back(*warning + ": the poses will be wrong");
       }
-      if (options.independent) run->tracker.Reset();
-      const TargetFrame& result = run->tracker.Track(frame.view());
-      WriteJsonLine(
-          sink, FrameJson(summary->frames, frame, undistorted, result, run->tracker.options().scan),
-          flush_each);
-      if (!options.annotate_dir.empty()) {
-        // A refused pose is not drawn as one: the lines and the region alone.
-        PoseResult drawn = result.pose;
-        if (result.status != TargetStatus::kOk) drawn.status = PoseStatus::kDegenerate;
-        WritePng(AnnotationPath(options, "pose", summary->frames),
-                 AnnotatePose(frame.gray, run->tracker.lines(), drawn, run->camera.camera,
-                              run->undistorted_by, result.region));
-      }
-      if (result.status == TargetStatus::kOk) {
-        ++summary->ok;
-        summary->straightness_px.push_back(result.straightness_px);
-      }
-      ++summary->frames;
     }
+    if (options.independent) run->tracker.Reset();
+    const TargetFrame& result = run->tracker.Track(frame.view());
+    WriteJsonLine(
+        sink, FrameJson(summary->frames, frame, undistorted, result, run->tracker.options().scan),
+        flush_each);
+    if (!options.annotate_dir.empty()) {
+      // A refused pose is not drawn as one: the lines and the region alone.
+      PoseResult drawn = result.pose;
+      if (result.status != TargetStatus::kOk) drawn.status = PoseStatus::kDegenerate;
+      WritePng(AnnotationPath(options, "pose", summary->frames),
+               AnnotatePose(frame.gray, run->tracker.lines(), drawn, run->camera.camera,
+                            run->undistorted_by, result.region));
+    }
+    if (result.status == TargetStatus::kOk) {
+      ++summary->ok;
+      summary->straightness_px.push_back(result.straightness_px);
+    }
+    ++summary->frames;
   }
 }
 
@@ -166,6 +266,10 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
 
 void PoseCommandOptions::Check() const {
   CheckFrameCommand(inputs, max_frames, out_path);
+  if (estimate_frames < 1 || estimate_frames > 100) {
+    throw std::invalid_argument("--estimate-frames = " + std::to_string(estimate_frames) +
+                                ": give 1 to 100 frames");
+  }
 }
 
 PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) {
@@ -174,6 +278,13 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   AppConfig config = LoadPoseConfig(options, &summary);
   summary.camera_path = FindCameraPath(options, &summary);
   CameraFile camera = LoadCameraFile(summary.camera_path, options.camera_name);
+  if (options.estimate_distortion &&
+      camera.camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
+    throw std::invalid_argument("--estimate-distortion is for a camera file without distortion; '" +
+                                summary.camera_path + "' has kdu " +
+                                std::to_string(camera.camera.get_kdu()) +
+                                ": remove the flag, or give the camera without it");
+  }
   // The target and the options with the camera, before any frame: a bad one fails here.
   TargetPoseTracker tracker(config.target, camera.camera, config.detector, config.pose,
                             config.tracking);
@@ -221,6 +332,13 @@ int RunPose(int argc, char** argv) {
                "estimate each frame on its own (a rendered data set of random poses); by default "
                "the frames of one input are a sequence, the target followed from one to the next "
                "and a pose that jumps away from the last one held until the next frame agrees");
+  cli.add_flag("--estimate-distortion", options.estimate_distortion,
+               "the camera file has no distortion: tell the lens (ViSP's kdu) from the target's "
+               "stripes, which must be straight, in the first frames that show it, then use it "
+               "for every frame");
+  cli.add_option("--estimate-frames", options.estimate_frames,
+                 "frames with the target that --estimate-distortion reads ahead")
+      ->capture_default_str();
   AddOutputOptions(cli, &options,
                    "directory for one PNG per frame with lines 1-4 and the target's axes drawn "
                    "(created if missing)");
@@ -232,6 +350,7 @@ int RunPose(int argc, char** argv) {
       "  oalservo pose /dev/video0 --camera camera.xml --max-frames 100");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   const PoseSummary summary = EstimatePoses(options, std::cout);
+  for (const std::string& note : summary.notes) std::cerr << "oalservo pose: " << note << '\n';
   for (const std::string& warning : summary.warnings) Warn("pose", warning);
   if (!options.out_path.empty()) {
     std::cerr << "oalservo pose: " << summary.frames << " frames, " << summary.ok

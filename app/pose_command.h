@@ -34,6 +34,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,11 @@ struct PoseCommandOptions : FrameCommandOptions {
   /// Each frame on its own (e.g. a rendered data set of random poses); false: the frames of
   /// one input are a sequence, the target followed from one to the next.
   bool independent = false;
+  /// The camera file has no distortion: kdu is estimated from the target's stripes in the
+  /// first `estimate_frames` frames with a pose (read ahead and then processed as all others,
+  /// calibration/plumb_line.h) and used for every frame.
+  bool estimate_distortion = false;
+  int estimate_frames = 10;  ///< Range [1, 100].
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;
@@ -66,6 +72,10 @@ struct PoseSummary {
   /// For the user (camera found automatically, skipped files, camera size mismatch, a camera
   /// file whose lens model leaves the stripes bent).
   std::vector<std::string> warnings;
+  /// What was done for the user (the lens estimated).
+  std::vector<std::string> notes;
+  /// kdu told from the stripes (--estimate-distortion), when it was.
+  std::optional<double> estimated_kdu;
   /// TargetFrame::straightness_px of the frames with a pose, in order.
   std::vector<double> straightness_px;
 };
