@@ -18,9 +18,20 @@ void StripeCollector::Add(const TargetPoseTracker& tracker) {
   ++frames_;
 }
 
-PlumbLineResult StripeCollector::Estimate(const vpCameraParameters& pinhole) const {
-  return EstimateKdu(stripes_, pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
-                     pinhole.get_v0());
+PlumbLineResult StripeCollector::Estimate(const vpCameraParameters& pinhole, int width,
+                                          int height) const {
+  PlumbLineOptions options;
+  options.width = width;
+  options.height = height;
+  return EstimateRadialDistortion(stripes_, pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
+                                  pinhole.get_v0(), options);
+}
+
+vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens) {
+  vpCameraParameters camera;
+  camera.initPersProjWithDistortion(pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
+                                    pinhole.get_v0(), lens.kud, lens.kdu);
+  return camera;
 }
 
 }  // namespace oal

@@ -19,13 +19,16 @@ class StripeCollector {
   void Add(const TargetPoseTracker& tracker);
   /// Frames added with a pose.
   int frames() const { return frames_; }
-  /// kdu from the stripes collected, through `pinhole`'s px, py, u0, v0. Throws
-  /// std::runtime_error saying why when they cannot tell it.
-  PlumbLineResult Estimate(const vpCameraParameters& pinhole) const;
+  /// kud and kdu from the stripes collected, through `pinhole`'s px, py, u0, v0, in a width x
+  /// height image. Throws std::runtime_error saying why when they cannot tell the lens.
+  PlumbLineResult Estimate(const vpCameraParameters& pinhole, int width, int height) const;
 
  private:
   std::vector<std::vector<Point2d>> stripes_;
   int frames_ = 0;
 };
+
+/// `pinhole` with the estimated lens (kud and kdu).
+vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens);
 
 }  // namespace oal

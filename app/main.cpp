@@ -11,7 +11,6 @@
 #include <string>
 
 #include "app/calibrate_command.h"
-#include "app/hand_eye_command.h"
 #include "app/command_line.h"
 #include "app/compare_command.h"
 #include "app/demo_command.h"
@@ -19,6 +18,7 @@
 #include "app/detector_accuracy_command.h"
 #include "app/edge_reference_command.h"
 #include "app/evaluate_command.h"
+#include "app/hand_eye_command.h"
 #include "app/pose_accuracy_command.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"

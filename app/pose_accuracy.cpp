@@ -113,15 +113,15 @@ vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
     return pinhole;
   }
   try {
-    const PlumbLineResult result = stripes.Estimate(pinhole);
+    const PlumbLineResult result = stripes.Estimate(pinhole, options.width, options.height);
     report->estimated_kdu = result.kdu;
-    report->estimated_kdu_sd = result.kdu_sd;
+    report->estimated_kud = result.kud;
+    report->estimated_kud_sd = result.kud_sd;
+    return WithLens(pinhole, result);
   } catch (const std::runtime_error& error) {
     report->estimate_failed = error.what();
     return pinhole;
   }
-  return CameraWithKdu(lens.get_px(), lens.get_py(), lens.get_u0(), lens.get_v0(),
-                       report->estimated_kdu, options.width, options.height);
 }
 
 }  // namespace

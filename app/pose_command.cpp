@@ -181,7 +181,7 @@ constexpr int kMaxLensFramesRead = 100;
 // and, when it succeeds, gives the tracker the camera with it. Says what it did in `summary`.
 void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* run,
                   PoseSummary* summary) {
-  const vpCameraParameters& pinhole = run->camera.camera;
+  const vpCameraParameters pinhole = run->camera.camera;
   StripeCollector stripes;
   int read = 0;
   Frame frame;
@@ -205,21 +205,21 @@ void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* r
   }
   PlumbLineResult lens;
   try {
-    lens = stripes.Estimate(pinhole);
+    lens = stripes.Estimate(pinhole, frame.gray.cols, frame.gray.rows);
   } catch (const std::runtime_error& error) {
     summary->warnings.push_back(std::string("--estimate-distortion: ") + error.what() +
                                 ": the poses are without distortion");
     return;
   }
   summary->estimated_kdu = lens.kdu;
-  run->camera.camera = CameraWithKdu(pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
-                                     pinhole.get_v0(), lens.kdu, frame.gray.cols, frame.gray.rows);
+  run->camera.camera = WithLens(pinhole, lens);
   run->tracker = TargetPoseTracker(run->config.target, run->camera.camera, run->config.detector,
                                    run->config.pose, run->config.tracking);
   run->undistorted_by = run->camera.camera;
-  said << "kdu " << lens.kdu << " +- " << lens.kdu_sd << " from the stripes of " << stripes.frames()
-       << " frames (they bend " << std::setprecision(2) << lens.rms_before_px
-       << " px RMS from straight, " << lens.rms_after_px << " px corrected); every pose uses it";
+  said << "kdu " << lens.kdu << ", kud " << lens.kud << " +- " << lens.kud_sd
+       << " from the stripes of " << stripes.frames() << " frames (they bend "
+       << std::setprecision(2) << lens.rms_before_px << " px RMS from straight, "
+       << lens.rms_after_px << " px corrected); every pose uses it";
   summary->notes.push_back(said.str());
 }
 

@@ -200,5 +200,4 @@ void Table3Columns(const vpHomogeneousMatrix& wMc, double* x_mm, double* y_mm, d
 /// The report as CSV: a header and one row per iteration.
 void WriteServoCsv(const ServoRunReport& report, std::ostream& out);
 
-
 }  // namespace oal

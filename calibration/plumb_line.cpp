@@ -5,15 +5,36 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "detector/options.h"  // RequireOption
+#include "calibration/calibrate.h"  // FitViSPDistortion
+#include "detector/options.h"       // RequireOption
 
 namespace oal {
 namespace {
 
-// A point in normalised coordinates with its squared radius: undistorted, it is p (1 + k r2).
+// A point in distorted normalised coordinates.
 struct Normalised {
-  double x = 0.0, y = 0.0, r2 = 0.0;
+  double x = 0.0, y = 0.0;
 };
+
+// The ideal point of a distorted one under x_d = x_u (1 + kud r_u^2), and the derivative of
+// the ideal point along itself with respect to kud: d x_u / d kud = slope * x_u.
+struct Ideal {
+  double x = 0.0, y = 0.0, slope = 0.0;
+};
+
+Ideal Undistort(const Normalised& p, double kud) {
+  double xu = p.x, yu = p.y;
+  for (int i = 0; i < 50; ++i) {
+    const double factor = 1.0 + kud * (xu * xu + yu * yu);
+    const double next_x = p.x / factor, next_y = p.y / factor;
+    const bool settled = std::fabs(next_x - xu) + std::fabs(next_y - yu) < 1e-15;
+    xu = next_x, yu = next_y;
+    if (settled) break;
+  }
+  const double s = xu * xu + yu * yu;
+  // From x_d = x_u (1 + k s): 0 = x_u' (1 + k s) + x_u (s + 2 k x_u . x_u'), x_u' radial.
+  return {xu, yu, -s / (1.0 + 3.0 * kud * s)};
+}
 
 struct Line {
   std::vector<Normalised> points;
@@ -21,89 +42,78 @@ struct Line {
   double nx = 0.0, ny = 0.0, c = 0.0;  // n . p_u = c, |n| = 1
 };
 
-// Total least squares on the inliers undistorted by k: the centroid and the direction of
-// least spread.
-void FitLine(double k, Line* line) {
-  double sx = 0, sy = 0, n = 0;
+// Total least squares on the inliers' ideal points: the centroid and the direction of least
+// spread.
+void FitLine(double kud, Line* line) {
+  std::vector<Ideal> ideal;
+  double sx = 0, sy = 0;
   for (std::size_t i = 0; i < line->points.size(); ++i) {
     if (!line->inlier[i]) continue;
-    const Normalised& p = line->points[i];
-    sx += p.x * (1 + k * p.r2), sy += p.y * (1 + k * p.r2), n += 1;
+    ideal.push_back(Undistort(line->points[i], kud));
+    sx += ideal.back().x, sy += ideal.back().y;
   }
-  const double mx = sx / n, my = sy / n;
+  const double mx = sx / ideal.size(), my = sy / ideal.size();
   double sxx = 0, sxy = 0, syy = 0;
-  for (std::size_t i = 0; i < line->points.size(); ++i) {
-    if (!line->inlier[i]) continue;
-    const Normalised& p = line->points[i];
-    const double dx = p.x * (1 + k * p.r2) - mx, dy = p.y * (1 + k * p.r2) - my;
+  for (const Ideal& p : ideal) {
+    const double dx = p.x - mx, dy = p.y - my;
     sxx += dx * dx, sxy += dx * dy, syy += dy * dy;
   }
-  // The normal is the eigenvector of the smaller eigenvalue of [[sxx, sxy], [sxy, syy]].
   const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);  // direction of the line
   line->nx = -std::sin(angle);
   line->ny = std::cos(angle);
   line->c = line->nx * mx + line->ny * my;
 }
 
-double Residual(const Line& line, const Normalised& p, double k) {
-  return line.nx * p.x * (1 + k * p.r2) + line.ny * p.y * (1 + k * p.r2) - line.c;
+double Residual(const Line& line, const Normalised& p, double kud) {
+  const Ideal u = Undistort(p, kud);
+  return line.nx * u.x + line.ny * u.y - line.c;
 }
 
 // Points further from their line than four robust standard deviations (and than `floor`,
 // normalised) are left out; the others are taken back.
-void CutOutliers(double k, double floor, std::vector<Line>* lines) {
+void CutOutliers(double kud, double floor, std::vector<Line>* lines) {
   std::vector<double> magnitudes;
   for (const Line& line : *lines) {
-    for (const Normalised& p : line.points) magnitudes.push_back(std::fabs(Residual(line, p, k)));
+    for (const Normalised& p : line.points) magnitudes.push_back(std::fabs(Residual(line, p, kud)));
   }
   const auto middle = magnitudes.begin() + magnitudes.size() / 2;
   std::nth_element(magnitudes.begin(), middle, magnitudes.end());
   const double limit = std::max(floor, 4.0 * 1.4826 * *middle);
   for (Line& line : *lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
-      line.inlier[i] = std::fabs(Residual(line, line.points[i], k)) <= limit;
+      line.inlier[i] = std::fabs(Residual(line, line.points[i], kud)) <= limit;
     }
   }
 }
 
-struct KSolution {
-  double k = 0.0, information = 0.0, rss = 0.0;
+struct KudStep {
+  double kud = 0.0, information = 0.0, rss = 0.0;
   int used = 0;
 };
 
-// With the lines fixed, e_i = a_i + k b_i: least squares in k.
-KSolution SolveK(const std::vector<Line>& lines) {
-  double ab = 0, bb = 0;
+// With the lines fixed, one Gauss-Newton step in kud: e_i + J_i dk = 0 in least squares.
+KudStep StepKud(const std::vector<Line>& lines, double kud) {
+  double ej = 0, jj = 0, ee = 0;
+  int used = 0;
   for (const Line& line : lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
       if (!line.inlier[i]) continue;
-      const Normalised& p = line.points[i];
-      const double along_normal = line.nx * p.x + line.ny * p.y;
-      const double a = along_normal - line.c, b = along_normal * p.r2;
-      ab += a * b, bb += b * b;
+      const Ideal u = Undistort(line.points[i], kud);
+      const double along_normal = line.nx * u.x + line.ny * u.y;
+      const double e = along_normal - line.c, j = along_normal * u.slope;
+      ej += e * j, jj += j * j, ee += e * e, ++used;
     }
   }
-  KSolution solution;
-  solution.information = bb;
-  solution.k = bb > 0 ? -ab / bb : 0.0;
-  for (const Line& line : lines) {
-    for (std::size_t i = 0; i < line.points.size(); ++i) {
-      if (!line.inlier[i]) continue;
-      const double e = Residual(line, line.points[i], solution.k);
-      solution.rss += e * e;
-      ++solution.used;
-    }
-  }
-  return solution;
+  return {jj > 0 ? kud - ej / jj : kud, jj, ee, used};
 }
 
-double RmsPx(const std::vector<Line>& lines, double k, double scale_px) {
+double RmsPx(const std::vector<Line>& lines, double kud, double scale_px) {
   double sum = 0;
   int n = 0;
   for (const Line& line : lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
       if (!line.inlier[i]) continue;
-      const double e = Residual(line, line.points[i], k) * scale_px;
+      const double e = Residual(line, line.points[i], kud) * scale_px;
       sum += e * e, ++n;
     }
   }
@@ -125,19 +135,21 @@ void PlumbLineOptions::Check() const {
   RequireOption(min_points_per_line >= 3 && min_points_per_line <= 1000000,
                 "PlumbLineOptions::min_points_per_line", min_points_per_line,
                 "3 <= min_points_per_line <= 1000000");
-  RequireOption(kdu_min < kdu_max, "PlumbLineOptions::kdu_min", kdu_min, "kdu_min < kdu_max");
+  RequireOption(kud_min < kud_max, "PlumbLineOptions::kud_min", kud_min, "kud_min < kud_max");
+  RequireOption(width > 0 && height > 0, "PlumbLineOptions::width", width,
+                "width > 0 and height > 0");
 }
 
-PlumbLineResult EstimateKdu(const std::vector<std::vector<Point2d>>& pixels, double px, double py,
-                            double u0, double v0, const PlumbLineOptions& options) {
+PlumbLineResult EstimateRadialDistortion(const std::vector<std::vector<Point2d>>& pixels, double px,
+                                         double py, double u0, double v0,
+                                         const PlumbLineOptions& options) {
   options.Check();
   std::vector<Line> lines;
   for (const std::vector<Point2d>& points : pixels) {
     if (static_cast<int>(points.size()) < options.min_points_per_line) continue;
     Line line;
     for (const Point2d& p : points) {
-      const double x = (p.u - u0) / px, y = (p.v - v0) / py;
-      line.points.push_back({x, y, x * x + y * y});
+      line.points.push_back({(p.u - u0) / px, (p.v - v0) / py});
     }
     line.inlier.assign(line.points.size(), true);
     lines.push_back(std::move(line));
@@ -153,34 +165,38 @@ PlumbLineResult EstimateKdu(const std::vector<std::vector<Point2d>>& pixels, dou
   for (Line& line : lines) FitLine(0.0, &line);
   result.rms_before_px = RmsPx(lines, 0.0, scale_px);
 
-  // Settle kdu on all points, cut the points far from their lines, settle again: three times,
-  // so that a first kdu still far off does not cut the ends of the bent lines themselves.
-  KSolution solution;
+  // Settle kud on all points, cut the points far from their lines, settle again: three times,
+  // so that a first kud still far off does not cut the ends of the bent lines themselves.
+  KudStep step;
   for (int round = 0; round < 4; ++round) {
-    if (round > 0) CutOutliers(solution.k, 0.5 / scale_px, &lines);
+    if (round > 0) CutOutliers(step.kud, 0.5 / scale_px, &lines);
     for (int iteration = 0; iteration < 1000; ++iteration) {
-      for (Line& line : lines) FitLine(solution.k, &line);
-      const double before = solution.k;
-      solution = SolveK(lines);
-      if (iteration > 0 && std::fabs(solution.k - before) < 1e-12) break;
+      for (Line& line : lines) FitLine(step.kud, &line);
+      const double before = step.kud;
+      step = StepKud(lines, step.kud);
+      if (iteration > 0 && std::fabs(step.kud - before) < 1e-12) break;
     }
   }
-  // How far kdu is pinned: 1/sqrt(information) in units of the residuals' spread.
-  const double sigma2 = solution.used > 1 ? solution.rss / (solution.used - 1) : 0.0;
-  result.kdu_sd = solution.information > 0 ? std::sqrt(sigma2 / solution.information) : HUGE_VAL;
-  if (!(solution.information > 0) || !(result.kdu_sd < 0.05)) {
+  // How far kud is pinned: the residuals' spread through the step's information.
+  const double sigma2 = step.used > 1 ? step.rss / (step.used - 1) : 0.0;
+  result.kud_sd = step.information > 0 ? std::sqrt(sigma2 / step.information) : HUGE_VAL;
+  if (!(step.information > 0) || !(result.kud_sd < 0.05)) {
     throw std::runtime_error(
-        "the lines pass too near the image's centre to show the lens (kdu +- " +
-        Number(result.kdu_sd) + "): view the target off-centre, its stripes reaching the edges");
+        "the lines pass too near the image's centre to show the lens (kud +- " +
+        Number(result.kud_sd) + "): view the target off-centre, its stripes reaching the edges");
   }
-  if (solution.k < options.kdu_min || solution.k > options.kdu_max) {
-    throw std::runtime_error("kdu came out at " + Number(solution.k) + ", outside [" +
-                             Number(options.kdu_min) + ", " + Number(options.kdu_max) +
+  if (step.kud < options.kud_min || step.kud > options.kud_max) {
+    throw std::runtime_error("kud came out at " + Number(step.kud) + ", outside [" +
+                             Number(options.kud_min) + ", " + Number(options.kud_max) +
                              "]: the points are not of straight lines through this camera");
   }
-  result.kdu = solution.k;
-  result.points = solution.used;
-  result.rms_after_px = RmsPx(lines, solution.k, scale_px);
+  result.kud = step.kud;
+  result.points = step.used;
+  result.rms_after_px = RmsPx(lines, step.kud, scale_px);
+  // ViSP's other direction: the kdu that best undoes kud over the image.
+  result.kdu = FitViSPDistortion(RadialDistortion{step.kud, 0.0, 0.0}, px, py, u0, v0,
+                                 options.width, options.height)
+                   .kdu;
   return result;
 }
 

@@ -1,5 +1,5 @@
-// kdu from straight lines (calibration/plumb_line.h): exactly from lines bent by ViSP's own
-// model, within a few per cent from the A3 sheet's stripes in rendered bench frames seen
+// The lens from straight lines (calibration/plumb_line.h): exactly from lines bent by ViSP's
+// own model, within a few per cent from the A3 sheet's stripes in rendered bench frames seen
 // through a lens the camera knows nothing of; lines that cannot tell refused with the reason.
 #include "calibration/plumb_line.h"
 
@@ -23,14 +23,10 @@ namespace {
 
 constexpr double kPx = 600.0, kU0 = 319.5, kV0 = 239.5;
 
-// The distorted pixel whose ViSP undistortion x_d (1 + kdu r_d^2) is the ideal point (x, y).
-Point2d Distort(double x, double y, double kdu) {
-  double xd = x, yd = y;
-  for (int i = 0; i < 200; ++i) {
-    const double factor = 1.0 + kdu * (xd * xd + yd * yd);
-    xd = x / factor, yd = y / factor;
-  }
-  return {kU0 + kPx * xd, kV0 + kPx * yd};
+// The pixel where ViSP's lens x_d = x_u (1 + kud r_u^2) puts the ideal point (x, y).
+Point2d Distort(double x, double y, double kud) {
+  const double factor = 1.0 + kud * (x * x + y * y);
+  return {kU0 + kPx * x * factor, kV0 + kPx * y * factor};
 }
 
 // Points along the ideal line through (x0, y0) in direction (dx, dy), distorted, with noise.
@@ -54,24 +50,26 @@ std::vector<std::vector<Point2d>> Hash(double kdu, double noise_px, unsigned see
           BentLine(0.01, 0.2, 0.7, -0.02, kdu, noise_px, &random)};
 }
 
-TEST(PlumbLine, RecoversViSPsKduFromLinesItBent) {
-  for (const double kdu : {0.0, 0.15, 0.35, -0.1}) {
-    const PlumbLineResult result = EstimateKdu(Hash(kdu, 0.0, 1), kPx, kPx, kU0, kV0);
-    EXPECT_NEAR(result.kdu, kdu, 1e-6) << "kdu " << kdu;
+TEST(PlumbLine, RecoversViSPsLensFromLinesItBent) {
+  for (const double kud : {0.0, -0.13, -0.3, 0.1}) {
+    const PlumbLineResult result = EstimateRadialDistortion(Hash(kud, 0.0, 1), kPx, kPx, kU0, kV0);
+    EXPECT_NEAR(result.kud, kud, 1e-6) << "kud " << kud;
+    // kdu undoes it: a corner pixel comes back to its ideal point within a pixel or so.
+    EXPECT_LT(result.kdu * kud, 1e-12) << "kud " << kud << ", kdu " << result.kdu;
     EXPECT_LT(result.rms_after_px, 1e-4);
-    if (kdu != 0.0) {
+    if (kud != 0.0) {
       EXPECT_GT(result.rms_before_px, 0.1);
     }
   }
 }
 
 TEST(PlumbLine, WithNoiseAndStrayPointsStaysWithinAPercent) {
-  std::vector<std::vector<Point2d>> lines = Hash(0.2, 0.2, 7);
+  std::vector<std::vector<Point2d>> lines = Hash(-0.2, 0.2, 7);
   lines[1][10].u += 6.0;  // a mark beside the stripe
   lines[2][70].v -= 9.0;
-  const PlumbLineResult result = EstimateKdu(lines, kPx, kPx, kU0, kV0);
-  EXPECT_NEAR(result.kdu, 0.2, 0.002);
-  EXPECT_LT(result.kdu_sd, 0.002);
+  const PlumbLineResult result = EstimateRadialDistortion(lines, kPx, kPx, kU0, kV0);
+  EXPECT_NEAR(result.kud, -0.2, 0.002);
+  EXPECT_LT(result.kud_sd, 0.002);
   EXPECT_EQ(result.lines, 4);
   EXPECT_LT(result.points, 4 * 81);  // the two stray points left out
 }
@@ -84,7 +82,7 @@ TEST(PlumbLine, LinesThroughTheCentreCannotTell) {
       BentLine(0.0, 0.0, 0.5, 0.5, 0.2, 0.2, &random),
       BentLine(0.0, 0.0, 0.5, -0.5, 0.2, 0.2, &random)};
   try {
-    EstimateKdu(through, kPx, kPx, kU0, kV0);
+    EstimateRadialDistortion(through, kPx, kPx, kU0, kV0);
     FAIL() << "lines through the centre accepted";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("too near the image's centre"), std::string::npos)
@@ -93,12 +91,12 @@ TEST(PlumbLine, LinesThroughTheCentreCannotTell) {
 }
 
 TEST(PlumbLine, TooFewLinesAreRefused) {
-  std::vector<std::vector<Point2d>> lines = Hash(0.1, 0.0, 1);
+  std::vector<std::vector<Point2d>> lines = Hash(-0.1, 0.0, 1);
   lines.resize(3);
-  EXPECT_THROW(EstimateKdu(lines, kPx, kPx, kU0, kV0), std::runtime_error);
-  lines = Hash(0.1, 0.0, 1);
+  EXPECT_THROW(EstimateRadialDistortion(lines, kPx, kPx, kU0, kV0), std::runtime_error);
+  lines = Hash(-0.1, 0.0, 1);
   lines[0].resize(5);  // too few points: not used
-  EXPECT_THROW(EstimateKdu(lines, kPx, kPx, kU0, kV0), std::runtime_error);
+  EXPECT_THROW(EstimateRadialDistortion(lines, kPx, kPx, kU0, kV0), std::runtime_error);
 }
 
 // The A3 sheet on the bench through lenses of kdu 0.08-0.3, tracked with a camera that knows no
@@ -137,8 +135,10 @@ TEST(PlumbLine, TheSheetsStripesTellTheLensInTenFrames) {
       ++frames;
     }
     ASSERT_EQ(frames, 10);
-    const PlumbLineResult result = EstimateKdu(lines, kPx, kPx, kU0, kV0);
-    EXPECT_NEAR(result.kdu, kdu, 0.05 * kdu) << "sd " << result.kdu_sd;
+    const PlumbLineResult result = EstimateRadialDistortion(lines, kPx, kPx, kU0, kV0);
+    EXPECT_NEAR(result.kdu, kdu, 0.05 * kdu) << "kud " << result.kud;
+    EXPECT_NEAR(result.kud, render.camera.get_kud(), 0.05 * std::fabs(render.camera.get_kud()));
+                render.camera.get_kud(), result.kud_sd);
     EXPECT_LT(result.rms_after_px, result.rms_before_px);
   }
 }
