@@ -547,6 +547,7 @@ const std::vector<Field<CameraConfig>>& CameraFields() {
       DoubleField("v0", &O::v0),
       DoubleField("kdu", &O::kdu),
       BoolField("correct_distortion", &O::correct_distortion),
+      BoolField("estimate_distortion", &O::estimate_distortion),
       IntField("width", &O::width),
       IntField("height", &O::height),
       DoubleField("noise", &O::noise),

@@ -74,6 +74,10 @@ struct CameraConfig {
   /// Undistort the feature points with kdu (detector) and use it in the pose; false ignores
   /// the lens in both (the paper's condition: its lines stay curved).
   bool correct_distortion = true;
+  /// Tell the lens from the target's stripes over the first frames, the robot still, instead
+  /// of from kdu (calibration/plumb_line.h); in a simulation kdu is then the rendered lens
+  /// only, which the loop does not see.
+  bool estimate_distortion = false;
   int width = 640, height = 480;  ///< image size, pixels, [16, 8192]
   double noise = 0.0;             ///< Gaussian noise of the rendering, grey levels, [0, 100]
   double blur = 0.0;              ///< Gaussian blur of the rendering, pixels, [0, 20]

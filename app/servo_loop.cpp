@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "app/image_source.h"
+#include "app/lens_estimate.h"
 #include "app/servo_rig.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
@@ -74,6 +75,12 @@ class StopGuard {
   const ServoRunHooks& hooks_;
   bool stopped_ = false;
 };
+
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
 
 std::string Fixed(double value, int digits) {
   std::ostringstream text;
@@ -173,6 +180,18 @@ void CheckServoConfig(const ServoAppConfig& config) {
         "source: {type: replay, path: " +
         config.source.device + "}");
   }
+  if (config.camera.estimate_distortion && !config.camera.correct_distortion) {
+    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
+                                " tells the lens to correct it, but camera.correct_distortion "
+                                "is false: give one of them");
+  }
+  if (config.camera.estimate_distortion && config.source.type != "simulated" &&
+      config.camera.kdu != 0.0) {
+    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
+                                " tells the lens from the stripes, but the camera gives kdu " +
+                                Number(config.camera.kdu) + " (" + KeyAt(config, "camera.kdu") +
+                                "): give one of them");
+  }
   if (config.camera.true_eMc && config.source.type != "simulated") {
     throw std::invalid_argument(KeyAt(config, "camera.true_eMc") +
                                 " is the mounting of a simulated camera; source.type is " +
@@ -180,15 +199,59 @@ void CheckServoConfig(const ServoAppConfig& config) {
   }
 }
 
+// Frames read, the robot still, for camera.estimate_distortion: the first that show the
+// target tell the lens (app/lens_estimate.h); their noise seeds apart from the loop's.
+constexpr int kLensFrames = 10;
+constexpr int kMaxLensFramesRead = 100;
+constexpr int kLensFrameIndex = 1000000;
+
+// camera.estimate_distortion: the lens from the stripes of the first frames that show the
+// target, the robot still; the model and the tracker then use it. False with `why` when the
+// frames cannot tell it.
+bool TellTheLens(const ServoAppConfig& config, SafeRobot& robot, LoopCamera& frames,
+                 LoopModel* model, TargetPoseTracker* tracker, std::ostream& log,
+                 std::string* why) {
+  StripeCollector stripes;
+  cv::Mat gray;
+  int read = 0;
+  for (; read < kMaxLensFramesRead && stripes.frames() < kLensFrames; ++read) {
+    const RobotPose at = TrueCameraPose(robot, config);
+    if (!at.result.ok()) {
+      *why = "the camera's pose cannot be read: " + at.result.message;
+      return false;
+    }
+    if (!frames.Grab(at.pose.inverse() * config.target_wMo, kLensFrameIndex + read, &gray)) {
+      break;
+    }
+    tracker->Reset();
+    tracker->Track(ViewOf(gray));
+    stripes.Add(*tracker);
+  }
+  tracker->Reset();
+  if (stripes.frames() < kLensFrames) {
+    *why = std::to_string(stripes.frames()) + " of the first " + std::to_string(read) +
+           " frames show the target, " + std::to_string(kLensFrames) + " needed";
+    return false;
+  }
+  PlumbLineResult lens;
+  try {
+    lens = stripes.Estimate(model->camera, config.camera.width, config.camera.height);
+  } catch (const std::runtime_error& error) {
+    *why = error.what();
+    return false;
+  }
+  model->camera = WithLens(model->camera, lens);
+  *tracker = model->Tracker();
+  log << "lens told from the stripes of " << stripes.frames() << " frames: kdu "
+      << Fixed(lens.kdu, 4) << ", kud " << Fixed(lens.kud, 4) << " +- " << Fixed(lens.kud_sd, 4)
+      << " (they bent " << Fixed(lens.rms_before_px, 2) << " px RMS, "
+      << Fixed(lens.rms_after_px, 2) << " px corrected)\n";
+  return true;
+}
+
 // Who asked for a stop, for "interrupted by ...".
 std::string InterruptedBy(const ServoRunHooks& hooks) {
   return hooks.interrupt_reason ? hooks.interrupt_reason() : "Ctrl-C or a stop from the window";
-}
-
-std::string Number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
 }
 
 // "1 move", "3 moves".
@@ -459,7 +522,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   // Everything checked, and the goal taught, before the robot moves.
   CheckServoConfig(config);
   const bool velocity_law = config.servo.law.mode == ServoMode::kVelocity;
-  const LoopModel model(config);
+  LoopModel model(config);
   TargetPoseTracker tracker = model.Tracker();
   std::vector<std::string> source_warnings;
   const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &source_warnings);
@@ -536,6 +599,12 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   report.started = true;
   if (hooks.on_started) hooks.on_started();
 
+  if (config.camera.estimate_distortion) {
+    std::string why;
+    if (!TellTheLens(config, robot, *frames, &model, &tracker, log, &why)) {
+      return finish({ServoRunStatus::kError, "cannot tell the lens: " + why});
+    }
+  }
   const ServoLoopOptions& loop = config.servo;
   const auto start = std::chrono::steady_clock::now();
   const int iteration_limit = loop.IterationLimit(!moves_robot);

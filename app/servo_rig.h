@@ -20,15 +20,16 @@
 
 namespace oal {
 
-// What the detector and the pose believe about the lens: the true one, or (the paper's
-// condition, camera.correct_distortion false) a pinhole camera with the same intrinsics.
+// What the detector and the pose believe about the lens: the configured one, or a pinhole
+// camera with the same intrinsics (the paper's condition, camera.correct_distortion false; or
+// camera.estimate_distortion before the stripes have told the lens).
 struct LoopModel {
   const ServoAppConfig& config;
   vpCameraParameters camera;
 
   explicit LoopModel(const ServoAppConfig& c)
       : config(c),
-        camera(c.camera.correct_distortion
+        camera(c.camera.correct_distortion && !c.camera.estimate_distortion
                    ? c.camera.Camera()
                    : vpCameraParameters(c.camera.px, c.camera.py, c.camera.u0, c.camera.v0)) {}
 
