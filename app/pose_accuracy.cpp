@@ -115,8 +115,7 @@ vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
   try {
     const PlumbLineResult result = stripes.Estimate(pinhole, options.width, options.height);
     report->estimated_kdu = result.kdu;
-    report->estimated_kud = result.kud;
-    report->estimated_kud_sd = result.kud_sd;
+    report->estimated_kdu_sd = result.kdu_sd;
     return WithLens(pinhole, result);
   } catch (const std::runtime_error& error) {
     report->estimate_failed = error.what();

@@ -61,9 +61,9 @@ struct PoseAccuracyReport {
   int lines_found = 0;  ///< frames whose four target lines were all found (line_ bounds)
   std::vector<double> find_time_us, detect_time_us, pose_time_us, total_time_us;
   std::vector<int> failed_frames;  ///< frames without a pose
-  /// With estimate_distortion: the lens told from the stripes (NaN when it could not be), kud's
+  /// With estimate_distortion: the lens told from the stripes (NaN when it could not be), kdu's
   /// standard deviation, and why not.
-  double estimated_kdu = 0.0, estimated_kud = 0.0, estimated_kud_sd = 0.0;
+  double estimated_kdu = 0.0, estimated_kdu_sd = 0.0;
   std::string estimate_failed;
 
   int posed() const;

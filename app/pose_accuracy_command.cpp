@@ -61,8 +61,8 @@ std::string Table(const PoseAccuracyReport& r) {
   if (r.options.estimate_distortion) {
     out << "| kdu told from the stripes of 10 frames | "
         << (r.estimate_failed.empty()
-                ? Fixed(r.estimated_kdu, 4) + " (truth " + Fixed(r.options.kdu, 4) + "); kud " +
-                      Fixed(r.estimated_kud, 4) + " +- " + Fixed(r.estimated_kud_sd, 4)
+                ? Fixed(r.estimated_kdu, 4) + " +- " + Fixed(r.estimated_kdu_sd, 4) + " (truth " +
+                      Fixed(r.options.kdu, 4) + ")"
                 : "none: " + r.estimate_failed + "; poses without distortion")
         << " |\n";
   }

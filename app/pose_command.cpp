@@ -216,7 +216,7 @@ void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* r
   run->tracker = TargetPoseTracker(run->config.target, run->camera.camera, run->config.detector,
                                    run->config.pose, run->config.tracking);
   run->undistorted_by = run->camera.camera;
-  said << "kdu " << lens.kdu << ", kud " << lens.kud << " +- " << lens.kud_sd
+  said << "kdu " << lens.kdu << " +- " << lens.kdu_sd << " (kud " << lens.kud << ")"
        << " from the stripes of " << stripes.frames() << " frames (they bend "
        << std::setprecision(2) << lens.rms_before_px << " px RMS from straight, "
        << lens.rms_after_px << " px corrected); every pose uses it";
@@ -302,7 +302,8 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
             << lens.frames << " frames; a camera file that matches the lens "
             << "leaves under 0.1 px) after '" << summary.camera_path
             << "' corrects them: it does not describe this lens (its distortion, or the "
-               "resolution it was made for). Calibrate the camera: oalservo calibrate";
+               "resolution it was made for). Calibrate the camera (oalservo calibrate), or give "
+               "one without distortion and --estimate-distortion";
     summary.warnings.push_back(message.str());
   }
   return summary;

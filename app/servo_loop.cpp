@@ -243,7 +243,8 @@ bool TellTheLens(const ServoAppConfig& config, SafeRobot& robot, LoopCamera& fra
   model->camera = WithLens(model->camera, lens);
   *tracker = model->Tracker();
   log << "lens told from the stripes of " << stripes.frames() << " frames: kdu "
-      << Fixed(lens.kdu, 4) << ", kud " << Fixed(lens.kud, 4) << " +- " << Fixed(lens.kud_sd, 4)
+      << Fixed(lens.kdu, 4) << " +- " << Fixed(lens.kdu_sd, 4) << " (kud " << Fixed(lens.kud, 4)
+      << ")"
       << " (they bent " << Fixed(lens.rms_before_px, 2) << " px RMS, "
       << Fixed(lens.rms_after_px, 2) << " px corrected)\n";
   return true;
@@ -673,7 +674,8 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
             << " px (median of " << lens.frames
             << " frames; a camera file that matches the lens leaves under 0.1 px) after the "
                "camera model's correction: it does not describe this lens, and every pose is "
-               "biased. Calibrate the camera: oalservo calibrate\n";
+               "biased. Calibrate the camera (oalservo calibrate), or set "
+               "camera.estimate_distortion\n";
       }
     }
     std::optional<ServoStep> step;

@@ -5,8 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "calibration/calibrate.h"  // FitViSPDistortion
-#include "detector/options.h"       // RequireOption
+#include "detector/options.h"  // RequireOption
 
 namespace oal {
 namespace {
@@ -16,24 +15,33 @@ struct Normalised {
   double x = 0.0, y = 0.0;
 };
 
-// The ideal point of a distorted one under x_d = x_u (1 + kud r_u^2), and the derivative of
-// the ideal point along itself with respect to kud: d x_u / d kud = slope * x_u.
+// The ideal point of a distorted one under ViSP's correction x_u = x_d (1 + kdu r_d^2), and
+// its derivative along itself with respect to kdu: d x_u / d kdu = slope * x_u.
 struct Ideal {
   double x = 0.0, y = 0.0, slope = 0.0;
 };
 
-Ideal Undistort(const Normalised& p, double kud) {
-  double xu = p.x, yu = p.y;
-  for (int i = 0; i < 50; ++i) {
-    const double factor = 1.0 + kud * (xu * xu + yu * yu);
-    const double next_x = p.x / factor, next_y = p.y / factor;
-    const bool settled = std::fabs(next_x - xu) + std::fabs(next_y - yu) < 1e-15;
-    xu = next_x, yu = next_y;
-    if (settled) break;
+Ideal Undistort(const Normalised& p, double kdu) {
+  const double r2 = p.x * p.x + p.y * p.y, factor = 1.0 + kdu * r2;
+  return {p.x * factor, p.y * factor, r2 / factor};
+}
+
+// The kud that best undoes kdu over a width x height image: least squares of
+// x_d = x_u (1 + kud r_u^2) on a grid of distorted points, linear in kud.
+double KudUndoing(double kdu, double px, double py, double u0, double v0, int width, int height) {
+  constexpr int kGrid = 32;
+  double num = 0.0, den = 0.0;
+  for (int j = 0; j <= kGrid; ++j) {
+    for (int i = 0; i <= kGrid; ++i) {
+      const Normalised d{((width - 1.0) * i / kGrid - u0) / px,
+                         ((height - 1.0) * j / kGrid - v0) / py};
+      const Ideal u = Undistort(d, kdu);
+      const double ru2 = u.x * u.x + u.y * u.y;
+      num += u.x * ru2 * (d.x - u.x) + u.y * ru2 * (d.y - u.y);
+      den += (u.x * ru2) * (u.x * ru2) + (u.y * ru2) * (u.y * ru2);
+    }
   }
-  const double s = xu * xu + yu * yu;
-  // From x_d = x_u (1 + k s): 0 = x_u' (1 + k s) + x_u (s + 2 k x_u . x_u'), x_u' radial.
-  return {xu, yu, -s / (1.0 + 3.0 * kud * s)};
+  return den > 0.0 ? num / den : 0.0;
 }
 
 struct Line {
@@ -44,12 +52,12 @@ struct Line {
 
 // Total least squares on the inliers' ideal points: the centroid and the direction of least
 // spread.
-void FitLine(double kud, Line* line) {
+void FitLine(double kdu, Line* line) {
   std::vector<Ideal> ideal;
   double sx = 0, sy = 0;
   for (std::size_t i = 0; i < line->points.size(); ++i) {
     if (!line->inlier[i]) continue;
-    ideal.push_back(Undistort(line->points[i], kud));
+    ideal.push_back(Undistort(line->points[i], kdu));
     sx += ideal.back().x, sy += ideal.back().y;
   }
   const double mx = sx / ideal.size(), my = sy / ideal.size();
@@ -64,56 +72,56 @@ void FitLine(double kud, Line* line) {
   line->c = line->nx * mx + line->ny * my;
 }
 
-double Residual(const Line& line, const Normalised& p, double kud) {
-  const Ideal u = Undistort(p, kud);
+double Residual(const Line& line, const Normalised& p, double kdu) {
+  const Ideal u = Undistort(p, kdu);
   return line.nx * u.x + line.ny * u.y - line.c;
 }
 
 // Points further from their line than four robust standard deviations (and than `floor`,
 // normalised) are left out; the others are taken back.
-void CutOutliers(double kud, double floor, std::vector<Line>* lines) {
+void CutOutliers(double kdu, double floor, std::vector<Line>* lines) {
   std::vector<double> magnitudes;
   for (const Line& line : *lines) {
-    for (const Normalised& p : line.points) magnitudes.push_back(std::fabs(Residual(line, p, kud)));
+    for (const Normalised& p : line.points) magnitudes.push_back(std::fabs(Residual(line, p, kdu)));
   }
   const auto middle = magnitudes.begin() + magnitudes.size() / 2;
   std::nth_element(magnitudes.begin(), middle, magnitudes.end());
   const double limit = std::max(floor, 4.0 * 1.4826 * *middle);
   for (Line& line : *lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
-      line.inlier[i] = std::fabs(Residual(line, line.points[i], kud)) <= limit;
+      line.inlier[i] = std::fabs(Residual(line, line.points[i], kdu)) <= limit;
     }
   }
 }
 
-struct KudStep {
-  double kud = 0.0, information = 0.0, rss = 0.0;
+struct KduStep {
+  double kdu = 0.0, information = 0.0, rss = 0.0;
   int used = 0;
 };
 
-// With the lines fixed, one Gauss-Newton step in kud: e_i + J_i dk = 0 in least squares.
-KudStep StepKud(const std::vector<Line>& lines, double kud) {
+// With the lines fixed, one Gauss-Newton step in kdu: e_i + J_i dk = 0 in least squares.
+KduStep StepKdu(const std::vector<Line>& lines, double kdu) {
   double ej = 0, jj = 0, ee = 0;
   int used = 0;
   for (const Line& line : lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
       if (!line.inlier[i]) continue;
-      const Ideal u = Undistort(line.points[i], kud);
+      const Ideal u = Undistort(line.points[i], kdu);
       const double along_normal = line.nx * u.x + line.ny * u.y;
       const double e = along_normal - line.c, j = along_normal * u.slope;
       ej += e * j, jj += j * j, ee += e * e, ++used;
     }
   }
-  return {jj > 0 ? kud - ej / jj : kud, jj, ee, used};
+  return {jj > 0 ? kdu - ej / jj : kdu, jj, ee, used};
 }
 
-double RmsPx(const std::vector<Line>& lines, double kud, double scale_px) {
+double RmsPx(const std::vector<Line>& lines, double kdu, double scale_px) {
   double sum = 0;
   int n = 0;
   for (const Line& line : lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
       if (!line.inlier[i]) continue;
-      const double e = Residual(line, line.points[i], kud) * scale_px;
+      const double e = Residual(line, line.points[i], kdu) * scale_px;
       sum += e * e, ++n;
     }
   }
@@ -135,7 +143,7 @@ void PlumbLineOptions::Check() const {
   RequireOption(min_points_per_line >= 3 && min_points_per_line <= 1000000,
                 "PlumbLineOptions::min_points_per_line", min_points_per_line,
                 "3 <= min_points_per_line <= 1000000");
-  RequireOption(kud_min < kud_max, "PlumbLineOptions::kud_min", kud_min, "kud_min < kud_max");
+  RequireOption(kdu_min < kdu_max, "PlumbLineOptions::kdu_min", kdu_min, "kdu_min < kdu_max");
   RequireOption(width > 0 && height > 0, "PlumbLineOptions::width", width,
                 "width > 0 and height > 0");
 }
@@ -165,38 +173,35 @@ PlumbLineResult EstimateRadialDistortion(const std::vector<std::vector<Point2d>>
   for (Line& line : lines) FitLine(0.0, &line);
   result.rms_before_px = RmsPx(lines, 0.0, scale_px);
 
-  // Settle kud on all points, cut the points far from their lines, settle again: three times,
-  // so that a first kud still far off does not cut the ends of the bent lines themselves.
-  KudStep step;
+  // Settle kdu on all points, cut the points far from their lines, settle again: three times,
+  // so that a first kdu still far off does not cut the ends of the bent lines themselves.
+  KduStep step;
   for (int round = 0; round < 4; ++round) {
-    if (round > 0) CutOutliers(step.kud, 0.5 / scale_px, &lines);
+    if (round > 0) CutOutliers(step.kdu, 0.5 / scale_px, &lines);
     for (int iteration = 0; iteration < 1000; ++iteration) {
-      for (Line& line : lines) FitLine(step.kud, &line);
-      const double before = step.kud;
-      step = StepKud(lines, step.kud);
-      if (iteration > 0 && std::fabs(step.kud - before) < 1e-12) break;
+      for (Line& line : lines) FitLine(step.kdu, &line);
+      const double before = step.kdu;
+      step = StepKdu(lines, step.kdu);
+      if (iteration > 0 && std::fabs(step.kdu - before) < 1e-12) break;
     }
   }
-  // How far kud is pinned: the residuals' spread through the step's information.
+  // How far kdu is pinned: the residuals' spread through the step's information.
   const double sigma2 = step.used > 1 ? step.rss / (step.used - 1) : 0.0;
-  result.kud_sd = step.information > 0 ? std::sqrt(sigma2 / step.information) : HUGE_VAL;
-  if (!(step.information > 0) || !(result.kud_sd < 0.05)) {
+  result.kdu_sd = step.information > 0 ? std::sqrt(sigma2 / step.information) : HUGE_VAL;
+  if (!(step.information > 0) || !(result.kdu_sd < 0.05)) {
     throw std::runtime_error(
-        "the lines pass too near the image's centre to show the lens (kud +- " +
-        Number(result.kud_sd) + "): view the target off-centre, its stripes reaching the edges");
+        "the lines pass too near the image's centre to show the lens (kdu +- " +
+        Number(result.kdu_sd) + "): view the target off-centre, its stripes reaching the edges");
   }
-  if (step.kud < options.kud_min || step.kud > options.kud_max) {
-    throw std::runtime_error("kud came out at " + Number(step.kud) + ", outside [" +
-                             Number(options.kud_min) + ", " + Number(options.kud_max) +
+  if (step.kdu < options.kdu_min || step.kdu > options.kdu_max) {
+    throw std::runtime_error("kdu came out at " + Number(step.kdu) + ", outside [" +
+                             Number(options.kdu_min) + ", " + Number(options.kdu_max) +
                              "]: the points are not of straight lines through this camera");
   }
-  result.kud = step.kud;
+  result.kdu = step.kdu;
   result.points = step.used;
-  result.rms_after_px = RmsPx(lines, step.kud, scale_px);
-  // ViSP's other direction: the kdu that best undoes kud over the image.
-  result.kdu = FitViSPDistortion(RadialDistortion{step.kud, 0.0, 0.0}, px, py, u0, v0,
-                                 options.width, options.height)
-                   .kdu;
+  result.rms_after_px = RmsPx(lines, step.kdu, scale_px);
+  result.kud = KudUndoing(step.kdu, px, py, u0, v0, options.width, options.height);
   return result;
 }
 
