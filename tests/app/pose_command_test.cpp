@@ -25,6 +25,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using ::testing::Contains;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 constexpr double kTranslationTolerance = 0.02;  // of the true translation's norm
 
@@ -331,6 +332,57 @@ TEST(ConfigPose, ShippedFileIsTheDefaults) {
   EXPECT_EQ(shipped.min_depth_m, defaults.min_depth_m);
   EXPECT_EQ(shipped.correct_stripe_centres, defaults.correct_stripe_centres);
   EXPECT_EQ(shipped.vvs_max_iterations, defaults.vvs_max_iterations);
+}
+
+}  // namespace
+}  // namespace oal
+
+namespace oal {
+namespace {
+
+// A camera file that knows nothing of the lens: kdu is told from the sheet's stripes.
+TEST(PoseCommand, EstimatesTheLensFromTheStripesAndUsesIt) {
+  const test::TestDir dir;
+  RenderCommandOptions render = test::ScaledRender(dir / "data", 14, 5, 640, 480);
+  render.target = "four-line-a3";
+  render.kdu = 0.15;
+  test::RenderChecked(render);
+  vpCameraParameters pinhole;
+  pinhole.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  SaveCameraFile(dir / "pinhole.xml", pinhole, "Camera", 640, 480);
+  PoseCommandOptions options;
+  options.inputs = {dir / "data"};
+  options.camera_path = dir / "pinhole.xml";
+  options.independent = true;
+  options.estimate_distortion = true;
+  std::ostringstream out;
+  const PoseSummary summary = EstimatePoses(options, out);
+  ASSERT_TRUE(summary.estimated_kdu.has_value());
+  EXPECT_NEAR(*summary.estimated_kdu, 0.15, 0.05 * 0.15);
+  ASSERT_EQ(summary.notes.size(), 1u);
+  EXPECT_THAT(summary.notes[0], HasSubstr("from the stripes of 10 frames"));
+  // Every frame, the ten read ahead too, once and in order, undistorted by the estimate.
+  const std::vector<json> frames = ParseJsonLines(out.str());
+  ASSERT_EQ(frames.size(), 14u);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].at("frame"), static_cast<int>(i));
+    EXPECT_EQ(frames[i].at("source"), FrameFile(dir / "data", static_cast<int>(i), ".png"));
+    EXPECT_EQ(frames[i].at("coordinates"), "undistorted");
+    ExpectPoseNearTruth(frames[i], FrameFile(dir / "data", static_cast<int>(i), ".json"));
+  }
+  // No lens warning: the estimate straightens the stripes.
+  for (const std::string& warning : summary.warnings) EXPECT_THAT(warning, Not(HasSubstr("bend")));
+}
+
+TEST(PoseCommand, EstimatingALensTheCameraFileAlreadyHasIsRefused) {
+  const test::TestDir dir;
+  const std::string data = RenderSmall(dir, "data", 2, 0.15);
+  PoseCommandOptions options;
+  options.inputs = {data};
+  options.estimate_distortion = true;
+  std::ostringstream out;
+  const std::string error = test::ErrorMessageOf([&] { EstimatePoses(options, out); });
+  EXPECT_THAT(error, HasSubstr("--estimate-distortion is for a camera file without distortion"));
 }
 
 }  // namespace

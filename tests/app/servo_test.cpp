@@ -251,6 +251,38 @@ TEST(ServoLoop, Table3WithDistortionCorrectedConverges) {
   EXPECT_LE(report.iterations.back().true_rotation_error_deg, kTolRotationDeg);
 }
 
+// A camera nobody calibrated: the loop tells the lens from the sheet's stripes before it
+// moves, and reaches the true goal as with the lens given.
+TEST(ServoLoop, ALensToldFromTheStripesConvergesAsTheLensGiven) {
+  const ServoAppConfig config = ParseConfig("camera:\n  kdu: 0.15\n  estimate_distortion: true\n",
+                                            "lens.yaml", DefaultServoConfig());
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_THAT(log.str(), HasSubstr("lens told from the stripes of 10 frames: kdu 0.15"));
+  EXPECT_THAT(log.str(), ::testing::Not(HasSubstr("Calibrate the camera")));
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  EXPECT_LE(report.iterations.back().true_translation_error_mm, 1.0);
+  EXPECT_LE(report.iterations.back().true_rotation_error_deg, 0.1);
+}
+
+TEST(ServoConfig, TellingTheLensConflictsWithIgnoringItOrGivingIt) {
+  std::ostringstream log;
+  const std::string ignored = test::ErrorMessageOf([&] {
+    RunServo(ParseConfig("camera:\n  estimate_distortion: true\n  correct_distortion: false\n",
+                         "lens.yaml", DefaultServoConfig()),
+             log);
+  });
+  EXPECT_THAT(ignored, HasSubstr("lens.yaml:2: camera.estimate_distortion"));
+  EXPECT_THAT(ignored, HasSubstr("camera.correct_distortion is false"));
+  const std::string given = test::ErrorMessageOf([&] {
+    RunServo(ParseConfig("camera:\n  kdu: 0.2\n  estimate_distortion: true\nsource: {type: "
+                         "replay, path: x.avi}\n",
+                         "lens.yaml", DefaultServoConfig()),
+             log);
+  });
+  EXPECT_THAT(given, HasSubstr("but the camera gives kdu 0.2 (lens.yaml:2: camera.kdu)"));
+}
+
 // Uncorrected, the curved lines bias the pose: the loop ends (it stops itself, or believes it
 // has arrived) far from the true goal, with the robot stopped.
 TEST(ServoLoop, Table3WithDistortionUncorrectedMissesTheTrueGoal) {
