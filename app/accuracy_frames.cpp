@@ -14,7 +14,7 @@
 #include "app/command_line.h"
 #include "app/image_source.h"
 #include "app/json_io.h"
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 
 namespace oal {
 namespace {

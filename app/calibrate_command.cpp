@@ -12,6 +12,7 @@
 #include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/image_source.h"
+#include "base/format.h"
 #include "calibration/calibrate.h"
 #include "calibration/chessboard.h"
 
@@ -29,12 +30,6 @@ void ParseChessboard(const std::string& text, ChessboardOptions* options) {
   }
   options->columns = columns;
   options->rows = rows;
-}
-
-std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
 }
 
 void PrintReport(const CalibrationResult& result) {

@@ -27,9 +27,10 @@
 #include "app/frame_command.h"  // CompanionFile
 #include "app/image_source.h"
 #include "app/truth_file.h"
+#include "base/check.h"
+#include "base/format.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
-#include "detector/options.h"  // RequireOption
 #include "detector/tracker.h"
 #include "scene/scene.h"
 #include "servo/target_tracker.h"
@@ -776,12 +777,6 @@ struct MethodFailure {
            (frames == 1 ? "" : "s") + " (first: " + first + "); scored as finding no line there";
   }
 };
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
 
 }  // namespace
 

@@ -13,7 +13,7 @@
 
 #include "app/atomic_file.h"
 #include "app/image_source.h"
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 
 namespace oal {
 namespace {

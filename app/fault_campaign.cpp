@@ -27,7 +27,7 @@
 #include "app/detector_accuracy.h"  // Quantile
 #include "app/servo_command.h"
 #include "app/servo_rig.h"
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 #include "robots/scorbot_controller_sim.h"
 
 namespace oal {

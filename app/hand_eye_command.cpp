@@ -21,6 +21,7 @@
 #include "app/image_source.h"
 #include "app/servo_command.h"
 #include "app/servo_rig.h"
+#include "base/format.h"
 #include "calibration/hand_eye_routine.h"
 #include "robots/safe_robot.h"
 #include "servo/target_layout.h"
@@ -33,12 +34,6 @@ namespace fs = std::filesystem;
 const char* const kColumns[12] = {"wMe_x_m",    "wMe_y_m",    "wMe_z_m",    "wMe_rx_deg",
                                   "wMe_ry_deg", "wMe_rz_deg", "cMo_x_m",    "cMo_y_m",
                                   "cMo_z_m",    "cMo_rx_deg", "cMo_ry_deg", "cMo_rz_deg"};
-
-std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
-}
 
 vpHomogeneousMatrix PoseOf(const double* v) {
   const vpRxyzVector rxyz(vpMath::rad(v[3]), vpMath::rad(v[4]), vpMath::rad(v[5]));

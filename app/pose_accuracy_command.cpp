@@ -12,16 +12,11 @@
 #include "app/config.h"
 #include "app/detector_accuracy.h"  // Quantile
 #include "app/pose_accuracy.h"
+#include "base/format.h"
 #include "servo/pose.h"
 
 namespace oal {
 namespace {
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
 
 std::string Table(const PoseAccuracyReport& r) {
   std::ostringstream out;

@@ -17,7 +17,7 @@
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/json_io.h"
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
 

@@ -14,7 +14,7 @@
 #include "app/servo_command.h"
 #include "app/servo_loop.h"
 #include "app/servo_rig.h"
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/scorbot_robot.h"

@@ -21,6 +21,7 @@
 #include "app/image_source.h"
 #include "app/lens_estimate.h"
 #include "app/servo_rig.h"
+#include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
 #include "robots/scorbot_controller_sim.h"
@@ -79,12 +80,6 @@ class StopGuard {
 std::string Number(double value) {
   std::ostringstream text;
   text << value;
-  return text.str();
-}
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(digits) << value;
   return text.str();
 }
 

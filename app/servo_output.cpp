@@ -30,6 +30,7 @@
 
 #include "app/annotate.h"
 #include "app/atomic_file.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -55,12 +56,6 @@ std::string Value(double value) {
   if (!std::isfinite(value)) return "nan";
   std::ostringstream text;
   text << std::setprecision(9) << value;
-  return text.str();
-}
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(digits) << value;
   return text.str();
 }
 

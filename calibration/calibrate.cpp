@@ -7,7 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -19,14 +20,6 @@ constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 constexpr double kLooseFocalFraction = 0.003;
 constexpr double kLoosePrincipalPx = 1.5;
 constexpr double kLooseK1 = 0.01;
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
 
 // The view's plane tilt from its rotation vector: the angle between the plane's normal (its z
 // axis) and the optical axis.

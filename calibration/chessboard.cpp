@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 
 namespace oal {
 

@@ -10,7 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -24,14 +25,6 @@ constexpr double kSameStationRad = 1e-3;
 constexpr double kWeakAxisSpreadDeg = 30.0;
 constexpr double kLoosePairsMm = 2.0;
 constexpr double kLoosePairsDeg = 0.5;
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
 
 struct Motion {
   double angle_rad = 0.0;

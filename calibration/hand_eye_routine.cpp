@@ -9,18 +9,11 @@
 #include <utility>
 #include <vector>
 
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
 
 bool Interrupted(const std::atomic<bool>* interrupt) {
   return interrupt != nullptr && interrupt->load(std::memory_order_relaxed);

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "detector/options.h"  // RequireOption
+#include "base/check.h"
 
 namespace oal {
 namespace {

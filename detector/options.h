@@ -1,22 +1,11 @@
 // Parameters of the OAL detector, with the paper's values as defaults where it gives them.
 #pragma once
 
-#include <sstream>
-#include <stdexcept>
 #include <string>
 
-namespace oal {
+#include "base/check.h"  // RequireOption, which every Options::Check() uses
 
-/// Throws std::invalid_argument "FIELD = VALUE. Violated constraint: CONSTRAINT" unless `ok`:
-/// the message every Options::Check() of the libraries gives (ceres' style).
-template <typename T>
-void RequireOption(bool ok, const std::string& field, const T& value,
-                   const std::string& constraint) {
-  if (ok) return;
-  std::ostringstream message;
-  message << field << " = " << value << ". Violated constraint: " << constraint;
-  throw std::invalid_argument(message.str());
-}
+namespace oal {
 
 /// What a feature point on a border is.
 enum class Polarity {

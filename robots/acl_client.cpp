@@ -7,7 +7,7 @@
 #include <optional>
 #include <sstream>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -315,8 +315,8 @@ std::string AclReply::text() const {
 }
 
 void AclClientOptions::Check() const {
-  RequireRobotOption(reply_timeout_s > 0 && reply_timeout_s <= 600,
-                     "AclClientOptions::reply_timeout_s", reply_timeout_s, "0 < value <= 600");
+  RequireOption(reply_timeout_s > 0 && reply_timeout_s <= 600, "AclClientOptions::reply_timeout_s",
+                reply_timeout_s, "0 < value <= 600");
 }
 
 AclClient::AclClient(ByteLink& link, const AclClientOptions& options)

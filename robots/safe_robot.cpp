@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -34,24 +34,23 @@ constexpr const char* kBoxAxis[3] = {"x", "y", "z"};
 
 void SafetyOptions::Check() const {
   const std::string p = "SafetyOptions::";
-  RequireRobotOption(max_translation_mps > 0 && std::isfinite(max_translation_mps),
-                     p + "max_translation_mps", max_translation_mps, "finite and > 0");
-  RequireRobotOption(max_rotation_radps > 0 && std::isfinite(max_rotation_radps),
-                     p + "max_rotation_radps", max_rotation_radps, "finite and > 0");
+  RequireOption(max_translation_mps > 0 && std::isfinite(max_translation_mps),
+                p + "max_translation_mps", max_translation_mps, "finite and > 0");
+  RequireOption(max_rotation_radps > 0 && std::isfinite(max_rotation_radps),
+                p + "max_rotation_radps", max_rotation_radps, "finite and > 0");
   for (int i = 0; i < 3; ++i) {
-    RequireRobotOption(std::isfinite(workspace_min_m[i]) && std::isfinite(workspace_max_m[i]) &&
-                           workspace_min_m[i] < workspace_max_m[i],
-                       p + "workspace_min_m/workspace_max_m [" + kBoxAxis[i] + "]",
-                       Str(workspace_min_m[i]) + " / " + Str(workspace_max_m[i]),
-                       "finite and min < max");
+    RequireOption(std::isfinite(workspace_min_m[i]) && std::isfinite(workspace_max_m[i]) &&
+                      workspace_min_m[i] < workspace_max_m[i],
+                  p + "workspace_min_m/workspace_max_m [" + kBoxAxis[i] + "]",
+                  Str(workspace_min_m[i]) + " / " + Str(workspace_max_m[i]),
+                  "finite and min < max");
   }
-  RequireRobotOption(move_timeout_s > 0 && std::isfinite(move_timeout_s), p + "move_timeout_s",
-                     move_timeout_s, "finite and > 0");
-  RequireRobotOption(reach_tolerance_m > 0, p + "reach_tolerance_m", reach_tolerance_m, "> 0");
-  RequireRobotOption(reach_tolerance_rad > 0, p + "reach_tolerance_rad", reach_tolerance_rad,
-                     "> 0");
-  RequireRobotOption(max_cycle_s >= 0 && std::isfinite(max_cycle_s), p + "max_cycle_s", max_cycle_s,
-                     "finite and >= 0");
+  RequireOption(move_timeout_s > 0 && std::isfinite(move_timeout_s), p + "move_timeout_s",
+                move_timeout_s, "finite and > 0");
+  RequireOption(reach_tolerance_m > 0, p + "reach_tolerance_m", reach_tolerance_m, "> 0");
+  RequireOption(reach_tolerance_rad > 0, p + "reach_tolerance_rad", reach_tolerance_rad, "> 0");
+  RequireOption(max_cycle_s >= 0 && std::isfinite(max_cycle_s), p + "max_cycle_s", max_cycle_s,
+                "finite and >= 0");
 }
 
 std::string ToString(SafeRobotState state) {

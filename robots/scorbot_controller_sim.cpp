@@ -17,7 +17,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -66,16 +66,16 @@ long ParameterValue(int n) {
 void ScorbotSimOptions::Check() const {
   geometry.Check();
   const std::string p = "ScorbotSimOptions::";
-  RequireRobotOption(time_scale >= 0.01 && time_scale <= 1000, p + "time_scale", time_scale,
-                     "0.01 <= value <= 1000");
-  RequireRobotOption(baud > 0, p + "baud", baud, "> 0");
-  RequireRobotOption(home_speed_percent >= 1 && home_speed_percent <= 100, p + "home_speed_percent",
-                     home_speed_percent, "1 <= value <= 100");
+  RequireOption(time_scale >= 0.01 && time_scale <= 1000, p + "time_scale", time_scale,
+                "0.01 <= value <= 1000");
+  RequireOption(baud > 0, p + "baud", baud, "> 0");
+  RequireOption(home_speed_percent >= 1 && home_speed_percent <= 100, p + "home_speed_percent",
+                home_speed_percent, "1 <= value <= 100");
   for (int i = 0; i < 5; ++i) {
     const std::string idx = "[" + std::to_string(i) + "]";
-    RequireRobotOption(max_joint_speed_dps[i] > 0 && std::isfinite(max_joint_speed_dps[i]),
-                       p + "max_joint_speed_dps" + idx, max_joint_speed_dps[i], "finite and > 0");
-    RequireRobotOption(
+    RequireOption(max_joint_speed_dps[i] > 0 && std::isfinite(max_joint_speed_dps[i]),
+                  p + "max_joint_speed_dps" + idx, max_joint_speed_dps[i], "finite and > 0");
+    RequireOption(
         start_deg[i] >= geometry.joint_min_deg[i] && start_deg[i] <= geometry.joint_max_deg[i],
         p + "start_deg" + idx, start_deg[i], "inside the joint range");
   }

@@ -6,7 +6,7 @@
 #include <optional>
 #include <sstream>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -106,30 +106,30 @@ bool ProjectOrientation(const vpHomogeneousMatrix& wMe, vpHomogeneousMatrix* out
 
 void ScorbotGeometry::Check() const {
   const std::string p = "ScorbotGeometry::";
-  RequireRobotOption(shoulder_height_m > 0 && std::isfinite(shoulder_height_m),
-                     p + "shoulder_height_m", shoulder_height_m, "finite and > 0");
-  RequireRobotOption(shoulder_offset_m >= 0 && std::isfinite(shoulder_offset_m),
-                     p + "shoulder_offset_m", shoulder_offset_m, "finite and >= 0");
-  RequireRobotOption(upper_arm_m > 0 && std::isfinite(upper_arm_m), p + "upper_arm_m", upper_arm_m,
-                     "finite and > 0");
-  RequireRobotOption(forearm_m > 0 && std::isfinite(forearm_m), p + "forearm_m", forearm_m,
-                     "finite and > 0");
-  RequireRobotOption(pitch_to_flange_m > 0 && std::isfinite(pitch_to_flange_m),
-                     p + "pitch_to_flange_m", pitch_to_flange_m, "finite and > 0");
-  RequireRobotOption(tool_length_m >= 0 && std::isfinite(tool_length_m), p + "tool_length_m",
-                     tool_length_m, "finite and >= 0");
+  RequireOption(shoulder_height_m > 0 && std::isfinite(shoulder_height_m), p + "shoulder_height_m",
+                shoulder_height_m, "finite and > 0");
+  RequireOption(shoulder_offset_m >= 0 && std::isfinite(shoulder_offset_m), p + "shoulder_offset_m",
+                shoulder_offset_m, "finite and >= 0");
+  RequireOption(upper_arm_m > 0 && std::isfinite(upper_arm_m), p + "upper_arm_m", upper_arm_m,
+                "finite and > 0");
+  RequireOption(forearm_m > 0 && std::isfinite(forearm_m), p + "forearm_m", forearm_m,
+                "finite and > 0");
+  RequireOption(pitch_to_flange_m > 0 && std::isfinite(pitch_to_flange_m), p + "pitch_to_flange_m",
+                pitch_to_flange_m, "finite and > 0");
+  RequireOption(tool_length_m >= 0 && std::isfinite(tool_length_m), p + "tool_length_m",
+                tool_length_m, "finite and >= 0");
   for (int i = 0; i < 5; ++i) {
     const std::string idx = "[" + std::to_string(i) + "]";
-    RequireRobotOption(std::isfinite(joint_min_deg[i]) && std::isfinite(joint_max_deg[i]) &&
-                           joint_min_deg[i] < joint_max_deg[i] &&
-                           joint_max_deg[i] - joint_min_deg[i] <= 360,
-                       p + "joint_min_deg/joint_max_deg" + idx,
-                       std::to_string(joint_min_deg[i]) + " / " + std::to_string(joint_max_deg[i]),
-                       "finite, min < max, max - min <= 360");
-    RequireRobotOption(home_deg[i] >= joint_min_deg[i] && home_deg[i] <= joint_max_deg[i],
-                       p + "home_deg" + idx, home_deg[i], "inside [joint_min_deg, joint_max_deg]");
-    RequireRobotOption(counts_per_deg[i] > 0 && std::isfinite(counts_per_deg[i]),
-                       p + "counts_per_deg" + idx, counts_per_deg[i], "finite and > 0");
+    RequireOption(std::isfinite(joint_min_deg[i]) && std::isfinite(joint_max_deg[i]) &&
+                      joint_min_deg[i] < joint_max_deg[i] &&
+                      joint_max_deg[i] - joint_min_deg[i] <= 360,
+                  p + "joint_min_deg/joint_max_deg" + idx,
+                  std::to_string(joint_min_deg[i]) + " / " + std::to_string(joint_max_deg[i]),
+                  "finite, min < max, max - min <= 360");
+    RequireOption(home_deg[i] >= joint_min_deg[i] && home_deg[i] <= joint_max_deg[i],
+                  p + "home_deg" + idx, home_deg[i], "inside [joint_min_deg, joint_max_deg]");
+    RequireOption(counts_per_deg[i] > 0 && std::isfinite(counts_per_deg[i]),
+                  p + "counts_per_deg" + idx, counts_per_deg[i], "finite and > 0");
   }
 }
 

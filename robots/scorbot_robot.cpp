@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -50,40 +50,40 @@ RobotStatus StatusOf(AclErrorKind kind) {
 
 void ScorbotOptions::Check() const {
   const std::string p = "ScorbotOptions::";
-  RequireRobotOption(!port.empty(), p + "port", "\"\"", "not empty");
+  RequireOption(!port.empty(), p + "port", "\"\"", "not empty");
   SerialPortOptions serial;
   serial.baud = baud;
   try {
     serial.Check();
   } catch (const std::invalid_argument&) {
-    RequireRobotOption(false, p + "baud", baud,
-                       "one of 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200");
+    RequireOption(false, p + "baud", baud,
+                  "one of 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200");
   }
-  RequireRobotOption(reply_timeout_s > 0 && reply_timeout_s <= 60, p + "reply_timeout_s",
-                     reply_timeout_s, "0 < value <= 60");
-  RequireRobotOption(move_timeout_s > 0 && std::isfinite(move_timeout_s), p + "move_timeout_s",
-                     move_timeout_s, "finite and > 0");
-  RequireRobotOption(home_timeout_s > 0 && std::isfinite(home_timeout_s), p + "home_timeout_s",
-                     home_timeout_s, "finite and > 0");
-  RequireRobotOption(speed_percent >= 1 && speed_percent <= 100, p + "speed_percent", speed_percent,
-                     "1 <= value <= 100");
-  RequireRobotOption(sampling_time_s > 0 && sampling_time_s <= 10, p + "sampling_time_s",
-                     sampling_time_s, "0 < value <= 10");
-  RequireRobotOption(arrive_tolerance_mm >= 0.1 && std::isfinite(arrive_tolerance_mm),
-                     p + "arrive_tolerance_mm", arrive_tolerance_mm, "finite and >= 0.1");
-  RequireRobotOption(arrive_tolerance_deg >= 0.1 && std::isfinite(arrive_tolerance_deg),
-                     p + "arrive_tolerance_deg", arrive_tolerance_deg, "finite and >= 0.1");
-  RequireRobotOption(position_check_mm >= 0 && std::isfinite(position_check_mm),
-                     p + "position_check_mm", position_check_mm, "finite and >= 0");
-  RequireRobotOption(position_check_deg >= 0 && std::isfinite(position_check_deg),
-                     p + "position_check_deg", position_check_deg, "finite and >= 0");
+  RequireOption(reply_timeout_s > 0 && reply_timeout_s <= 60, p + "reply_timeout_s",
+                reply_timeout_s, "0 < value <= 60");
+  RequireOption(move_timeout_s > 0 && std::isfinite(move_timeout_s), p + "move_timeout_s",
+                move_timeout_s, "finite and > 0");
+  RequireOption(home_timeout_s > 0 && std::isfinite(home_timeout_s), p + "home_timeout_s",
+                home_timeout_s, "finite and > 0");
+  RequireOption(speed_percent >= 1 && speed_percent <= 100, p + "speed_percent", speed_percent,
+                "1 <= value <= 100");
+  RequireOption(sampling_time_s > 0 && sampling_time_s <= 10, p + "sampling_time_s",
+                sampling_time_s, "0 < value <= 10");
+  RequireOption(arrive_tolerance_mm >= 0.1 && std::isfinite(arrive_tolerance_mm),
+                p + "arrive_tolerance_mm", arrive_tolerance_mm, "finite and >= 0.1");
+  RequireOption(arrive_tolerance_deg >= 0.1 && std::isfinite(arrive_tolerance_deg),
+                p + "arrive_tolerance_deg", arrive_tolerance_deg, "finite and >= 0.1");
+  RequireOption(position_check_mm >= 0 && std::isfinite(position_check_mm), p + "position_check_mm",
+                position_check_mm, "finite and >= 0");
+  RequireOption(position_check_deg >= 0 && std::isfinite(position_check_deg),
+                p + "position_check_deg", position_check_deg, "finite and >= 0");
   bool name_ok = !point_name.empty() && point_name.size() <= 5 &&
                  std::isalpha(static_cast<unsigned char>(point_name[0]));
   for (char c : point_name) name_ok = name_ok && std::isalnum(static_cast<unsigned char>(c));
-  RequireRobotOption(name_ok, p + "point_name", point_name,
-                     "1-5 letters and digits, starting with a letter");
+  RequireOption(name_ok, p + "point_name", point_name,
+                "1-5 letters and digits, starting with a letter");
   geometry.Check();
-  RequireRobotOption(eMc.isAnHomogeneousMatrix(), p + "eMc", "(matrix)", "a rigid transform");
+  RequireOption(eMc.isAnHomogeneousMatrix(), p + "eMc", "(matrix)", "a rigid transform");
 }
 
 ScorbotRobot::ScorbotRobot(const ScorbotOptions& options) : options_(options) {

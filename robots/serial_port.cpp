@@ -12,7 +12,7 @@
 #include <chrono>
 #include <cstring>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -83,8 +83,8 @@ IoResult ByteLink::ReadUntil(std::string* buffer, const std::string& terminator,
 }
 
 void SerialPortOptions::Check() const {
-  RequireRobotOption(BaudConstant(baud) != B0, "SerialPortOptions::baud", baud,
-                     "one of 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200");
+  RequireOption(BaudConstant(baud) != B0, "SerialPortOptions::baud", baud,
+                "one of 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200");
 }
 
 SerialPort::~SerialPort() {

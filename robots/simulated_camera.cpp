@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "robots/check_option.h"
+#include "base/check.h"
 
 namespace oal {
 namespace {
@@ -25,16 +25,16 @@ void CheckTwistSize(const vpColVector& v) {
 
 void SimulatedCameraOptions::Check() const {
   const std::string p = "SimulatedCameraOptions::";
-  RequireRobotOption(sampling_time_s > 0 && sampling_time_s <= 1, p + "sampling_time_s",
-                     sampling_time_s, "0 < sampling_time_s <= 1");
-  RequireRobotOption(max_translation_mps > 0 && std::isfinite(max_translation_mps),
-                     p + "max_translation_mps", max_translation_mps, "finite and > 0");
-  RequireRobotOption(max_rotation_radps > 0 && std::isfinite(max_rotation_radps),
-                     p + "max_rotation_radps", max_rotation_radps, "finite and > 0");
-  RequireRobotOption(move_duration_s >= 0 && std::isfinite(move_duration_s), p + "move_duration_s",
-                     move_duration_s, "finite and >= 0");
-  RequireRobotOption(wMc.isAnHomogeneousMatrix(), p + "wMc", 0, "a rigid transform");
-  RequireRobotOption(eMc.isAnHomogeneousMatrix(), p + "eMc", 0, "a rigid transform");
+  RequireOption(sampling_time_s > 0 && sampling_time_s <= 1, p + "sampling_time_s", sampling_time_s,
+                "0 < sampling_time_s <= 1");
+  RequireOption(max_translation_mps > 0 && std::isfinite(max_translation_mps),
+                p + "max_translation_mps", max_translation_mps, "finite and > 0");
+  RequireOption(max_rotation_radps > 0 && std::isfinite(max_rotation_radps),
+                p + "max_rotation_radps", max_rotation_radps, "finite and > 0");
+  RequireOption(move_duration_s >= 0 && std::isfinite(move_duration_s), p + "move_duration_s",
+                move_duration_s, "finite and >= 0");
+  RequireOption(wMc.isAnHomogeneousMatrix(), p + "wMc", 0, "a rigid transform");
+  RequireOption(eMc.isAnHomogeneousMatrix(), p + "eMc", 0, "a rigid transform");
 }
 
 SimulatedCamera::SimulatedCamera(const SimulatedCameraOptions& options) : options_(options) {
