@@ -36,6 +36,7 @@
 #include "app/image_source.h"
 #include "app/report.h"
 #include "app/truth_file.h"
+#include "base/format.h"
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "detector/tracker.h"
@@ -888,7 +889,7 @@ std::optional<PoseJump> JumpFrom(const std::optional<TrustedPose>& trusted, int 
 }
 
 Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids,
-                   const std::optional<PoseJump>& jump) {
+                   const std::optional<PoseJump>& jump, std::optional<double> straightness_px) {
   Json lines = Json::array();
   for (int track : IdentifiedTracks(pose, ids)) lines.push_back(track);
   const bool ok = pose.status == PoseStatus::kOk;
@@ -908,6 +909,7 @@ Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids,
               {"t_m", std::move(t)},
               {"thetau_rad", std::move(tu)},
               {"residual_px", ok ? Json(pose.residual_px) : Json()},
+              {"straightness_px", ok && straightness_px ? Json(*straightness_px) : Json()},
               {"identification", identified ? Json{{"cost", pose.identification_cost},
                                                    {"margin", pose.identification_margin}}
                                             : Json()},
@@ -932,6 +934,7 @@ struct Tally {
   std::set<int> track_ids;
   int pose_jumps = 0;
   std::vector<int> jump_frames;
+  std::vector<double> straightness_px;  ///< of the target tracker's frames with a pose
 };
 
 // The evaluation of one input: decoder, tracker and writer (file comment of evaluate.h).
@@ -1081,6 +1084,7 @@ class InputEvaluation {
   PoseResult TargetPose(const vpImage<unsigned char>& image,
                         const std::vector<DetectedLine>& held) {
     const TargetFrame& found = target_tracker_->Track(ViewOf(image));
+    straightness_px_ = found.straightness_px;
     PoseResult pose = found.pose;
     if (found.status != TargetStatus::kOk) {
       if (pose.status == PoseStatus::kOk) pose.status = PoseStatus::kDegenerate;
@@ -1169,7 +1173,12 @@ class InputEvaluation {
           trusted_ = TrustedPose{frame.index, out.pose->cMo, identified};
         }
       }
-      pose_json = PoseFrameJson(*out.pose, out.ids, jump);
+      const std::optional<double> straightness =
+          target_tracker_ ? std::optional<double>(straightness_px_) : std::nullopt;
+      if (straightness && out.pose->status == PoseStatus::kOk) {
+        tally_.straightness_px.push_back(*straightness);
+      }
+      pose_json = PoseFrameJson(*out.pose, out.ids, jump, straightness);
     }
     const Clock::time_point t3 = Clock::now();
     const double track_us = Us(t1 - t0), pose_us = Us(t3 - t2);
@@ -1340,12 +1349,23 @@ class InputEvaluation {
     }
     if (!decode.stop_reason.empty()) warnings.push_back(decode.stop_reason);
     if (t.readable > 0 && t.detected < 0.1 * t.readable) warnings.push_back(LowDetectionHint(t));
+    const LensCheck lens = CheckLens(t.straightness_px);
+    if (lens.mismatch) {
+      warnings.push_back(
+          "lines 1-4 still bend by " + Fixed(lens.median_px, 2) + " px (median of " +
+          std::to_string(lens.frames) +
+          " frames; a camera file that matches the lens leaves under 0.1 px) after '" +
+          camera_path_ +
+          "' corrects them: it does not describe this lens (its distortion, or the "
+          "resolution it was made for). Calibrate the camera (oalservo calibrate)");
+    }
     Json pose;
     if (camera_) {
       Json by_status = Json::object();
       for (const auto& [status, count] : t.pose_status) by_status[status] = count;
       pose = Json{{"frames_ok", t.pose_ok},
                   {"availability", t.pose_ok / readable},
+                  {"straightness_px_median", lens.frames > 0 ? Json(lens.median_px) : Json()},
                   {"by_status", std::move(by_status)},
                   {"jumps", t.pose_jumps},
                   {"jump_frames", t.jump_frames}};
@@ -1422,6 +1442,7 @@ class InputEvaluation {
   std::optional<vpCameraParameters> undistorted_by_;
   std::optional<PointUndistorter> undistorter_;
   std::vector<std::string> warnings_;
+  double straightness_px_ = 0.0;  // the target tracker's last frame
   Tally tally_;
   std::optional<TrustedPose> trusted_;               ///< the last trusted pose (JumpFrom)
   std::optional<TargetPoseTracker> target_tracker_;  ///< the pose of a '#' target

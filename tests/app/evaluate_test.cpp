@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/render_command.h"
 #include "app/report.h"
@@ -36,6 +37,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 constexpr int kFrames = 8;
 constexpr double kRhoShiftPx = 1.5;  // the truth CSV's lines are this far off
@@ -465,6 +467,39 @@ TEST(Evaluate, ASheetsPoseComesFromTheTargetTracker) {
   const json& summary = result.inputs[0].summary;
   EXPECT_EQ(summary.at("pose").at("frames_ok"), 8) << summary.dump(2);
   EXPECT_LT(summary.at("truth").at("pose_translation_mm").at("max").get<double>(), 2.0);
+}
+
+// The lens check: a camera file without the lens's distortion leaves the sheet's stripes
+// bent; the summary says so once and gives the median bend, the frames give theirs.
+TEST(Evaluate, ACameraFileThatMissesTheLensIsSaid) {
+  test::TestDir dir;
+  RenderCommandOptions render = test::ScaledRender(dir / "sheet", 6, 3, 640, 480);
+  render.target = "four-line-a3";
+  render.kdu = 0.2;
+  const std::string frames = test::RenderChecked(render);
+  vpCameraParameters pinhole;
+  pinhole.initPersProjWithoutDistortion(render.fx_px, render.fx_px, 0.5 * (render.width - 1),
+                                        0.5 * (render.height - 1));
+  SaveCameraFile(dir / "pinhole.xml", pinhole, "Camera", render.width, render.height);
+  for (const bool right : {true, false}) {
+    EvaluateOptions options = Options({frames}, dir / (right ? "right" : "wrong"));
+    options.camera_path = right ? frames + "/camera.xml" : dir / "pinhole.xml";
+    options.write_video = false;
+    const EvaluateResult result = Evaluate(options);
+    ASSERT_EQ(result.inputs.size(), 1u);
+    ASSERT_EQ(result.inputs[0].status, "complete") << result.inputs[0].error;
+    const json& summary = result.inputs[0].summary;
+    const double median = summary.at("pose").at("straightness_px_median").get<double>();
+    const std::string warnings = summary.at("warnings").dump();
+    if (right) {
+      EXPECT_LT(median, 0.2);
+      EXPECT_THAT(warnings, Not(HasSubstr("still bend")));
+    } else {
+      EXPECT_GT(median, 0.2);
+      EXPECT_THAT(warnings, HasSubstr("lines 1-4 still bend by"));
+      EXPECT_THAT(warnings, HasSubstr("pinhole.xml"));
+    }
+  }
 }
 
 TEST(Evaluate, UndecodableImageIsSkippedCountedAndListed) {
