@@ -1,4 +1,4 @@
-// `oalservo compare`: line detectors and trackers head to head on the same frames (issue 3).
+// `oalservo compare`: line detectors and trackers head to head on the same frames.
 //
 // Methods (LineMethod below), each timed per frame with the steady clock around its
 // detection or tracking call only (no image loading, no conversion, no scoring):

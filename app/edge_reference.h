@@ -1,4 +1,4 @@
-// Independent reference lines for real image sequences (issue 3's `compare` on ViSP's
+// Independent reference lines for real image sequences (for `compare` on ViSP's
 // line/ sequence): a documented sub-pixel edge fit that shares no code with detector/
 // (only the line convention of detector/line.h).
 //

@@ -39,7 +39,7 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
   /// then used for every frame (app/lens_estimate.h).
   bool estimate_distortion = false;
 
-  /// The paper's board (issue 4's evaluation): 0.3-1.0 m, tilt up to 40 deg, any roll, every
+  /// The paper's board (its first evaluation): 0.3-1.0 m, tilt up to 40 deg, any roll, every
   /// line crossing 150 px of the image.
   static PoseSampling BoardSampling();
   /// RenderedFrameOptions::Check(), the detector's, the pose's (with the camera) and the

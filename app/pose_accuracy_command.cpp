@@ -113,7 +113,7 @@ nlohmann::json ToJson(const PoseAccuracyReport& r, const std::string& config_pat
 }
 
 // The evaluation conditions a target is made for, where the command line leaves them open:
-// the paper's board as issue 4 measured it; a sheet on photographs of a bench
+// the paper's board as its first evaluation measured it; a sheet on photographs of a bench
 // (ApplySheetDefaults).
 void ApplyTargetDefaults(const CLI::App& cli, bool scene_given, PoseAccuracyOptions* options) {
   if (!IsSheet(options->target)) {

@@ -1,6 +1,6 @@
 // `oalservo scorbot-sim`: the Scorbot ER-VII Controller-A simulator (robots/
 // scorbot_controller_sim.h) on a pseudo-terminal, for the servo app or any terminal program to
-// connect to as if it were the robot's RS-232 port (issue 6).
+// connect to as if it were the robot's RS-232 port.
 //
 //   oalservo scorbot-sim [--port-link PATH] [--time-scale X] [--no-throttle] [--baud N]
 //       prints the device path (and the link) to connect to, serves until Ctrl-C, then prints

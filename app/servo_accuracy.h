@@ -1,4 +1,4 @@
-// Closed-loop convergence from many random start poses (issue 5's "≥ 99 % converge" figure):
+// Closed-loop convergence from many random start poses (the "≥ 99 % converge" figure):
 // `oalservo servo-accuracy`. Each start is a camera pose drawn with scene/'s SamplePose
 // (fixed seed) and run through RunServo with the image in the loop, for each law asked.
 //

@@ -1,4 +1,4 @@
-// The servo loop with the camera in the loop (issue 5): each iteration reads the camera pose
+// The servo loop with the camera in the loop: each iteration reads the camera pose
 // from the robot, renders the frame the simulated camera sees, detects the lines, estimates
 // the pose and commands one step of the PBVS law, until it converges or a stop condition
 // holds. A plain function that tests call directly; `oalservo servo` (servo_command.h) wraps it.

@@ -1,4 +1,4 @@
-// What `oalservo servo` shows and writes besides the table (issue 5): the pose-error plot, the
+// What `oalservo servo` shows and writes besides the table: the pose-error plot, the
 // annotated frames of a headless run and the live vpDisplayX window.
 //
 //   DIR/servo.csv          one row per iteration (WriteServoCsv, servo_loop.h)

@@ -1,4 +1,4 @@
-// The ACL command layer of the Scorbot driver (issue 6): one command at a time over a ByteLink.
+// The ACL command layer of the Scorbot driver: one command at a time over a ByteLink.
 //
 // A command is sent as its text plus CR. The controller echoes what it receives (unless NOECHO),
 // runs the command, prints its reply lines and prompts with '>' at the start of a line.

@@ -1,4 +1,4 @@
-// The robot interface the servo loop drives, in ViSP's terms (issue 5), split as ros2_control
+// The robot interface the servo loop drives, in ViSP's terms, split as ros2_control
 // splits it (shared/STYLE.md, "A driver contract that fails safe"):
 //
 //   Robot      what each driver implements: open communication, allow motion, stop, read the

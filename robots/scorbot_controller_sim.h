@@ -1,4 +1,4 @@
-// A simulator of the Scorbot ER-VII's Controller-A speaking ACL on a pseudo-terminal (issue 6),
+// A simulator of the Scorbot ER-VII's Controller-A speaking ACL on a pseudo-terminal,
 // so that the real driver (SerialPort + AclClient + ScorbotRobot) runs against it unchanged.
 //
 // Start() opens a pty pair (openpty, raw mode), optionally points a symlink at the slave, prints

@@ -1,4 +1,4 @@
-// Kinematics of the Scorbot ER-VII (5 axes: base, shoulder, elbow, pitch, roll), issue 6.
+// Kinematics of the Scorbot ER-VII (5 axes: base, shoulder, elbow, pitch, roll).
 //
 // FRAMES AND CONVENTIONS (ours; what the real controller does is noted in docs/SCORBOT.md)
 //   w  the robot base frame = the world: origin on the base axis at floor level, Z up along the

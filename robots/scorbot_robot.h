@@ -1,4 +1,4 @@
-// The Scorbot ER-VII on its Controller-A over RS-232 in ACL (issue 6), as a Robot (robot.h).
+// The Scorbot ER-VII on its Controller-A over RS-232 in ACL, as a Robot (robot.h).
 //
 // Layers: SerialPort (serial_port.h) -> AclClient (acl_client.h) -> ScorbotRobot, with the
 // arm's kinematics from scorbot_kinematics.h. Position-only: a move is a Cartesian ACL point

@@ -1,4 +1,4 @@
-// The serial transport of the Scorbot driver (issue 6): a byte link with timeouts.
+// The serial transport of the Scorbot driver: a byte link with timeouts.
 //
 // ByteLink is the small interface the ACL command layer depends on (shared/STYLE.md: "the
 // serial driver depends on a small transport interface"), so tests can run the command layer

@@ -1,4 +1,4 @@
-// A free-flying camera robot on vpSimulatorCamera (issue 5): 6 DOF, velocity and position.
+// A free-flying camera robot on vpSimulatorCamera: 6 DOF, velocity and position.
 //
 // Velocity: SetVelocity() integrates the twist over one sampling period through the
 // exponential map, as vpSimulatorCamera does: wMc <- wMc * vpExponentialMap::direct(v, dt).

@@ -1,4 +1,4 @@
-// Rendered sequences with ground truth for comparing line trackers (issue 3): a camera moving
+// Rendered sequences with ground truth for comparing line trackers: a camera moving
 // in front of a line target, with per-frame effects (occluders, illumination changes), each
 // a pure function of (kind, frame count, seed).
 //

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 3's comparison: renders the six tracking sequences on the 2 m four-line board (the
+# The tracker comparison: renders the six tracking sequences on the 2 m four-line board (the
 # target they are made for; render's default is the A3 sheet) and ViSP's real line/
 # sequence's reference, runs `oalservo compare` on each and gathers the tables in out/compare/.
 #   scripts/compare-sequences.sh [FRAMES] [SEED]

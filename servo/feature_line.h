@@ -31,7 +31,7 @@
 //
 // vpFeatureLine::interaction() also needs the plane (A, B, C, D) through the 3-D line, which
 // no image gives: these builders set rho and theta only; set the plane with setABCD() (from a
-// pose, e.g. issue 4's). They never touch A, B, C, D.
+// pose, e.g. the pose evaluation's). They never touch A, B, C, D.
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>

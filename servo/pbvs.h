@@ -1,5 +1,5 @@
-// Position-based visual servoing of an eye-in-hand camera to a goal pose (paper, section 4;
-// issue 5): three laws on one vpServo PBVS task.
+// Position-based visual servoing of an eye-in-hand camera to a goal pose (paper, section 4):
+// three laws on one vpServo PBVS task.
 //
 // Frames (docs/ARCHITECTURE.md): c = current camera, cd = desired (goal) camera, o = target.
 //   cMo   the current pose of the target in the camera (estimated by servo/pose.h),

@@ -1,5 +1,5 @@
 // The servo app driving the Scorbot ER-VII through the real ACL driver over a pseudo-terminal,
-// against the Controller-A simulator started by the loop (config/scorbot-sim.yaml; issue 6).
+// against the Controller-A simulator started by the loop (config/scorbot-sim.yaml).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>

@@ -1,4 +1,4 @@
-// The servo app beyond the simulated default (issue 5): replayed recordings (open loop), the
+// The servo app beyond the simulated default: replayed recordings (open loop), the
 // V4L2 source failing clearly, a goal taught from an image, the output files (plot, annotated
 // frames, window), the per-law convergence from random starts, and the new config sections.
 #include <gmock/gmock.h>
@@ -466,7 +466,7 @@ TEST(ServoOutput, PlotScriptHasBothSeriesAndTheTolerances) {
   EXPECT_THAT(script, ::testing::Not(HasSubstr("true (simulation)")));  // no truth: no series
 }
 
-// Issue 5's convergence from random starts (0.3-0.8 m, up to 30 deg off), image in the loop,
+// Convergence from random starts (0.3-0.8 m, up to 30 deg off), image in the loop,
 // every law; a few starts on small images here, 100 at 640x480 in docs/BENCHMARKS.md.
 TEST(ServoAccuracy, EveryLawConvergesFromRandomStarts) {
   const ServoAppConfig config = Small(DefaultServoConfig());

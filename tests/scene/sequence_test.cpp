@@ -1,4 +1,4 @@
-// Rendered sequences (issue 3): names, determinism, and that each scenario has the property it
+// Rendered sequences: names, determinism, and that each scenario has the property it
 // claims. Most checks use the ground truth only; frames are rendered where the image matters.
 #include "scene/sequence.h"
 
