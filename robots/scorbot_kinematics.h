@@ -50,9 +50,9 @@ using ScorbotJoints = std::array<double, 5>;
 /// Encoder counts of axes 1..5.
 using ScorbotCounts = std::array<long, 5>;
 
-/// Geometry and joint limits of the arm. Lengths from the issue (ER-VII data sheet values as
-/// quoted there); how the joint ranges sit around zero and the encoder resolution are ours and
-/// unverified on hardware (docs/SCORBOT.md).
+/// Geometry and joint limits of the arm. Lengths: the ER-VII data sheet's values; how the joint
+/// ranges sit around zero and the encoder resolution are ours and unverified on hardware
+/// (docs/SCORBOT.md).
 struct ScorbotGeometry {
   /// Height of the shoulder axis above the base plane, m; > 0.
   double shoulder_height_m = 0.3585;
@@ -66,7 +66,7 @@ struct ScorbotGeometry {
   double pitch_to_flange_m = 0.251;
   /// Flange to the tool centre point along the tool axis, m; >= 0.
   double tool_length_m = 0.0;
-  /// Joint ranges, degrees; min < max. Spans from the issue (250, 170, 225, 180, 360).
+  /// Joint ranges, degrees; min < max. Spans from the data sheet (250, 170, 225, 180, 360).
   std::array<double, 5> joint_min_deg{-125.0, -35.0, -112.5, -90.0, -180.0};
   std::array<double, 5> joint_max_deg{125.0, 135.0, 112.5, 90.0, 180.0};
   /// Joint angles at the home position (encoder counts 0), degrees; inside the ranges.

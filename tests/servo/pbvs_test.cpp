@@ -20,7 +20,7 @@
 namespace oal {
 namespace {
 
-constexpr double kTolTranslationM = 0.001;  // the 1 mm
+constexpr double kTolTranslationM = 0.001;  // the servo tolerance, 1 mm
 constexpr double kTolRotationDeg = 0.1;     // and 0.1 deg
 constexpr double kExact = 1e-9;             // floating-point identities
 constexpr int kTrials = 100;
