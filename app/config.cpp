@@ -747,11 +747,12 @@ const std::vector<Field<RobotConfig>>& RobotFields() {
   static const std::vector<Field<O>> fields = {
       {"type",
        [](const Value& value, O* robot) {
-         robot->type = value.As<std::string>("a string");
-         if (robot->type != "simulated" && robot->type != "scorbot") {
-           value.Fail("'" + value.key + "' must be one of simulated, scorbot, got '" + robot->type +
-                      "'");
+         const std::string word = value.As<std::string>("a string");
+         const std::optional<RobotType> type = RobotTypeFromString(word);
+         if (!type) {
+           value.Fail("'" + value.key + "' must be one of simulated, scorbot, got '" + word + "'");
          }
+         robot->type = *type;
        }},
       {"scorbot",
        [](const Value& value, O* robot) {
@@ -849,7 +850,15 @@ const std::vector<Field<SourceConfig>>& SourceFields() {
   using O = SourceConfig;
   static const std::vector<Field<O>> fields = {
       {"type",
-       [](const Value& value, O* source) { source->type = value.As<std::string>("a string"); }},
+       [](const Value& value, O* source) {
+         const std::string word = value.As<std::string>("a string");
+         const std::optional<SourceType> type = SourceTypeFromString(word);
+         if (!type) {
+           value.Fail("'" + value.key + "' is invalid: '" + word +
+                      "' is not one of simulated, v4l2, replay");
+         }
+         source->type = *type;
+       }},
       {"device",
        [](const Value& value, O* source) { source->device = value.As<std::string>("a path"); }},
       IntField("fps", &O::fps),
@@ -868,7 +877,14 @@ const std::vector<Field<OutputConfig>>& OutputFields() {
       {"directory",
        [](const Value& value, O* output) { output->directory = value.As<std::string>("a path"); }},
       {"display",
-       [](const Value& value, O* output) { output->display = value.As<std::string>("a string"); }},
+       [](const Value& value, O* output) {
+         const std::string word = value.As<std::string>("a string");
+         const std::optional<DisplayMode> mode = DisplayModeFromString(word);
+         if (!mode) {
+           value.Fail("'" + value.key + "' is invalid: '" + word + "' is not one of auto, on, off");
+         }
+         output->display = *mode;
+       }},
       BoolField("save_frames", &O::save_frames),
   };
   return fields;
@@ -1070,7 +1086,8 @@ void RecordOrigins(const YAML::Node& node, const std::string& prefix, const std:
 // workspace box: the run would begin where no move is allowed.
 void CheckStartInWorkspace(const AppConfig& config, const std::string& file) {
   const RobotConfig& robot = config.robot;
-  if (robot.type != "simulated" && robot.scorbot.port != "simulator") return;  // a real arm
+  if (robot.type != RobotType::kSimulated && robot.scorbot.port != "simulator")
+    return;  // a real arm
   const vpHomogeneousMatrix wMx = robot.safety.workspace_frame == RobotFrame::kCamera
                                       ? robot.start_wMc
                                       : robot.start_wMc * config.camera.eMc.inverse();
@@ -1239,36 +1256,76 @@ void CameraConfig::Check() const {
 }
 
 void RobotConfig::Check() const {
-  if (type != "simulated" && type != "scorbot") {
-    Violated("RobotConfig::type", type, "type is simulated or scorbot");
-  }
   if (!(sampling_time_s > 0.0 && sampling_time_s <= 1.0)) {
     Violated("RobotConfig::sampling_time_s", Num(sampling_time_s), "0 < sampling_time_s <= 1");
   }
   safety.Check();
-  if (type == "scorbot") {
+  if (type == RobotType::kScorbot) {
     scorbot.Check();
     if (scorbot.port == "simulator") simulator.Check();
   }
 }
 
 void SourceConfig::Check() const {
-  if (type != "simulated" && type != "v4l2" && type != "replay") {
-    Violated("SourceConfig::type", type, "type is one of simulated, v4l2, replay");
-  }
-  if (type == "v4l2" && device.empty()) Violated("SourceConfig::device", "''", "a device path");
+  if (type == SourceType::kV4l2 && device.empty())
+    Violated("SourceConfig::device", "''", "a device path");
   if (fps != 0 && fps != 25 && fps != 50) {
     Violated("SourceConfig::fps", Num(fps), "fps is 0 (the driver's), 25 or 50");
   }
-  if (type == "replay" && path.empty()) {
+  if (type == SourceType::kReplay && path.empty()) {
     Violated("SourceConfig::path", "''", "a video, directory or pattern to replay");
   }
 }
 
-void OutputConfig::Check() const {
-  if (display != "auto" && display != "on" && display != "off") {
-    Violated("OutputConfig::display", display, "display is one of auto, on, off");
+void OutputConfig::Check() const {}
+
+std::string ToString(RobotType type) {
+  return type == RobotType::kScorbot ? "scorbot" : "simulated";
+}
+
+std::string ToString(SourceType type) {
+  switch (type) {
+    case SourceType::kV4l2:
+      return "v4l2";
+    case SourceType::kReplay:
+      return "replay";
+    case SourceType::kSimulated:
+      break;
   }
+  return "simulated";
+}
+
+std::string ToString(DisplayMode mode) {
+  switch (mode) {
+    case DisplayMode::kOn:
+      return "on";
+    case DisplayMode::kOff:
+      return "off";
+    case DisplayMode::kAuto:
+      break;
+  }
+  return "auto";
+}
+
+std::optional<RobotType> RobotTypeFromString(const std::string& word) {
+  for (const RobotType type : {RobotType::kSimulated, RobotType::kScorbot}) {
+    if (word == ToString(type)) return type;
+  }
+  return std::nullopt;
+}
+
+std::optional<SourceType> SourceTypeFromString(const std::string& word) {
+  for (const SourceType type : {SourceType::kSimulated, SourceType::kV4l2, SourceType::kReplay}) {
+    if (word == ToString(type)) return type;
+  }
+  return std::nullopt;
+}
+
+std::optional<DisplayMode> DisplayModeFromString(const std::string& word) {
+  for (const DisplayMode mode : {DisplayMode::kAuto, DisplayMode::kOn, DisplayMode::kOff}) {
+    if (word == ToString(mode)) return mode;
+  }
+  return std::nullopt;
 }
 
 int ServoLoopOptions::IterationLimit(bool replay) const {

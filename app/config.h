@@ -97,12 +97,31 @@ struct CameraConfig {
   void Check() const;
 };
 
+/// `robot.type`: a free-flying camera (vpSimulatorCamera), or the Scorbot ER-VII over RS-232 in
+/// ACL (robot.scorbot.port "simulator" runs the Controller-A simulator on a pseudo-terminal in
+/// the process).
+enum class RobotType { kSimulated, kScorbot };
+/// `source.type`: the target rendered from the robot's camera pose every iteration (closed
+/// loop, the default); a real camera on the robot (vpV4l2Grabber), closed loop; a video, image
+/// directory, printf pattern or /dev/videoN replayed open loop (the law's commands computed and
+/// logged, the robot not moved).
+enum class SourceType { kSimulated, kV4l2, kReplay };
+/// `output.display`: a vpDisplayX window when $DISPLAY is set; a window or an error; none.
+enum class DisplayMode { kAuto, kOn, kOff };
+
+/// The one place these meet the configuration's words: "simulated", "scorbot"; "simulated",
+/// "v4l2", "replay"; "auto", "on", "off".
+std::string ToString(RobotType type);
+std::string ToString(SourceType type);
+std::string ToString(DisplayMode mode);
+/// The word's value; nullopt for a word that is none of them.
+std::optional<RobotType> RobotTypeFromString(const std::string& word);
+std::optional<SourceType> SourceTypeFromString(const std::string& word);
+std::optional<DisplayMode> DisplayModeFromString(const std::string& word);
+
 /// `robot:` which robot, where it starts, and the runner's safety limits.
 struct RobotConfig {
-  /// "simulated" (a free-flying camera, vpSimulatorCamera) or "scorbot" (the ER-VII over
-  /// RS-232 in ACL; robot.scorbot.port "simulator" runs the Controller-A simulator on a
-  /// pseudo-terminal in the process).
-  std::string type = "simulated";
+  RobotType type = RobotType::kSimulated;
   /// Start pose of the camera in the world: the simulated robot's, or the Scorbot
   /// simulator's (nearest reachable); a real arm starts where it stands.
   vpHomogeneousMatrix start_wMc;
@@ -140,11 +159,7 @@ struct ServoLoopOptions {
 
 /// `source:` where the servo loop's frames come from.
 struct SourceConfig {
-  /// "simulated": the target rendered from the robot's camera pose every iteration (closed
-  /// loop, the default); "v4l2": a real camera on the robot (vpV4l2Grabber), closed loop;
-  /// "replay": a video, image directory, printf pattern or /dev/videoN played open loop: the
-  /// law's commands are computed and logged, the robot is not moved.
-  std::string type = "simulated";
+  SourceType type = SourceType::kSimulated;
   std::string device = "/dev/video0";  ///< v4l2: the device; its size is camera.width/height
   int fps = 0;                         ///< v4l2: 25 or 50 (vpV4l2Grabber's rates); 0: driver's
   /// replay: what to play (app/image_source.h); relative paths are relative to the config file.
@@ -159,8 +174,7 @@ struct OutputConfig {
   /// servo.csv, servo-error.png and frames/ go here (relative to the working directory);
   /// `oalservo servo --out DIR` overrides it. Empty: write nothing.
   std::string directory = "out/servo";
-  /// "auto": a vpDisplayX window when $DISPLAY is set; "on": a window or an error; "off".
-  std::string display = "auto";
+  DisplayMode display = DisplayMode::kAuto;
   /// Without a window, write each iteration's annotated frame to DIR/frames/iter_NNNN.png.
   bool save_frames = true;
 

@@ -261,8 +261,8 @@ Outcome RunOnce(const ServoAppConfig& base, const FaultCampaignOptions& options,
                 const std::optional<FaultPlan>& plan, const fs::path& dir) {
   ServoAppConfig config = base;
   config.output.directory = dir.string();
-  config.output.display = "off";
-  const bool scorbot = config.robot.type == "scorbot";
+  config.output.display = DisplayMode::kOff;
+  const bool scorbot = config.robot.type == RobotType::kScorbot;
   std::unique_ptr<ScorbotControllerSim> sim;
   if (scorbot) {
     ScorbotSimOptions sim_options = ControllerSimOptions(config);
@@ -467,13 +467,13 @@ FaultRun Judge(const Outcome& outcome, const FaultPlan& plan, const fs::path& di
 void CheckCampaignConfig(const ServoAppConfig& config) {
   config.robot.Check();
   config.source.Check();
-  if (config.source.type != "simulated") {
+  if (config.source.type != SourceType::kSimulated) {
     throw std::invalid_argument(
         "the fault campaign renders its frames: source.type must be "
         "simulated, not " +
-        config.source.type);
+        ToString(config.source.type));
   }
-  if (config.robot.type == "scorbot" && config.robot.scorbot.port != "simulator") {
+  if (config.robot.type == RobotType::kScorbot && config.robot.scorbot.port != "simulator") {
     const std::string origin = config.Origin("robot.scorbot.port");
     throw std::invalid_argument(
         "the fault campaign drives the Controller-A simulator, never an arm: " +
@@ -512,11 +512,11 @@ std::string ToString(FaultKind kind) {
   return "impact";
 }
 
-std::vector<FaultKind> FaultKindsFor(const std::string& robot_type) {
+std::vector<FaultKind> FaultKindsFor(RobotType robot_type) {
   const std::vector<FaultKind> frames = {FaultKind::kUnreadableFrame, FaultKind::kOcclusion,
                                          FaultKind::kPoseJump};
   std::vector<FaultKind> kinds;
-  if (robot_type == "scorbot") {
+  if (robot_type == RobotType::kScorbot) {
     kinds = {FaultKind::kImpact,    FaultKind::kControllerSilent, FaultKind::kReplyCut,
              FaultKind::kLineNoise, FaultKind::kPortClosed,       FaultKind::kXoffHeld};
   } else {
@@ -691,7 +691,7 @@ std::string FaultCampaignJson(const FaultCampaignReport& report) {
                           {"time_scale", o.time_scale},
                           {"jobs", o.jobs},
                           {"work_dir", o.work_dir}}},
-                        {"robot", report.robot_type},
+                        {"robot", ToString(report.robot_type)},
                         {"fault_free_run_s", report.fault_free_s},
                         {"fault_free_true_translation_error_mm", report.fault_free_translation_mm},
                         {"fault_free_true_rotation_error_deg", report.fault_free_rotation_deg},

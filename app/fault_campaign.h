@@ -49,9 +49,9 @@ enum class FaultKind {
 /// "drive-fault", "drive-timeout", "unreadable-frame", "occlusion", "pose-jump".
 std::string ToString(FaultKind kind);
 
-/// The faults of `robot_type` ("scorbot": the link's and the frames'; else the drive's and the
+/// The faults of `robot_type` (the Scorbot: the link's and the frames'; else the drive's and the
 /// frames'), in the order runs take them in turn.
-std::vector<FaultKind> FaultKindsFor(const std::string& robot_type);
+std::vector<FaultKind> FaultKindsFor(RobotType robot_type);
 
 struct FaultCampaignOptions {
   int runs = 1000;         ///< [1, 1000000]
@@ -89,7 +89,7 @@ struct FaultRun {
 
 struct FaultCampaignReport {
   FaultCampaignOptions options;
-  std::string robot_type;
+  RobotType robot_type = RobotType::kSimulated;
   double fault_free_s = 0;  ///< the fault-free run's duration
   double fault_free_translation_mm = 0, fault_free_rotation_deg = 0;  ///< its true final error
   std::vector<FaultRun> runs;

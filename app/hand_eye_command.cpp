@@ -102,16 +102,16 @@ std::string ConfigNames(const std::vector<std::string>& paths) {
 std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix* configured_eMc) {
   ServoAppConfig config = DefaultServoConfig();
   for (const std::string& path : settings.config_paths) config = LoadConfig(path, config);
-  if (config.source.type == "replay") {
+  if (config.source.type == SourceType::kReplay) {
     throw std::runtime_error(
         KeyAt(config, "source.type") +
         " is replay: the routine needs the camera on the arm (simulated or v4l2); for pairs "
         "recorded before use --pairs");
   }
-  if (config.camera.true_eMc && config.source.type != "simulated") {
+  if (config.camera.true_eMc && config.source.type != SourceType::kSimulated) {
     throw std::runtime_error(KeyAt(config, "camera.true_eMc") +
                              " is the mounting of a simulated camera; source.type is " +
-                             config.source.type + ": remove it");
+                             ToString(config.source.type) + ": remove it");
   }
   *configured_eMc = config.camera.eMc;
   const LoopModel model(config);

@@ -32,9 +32,9 @@ ScorbotSimOptions SimOptions(const ScorbotSimCommandOptions& options) {
     ServoCommandOptions servo;
     servo.config_path = options.config_path;
     const ServoAppConfig config = LoadServoConfig(servo);
-    if (config.robot.type != "scorbot") {
+    if (config.robot.type != RobotType::kScorbot) {
       throw std::invalid_argument("--config " + options.config_path + ": robot.type is '" +
-                                  config.robot.type +
+                                  ToString(config.robot.type) +
                                   "', not scorbot: it has no Scorbot start to take");
     }
     sim = ControllerSimOptions(config);

@@ -78,7 +78,13 @@ ServoAppConfig LoadServoConfig(const ServoCommandOptions& options) {
   for (const std::string& path : options.more_config_paths) config = LoadConfig(path, config);
   if (!options.out_dir.empty()) config.output.directory = options.out_dir;
   if (!options.mode.empty()) config.servo.law.mode = ServoModeFromString(options.mode);
-  if (!options.display.empty()) config.output.display = options.display;
+  if (!options.display.empty()) {
+    const std::optional<DisplayMode> display = DisplayModeFromString(options.display);
+    if (!display) {
+      throw std::invalid_argument("--display " + options.display + ": give auto, on or off");
+    }
+    config.output.display = *display;
+  }
   config.output.Check();
   return config;
 }
@@ -108,7 +114,7 @@ class FrameOutput {
   FrameOutput(const ServoAppConfig& config, const fs::path& frames_dir) : frames_dir_(frames_dir) {
     const OutputConfig& output = config.output;
     const int width = config.camera.width, height = config.camera.height;
-    if (output.display == "on") {
+    if (output.display == DisplayMode::kOn) {
       try {
         window_ = std::make_unique<ServoWindow>(width, height);
       } catch (const std::runtime_error& error) {
@@ -116,7 +122,7 @@ class FrameOutput {
         throw std::runtime_error("output.display is on but " + std::string(error.what()) +
                                  "; use output.display auto or off (--display)");
       }
-    } else if (output.display == "auto" && CanOpenServoWindow()) {
+    } else if (output.display == DisplayMode::kAuto && CanOpenServoWindow()) {
       try {
         window_ = std::make_unique<ServoWindow>(width, height);
       } catch (const std::runtime_error& error) {

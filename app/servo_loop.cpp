@@ -168,7 +168,7 @@ void CheckServoConfig(const ServoAppConfig& config) {
   config.robot.Check();
   config.servo.Check();
   config.source.Check();
-  if (config.source.type == "v4l2" && config.robot.type == "simulated") {
+  if (config.source.type == SourceType::kV4l2 && config.robot.type == RobotType::kSimulated) {
     throw std::invalid_argument(
         "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
         "whose motion the camera would not see); to watch a camera without moving anything use "
@@ -180,17 +180,17 @@ void CheckServoConfig(const ServoAppConfig& config) {
                                 " tells the lens to correct it, but camera.correct_distortion "
                                 "is false: give one of them");
   }
-  if (config.camera.estimate_distortion && config.source.type != "simulated" &&
+  if (config.camera.estimate_distortion && config.source.type != SourceType::kSimulated &&
       config.camera.kdu != 0.0) {
     throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
                                 " tells the lens from the stripes, but the camera gives kdu " +
                                 Number(config.camera.kdu) + " (" + KeyAt(config, "camera.kdu") +
                                 "): give one of them");
   }
-  if (config.camera.true_eMc && config.source.type != "simulated") {
+  if (config.camera.true_eMc && config.source.type != SourceType::kSimulated) {
     throw std::invalid_argument(KeyAt(config, "camera.true_eMc") +
                                 " is the mounting of a simulated camera; source.type is " +
-                                config.source.type + ": remove it");
+                                ToString(config.source.type) + ": remove it");
   }
 }
 
@@ -318,7 +318,7 @@ ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomoge
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   ServoIteration row;
   row.iteration = iteration;
-  if (config.robot.type == "scorbot") {
+  if (config.robot.type == RobotType::kScorbot) {
     const AclPose acl = ToAclPose(wMc * config.camera.eMc.inverse());
     row.x_mm = acl.x / 10.0;
     row.y_mm = acl.y / 10.0;
@@ -331,7 +331,7 @@ ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomoge
                   &row.yaw_deg);
   }
   row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
-  if (config.source.type == "simulated") {
+  if (config.source.type == SourceType::kSimulated) {
     const PoseDistance truth = Distance(cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
     row.true_translation_error_mm = truth.translation_m * 1e3;
     row.true_rotation_error_deg = vpMath::deg(truth.rotation_rad);
@@ -523,7 +523,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   std::vector<std::string> source_warnings;
   const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &source_warnings);
   for (const std::string& warning : source_warnings) log << "warning: " << warning << '\n';
-  const bool moves_robot = config.source.type != "replay";
+  const bool moves_robot = config.source.type != SourceType::kReplay;
 
   int move_iteration = -1;  // the iteration whose move runs, for Hooks::on_move_poll
   const RobotRig rig = OpenRobot(
@@ -549,7 +549,8 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   if (!moves_robot) {
     log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
   }
-  const TableColumns columns{config.robot.type != "scorbot", config.source.type == "simulated"};
+  const TableColumns columns{config.robot.type != RobotType::kScorbot,
+                             config.source.type == SourceType::kSimulated};
   std::optional<StopGuard> guard;  // from Connect() on
   bool moved_since_row = false;    // a motion was commanded after it
   auto finish = [&](Stop stop) {
@@ -581,7 +582,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
 
   if (RobotResult r = robot.Connect(); !r.ok()) {
     std::string message = "cannot connect the robot: " + r.message;
-    if (config.robot.type == "scorbot" && config.robot.scorbot.port != "simulator") {
+    if (config.robot.type == RobotType::kScorbot && config.robot.scorbot.port != "simulator") {
       message += " (check " + KeyAt(config, "robot.scorbot.port") + " = '" +
                  config.robot.scorbot.port + "')";
     }

@@ -98,7 +98,7 @@ ScorbotSimOptions ControllerSimOptions(const ServoAppConfig& config) {
 
 RobotRig OpenConfiguredRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll) {
   RobotRig rig;
-  if (config.robot.type == "scorbot") {
+  if (config.robot.type == RobotType::kScorbot) {
     ScorbotOptions options = config.robot.scorbot;
     options.eMc = config.camera.eMc;
     if (options.port == "simulator") {
@@ -136,8 +136,8 @@ std::string KeyAt(const ServoAppConfig& config, const std::string& key) {
 std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config,
                                            std::vector<std::string>* warnings) {
   const SourceConfig& source = config.source;
-  if (source.type == "simulated") return std::make_unique<RenderedCamera>(config);
-  const bool v4l2 = source.type == "v4l2";
+  if (source.type == SourceType::kSimulated) return std::make_unique<RenderedCamera>(config);
+  const bool v4l2 = source.type == SourceType::kV4l2;
   const std::string key = v4l2 ? "source.device" : "source.path";
   try {
     if (v4l2) {

@@ -99,7 +99,7 @@ TEST(FaultCampaign, RefusesARealArmOrCamera) {
                             "scorbot-sim.yaml:[0-9]+: robot.scorbot.port is '/dev/ttyUSB0', not "
                             "simulator"));
   config = DefaultServoConfig();
-  config.source.type = "replay";
+  config.source.type = SourceType::kReplay;
   config.source.path = "frames/";
   EXPECT_THAT(
       test::ErrorMessageOf<std::invalid_argument>([&] { RunFaultCampaign(config, options); }),

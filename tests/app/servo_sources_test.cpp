@@ -50,10 +50,10 @@ TEST(ServoConfigSections, SourceOutputAndGoalImageAreReadAndChecked) {
       "output: {directory: out/x, display: off, save_frames: false}\n"
       "goal: {image: goal.png}\n",
       "dir/servo.yaml");
-  EXPECT_EQ(config.source.type, "replay");
+  EXPECT_EQ(config.source.type, SourceType::kReplay);
   EXPECT_EQ(config.source.path, "dir/rec/frame_%04d.png");  // next to the config file
   EXPECT_EQ(config.output.directory, "out/x");
-  EXPECT_EQ(config.output.display, "off");
+  EXPECT_EQ(config.output.display, DisplayMode::kOff);
   EXPECT_FALSE(config.output.save_frames);
   EXPECT_EQ(config.goal_image, "dir/goal.png");
   EXPECT_EQ(config.goal_image_origin, "dir/servo.yaml:3");
@@ -82,7 +82,7 @@ ServoAppConfig ReplayOfStillFrames(const test::TestDir& dir, int count) {
     std::snprintf(name, sizeof(name), "frame_%04d.png", i);
     WriteView(config, start_cMo, 7 + i, dir / name);
   }
-  config.source.type = "replay";
+  config.source.type = SourceType::kReplay;
   config.source.path = dir / "frame_%04d.png";
   return config;
 }
@@ -167,7 +167,7 @@ TEST(ServoSources, AMissingRecordingNamesSourcePathAndWhereItWasSet) {
 TEST(ServoSources, ReplayOfAWrongSizeOrMissingRecordingFailsClearly) {
   const test::TestDir dir;
   ServoAppConfig config = Small(DefaultServoConfig());
-  config.source.type = "replay";
+  config.source.type = SourceType::kReplay;
   config.source.path = dir / "missing.avi";
   std::ostringstream log;
   EXPECT_THROW(
@@ -192,7 +192,7 @@ TEST(ServoSources, ReplayOfAWrongSizeOrMissingRecordingFailsClearly) {
 
 TEST(ServoSources, V4l2WithoutADeviceOrWithTheSimulatedRobotFailsBeforeMoving) {
   ServoAppConfig config = Small(DefaultServoConfig());
-  config.source.type = "v4l2";
+  config.source.type = SourceType::kV4l2;
   config.source.device = "/dev/video97";
   std::ostringstream log;
   try {
@@ -202,7 +202,7 @@ TEST(ServoSources, V4l2WithoutADeviceOrWithTheSimulatedRobotFailsBeforeMoving) {
     EXPECT_THAT(error.what(), HasSubstr("needs a real robot carrying the camera"));
     EXPECT_THAT(error.what(), HasSubstr("type: replay, path: /dev/video97"));
   }
-  config.source.type = "replay";
+  config.source.type = SourceType::kReplay;
   config.source.path = "/dev/video97";
   try {
     RunServo(config, log);
