@@ -120,6 +120,7 @@ class TappedRobot final : public Robot {
     return inner_->PoseAlongMove(frame, from, target, fraction);
   }
   vpHomogeneousMatrix eMc() const override { return inner_->eMc(); }
+  std::string LinkSummary(int moves) const override { return inner_->LinkSummary(moves); }
 
  private:
   std::optional<RobotResult> Fault() const {

@@ -24,10 +24,6 @@
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
-#include "robots/scorbot_controller_sim.h"
-#include "robots/scorbot_kinematics.h"
-#include "robots/scorbot_robot.h"
-#include "robots/simulated_camera.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"
@@ -139,21 +135,6 @@ RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> o
   RobotRig rig = OpenConfiguredRobot(config, std::move(on_poll));
   if (hooks.wrap_driver) rig.driver = hooks.wrap_driver(std::move(rig.driver));
   return rig;
-}
-
-// Bytes and serial time the run cost on the Scorbot's link ("" for other robots).
-std::string LinkSummary(const Robot& driver, int baud, int moves) {
-  const auto* scorbot = dynamic_cast<const ScorbotRobot*>(&driver);
-  if (scorbot == nullptr) return "";
-  const AclStats stats = scorbot->link_stats();
-  const double bytes = static_cast<double>(stats.link.bytes_written + stats.link.bytes_read);
-  const double serial_s = bytes * 10.0 / baud;  // 8N1: 10 bits a byte
-  std::string summary = "ACL link: " + std::to_string(stats.commands) + " commands, " +
-                        std::to_string(stats.link.bytes_written) + " bytes sent, " +
-                        std::to_string(stats.link.bytes_read) + " received: " + Fixed(serial_s, 2) +
-                        " s of serial time at " + std::to_string(baud) + " baud";
-  if (moves > 0) summary += ", " + Fixed(serial_s / moves, 2) + " s per move";
-  return summary;
 }
 
 // Why the loop ends, for the report.
@@ -313,23 +294,15 @@ std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
 
 // The table row of a camera pose: the Table 3 columns (the Scorbot's own X Y Z P R) and, in
 // simulation, the true error to the goal; the estimate's columns are filled in later.
-ServoIteration RowAt(const ServoAppConfig& config, int iteration, const vpHomogeneousMatrix& wMc,
-                     const vpHomogeneousMatrix& true_cMo, const vpHomogeneousMatrix& cdMo) {
+ServoIteration RowAt(const ServoAppConfig& config, const RobotRig& rig, int iteration,
+                     const vpHomogeneousMatrix& wMc, const vpHomogeneousMatrix& true_cMo,
+                     const vpHomogeneousMatrix& cdMo) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   ServoIteration row;
   row.iteration = iteration;
-  if (config.robot.type == RobotType::kScorbot) {
-    const AclPose acl = ToAclPose(wMc * config.camera.eMc.inverse());
-    row.x_mm = acl.x / 10.0;
-    row.y_mm = acl.y / 10.0;
-    row.z_mm = acl.z / 10.0;
-    row.pitch_deg = acl.p / 10.0;
-    row.roll_deg = acl.r / 10.0;
-    row.yaw_deg = kNaN;  // 5 axes: the tool's yaw follows the base
-  } else {
-    Table3Columns(wMc, &row.x_mm, &row.y_mm, &row.z_mm, &row.pitch_deg, &row.roll_deg,
-                  &row.yaw_deg);
-  }
+  const PoseColumns at = rig.columns(wMc);
+  row.x_mm = at.x_mm, row.y_mm = at.y_mm, row.z_mm = at.z_mm;
+  row.pitch_deg = at.pitch_deg, row.roll_deg = at.roll_deg, row.yaw_deg = at.yaw_deg;
   row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
   if (config.source.type == SourceType::kSimulated) {
     const PoseDistance truth = Distance(cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
@@ -549,8 +522,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   if (!moves_robot) {
     log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
   }
-  const TableColumns columns{config.robot.type != RobotType::kScorbot,
-                             config.source.type == SourceType::kSimulated};
+  const TableColumns columns{rig.has_yaw, config.source.type == SourceType::kSimulated};
   std::optional<StopGuard> guard;  // from Connect() on
   bool moved_since_row = false;    // a motion was commanded after it
   auto finish = [&](Stop stop) {
@@ -565,8 +537,9 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
       if (where.result.ok()) {
         report.final_wMc = where.pose;
         if (moved_since_row && !report.iterations.empty()) {
-          ServoIteration row = RowAt(config, report.iterations.back().iteration + 1, where.pose,
-                                     where.pose.inverse() * config.target_wMo, report.cdMo);
+          ServoIteration row =
+              RowAt(config, rig, report.iterations.back().iteration + 1, where.pose,
+                    where.pose.inverse() * config.target_wMo, report.cdMo);
           row.status = "stopped";
           LogRow(row, columns, log);
           report.iterations.push_back(row);
@@ -575,18 +548,13 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
         report.message += "; position after the stop unknown: " + where.result.message;
       }
     }
-    if (guard)
-      report.link_summary = LinkSummary(*rig.driver, config.robot.scorbot.baud, report.moves);
+    if (guard) report.link_summary = rig.driver->LinkSummary(report.moves);
     return report;
   };
 
   if (RobotResult r = robot.Connect(); !r.ok()) {
-    std::string message = "cannot connect the robot: " + r.message;
-    if (config.robot.type == RobotType::kScorbot && config.robot.scorbot.port != "simulator") {
-      message += " (check " + KeyAt(config, "robot.scorbot.port") + " = '" +
-                 config.robot.scorbot.port + "')";
-    }
-    return finish({ServoRunStatus::kError, message});
+    return finish(
+        {ServoRunStatus::kError, "cannot connect the robot: " + r.message + rig.connect_hint});
   }
   guard.emplace(robot, hooks);
   if (RobotResult r = robot.Enable(); !r.ok()) {
@@ -642,7 +610,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
             Grab(*frames, config.camera, true_cMo, iteration, hooks.on_grab, &gray)) {
       return finish(*stop);
     }
-    report.iterations.push_back(RowAt(config, iteration, wMc, true_cMo, report.cdMo));
+    report.iterations.push_back(RowAt(config, rig, iteration, wMc, true_cMo, report.cdMo));
     moved_since_row = false;
     ServoIteration& current = report.iterations.back();
 

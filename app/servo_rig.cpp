@@ -1,10 +1,12 @@
 #include "app/servo_rig.h"
 
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
 #include "app/image_source.h"
+#include "app/servo_loop.h"  // Table3Columns
 #include "robots/scorbot_kinematics.h"
 #include "robots/scorbot_robot.h"
 #include "robots/simulated_camera.h"
@@ -107,6 +109,17 @@ RobotRig OpenConfiguredRobot(const ServoAppConfig& config, std::function<void(in
       options.port = rig.controller->ConnectPath();
     }
     rig.driver = std::make_unique<ScorbotRobot>(options);
+    // The controller's own X, Y, Z of the tool centre point and P, R (ACL); no free yaw.
+    rig.columns = [eMc = config.camera.eMc](const vpHomogeneousMatrix& wMc) {
+      const AclPose acl = ToAclPose(wMc * eMc.inverse());
+      return PoseColumns{acl.x / 10.0, acl.y / 10.0, acl.z / 10.0,
+                         acl.p / 10.0, acl.r / 10.0, std::numeric_limits<double>::quiet_NaN()};
+    };
+    rig.has_yaw = false;
+    if (config.robot.scorbot.port != "simulator") {
+      rig.connect_hint = " (check " + KeyAt(config, "robot.scorbot.port") + " = '" +
+                         config.robot.scorbot.port + "')";
+    }
     return rig;
   }
   SimulatedCameraOptions options;
@@ -118,6 +131,11 @@ RobotRig OpenConfiguredRobot(const ServoAppConfig& config, std::function<void(in
   options.eMc = config.camera.eMc;
   options.on_poll = std::move(on_poll);
   rig.driver = std::make_unique<SimulatedCamera>(options);
+  rig.columns = [](const vpHomogeneousMatrix& wMc) {
+    PoseColumns c;
+    Table3Columns(wMc, &c.x_mm, &c.y_mm, &c.z_mm, &c.pitch_deg, &c.roll_deg, &c.yaw_deg);
+    return c;
+  };
   return rig;
 }
 

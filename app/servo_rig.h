@@ -44,6 +44,12 @@ struct LoopModel {
   }
 };
 
+// A robot's position as the log's and servo.csv's columns show it.
+struct PoseColumns {
+  double x_mm = 0, y_mm = 0, z_mm = 0;
+  double pitch_deg = 0, roll_deg = 0, yaw_deg = 0;
+};
+
 // Where the loop's frames come from (config `source:`).
 class LoopCamera {
  public:
@@ -64,6 +70,12 @@ class LoopCamera {
 struct RobotRig {
   std::unique_ptr<ScorbotControllerSim> controller;
   std::unique_ptr<Robot> driver;
+  /// Where a camera pose wMc puts the robot, as its controller would say it: the log's and
+  /// servo.csv's position columns (ServoIteration). yaw NaN for an arm without a free yaw.
+  std::function<PoseColumns(const vpHomogeneousMatrix& wMc)> columns;
+  bool has_yaw = true;  ///< the columns have a yaw
+  /// Appended to a failure to connect: which setting to check ("" when none).
+  std::string connect_hint;
 };
 
 /// The Controller-A simulator of a Scorbot configuration (robot.simulator, the arm's geometry

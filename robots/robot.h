@@ -157,6 +157,10 @@ class Robot {
 
   /// The hand-eye transform: the camera in the end-effector frame.
   virtual vpHomogeneousMatrix eMc() const = 0;
+  /// What the session has cost on the robot's link so far, one line for the user (commands,
+  /// bytes, serial time; `moves` position moves, for a per-move figure); empty for a robot
+  /// without one (the default).
+  virtual std::string LinkSummary(int /*moves*/) const { return ""; }
 };
 
 /// Distance between two poses: translation in metres and rotation angle in radians of

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "base/check.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -110,6 +111,18 @@ AclStats ScorbotRobot::link_stats() const {
   if (client_) s.commands += client_->stats().commands;
   s.link = port_.counters();
   return s;
+}
+
+std::string ScorbotRobot::LinkSummary(int moves) const {
+  const AclStats stats = link_stats();
+  const double bytes = static_cast<double>(stats.link.bytes_written + stats.link.bytes_read);
+  const double serial_s = bytes * 10.0 / options_.baud;  // 8N1: 10 bits a byte
+  std::string summary = "ACL link: " + std::to_string(stats.commands) + " commands, " +
+                        std::to_string(stats.link.bytes_written) + " bytes sent, " +
+                        std::to_string(stats.link.bytes_read) + " received: " + Fixed(serial_s, 2) +
+                        " s of serial time at " + std::to_string(options_.baud) + " baud";
+  if (moves > 0) summary += ", " + Fixed(serial_s / moves, 2) + " s per move";
+  return summary;
 }
 
 RobotResult ScorbotRobot::FromReply(const AclReply& reply, const std::string& what) {

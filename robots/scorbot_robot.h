@@ -138,6 +138,8 @@ class ScorbotRobot final : public Robot {
   RobotPose PoseAlongMove(RobotFrame frame, const vpHomogeneousMatrix& from,
                           const vpHomogeneousMatrix& target, double fraction) const override;
   vpHomogeneousMatrix eMc() const override { return options_.eMc; }
+  /// The ACL commands, the bytes each way and their serial time at the configured baud rate.
+  std::string LinkSummary(int moves) const override;
 
   /// HOME (blocking, up to home_timeout_s). Needs Enable(). Moves the arm!
   RobotResult Home();
