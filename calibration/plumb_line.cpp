@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "base/check.h"
+#include "detector/lens.h"  // FitKud
 
 namespace oal {
 namespace {
@@ -24,24 +25,6 @@ struct Ideal {
 Ideal Undistort(const Normalised& p, double kdu) {
   const double r2 = p.x * p.x + p.y * p.y, factor = 1.0 + kdu * r2;
   return {p.x * factor, p.y * factor, r2 / factor};
-}
-
-// The kud that best undoes kdu over a width x height image: least squares of
-// x_d = x_u (1 + kud r_u^2) on a grid of distorted points, linear in kud.
-double KudUndoing(double kdu, double px, double py, double u0, double v0, int width, int height) {
-  constexpr int kGrid = 32;
-  double num = 0.0, den = 0.0;
-  for (int j = 0; j <= kGrid; ++j) {
-    for (int i = 0; i <= kGrid; ++i) {
-      const Normalised d{((width - 1.0) * i / kGrid - u0) / px,
-                         ((height - 1.0) * j / kGrid - v0) / py};
-      const Ideal u = Undistort(d, kdu);
-      const double ru2 = u.x * u.x + u.y * u.y;
-      num += u.x * ru2 * (d.x - u.x) + u.y * ru2 * (d.y - u.y);
-      den += (u.x * ru2) * (u.x * ru2) + (u.y * ru2) * (u.y * ru2);
-    }
-  }
-  return den > 0.0 ? num / den : 0.0;
 }
 
 struct Line {
@@ -201,7 +184,9 @@ PlumbLineResult EstimateRadialDistortion(const std::vector<std::vector<Point2d>>
   result.kdu = step.kdu;
   result.points = step.used;
   result.rms_after_px = RmsPx(lines, step.kdu, scale_px);
-  result.kud = KudUndoing(step.kdu, px, py, u0, v0, options.width, options.height);
+  vpCameraParameters camera;
+  camera.initPersProjWithDistortion(px, py, u0, v0, 0.0, step.kdu);
+  result.kud = FitKud(camera, options.width, options.height);
   return result;
 }
 

@@ -1,6 +1,6 @@
 # `cmake --install build [--prefix DIR]`: the oalservo executable in bin/, the example
-# configurations in share/oalservo/config/, and the libraries (base, detector, scene, servo,
-# robots) with their headers and a CMake package, so that another project can write
+# configurations in share/oalservo/config/, and the libraries (base, detector, target, scene,
+# servo, robots) with their headers and a CMake package, so that another project can write
 #
 #   find_package(oalservo 0.1 REQUIRED)
 #   target_link_libraries(my_node PRIVATE oal::detector oal::servo)
@@ -10,7 +10,7 @@
 include(CMakePackageConfigHelpers)
 
 set(OAL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/oalservo)
-foreach(folder base detector scene servo robots)
+foreach(folder base detector target scene servo robots)
   set_target_properties(oal_${folder} PROPERTIES EXPORT_NAME ${folder})
   install(TARGETS oal_${folder} EXPORT oalservoTargets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -1,6 +1,38 @@
 #include "detector/lens.h"
 
+#include <visp3/core/vpPixelMeterConversion.h>
+
+#include <cmath>
+#include <limits>
+
 namespace oal {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Distorted normalised radius r with r (1 + k r^2) = rho (Newton; monotone convergence from
+// r = rho since the cubic is convex for k > 0 and concave for k < 0). NaN when unreachable.
+double DistortedRadius(double k, double rho) {
+  if (k < 0.0) {
+    const double r_turn = 1.0 / std::sqrt(-3.0 * k);  // where d(rho)/dr = 0
+    if (rho > r_turn * (2.0 / 3.0)) return kNaN;
+  }
+  double r = rho;
+  for (int i = 0; i < 200; ++i) {
+    const double step = (k * r * r * r + r - rho) / (3.0 * k * r * r + 1.0);
+    r -= step;
+    if (std::fabs(step) <= 1e-16 * (1.0 + r)) break;
+  }
+  return r;
+}
+
+}  // namespace
+
+double Kdu(const vpCameraParameters& camera) {
+  return camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
+             ? camera.get_kdu()
+             : 0.0;
+}
 
 // Undistort() is vpPixelMeterConversion::convertPoint (distorted pixel -> metre, with kdu)
 // followed by x -> u0 + px * x, folded into one expression; tests/detector/lens_test.cpp
@@ -10,8 +42,49 @@ PointUndistorter::PointUndistorter(const vpCameraParameters& camera)
       v0_(camera.get_v0()),
       inv_px2_(1.0 / (camera.get_px() * camera.get_px())),
       inv_py2_(1.0 / (camera.get_py() * camera.get_py())),
-      kdu_(camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
-               ? camera.get_kdu()
-               : 0.0) {}
+      kdu_(Kdu(camera)) {}
+
+Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y) {
+  const double k = Kdu(camera);
+  const double rho = std::hypot(x, y);
+  double scale = 1.0;  // distorted over ideal normalised radius
+  if (k != 0.0 && rho > 0.0) {
+    const double r = DistortedRadius(k, rho);
+    if (std::isnan(r)) return Point2d{kNaN, kNaN};
+    scale = r / rho;
+  }
+  return Point2d{camera.get_u0() + camera.get_px() * x * scale,
+                 camera.get_v0() + camera.get_py() * y * scale};
+}
+
+double FitKud(const vpCameraParameters& camera, int width, int height) {
+  if (Kdu(camera) == 0.0) return 0.0;
+  // Minimise sum over a grid of distorted pixels of |u0 + px x (1 + kud r^2) - u|^2 (and v),
+  // (x, y) the ideal point of (u, v): linear in kud.
+  constexpr int kSteps = 40;
+  double saa = 0.0, sab = 0.0;
+  for (int j = 0; j <= kSteps; ++j) {
+    for (int i = 0; i <= kSteps; ++i) {
+      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
+      double x = 0.0, y = 0.0;
+      vpPixelMeterConversion::convertPoint(camera, u, v, x, y);
+      const double r2 = x * x + y * y;
+      const double au = camera.get_px() * x * r2, av = camera.get_py() * y * r2;
+      const double bu = u - camera.get_u0() - camera.get_px() * x;
+      const double bv = v - camera.get_v0() - camera.get_py() * y;
+      saa += au * au + av * av;
+      sab += au * bu + av * bv;
+    }
+  }
+  return saa > 0.0 ? sab / saa : 0.0;
+}
+
+vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
+                                 int height) {
+  vpCameraParameters camera;
+  camera.initPersProjWithDistortion(px, py, u0, v0, 0.0, kdu);
+  camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
+  return camera;
+}
 
 }  // namespace oal

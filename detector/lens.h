@@ -1,4 +1,6 @@
-// Lens distortion of feature points (the paper's main source of failures, see NOTES 5).
+// Lens distortion of feature points (the paper's main source of failures, see NOTES 5), and
+// the model's other direction for those who draw or project (the renderer, the tracker's
+// model check, the calibrations).
 //
 // Only the feature points are corrected, never the image: a distorted pixel (u, v) maps to
 // the pixel (u', v') where an ideal pinhole camera with the same intrinsics would have seen
@@ -27,5 +29,22 @@ class PointUndistorter {
  private:
   double u0_, v0_, inv_px2_, inv_py2_, kdu_;
 };
+
+/// ViSP's kdu of `camera`; 0 for a camera without distortion.
+double Kdu(const vpCameraParameters& camera);
+
+/// Distorted pixel of an ideal normalised point (x, y) under the kdu model (numerical
+/// inverse of vpPixelMeterConversion); exact to 1e-9 px. With kdu < 0 the model cannot reach
+/// points beyond a radius; they come back as NaN.
+Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y);
+
+/// The kud that best inverts `kdu` over a width x height image (least squares), so a
+/// camera file written with both is consistent in ViSP's two directions.
+double FitKud(const vpCameraParameters& camera, int width, int height);
+
+/// A camera with ViSP's distortion model: `kdu` and the kud that best inverts it over a
+/// width x height image (FitKud), as a calibration gives both (kud = 0 when kdu = 0).
+vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
+                                 int height);
 
 }  // namespace oal

@@ -35,12 +35,6 @@ bool InRange(double value, double lo, double hi) {
   return value >= lo && value <= hi;
 }
 
-double Kdu(const vpCameraParameters& camera) {
-  return camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
-             ? camera.get_kdu()
-             : 0.0;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Small 3D helpers.
 
@@ -69,22 +63,6 @@ bool IdealLineOf(const vpCameraParameters& camera, const Vec3& a, const Vec3& b,
 Point2d IdealPixel(const vpCameraParameters& camera, const Vec3& p) {
   return {camera.get_u0() + camera.get_px() * p.x / p.z,
           camera.get_v0() + camera.get_py() * p.y / p.z};
-}
-
-// Distorted normalised radius r with r (1 + k r^2) = rho (Newton; monotone convergence from
-// r = rho since the cubic is convex for k > 0 and concave for k < 0). NaN when unreachable.
-double DistortedRadius(double k, double rho) {
-  if (k < 0.0) {
-    const double r_turn = 1.0 / std::sqrt(-3.0 * k);  // where d(rho)/dr = 0
-    if (rho > r_turn * (2.0 / 3.0)) return kNaN;
-  }
-  double r = rho;
-  for (int i = 0; i < 200; ++i) {
-    const double step = (k * r * r * r + r - rho) / (3.0 * k * r * r + 1.0);
-    r -= step;
-    if (std::fabs(step) <= 1e-16 * (1.0 + r)) break;
-  }
-  return r;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1251,106 +1229,6 @@ std::shared_ptr<const SceneDressing> BuildDressing(const LineTarget& target,
 }  // namespace
 
 // -------------------------------------------------------------------------------------------
-// Targets.
-
-void LineTarget::Check() const {
-  RequireOption(board_width_m > 0.0, "LineTarget::board_width_m", board_width_m,
-                "board_width_m > 0");
-  RequireOption(board_height_m > 0.0, "LineTarget::board_height_m", board_height_m,
-                "board_height_m > 0");
-  RequireOption(board_grey >= 0 && board_grey <= 255, "LineTarget::board_grey", board_grey,
-                "0 <= board_grey <= 255");
-  RequireOption(line_grey >= 0 && line_grey <= 255, "LineTarget::line_grey", line_grey,
-                "0 <= line_grey <= 255");
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    const TargetLine& line = lines[i];
-    const std::string prefix = "LineTarget::lines[" + std::to_string(i) + "].";
-    for (const auto& [field, value] : {std::pair<const char*, double>{"x1_m", line.x1_m},
-                                       {"y1_m", line.y1_m},
-                                       {"x2_m", line.x2_m},
-                                       {"y2_m", line.y2_m}}) {
-      RequireOption(std::isfinite(value), prefix + field, value, std::string(field) + " is finite");
-    }
-    RequireOption(line.width_m > 0.0, prefix + "width_m", line.width_m, "width_m > 0");
-    const double length = std::hypot(line.x2_m - line.x1_m, line.y2_m - line.y1_m);
-    RequireOption(length > 0.0, prefix + "length", length, "the two ends differ");
-  }
-}
-
-LineTarget TwoLineTarget() {
-  LineTarget target;
-  target.name = "two-line";
-  target.lines = {TargetLine{-0.06, -1.0, -0.06, 1.0, 0.02},
-                  TargetLine{0.06, -1.0, 0.06, 1.0, 0.02}};
-  return target;
-}
-
-LineTarget FourLineTarget() {
-  LineTarget target;
-  target.name = "four-line-board";
-  // Lines 1 and 3 vertical (0.18 m apart), lines 2 and 4 horizontal (0.13 m apart); the
-  // widths 30, 15, 20 and 17.5 mm differ, line 1 is the widest.
-  target.lines = {
-      TargetLine{-0.08, -1.0, -0.08, 1.0, 0.03}, TargetLine{-1.0, -0.07, 1.0, -0.07, 0.015},
-      TargetLine{0.10, -1.0, 0.10, 1.0, 0.02}, TargetLine{-1.0, 0.06, 1.0, 0.06, 0.0175}};
-  return target;
-}
-
-namespace {
-
-// A '#' on one landscape sheet (config/four-line-a3.yaml explains the choices): the stripes
-// run from margin to margin, the four crossings form a half_x x half_y rectangle (times 2)
-// centred on the sheet, lines 1 and 3 at x = -+half_x, lines 2 and 4 at y = -+half_y.
-LineTarget SheetTarget(const std::string& name, double sheet_width_m, double sheet_height_m,
-                       double margin_m, double half_x_m, double half_y_m,
-                       const std::array<double, 4>& widths_m) {
-  LineTarget target;
-  target.name = name;
-  target.board_width_m = sheet_width_m;
-  target.board_height_m = sheet_height_m;
-  const double x_end = 0.5 * sheet_width_m - margin_m, y_end = 0.5 * sheet_height_m - margin_m;
-  target.lines = {TargetLine{-half_x_m, -y_end, -half_x_m, y_end, widths_m[0]},
-                  TargetLine{-x_end, -half_y_m, x_end, -half_y_m, widths_m[1]},
-                  TargetLine{half_x_m, -y_end, half_x_m, y_end, widths_m[2]},
-                  TargetLine{-x_end, half_y_m, x_end, half_y_m, widths_m[3]}};
-  return target;
-}
-
-}  // namespace
-
-LineTarget FourLineA3Target() {
-  return SheetTarget("four-line-a3", 0.420, 0.297, 0.010, 0.090, 0.062,
-                     {0.024, 0.012, 0.016, 0.014});
-}
-
-LineTarget FourLineA4Target() {
-  return SheetTarget("four-line-a4", 0.297, 0.210, 0.010, 0.063, 0.043,
-                     {0.018, 0.009, 0.012, 0.0105});
-}
-
-LineTarget FourLineLetterTarget() {
-  return SheetTarget("four-line-letter", 0.2794, 0.2159, 0.010, 0.0594, 0.0441,
-                     {0.018, 0.009, 0.012, 0.0105});
-}
-
-const std::vector<std::string>& TargetNames() {
-  static const std::vector<std::string> names = {"four-line-a3", "four-line-a4", "four-line-letter",
-                                                 "four-line-board", "two-line"};
-  return names;
-}
-
-LineTarget TargetByName(const std::string& name) {
-  if (name == "two-line") return TwoLineTarget();
-  if (name == "four-line-board" || name == "four-line") return FourLineTarget();
-  if (name == "four-line-a3") return FourLineA3Target();
-  if (name == "four-line-a4") return FourLineA4Target();
-  if (name == "four-line-letter") return FourLineLetterTarget();
-  std::string list;
-  for (const std::string& known : TargetNames()) list += (list.empty() ? "" : ", ") + known;
-  throw std::invalid_argument("target '" + name + "' is not one of: " + list);
-}
-
-// -------------------------------------------------------------------------------------------
 // Options.
 
 void RenderOptions::Check() const {
@@ -1590,49 +1468,6 @@ std::vector<TruthLine> SceneRenderer::Truth(const vpHomogeneousMatrix& cMo,
 
 // -------------------------------------------------------------------------------------------
 // Lens helpers and pose sampling.
-
-Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y) {
-  const double k = Kdu(camera);
-  const double rho = std::hypot(x, y);
-  double scale = 1.0;  // distorted over ideal normalised radius
-  if (k != 0.0 && rho > 0.0) {
-    const double r = DistortedRadius(k, rho);
-    if (std::isnan(r)) return Point2d{kNaN, kNaN};
-    scale = r / rho;
-  }
-  return Point2d{camera.get_u0() + camera.get_px() * x * scale,
-                 camera.get_v0() + camera.get_py() * y * scale};
-}
-
-double FitKud(const vpCameraParameters& camera, int width, int height) {
-  if (Kdu(camera) == 0.0) return 0.0;
-  // Minimise sum over a grid of distorted pixels of |u0 + px x (1 + kud r^2) - u|^2 (and v),
-  // (x, y) the ideal point of (u, v): linear in kud.
-  constexpr int kSteps = 40;
-  double saa = 0.0, sab = 0.0;
-  for (int j = 0; j <= kSteps; ++j) {
-    for (int i = 0; i <= kSteps; ++i) {
-      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(camera, u, v, x, y);
-      const double r2 = x * x + y * y;
-      const double au = camera.get_px() * x * r2, av = camera.get_py() * y * r2;
-      const double bu = u - camera.get_u0() - camera.get_px() * x;
-      const double bv = v - camera.get_v0() - camera.get_py() * y;
-      saa += au * au + av * av;
-      sab += au * bu + av * bv;
-    }
-  }
-  return saa > 0.0 ? sab / saa : 0.0;
-}
-
-vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
-                                 int height) {
-  vpCameraParameters camera;
-  camera.initPersProjWithDistortion(px, py, u0, v0, 0.0, kdu);
-  camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
-  return camera;
-}
 
 std::vector<StripeCrossing> StripeCrossings(const LineTarget& target) {
   const double min_sin = std::sin(kPi / 180.0);

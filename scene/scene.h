@@ -34,48 +34,11 @@
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"  // DistortedPixel, FitKud, CameraWithKdu
 #include "detector/line.h"
+#include "target/line_target.h"
 
 namespace oal {
-
-/// A straight stripe on the target plane, metres in the object frame.
-struct TargetLine {
-  double x1_m = 0.0, y1_m = 0.0;  ///< one end of the centre line
-  double x2_m = 0.0, y2_m = 0.0;  ///< the other end
-  double width_m = 0.01;          ///< printed width, > 0
-};
-
-/// A light board with dark stripes, centred on the object origin.
-struct LineTarget {
-  std::string name;
-  double board_width_m = 2.0;     ///< along x, > 0
-  double board_height_m = 2.0;    ///< along y, > 0
-  int board_grey = 215;           ///< [0, 255]
-  int line_grey = 35;             ///< [0, 255]
-  std::vector<TargetLine> lines;  ///< may be empty (a blank board)
-
-  /// Throws std::invalid_argument naming the field and the violated constraint.
-  void Check() const;
-};
-
-/// Two parallel stripes on a 2 m board (the paper's line-detection target).
-LineTarget TwoLineTarget();
-/// Four stripes in a '#' on a 2 m x 2 m board, whose asymmetric spacing and widths make
-/// lines 1-4 identifiable (the paper's pose target, Figure 2, in the paper's condition: the
-/// lines traverse the image). Line 1 is the widest. Named "four-line-board".
-LineTarget FourLineTarget();
-/// The '#' printed on one landscape sheet: the sheet is the board, the stripes end 10 mm
-/// inside its edges, the four crossings are centred on it (config/four-line-a3.yaml gives
-/// the geometry and why). A3 (420 x 297 mm), A4 (297 x 210 mm), US letter (279.4 x 215.9).
-LineTarget FourLineA3Target();
-LineTarget FourLineA4Target();
-LineTarget FourLineLetterTarget();
-/// The built-in targets' names, the default first: "four-line-a3", "four-line-a4",
-/// "four-line-letter", "four-line-board", "two-line".
-const std::vector<std::string>& TargetNames();
-/// One of TargetNames() ("four-line" is kept as a name of "four-line-board"); throws
-/// std::invalid_argument listing them otherwise.
-LineTarget TargetByName(const std::string& name);
 
 struct RenderOptions {
   int width = 640;                                        ///< pixels, [16, 8192]
@@ -247,20 +210,6 @@ class SceneRenderer {
   // Annotations and clutter laid out on the plane (scene.cpp; null when there are none).
   std::shared_ptr<const SceneDressing> dressing_;
 };
-
-/// Distorted pixel of an ideal normalised point (x, y) under the kdu model (numerical
-/// inverse of vpPixelMeterConversion); exact to 1e-9 px. With kdu < 0 the model cannot reach
-/// points beyond a radius; they come back as NaN.
-Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y);
-
-/// The kud that best inverts `kdu` over a width x height image (least squares), so a
-/// camera file written with both is consistent in ViSP's two directions.
-double FitKud(const vpCameraParameters& camera, int width, int height);
-
-/// A camera with ViSP's distortion model: `kdu` and the kud that best inverts it over a
-/// width x height image (FitKud), as a calibration gives both (kud = 0 when kdu = 0).
-vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
-                                 int height);
 
 /// Random camera poses looking at the target for data sets and tests.
 /// The optical axis meets the board at a point drawn uniformly in a disc of radius

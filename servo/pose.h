@@ -8,7 +8,7 @@
 //           servoing, also from the previous pose if given)
 //   step 4  the position; the paper's plane angles (Eq. 5) reported  PoseResult::plane_angle_deg
 //
-// Target. A LineTarget (scene/scene.h) whose lines 1 and 3 are parallel, lines 2 and 4 are
+// Target. A LineTarget (target/line_target.h) whose lines 1 and 3 are parallel, lines 2 and 4 are
 // parallel and lines 1 and 2 cross: a '#'. Its four corners are
 //     corner k = line k ∩ line k+1   (k = 1..4, line 5 = line 1),
 // i.e. in 0-based arrays corner[k] = lines[k] ∩ lines[(k + 1) % 4]. FourLineTarget() is one.
@@ -58,7 +58,7 @@
 
 #include "detector/detector.h"
 #include "detector/line.h"
-#include "scene/scene.h"
+#include "target/line_target.h"
 
 namespace oal {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "detector/detector.h"
-#include "scene/scene.h"
+#include "target/line_target.h"
 #include "servo/pose.h"
 
 namespace oal::pose_internal {

@@ -28,7 +28,7 @@
 #include "detector/line.h"
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
-#include "scene/scene.h"
+#include "target/line_target.h"
 
 namespace oal {
 

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "detector/lens.h"  // DistortedPixel
 #include "detector/options.h"
 
 namespace oal {

@@ -36,7 +36,7 @@
 #include "detector/detector.h"
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
-#include "scene/scene.h"
+#include "target/line_target.h"
 #include "servo/pose.h"
 #include "servo/target_layout.h"
 
