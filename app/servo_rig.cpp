@@ -1,6 +1,7 @@
 #include "app/servo_rig.h"
 
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -56,31 +57,38 @@ class SourceCamera : public LoopCamera {
   explicit SourceCamera(std::unique_ptr<ImageSource> source) : source_(std::move(source)) {}
 
   bool Grab(const vpHomogeneousMatrix& /*true_cMo*/, int /*iteration*/, cv::Mat* gray) override {
+    if (peeked_ && peeked_error_) {
+      // The frame AtEnd() read ahead could not be read: reported here, where it is taken.
+      peeked_ = false;
+      std::rethrow_exception(std::exchange(peeked_error_, nullptr));
+    }
     const bool have_frame = peeked_ ? peeked_frame_ : source_->Next(&frame_);
     peeked_ = false;
     if (!have_frame) return false;
     *gray = frame_.gray;
     return true;
   }
-  // Reads the next frame ahead (Grab() then hands it out); an unreadable one is not the end.
+  // Reads the next frame ahead (Grab() then hands it out); an unreadable one is not the end,
+  // and the next Grab() throws its error.
   bool AtEnd() override {
     if (!peeked_) {
       try {
         peeked_frame_ = source_->Next(&frame_);
       } catch (const std::exception&) {
-        return false;  // Grab() reads on past it and reports it
+        peeked_error_ = std::current_exception();
       }
       peeked_ = true;
     }
-    return !peeked_frame_;
+    return !peeked_error_ && !peeked_frame_;
   }
   std::string Name() const override { return source_->Name(); }
 
  private:
   std::unique_ptr<ImageSource> source_;
   Frame frame_;
-  bool peeked_ = false;        // frame_ holds the next frame already (AtEnd())
-  bool peeked_frame_ = false;  // ... and there was one
+  bool peeked_ = false;              // frame_ holds the next frame already (AtEnd())
+  bool peeked_frame_ = false;        // ... and there was one
+  std::exception_ptr peeked_error_;  // ... or it could not be read
 };
 
 }  // namespace

@@ -190,6 +190,20 @@ TEST(ServoSources, ReplayOfAWrongSizeOrMissingRecordingFailsClearly) {
   EXPECT_TRUE(report.robot_stopped);
 }
 
+// A recording with a frame that cannot be decoded: the run stops there and says which, rather
+// than skip it unseen when the frame was read ahead to tell the end.
+TEST(ServoSources, AnUnreadableFrameInAReplayStopsTheRunNamingIt) {
+  const test::TestDir dir;
+  const ServoAppConfig config = ReplayOfStillFrames(dir, 4);
+  test::WriteText(dir / "frame_0002.png", "not a png");
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kError) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("cannot read the next frame at iteration 2"));
+  EXPECT_THAT(report.message, HasSubstr("frame_0002.png"));
+  EXPECT_EQ(report.iterations.size(), 2u);
+}
+
 TEST(ServoSources, V4l2WithoutADeviceOrWithTheSimulatedRobotFailsBeforeMoving) {
   ServoAppConfig config = Small(DefaultServoConfig());
   config.source.type = SourceType::kV4l2;
