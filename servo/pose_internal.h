@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "detector/detector.h"
-#include "target/line_target.h"
 #include "servo/pose.h"
+#include "target/line_target.h"
 
 namespace oal::pose_internal {
 

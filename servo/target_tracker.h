@@ -36,9 +36,9 @@
 #include "detector/detector.h"
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
-#include "target/line_target.h"
 #include "servo/pose.h"
 #include "servo/target_layout.h"
+#include "target/line_target.h"
 
 namespace oal {
 
