@@ -5,11 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
@@ -1268,9 +1266,6 @@ void RenderOptions::Check() const {
                 "0 <= background_grey <= 255");
   RequireOption(InRange(supersample, 1, 8), "RenderOptions::supersample", supersample,
                 "1 <= supersample <= 8");
-  RequireOption(background == nullptr || background_image.empty(),
-                "RenderOptions::background_image", "'" + background_image + "'",
-                "empty when RenderOptions::background is set");
   RequireOption(background_texel_m > 0.0 && background_texel_m <= 1.0,
                 "RenderOptions::background_texel_m", background_texel_m,
                 "0 < background_texel_m <= 1");
@@ -1362,20 +1357,6 @@ SceneRenderer::SceneRenderer(LineTarget target, RenderOptions options)
   options_.Check();
   if (options_.background != nullptr) {
     background_ = options_.background;
-  } else if (!options_.background_image.empty()) {
-    // Deprecated (RenderOptions::background_image): to be removed with the field.
-    // Checked first: OpenCV logs a warning when asked to read a missing file.
-    const bool exists = std::ifstream(options_.background_image).good();
-    const cv::Mat grey =
-        exists ? cv::imread(options_.background_image, cv::IMREAD_GRAYSCALE) : cv::Mat();
-    RequireOption(!grey.empty(), "RenderOptions::background_image",
-                  "'" + options_.background_image + "'", "a readable image file");
-    auto image = std::make_shared<vpImage<unsigned char>>(static_cast<unsigned>(grey.rows),
-                                                          static_cast<unsigned>(grey.cols));
-    for (int r = 0; r < grey.rows; ++r) {
-      std::copy_n(grey.ptr<unsigned char>(r), grey.cols, (*image)[r]);
-    }
-    background_ = image;
   } else {
     background_ = std::make_shared<vpImage<unsigned char>>();
   }

@@ -59,11 +59,8 @@ struct RenderOptions {
   /// options and by the renderer.
   std::shared_ptr<const vpImage<unsigned char>> background;
   double background_texel_m = 0.002;  ///< size of one background texel on the plane, m, (0, 1]
-  /// Deprecated, to be removed once app/ decodes the image itself and sets `background`: an
-  /// image file the constructor reads as `background` (exclusive with it).
-  std::string background_image;
-  int background_grey = 90;  ///< [0, 255]
-  int supersample = 4;       ///< anti-aliasing factor per axis where edges meet, [1, 8]
+  int background_grey = 90;           ///< [0, 255]
+  int supersample = 4;                ///< anti-aliasing factor per axis where edges meet, [1, 8]
 
   // Light fall-off, applied with the illumination gradient (after occluders, before gain). -----
   /// Vignetting: brightness times 1 - vignetting * (r / r_corner)^2, r the distance of the pixel
@@ -180,9 +177,8 @@ struct SceneDressing;  // scene.cpp
 
 class SceneRenderer {
  public:
-  /// Throws std::invalid_argument if the target or the options fail Check(), or the
-  /// (deprecated) background_image file cannot be read. Annotations and clutter are laid out
-  /// here, once.
+  /// Throws std::invalid_argument if the target or the options fail Check(). Annotations and
+  /// clutter are laid out here, once.
   SceneRenderer(LineTarget target, RenderOptions options);
 
   /// Renders the target seen from `cMo`; `noise_seed` makes the noise reproducible.

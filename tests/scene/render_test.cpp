@@ -263,7 +263,7 @@ TEST(Render, BackgroundImageIsShownAroundTheBoardOnly) {
   if (!std::ifstream(path).good()) GTEST_SKIP() << "ViSP test image missing: " << path;
   const LineTarget target = TwoLineTarget();
   RenderOptions options;
-  options.background_image = path;
+  options.background = testing::ReadPgm(path);
   const SceneRenderer renderer(target, options);
   const vpHomogeneousMatrix cMo = FrontoParallel(5.0);
   const RenderedFrame frame = renderer.Render(cMo, 1);
@@ -331,7 +331,7 @@ TEST(RenderRegression, BackgroundFileGivesTheFrameOfBefore) {
   const std::string path = std::string(OAL_VISP_IMAGES_DIR) + "/Klimt/Klimt.pgm";
   if (!std::ifstream(path).good()) GTEST_SKIP() << "ViSP test image missing: " << path;
   RenderOptions options = OldEffects();
-  options.background_image = path;
+  options.background = testing::ReadPgm(path);
   const SceneRenderer sheet(FourLineA3Target(), options);
   const std::uint64_t a =
       ImageChecksum(sheet.Render(TiltedView(0.7, -0.05, 0.03, 1.1), 9, OldFrameEffects()).image);
@@ -421,26 +421,6 @@ TEST(RenderBackground, TexelIsSeenAtItsPlanePointAndTiles) {
   EXPECT_EQ(frame.image[239 + 4][319 + 18], 10 + 8 * 4.5 + 29 * 1);
   // The board hides it.
   EXPECT_EQ(frame.image[239][319], small.board_grey);
-}
-
-TEST(RenderBackground, AnImageGivesTheSameFrameAsItsFile) {
-  const std::string path = std::string(OAL_VISP_IMAGES_DIR) + "/Klimt/Klimt.pgm";
-  const auto image = ReadPgm(path);
-  if (image == nullptr) GTEST_SKIP() << "ViSP test image missing: " << path;
-  RenderOptions from_file = OldEffects();
-  from_file.background_image = path;
-  RenderOptions from_image = OldEffects();
-  from_image.background = image;
-  const vpHomogeneousMatrix cMo = TiltedView(0.7, -0.05, 0.03, 1.1);
-  EXPECT_TRUE(SameImage(SceneRenderer(FourLineA3Target(), from_file).Render(cMo, 9).image,
-                        SceneRenderer(FourLineA3Target(), from_image).Render(cMo, 9).image));
-}
-
-TEST(RenderBackground, ImageAndFileTogetherAreRefused) {
-  RenderOptions options;
-  options.background = NumberedTexels(2, 2);
-  options.background_image = "wall.png";
-  EXPECT_THROW(SceneRenderer(TwoLineTarget(), options), std::invalid_argument);
 }
 
 TEST(RenderLight, VignettingFallsWithTheSquaredRadiusFromThePrincipalPoint) {

@@ -200,14 +200,5 @@ TEST(SceneRenderer, ConstructorChecksTargetAndOptions) {
   EXPECT_THROW(SceneRenderer(TwoLineTarget(), options), std::invalid_argument);
 }
 
-TEST(SceneRenderer, MissingBackgroundImageIsNamed) {
-  RenderOptions options;
-  options.background_image = "/nonexistent/wall.png";
-  const std::string message =
-      InvalidArgumentMessage([&] { SceneRenderer(TwoLineTarget(), options); });
-  EXPECT_NE(message.find("RenderOptions::background_image"), std::string::npos) << message;
-  EXPECT_NE(message.find("/nonexistent/wall.png"), std::string::npos) << message;
-}
-
 }  // namespace
 }  // namespace oal
