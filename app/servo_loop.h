@@ -1,69 +1,9 @@
-// The servo loop with the camera in the loop: each iteration reads the camera pose
-// from the robot, renders the frame the simulated camera sees, detects the lines, estimates
-// the pose and commands one step of the PBVS law, until it converges or a stop condition
-// holds. A plain function that tests call directly; `oalservo servo` (servo_command.h) wraps it.
-//
-// Frames (docs/ARCHITECTURE.md): w world (robot base), c current camera, o target.
-//   wMc   from the robot (SafeRobot over SimulatedCamera);
-//   wMo   the target in the world (config `target_pose`), so the true cMo = wMc⁻¹·wMo;
-//   cdMo  the goal (config `goal.cdMo`).
-//
-// One iteration:
-//   1. stop (interrupted) if the interrupt flag is set, (time-limit) past servo.max_time_s;
-//   2. render the frame from the true cMo (camera intrinsics, kdu, noise and blur from the
-//      config, the scene around the target from `scene:`), find the target and its pose with
-//      the TargetPoseTracker (servo/target_tracker.h, config `tracking:`) given the odometry
-//      prediction of step 4 as its prior: the borders it scans on the target's plane, the
-//      lines it seeds in the accumulator list and the pose's starting point (after a move:
-//      the previous estimate carried by the motion, so that a move that rolls the camera far
-//      keeps the lines' identities);
-//   3. stop (target-lost) when the tracker has no pose, or refuses one (model check);
-//   4. stop (pose-jump) when the estimate disagrees with the previous estimate carried by the
-//      robot's own motion (odometry: predicted cMo = wMc⁻¹·wMc_prev·cMo_prev) by more than
-//      servo.max_pose_jump_m or max_pose_jump_deg;
-//   5. ComputeServoStep(estimate, cdMo): converged ends the run (converged); otherwise
-//   6. position laws: a step larger than servo.max_step_m or max_step_deg ends the run
-//      (limit) before the robot moves; else SafeRobot::MovePosition(camera, wMc·c_T_cnew).
-//      Velocity law: SafeRobot::SetVelocity(camera, twist) for one sampling period (bounded
-//      by the velocity saturation instead). A refusal, or a failure on the way, ends the run:
-//      a workspace, velocity or reach limit (limit), the emergency stop (interrupted), any
-//      other failure (error); the message says whether the robot had begun to move;
-//   7. after servo.max_iterations frames without convergence: iteration-limit (a recording
-//      that ends exactly there ends the run with end-of-input instead).
-//
-// The first pose is confirmed before anything moves: the planar target's pose has two
-// solutions that fit a frame almost equally (the pose ambiguity), and the first estimate has
-// nothing to be checked against, so a wrong one would send the robot the whole wrong way in
-// one point-and-go move. Frame 0 commands nothing; frame 1, taken with the robot still, is
-// estimated on its own (not seeded by frame 0) and must agree with frame 0 within
-// servo.max_pose_jump_m / max_pose_jump_deg, else the run stops (pose-jump, "pose not
-// confirmed") with the robot where it started. The first move is that of frame 1. (A replay
-// moves nothing and confirms nothing.) servo.max_step_m / max_step_deg bound what a pose that
-// is wrong in both frames can still command.
-//
-// Frame sources (config `source:`): "simulated" renders the frame from the true cMo (above);
-// "v4l2" grabs from a camera carried by the robot (closed loop; not with the simulated robot,
-// whose motion a real camera would not see); "replay" plays a recorded video or image
-// sequence open loop: every step is computed and logged but the robot is not moved, so the
-// odometry prediction of step 4 is the previous estimate itself; the end of the recording
-// ends the run (end-of-input). Without simulation there is no true pose: the true-error
-// columns are NaN.
-//
-// A taught goal (config `goal.image`) is read before the robot moves: the pose estimated in
-// that image becomes cdMo (TeachGoal).
-// Whatever the outcome, the robot is stopped when RunServo returns (a guard stops it also on
-// an exception), and the message says whether the stop could be sent ("robot stopped", or
-// "STOP COULD NOT BE SENT: why"). After the stop the robot's position is read once: when the
-// robot moved since the last frame's row (a limit, an interrupt, an error during a move), one
-// more row with status "stopped" records where it stopped.
-//
-// Before the first frame: the source is opened (a missing recording names source.path and
-// where it was set), the robot connected (a bad port names robot.scorbot.port) and enabled; a
-// robot that starts outside the workspace box is reported by a warning in the log (every
-// move is still checked against the box). Hooks::on_started then says the run has begun.
-// The simulated robot (robot.type simulated) runs a position move along its screw, one
-// sampling period (robot.sampling_time_s) per poll, over 1 s of simulated time (lengthened to
-// its hardware limits; nothing sleeps): a stop during a move leaves the camera on its way.
+// The servo loop with the camera in the loop: each iteration takes a frame, finds the target's
+// pose (servo/target_tracker.h), checks it against the robot's own motion, and commands one
+// step of the PBVS law (servo/pbvs.h) through the safety runner, until it converges or a stop
+// condition holds; the robot is stopped however it ends. A plain function that tests call
+// directly; `oalservo servo` (servo_command.h) wraps it. The iteration's steps, the first
+// pose's confirmation, the frame sources and every stop: docs/SERVO_LOOP.md.
 #pragma once
 
 #include <atomic>
