@@ -7,11 +7,11 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
-#include <sstream>
 #include <stdexcept>
 
 #include "base/check.h"
 #include "base/format.h"
+#include "robots/robot.h"  // Distance
 
 namespace oal {
 namespace {
@@ -52,10 +52,8 @@ double AxisAngleDeg(const vpColVector& a, const vpColVector& b) {
 void CheckStationsDiffer(const std::vector<HandEyePair>& pairs) {
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     for (std::size_t j = i + 1; j < pairs.size(); ++j) {
-      const vpHomogeneousMatrix move = pairs[i].wMe.inverse() * pairs[j].wMe;
-      const double moved_m = std::sqrt(move.getTranslationVector().sumSquare());
-      if (moved_m < kSameStationM &&
-          RotationBetween(pairs[i].wMe, pairs[j].wMe).angle_rad < kSameStationRad) {
+      const PoseDistance moved = Distance(pairs[i].wMe, pairs[j].wMe);
+      if (moved.translation_m < kSameStationM && moved.rotation_rad < kSameStationRad) {
         throw std::runtime_error("pairs " + std::to_string(i + 1) + " and " +
                                  std::to_string(j + 1) +
                                  " have the same end-effector pose: the arm did not move between "
@@ -142,11 +140,10 @@ void Residuals(const std::vector<HandEyePair>& pairs, HandEyeResult* result) {
   result->wMo = vpHomogeneousMatrix::mean(wMo);
   double sum_mm2 = 0.0, sum_deg2 = 0.0;
   for (const vpHomogeneousMatrix& each : wMo) {
-    const vpHomogeneousMatrix difference = result->wMo.inverse() * each;
+    const PoseDistance off = Distance(result->wMo, each);
     HandEyePairResidual residual;
-    residual.translation_mm = std::sqrt(difference.getTranslationVector().sumSquare()) * 1e3;
-    const vpThetaUVector theta_u(difference.getRotationMatrix());
-    residual.rotation_deg = std::sqrt(theta_u.sumSquare()) * kDegPerRad;
+    residual.translation_mm = off.translation_m * 1e3;
+    residual.rotation_deg = off.rotation_rad * kDegPerRad;
     sum_mm2 += residual.translation_mm * residual.translation_mm;
     sum_deg2 += residual.rotation_deg * residual.rotation_deg;
     result->residuals.push_back(residual);

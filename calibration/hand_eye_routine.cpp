@@ -3,9 +3,7 @@
 #include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpMath.h>
 
-#include <algorithm>
-#include <cmath>
-#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -25,6 +23,7 @@ bool Interrupted(const std::atomic<bool>* interrupt) {
 std::optional<vpHomogeneousMatrix> StillPose(const MeasureTarget& measure,
                                              const HandEyeRoutineOptions& options,
                                              const std::atomic<bool>* interrupt, std::string* why) {
+  why->clear();                            // a reason from an earlier station is not this one's
   std::vector<vpHomogeneousMatrix> still;  // successive agreeing poses
   for (int frame = 0; frame < options.max_frames_per_station; ++frame) {
     if (Interrupted(interrupt)) {
@@ -147,7 +146,6 @@ HandEyeRoutineResult RunHandEyeRoutine(SafeRobot& robot, const vpHomogeneousMatr
   const int count = static_cast<int>(planned.size());
   for (int k = 0; k < count; ++k) {
     HandEyeStation station;
-    station.wMe_planned = planned[k];
     const std::string name = "station " + std::to_string(k + 1) + "/" + std::to_string(count);
     if (Interrupted(interrupt)) return StopHere(robot, "interrupted at " + name, &result);
     const StationPlan plan =
