@@ -6,7 +6,6 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -22,14 +21,13 @@
 #include "app/servo_command.h"
 #include "app/servo_rig.h"
 #include "base/format.h"
+#include "base/parse.h"
 #include "calibration/hand_eye_routine.h"
 #include "robots/safe_robot.h"
 #include "servo/target_layout.h"
 
 namespace oal {
 namespace {
-
-namespace fs = std::filesystem;
 
 const char* const kColumns[12] = {"wMe_x_m",    "wMe_y_m",    "wMe_z_m",    "wMe_rx_deg",
                                   "wMe_ry_deg", "wMe_rz_deg", "cMo_x_m",    "cMo_y_m",
@@ -237,15 +235,11 @@ std::vector<HandEyePair> ReadHandEyePairs(const std::string& path) {
     }
     double v[12];
     for (int i = 0; i < 12; ++i) {
-      std::size_t used = 0;
-      try {
-        v[i] = std::stod(cells[i], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != cells[i].size() || !std::isfinite(v[i])) {
+      const std::optional<double> value = ParseFiniteDouble(cells[i]);
+      if (!value) {
         throw std::runtime_error(at + kColumns[i] + " = '" + cells[i] + "' is not a number");
       }
+      v[i] = *value;
     }
     pairs.push_back({PoseOf(v), PoseOf(v + 6)});
   }

@@ -3,8 +3,11 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+
+#include "base/parse.h"
 
 namespace oal {
 namespace {
@@ -34,17 +37,11 @@ struct Row {
   const std::vector<std::string>& fields;
 
   double Number(std::size_t i, const char* name) const {
-    std::size_t used = 0;
-    double value = 0.0;
-    try {
-      value = std::stod(fields[i], &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != fields[i].size() || !std::isfinite(value)) {
+    const std::optional<double> value = ParseFiniteDouble(fields[i]);
+    if (!value) {
       Fail(path, number, std::string("field ") + name + " is not a number: '" + fields[i] + "'");
     }
-    return value;
+    return *value;
   }
   int Index(std::size_t i, const char* name) const {
     const double value = Number(i, name);
