@@ -34,6 +34,7 @@
 #include "app/detector_accuracy.h"
 #include "app/frame_command.h"
 #include "app/image_source.h"
+#include "app/lens_estimate.h"
 #include "app/report.h"
 #include "app/truth_file.h"
 #include "base/format.h"
@@ -1351,13 +1352,8 @@ class InputEvaluation {
     if (t.readable > 0 && t.detected < 0.1 * t.readable) warnings.push_back(LowDetectionHint(t));
     const LensCheck lens = CheckLens(t.straightness_px);
     if (lens.mismatch) {
-      warnings.push_back(
-          "lines 1-4 still bend by " + Fixed(lens.median_px, 2) + " px (median of " +
-          std::to_string(lens.frames) +
-          " frames; a camera file that matches the lens leaves under 0.1 px) after '" +
-          camera_path_ +
-          "' corrects them: it does not describe this lens (its distortion, or the "
-          "resolution it was made for). Calibrate the camera (oalservo calibrate)");
+      warnings.push_back(LensMismatchWarning(lens, "'" + camera_path_ + "'",
+                                             "Calibrate the camera (oalservo calibrate)"));
     }
     Json pose;
     if (camera_) {

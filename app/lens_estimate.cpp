@@ -1,6 +1,9 @@
 #include "app/lens_estimate.h"
 
+#include <stdexcept>
 #include <utility>
+
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -25,6 +28,43 @@ PlumbLineResult StripeCollector::Estimate(const vpCameraParameters& pinhole, int
   options.height = height;
   return EstimateRadialDistortion(stripes_, pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
                                   pinhole.get_v0(), options);
+}
+
+ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameters& pinhole,
+                             const NextFrame& next, int frames, int max_read) {
+  StripeCollector stripes;
+  GrayImageView view;
+  int read = 0;
+  while (stripes.frames() < frames && read < max_read && next(&view)) {
+    ++read;
+    tracker.Reset();
+    tracker.Track(view);
+    stripes.Add(tracker);
+  }
+  tracker.Reset();
+  ToldLens told;
+  told.frames = stripes.frames();
+  if (stripes.frames() < frames) {
+    told.why = std::to_string(stripes.frames()) + " of the first " + std::to_string(read) +
+               " frames show the target, " + std::to_string(frames) + " needed";
+    return told;
+  }
+  try {
+    told.lens = stripes.Estimate(pinhole, view.width, view.height);
+  } catch (const std::runtime_error& error) {
+    told.why = error.what();
+  }
+  return told;
+}
+
+std::string LensMismatchWarning(const LensCheck& lens, const std::string& corrected_by,
+                                const std::string& remedy) {
+  return "lines 1-4 still bend by " + Fixed(lens.median_px, 2) + " px (median of " +
+         std::to_string(lens.frames) +
+         " frames; a camera file that matches the lens leaves under 0.1 px) after " + corrected_by +
+         " corrects them: it does not describe this lens (its distortion, or the resolution it "
+         "was made for), and every pose is biased. " +
+         remedy;
 }
 
 vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens) {

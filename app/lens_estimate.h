@@ -1,13 +1,18 @@
 // The lens told from the target's stripes (calibration/plumb_line.h) over the first frames a
 // pinhole tracker finds the target in: what `pose --estimate-distortion`, `pose-accuracy
-// --estimate-distortion` and the servo loop's camera.estimate_distortion share.
+// --estimate-distortion` and the servo loop's camera.estimate_distortion share; and what the
+// commands say when the lens check finds a camera file that misses the lens.
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
 
+#include <functional>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "calibration/plumb_line.h"
+#include "detector/image_view.h"
 #include "detector/line.h"
 #include "servo/target_tracker.h"
 
@@ -27,6 +32,32 @@ class StripeCollector {
   std::vector<std::vector<Point2d>> stripes_;
   int frames_ = 0;
 };
+
+/// Frames with the target that tell the lens, and how many frames are read at most to find
+/// them.
+constexpr int kLensFrames = 10;
+constexpr int kMaxLensFramesRead = 100;
+
+/// The next frame: `view` set (valid until the next call) and true, or false at the end.
+using NextFrame = std::function<bool(GrayImageView* view)>;
+
+struct ToldLens {
+  std::optional<PlumbLineResult> lens;  ///< when the stripes told it
+  std::string why;                      ///< why they did not
+  int frames = 0;                       ///< frames that showed the target
+};
+
+/// Tracks frames from `next`, each on its own, with `tracker` (a pinhole camera's), until
+/// `frames` show the target or `max_read` have been read, and tells the lens from their stripes
+/// through `pinhole`. The tracker is reset after. What `next` throws goes through.
+ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameters& pinhole,
+                             const NextFrame& next, int frames = kLensFrames,
+                             int max_read = kMaxLensFramesRead);
+
+/// The lens check's warning: "lines 1-4 still bend by ... after `corrected_by` corrects them:
+/// ... this lens ... `remedy`".
+std::string LensMismatchWarning(const LensCheck& lens, const std::string& corrected_by,
+                                const std::string& remedy);
 
 /// `pinhole` with the estimated lens (kud and kdu).
 vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens);

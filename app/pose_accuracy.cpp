@@ -80,14 +80,11 @@ void PoseAccuracyOptions::Check() const {
 
 namespace {
 
-// Frames told apart from the evaluated ones: the lens is estimated on poses of its own.
-constexpr int kLensFrames = 10;
-constexpr int kMaxLensFramesRendered = 100;
+// The lens is told on poses of its own, apart from the evaluated ones.
 constexpr std::uint64_t kLensSeedOffset = 0x9e3779b97f4a7c15ULL;
 
-// The camera with the kdu the stripes tell, from up to kMaxLensFramesRendered frames tracked
-// by a pinhole camera; the pinhole camera itself, with report->estimate_failed saying why,
-// when they cannot tell it.
+// The camera with the lens the stripes tell, from frames tracked by a pinhole camera; the
+// pinhole camera itself, with report->estimate_failed saying why, when they cannot tell it.
 vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
                                    const PoseAccuracyOptions& options, PoseAccuracyReport* report) {
   const vpCameraParameters lens = scenes.For(0).options().camera;
@@ -95,32 +92,25 @@ vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
   pinhole.initPersProjWithoutDistortion(lens.get_px(), lens.get_py(), lens.get_u0(), lens.get_v0());
   TargetPoseTracker tracker(options.target, pinhole, options.detector, options.pose,
                             options.tracking);
-  StripeCollector stripes;
   std::uint64_t state = options.seed + kLensSeedOffset;
-  for (int frame = 0; frame < kMaxLensFramesRendered && stripes.frames() < kLensFrames; ++frame) {
+  int frame = 0;
+  RenderedFrame rendered;
+  const ToldLens told = TellLensFromStripes(tracker, pinhole, [&](GrayImageView* view) {
     const SceneRenderer& renderer = scenes.For(frame);
-    const RenderedFrame rendered =
-        renderer.Render(SamplePose(renderer, options.sampling, &state),
-                        state + static_cast<std::uint64_t>(frame), scenes.EffectsFor(frame));
-    tracker.Reset();
-    tracker.Track(ViewOf(rendered.image));
-    stripes.Add(tracker);
-  }
+    rendered = renderer.Render(SamplePose(renderer, options.sampling, &state),
+                               state + static_cast<std::uint64_t>(frame), scenes.EffectsFor(frame));
+    ++frame;
+    *view = ViewOf(rendered.image);
+    return true;
+  });
   report->estimated_kdu = std::numeric_limits<double>::quiet_NaN();
-  if (stripes.frames() < kLensFrames) {
-    report->estimate_failed = std::to_string(stripes.frames()) + " of " +
-                              std::to_string(kMaxLensFramesRendered) + " frames showed the target";
+  if (!told.lens) {
+    report->estimate_failed = told.why;
     return pinhole;
   }
-  try {
-    const PlumbLineResult result = stripes.Estimate(pinhole, options.width, options.height);
-    report->estimated_kdu = result.kdu;
-    report->estimated_kdu_sd = result.kdu_sd;
-    return WithLens(pinhole, result);
-  } catch (const std::runtime_error& error) {
-    report->estimate_failed = error.what();
-    return pinhole;
-  }
+  report->estimated_kdu = told.lens->kdu;
+  report->estimated_kdu_sd = told.lens->kdu_sd;
+  return WithLens(pinhole, *told.lens);
 }
 
 }  // namespace

@@ -182,44 +182,37 @@ constexpr int kMaxLensFramesRead = 100;
 void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* run,
                   PoseSummary* summary) {
   const vpCameraParameters pinhole = run->camera.camera;
-  StripeCollector stripes;
-  int read = 0;
   Frame frame;
-  while (stripes.frames() < options.estimate_frames && read < kMaxLensFramesRead &&
-         (options.max_frames == 0 || read < options.max_frames) && feed->ReadAhead(&frame)) {
-    ++read;
-    run->tracker.Reset();
-    run->tracker.Track(frame.view());
-    stripes.Add(run->tracker);
+  int read = 0;
+  const ToldLens told = TellLensFromStripes(
+      run->tracker, pinhole,
+      [&](GrayImageView* view) {
+        if ((options.max_frames != 0 && read >= options.max_frames) || !feed->ReadAhead(&frame)) {
+          return false;
+        }
+        ++read;
+        *view = frame.view();
+        return true;
+      },
+      options.estimate_frames);
+  if (!told.lens) {
+    summary->warnings.push_back("--estimate-distortion: cannot tell the lens: " + told.why +
+                                "; the poses are without distortion");
+    return;
   }
-  run->tracker.Reset();
+  const PlumbLineResult& lens = *told.lens;
   std::ostringstream said;
   said.precision(4);
   said << std::fixed;
-  if (stripes.frames() < options.estimate_frames) {
-    said << "--estimate-distortion: " << stripes.frames() << " of the first " << read
-         << " frames show the target, " << options.estimate_frames
-         << " needed to tell the lens: the poses are without distortion";
-    summary->warnings.push_back(said.str());
-    return;
-  }
-  PlumbLineResult lens;
-  try {
-    lens = stripes.Estimate(pinhole, frame.gray.cols, frame.gray.rows);
-  } catch (const std::runtime_error& error) {
-    summary->warnings.push_back(std::string("--estimate-distortion: ") + error.what() +
-                                ": the poses are without distortion");
-    return;
-  }
   summary->estimated_kdu = lens.kdu;
   run->camera.camera = WithLens(pinhole, lens);
   run->tracker = TargetPoseTracker(run->config.target, run->camera.camera, run->config.detector,
                                    run->config.pose, run->config.tracking);
   run->undistorted_by = run->camera.camera;
   said << "kdu " << lens.kdu << " +- " << lens.kdu_sd << " (kud " << lens.kud << ")"
-       << " from the stripes of " << stripes.frames() << " frames (they bend "
-       << std::setprecision(2) << lens.rms_before_px << " px RMS from straight, "
-       << lens.rms_after_px << " px corrected); every pose uses it";
+       << " from the stripes of " << told.frames << " frames (they bend " << std::setprecision(2)
+       << lens.rms_before_px << " px RMS from straight, " << lens.rms_after_px
+       << " px corrected); every pose uses it";
   summary->notes.push_back(said.str());
 }
 
@@ -296,15 +289,10 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   });
   const LensCheck lens = CheckLens(summary.straightness_px);
   if (lens.mismatch) {
-    std::ostringstream message;
-    message.precision(2);
-    message << std::fixed << "lines 1-4 still bend by " << lens.median_px << " px (median of "
-            << lens.frames << " frames; a camera file that matches the lens "
-            << "leaves under 0.1 px) after '" << summary.camera_path
-            << "' corrects them: it does not describe this lens (its distortion, or the "
-               "resolution it was made for). Calibrate the camera (oalservo calibrate), or give "
-               "one without distortion and --estimate-distortion";
-    summary.warnings.push_back(message.str());
+    summary.warnings.push_back(LensMismatchWarning(
+        lens, "'" + summary.camera_path + "'",
+        "Calibrate the camera (oalservo calibrate), or give one without distortion and "
+        "--estimate-distortion"));
   }
   return summary;
 }

@@ -175,10 +175,8 @@ void CheckServoConfig(const ServoAppConfig& config) {
   }
 }
 
-// Frames read, the robot still, for camera.estimate_distortion: the first that show the
-// target tell the lens (app/lens_estimate.h); their noise seeds apart from the loop's.
-constexpr int kLensFrames = 10;
-constexpr int kMaxLensFramesRead = 100;
+// The frames read, the robot still, for camera.estimate_distortion (app/lens_estimate.h):
+// their noise seeds apart from the loop's.
 constexpr int kLensFrameIndex = 1000000;
 
 // camera.estimate_distortion: the lens from the stripes of the first frames that show the
@@ -187,40 +185,30 @@ constexpr int kLensFrameIndex = 1000000;
 bool TellTheLens(const ServoAppConfig& config, SafeRobot& robot, LoopCamera& frames,
                  LoopModel* model, TargetPoseTracker* tracker, std::ostream& log,
                  std::string* why) {
-  StripeCollector stripes;
   cv::Mat gray;
   int read = 0;
-  for (; read < kMaxLensFramesRead && stripes.frames() < kLensFrames; ++read) {
+  std::string pose_error;
+  const ToldLens told = TellLensFromStripes(*tracker, model->camera, [&](GrayImageView* view) {
     const RobotPose at = TrueCameraPose(robot, config);
     if (!at.result.ok()) {
-      *why = "the camera's pose cannot be read: " + at.result.message;
+      pose_error = "the camera's pose cannot be read: " + at.result.message;
       return false;
     }
-    if (!frames.Grab(at.pose.inverse() * config.target_wMo, kLensFrameIndex + read, &gray)) {
-      break;
+    if (!frames.Grab(at.pose.inverse() * config.target_wMo, kLensFrameIndex + read++, &gray)) {
+      return false;
     }
-    tracker->Reset();
-    tracker->Track(ViewOf(gray));
-    stripes.Add(*tracker);
-  }
-  tracker->Reset();
-  if (stripes.frames() < kLensFrames) {
-    *why = std::to_string(stripes.frames()) + " of the first " + std::to_string(read) +
-           " frames show the target, " + std::to_string(kLensFrames) + " needed";
+    *view = ViewOf(gray);
+    return true;
+  });
+  if (!told.lens) {
+    *why = pose_error.empty() ? told.why : pose_error;
     return false;
   }
-  PlumbLineResult lens;
-  try {
-    lens = stripes.Estimate(model->camera, config.camera.width, config.camera.height);
-  } catch (const std::runtime_error& error) {
-    *why = error.what();
-    return false;
-  }
+  const PlumbLineResult& lens = *told.lens;
   model->camera = WithLens(model->camera, lens);
   *tracker = model->Tracker();
-  log << "lens told from the stripes of " << stripes.frames() << " frames: kdu "
-      << Fixed(lens.kdu, 4) << " +- " << Fixed(lens.kdu_sd, 4) << " (kud " << Fixed(lens.kud, 4)
-      << ")"
+  log << "lens told from the stripes of " << told.frames << " frames: kdu " << Fixed(lens.kdu, 4)
+      << " +- " << Fixed(lens.kdu_sd, 4) << " (kud " << Fixed(lens.kud, 4) << ")"
       << " (they bent " << Fixed(lens.rms_before_px, 2) << " px RMS, "
       << Fixed(lens.rms_after_px, 2) << " px corrected)\n";
   return true;
@@ -634,12 +622,11 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
       const LensCheck lens =
           CheckLens(straightness, kLensMismatchPx, static_cast<int>(kLensCheckFrames));
       if (lens.mismatch) {
-        log << "oalservo servo: warning: lines 1-4 still bend by " << Fixed(lens.median_px, 2)
-            << " px (median of " << lens.frames
-            << " frames; a camera file that matches the lens leaves under 0.1 px) after the "
-               "camera model's correction: it does not describe this lens, and every pose is "
-               "biased. Calibrate the camera (oalservo calibrate), or set "
-               "camera.estimate_distortion\n";
+        log << "oalservo servo: warning: "
+            << LensMismatchWarning(lens, "the camera model",
+                                   "Calibrate the camera (oalservo calibrate), or set "
+                                   "camera.estimate_distortion")
+            << '\n';
       }
     }
     std::optional<ServoStep> step;
