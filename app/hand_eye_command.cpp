@@ -90,29 +90,26 @@ TargetInView CrossingsInView(const LineTarget& target, const vpCameraParameters&
   };
 }
 
-std::string ConfigNames(const std::vector<std::string>& paths) {
-  std::string names;
-  for (const std::string& path : paths) names += (names.empty() ? "" : " + ") + path;
-  return names;
+// The files as `servo --config` takes them: the first, then each over the ones before.
+ServoCommandOptions ConfigFiles(const std::vector<std::string>& paths) {
+  ServoCommandOptions files;
+  files.config_path = paths.front();
+  files.more_config_paths.assign(paths.begin() + 1, paths.end());
+  return files;
 }
 
 // The pairs taken by moving the configured arm; the configured eMc through `configured_eMc`.
 std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix* configured_eMc) {
-  ServoAppConfig config = DefaultServoConfig();
-  for (const std::string& path : settings.config_paths) config = LoadConfig(path, config);
+  const ServoAppConfig config = LoadServoConfig(ConfigFiles(settings.config_paths));
   if (config.source.type == SourceType::kReplay) {
     throw std::runtime_error(
         KeyAt(config, "source.type") +
         " is replay: the routine needs the camera on the arm (simulated or v4l2); for pairs "
         "recorded before use --pairs");
   }
-  if (config.camera.true_eMc && config.source.type != SourceType::kSimulated) {
-    throw std::runtime_error(KeyAt(config, "camera.true_eMc") +
-                             " is the mounting of a simulated camera; source.type is " +
-                             ToString(config.source.type) + ": remove it");
-  }
+  CheckServoConfig(config);
   *configured_eMc = config.camera.eMc;
-  const LoopModel model(config);
+  LoopModel model(config);
   TargetPoseTracker tracker = model.Tracker();
   std::vector<std::string> warnings;
   const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &warnings);
@@ -129,10 +126,16 @@ std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix
   if (RobotResult r = robot.Enable(); !r.ok()) {
     throw std::runtime_error("cannot enable the robot: " + r.message);
   }
-  std::cout << "oalservo hand-eye: " << ConfigNames(settings.config_paths) << ", "
+  std::cout << "oalservo hand-eye: " << ConfigNames(ConfigFiles(settings.config_paths)) << ", "
             << settings.routine.stations.count << " stations around the arm's pose through "
             << frames->Name() << "\n";
 
+  if (config.camera.estimate_distortion) {
+    std::string why;
+    if (!TellTheLens(config, robot, *frames, &model, &tracker, std::cout, &why)) {
+      throw std::runtime_error("cannot tell the lens: " + why + "; the arm did not move");
+    }
+  }
   int frame_count = 0;
   const MeasureTarget measure = [&](std::string* why) -> std::optional<vpHomogeneousMatrix> {
     const RobotPose camera = TrueCameraPose(robot, config);
@@ -324,9 +327,10 @@ int RunHandEye(int argc, char** argv) {
                              settings.out_path);
   }
   PrintResult(result, moved ? &configured_eMc : nullptr);
-  WriteFileAtomically(settings.out_path,
-                      ResultYaml(result, pairs.size(),
-                                 moved ? ConfigNames(settings.config_paths) : settings.pairs_path));
+  WriteFileAtomically(
+      settings.out_path,
+      ResultYaml(result, pairs.size(),
+                 moved ? ConfigNames(ConfigFiles(settings.config_paths)) : settings.pairs_path));
   std::cout << "written " << settings.out_path << '\n';
   return kExitOk;
 }

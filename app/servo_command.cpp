@@ -70,6 +70,12 @@ ServoAppConfig DefaultServoConfig() {
   return ParseConfig(kDefaultServoConfigYaml, kDefaultServoConfigName);
 }
 
+std::string ConfigNames(const ServoCommandOptions& options) {
+  std::string names = options.config_path.empty() ? kDefaultServoConfigName : options.config_path;
+  for (const std::string& path : options.more_config_paths) names += " + " + path;
+  return names;
+}
+
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options) {
   // A file only says what differs from the built-in default.
   ServoAppConfig config = options.config_path.empty()
@@ -196,11 +202,8 @@ std::optional<std::string> TrueErrorLine(const ServoRunReport& report, const Ser
 
 ServoRunReport RunServoCommand(const ServoCommandOptions& options, std::ostream& out,
                                const ServoRunHooks& hooks) {
-  std::string config_name =
-      options.config_path.empty() ? kDefaultServoConfigName : options.config_path;
-  for (const std::string& path : options.more_config_paths) config_name += " + " + path;
   return RunServoWithOutputs(
-      LoadServoConfig(options), config_name,
+      LoadServoConfig(options), ConfigNames(options),
       options.out_dir.empty() ? "output directory (output.directory)" : "output directory (--out)",
       out, hooks);
 }

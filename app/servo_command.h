@@ -47,6 +47,10 @@ ServoAppConfig DefaultServoConfig();
 /// bad file or override.
 ServoAppConfig LoadServoConfig(const ServoCommandOptions& options);
 
+/// The configuration's files as the run's first line names them: "a.yaml + b.yaml", or the
+/// built-in default's name.
+std::string ConfigNames(const ServoCommandOptions& options);
+
 /// Requests the emergency stop of the robot registered by StopSignalHooks()' on_robot (the
 /// StopSignalScope's callback: async-signal-safe; a no-op when none is registered).
 void StopRobotOnSignal();

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "app/image_source.h"
-#include "app/lens_estimate.h"
+#include "app/lens_estimate.h"  // LensMismatchWarning
 #include "app/servo_rig.h"
 #include "base/format.h"
 #include "detector/detector.h"
@@ -144,75 +144,6 @@ struct Stop {
 };
 
 // The combinations of sections the loop cannot run, before anything moves.
-void CheckServoConfig(const ServoAppConfig& config) {
-  config.camera.Check();
-  config.robot.Check();
-  config.servo.Check();
-  config.source.Check();
-  if (config.source.type == SourceType::kV4l2 && config.robot.type == RobotType::kSimulated) {
-    throw std::invalid_argument(
-        "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
-        "whose motion the camera would not see); to watch a camera without moving anything use "
-        "source: {type: replay, path: " +
-        config.source.device + "}");
-  }
-  if (config.camera.estimate_distortion && !config.camera.correct_distortion) {
-    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
-                                " tells the lens to correct it, but camera.correct_distortion "
-                                "is false: give one of them");
-  }
-  if (config.camera.estimate_distortion && config.source.type != SourceType::kSimulated &&
-      config.camera.kdu != 0.0) {
-    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
-                                " tells the lens from the stripes, but the camera gives kdu " +
-                                Number(config.camera.kdu) + " (" + KeyAt(config, "camera.kdu") +
-                                "): give one of them");
-  }
-  if (config.camera.true_eMc && config.source.type != SourceType::kSimulated) {
-    throw std::invalid_argument(KeyAt(config, "camera.true_eMc") +
-                                " is the mounting of a simulated camera; source.type is " +
-                                ToString(config.source.type) + ": remove it");
-  }
-}
-
-// The frames read, the robot still, for camera.estimate_distortion (app/lens_estimate.h):
-// their noise seeds apart from the loop's.
-constexpr int kLensFrameIndex = 1000000;
-
-// camera.estimate_distortion: the lens from the stripes of the first frames that show the
-// target, the robot still; the model and the tracker then use it. False with `why` when the
-// frames cannot tell it.
-bool TellTheLens(const ServoAppConfig& config, SafeRobot& robot, LoopCamera& frames,
-                 LoopModel* model, TargetPoseTracker* tracker, std::ostream& log,
-                 std::string* why) {
-  cv::Mat gray;
-  int read = 0;
-  std::string pose_error;
-  const ToldLens told = TellLensFromStripes(*tracker, model->camera, [&](GrayImageView* view) {
-    const RobotPose at = TrueCameraPose(robot, config);
-    if (!at.result.ok()) {
-      pose_error = "the camera's pose cannot be read: " + at.result.message;
-      return false;
-    }
-    if (!frames.Grab(at.pose.inverse() * config.target_wMo, kLensFrameIndex + read++, &gray)) {
-      return false;
-    }
-    *view = ViewOf(gray);
-    return true;
-  });
-  if (!told.lens) {
-    *why = pose_error.empty() ? told.why : pose_error;
-    return false;
-  }
-  const PlumbLineResult& lens = *told.lens;
-  model->camera = WithLens(model->camera, lens);
-  *tracker = model->Tracker();
-  log << "lens told from the stripes of " << told.frames << " frames: kdu " << Fixed(lens.kdu, 4)
-      << " +- " << Fixed(lens.kdu_sd, 4) << " (kud " << Fixed(lens.kud, 4) << ")"
-      << " (they bent " << Fixed(lens.rms_before_px, 2) << " px RMS, "
-      << Fixed(lens.rms_after_px, 2) << " px corrected)\n";
-  return true;
-}
 
 // Who asked for a stop, for "interrupted by ...".
 std::string InterruptedBy(const ServoRunHooks& hooks) {
@@ -472,6 +403,37 @@ vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
                              (found.message.empty() ? "" : " (" + found.message + ")"));
   }
   return found.pose.cMo;
+}
+
+void CheckServoConfig(const ServoAppConfig& config) {
+  config.camera.Check();
+  config.robot.Check();
+  config.servo.Check();
+  config.source.Check();
+  if (config.source.type == SourceType::kV4l2 && config.robot.type == RobotType::kSimulated) {
+    throw std::invalid_argument(
+        "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
+        "whose motion the camera would not see); to watch a camera without moving anything use "
+        "source: {type: replay, path: " +
+        config.source.device + "}");
+  }
+  if (config.camera.estimate_distortion && !config.camera.correct_distortion) {
+    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
+                                " tells the lens to correct it, but camera.correct_distortion "
+                                "is false: give one of them");
+  }
+  if (config.camera.estimate_distortion && config.source.type != SourceType::kSimulated &&
+      config.camera.kdu != 0.0) {
+    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
+                                " tells the lens from the stripes, but the camera gives kdu " +
+                                Number(config.camera.kdu) + " (" + KeyAt(config, "camera.kdu") +
+                                "): give one of them");
+  }
+  if (config.camera.true_eMc && config.source.type != SourceType::kSimulated) {
+    throw std::invalid_argument(KeyAt(config, "camera.true_eMc") +
+                                " is the mounting of a simulated camera; source.type is " +
+                                ToString(config.source.type) + ": remove it");
+  }
 }
 
 ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,

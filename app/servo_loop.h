@@ -127,6 +127,11 @@ struct ServoRunHooks {
 /// camera, or shows no pose.
 vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config);
 
+/// Checks what the loop needs of a configuration beyond each section's own Check(): a V4L2
+/// camera on a real robot, the lens either told or given, true_eMc only for a simulated
+/// camera. Throws std::invalid_argument naming the key.
+void CheckServoConfig(const ServoAppConfig& config);
+
 /// Runs the loop (see the file comment). Writes one line per iteration to `log`. Throws
 /// std::invalid_argument / std::runtime_error for a bad configuration, before the robot moves.
 ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,

@@ -7,7 +7,9 @@
 #include <utility>
 
 #include "app/image_source.h"
+#include "app/lens_estimate.h"
 #include "app/servo_loop.h"  // Table3Columns
+#include "base/format.h"
 #include "robots/scorbot_kinematics.h"
 #include "robots/scorbot_robot.h"
 #include "robots/simulated_camera.h"
@@ -17,6 +19,9 @@ namespace oal {
 namespace {
 
 constexpr std::uint64_t kNoiseSeed = 20240605;
+// The frames read, the robot still, for camera.estimate_distortion (app/lens_estimate.h):
+// their noise seeds apart from the loop's.
+constexpr int kLensFrameIndex = 1000000;
 
 // The simulated camera: the target rendered from the true pose with the configured lens,
 // noise and blur.
@@ -152,6 +157,38 @@ RobotPose TrueCameraPose(SafeRobot& robot, const ServoAppConfig& config) {
   RobotPose wMe = robot.GetPosition(RobotFrame::kEndEffector);
   if (wMe.result.ok()) wMe.pose = wMe.pose * *config.camera.true_eMc;
   return wMe;
+}
+
+bool TellTheLens(const ServoAppConfig& config, SafeRobot& robot, LoopCamera& frames,
+                 LoopModel* model, TargetPoseTracker* tracker, std::ostream& log,
+                 std::string* why) {
+  cv::Mat gray;
+  int read = 0;
+  std::string pose_error;
+  const ToldLens told = TellLensFromStripes(*tracker, model->camera, [&](GrayImageView* view) {
+    const RobotPose at = TrueCameraPose(robot, config);
+    if (!at.result.ok()) {
+      pose_error = "the camera's pose cannot be read: " + at.result.message;
+      return false;
+    }
+    if (!frames.Grab(at.pose.inverse() * config.target_wMo, kLensFrameIndex + read++, &gray)) {
+      return false;
+    }
+    *view = ViewOf(gray);
+    return true;
+  });
+  if (!told.lens) {
+    *why = pose_error.empty() ? told.why : pose_error;
+    return false;
+  }
+  const PlumbLineResult& lens = *told.lens;
+  model->camera = WithLens(model->camera, lens);
+  *tracker = model->Tracker();
+  log << "lens told from the stripes of " << told.frames << " frames: kdu " << Fixed(lens.kdu, 4)
+      << " +- " << Fixed(lens.kdu_sd, 4) << " (kud " << Fixed(lens.kud, 4) << ")"
+      << " (they bent " << Fixed(lens.rms_before_px, 2) << " px RMS, "
+      << Fixed(lens.rms_after_px, 2) << " px corrected)\n";
+  return true;
 }
 
 std::string KeyAt(const ServoAppConfig& config, const std::string& key) {

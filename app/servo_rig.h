@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,12 @@ std::unique_ptr<LoopCamera> OpenLoopCamera(const ServoAppConfig& config,
 /// Where the camera is: the robot's camera pose, or, with camera.true_eMc (a simulation whose
 /// camera is not mounted as eMc says), the end effector's pose through true_eMc.
 RobotPose TrueCameraPose(SafeRobot& robot, const ServoAppConfig& config);
+
+/// camera.estimate_distortion: the lens from the stripes of the first frames that show the
+/// target, the robot still (app/lens_estimate.h); `model` and `tracker` then use it, and `log`
+/// gets one line saying what it is. False with `why` when the frames cannot tell it.
+bool TellTheLens(const ServoAppConfig& config, SafeRobot& robot, LoopCamera& frames,
+                 LoopModel* model, TargetPoseTracker* tracker, std::ostream& log, std::string* why);
 
 /// "FILE:LINE: key" where the configuration set `key`, or "key" when no file set it.
 std::string KeyAt(const ServoAppConfig& config, const std::string& key);

@@ -61,6 +61,23 @@ TEST(HandEyeCommand, MeasuresTheMountingOfTheSimulatedArmAndServoReadsIt) {
   EXPECT_LT(Distance(read.camera.eMc, reread.camera.eMc).translation_m, 1e-6);
 }
 
+// A camera nobody calibrated (camera.estimate_distortion): the lens is told from the stripes
+// before the arm moves, as the servo loop does, and the mounting still comes out.
+TEST(HandEyeCommand, TellsTheLensFirstWhenTheConfigAsksIt) {
+  const TestDir dir;
+  const std::string config = dir / "lens.yaml";
+  WriteText(config, "camera:\n  kdu: 0.15\n  estimate_distortion: true\n  eMc: " +
+                        PoseYaml(kBracket) + "\n  true_eMc: " + PoseYaml(kBracket) + "\n");
+  const OalservoRun run =
+      RunOalservo(dir, "hand-eye --config '" + config + "' --out '" + (dir / "he.yaml") + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.out.find("lens told from the stripes of 10 frames"), std::string::npos) << run.out;
+  const AppConfig read = LoadConfig(dir / "he.yaml", LoadConfig(config, DefaultServoConfig()));
+  const PoseDistance error = Distance(kBracket, read.camera.eMc);
+  EXPECT_LT(error.translation_m, 1e-3);
+  EXPECT_LT(vpMath::deg(error.rotation_rad), 0.2);
+}
+
 TEST(HandEyeCommand, PairsRoundTripThroughTheCsv) {
   const std::vector<HandEyePair> pairs = {{vpHomogeneousMatrix(0.5, 0.1, 0.6, 3.0, 0.2, -0.1),
                                            vpHomogeneousMatrix(0, 0.01, 0.5, 0, 0, 1)},
