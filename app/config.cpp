@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <optional>
@@ -1307,25 +1308,29 @@ std::string ToString(DisplayMode mode) {
   return "auto";
 }
 
-std::optional<RobotType> RobotTypeFromString(const std::string& word) {
-  for (const RobotType type : {RobotType::kSimulated, RobotType::kScorbot}) {
-    if (word == ToString(type)) return type;
+namespace {
+
+// The value among `values` whose word (ToString) is `word`.
+template <typename Enum>
+std::optional<Enum> FromWord(const std::string& word, std::initializer_list<Enum> values) {
+  for (const Enum value : values) {
+    if (word == ToString(value)) return value;
   }
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<RobotType> RobotTypeFromString(const std::string& word) {
+  return FromWord(word, {RobotType::kSimulated, RobotType::kScorbot});
 }
 
 std::optional<SourceType> SourceTypeFromString(const std::string& word) {
-  for (const SourceType type : {SourceType::kSimulated, SourceType::kV4l2, SourceType::kReplay}) {
-    if (word == ToString(type)) return type;
-  }
-  return std::nullopt;
+  return FromWord(word, {SourceType::kSimulated, SourceType::kV4l2, SourceType::kReplay});
 }
 
 std::optional<DisplayMode> DisplayModeFromString(const std::string& word) {
-  for (const DisplayMode mode : {DisplayMode::kAuto, DisplayMode::kOn, DisplayMode::kOff}) {
-    if (word == ToString(mode)) return mode;
-  }
-  return std::nullopt;
+  return FromWord(word, {DisplayMode::kAuto, DisplayMode::kOn, DisplayMode::kOff});
 }
 
 int ServoLoopOptions::IterationLimit(bool replay) const {
