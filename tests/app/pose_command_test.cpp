@@ -383,6 +383,11 @@ TEST(PoseCommand, EstimatingALensTheCameraFileAlreadyHasIsRefused) {
   std::ostringstream out;
   const std::string error = test::ErrorMessageOf([&] { EstimatePoses(options, out); });
   EXPECT_THAT(error, HasSubstr("--estimate-distortion is for a camera file without distortion"));
+
+  options.estimate_frames = 0;
+  EXPECT_THAT(test::ErrorMessageOf([&] { EstimatePoses(options, out); }),
+              HasSubstr("--estimate-frames = 0: give 1 to 100 frames"));
+  EXPECT_TRUE(out.str().empty()) << "nothing is written before the options are checked";
 }
 
 }  // namespace
