@@ -21,7 +21,8 @@ namespace {
 
 constexpr const char* kVispImages = "/usr/share/visp-images-data/ViSP-images";
 
-// A uniform number in [0, 1) from a seed and a frame (SplitMix64).
+}  // namespace
+
 double Uniform01(std::uint64_t seed, int frame, std::uint64_t stream) {
   std::uint64_t x = seed * 0x9E3779B97F4A7C15ULL +
                     static_cast<std::uint64_t>(frame) * 0xBF58476D1CE4E5B9ULL + stream;
@@ -32,8 +33,6 @@ double Uniform01(std::uint64_t seed, int frame, std::uint64_t stream) {
   x ^= x >> 31;
   return static_cast<double>(x >> 11) * 0x1.0p-53;
 }
-
-}  // namespace
 
 void RenderedFrameOptions::Check() const {
   RequireOption(frames >= 1 && frames <= 1000000, "--frames", frames, "1 <= --frames <= 1000000");
@@ -59,6 +58,7 @@ RenderOptions MakeRenderOptions(const RenderedFrameOptions& options) {
   render.camera =
       CameraWithKdu(options.focal_px, options.focal_px, 0.5 * (options.width - 1),
                     0.5 * (options.height - 1), options.kdu, options.width, options.height);
+  if (options.camera) render.camera = *options.camera;
   SceneConfig scene = options.scene;
   scene.background.clear();  // EvaluationScenes reads them
   scene.ApplyTo(&render);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,10 @@ struct RenderedFrameOptions {
   std::uint64_t seed = 1;  ///< poses and noise
   int width = 640, height = 480;
   double focal_px = 600.0;
-  double kdu = 0.33;         ///< cheap wide lens (barrel, k1 ≈ -0.25)
+  double kdu = 0.33;  ///< cheap wide lens (barrel, k1 ≈ -0.25)
+  /// A camera to render through instead (its own px, py, u0, v0 and kdu; `oalservo
+  /// calibrate-accuracy`'s off-centre cameras); focal_px and kdu are then unused.
+  std::optional<vpCameraParameters> camera;
   double noise_sigma = 8.0;  ///< grey levels
   /// Each frame's noise drawn uniformly in [noise_sigma, noise_max] (from the seed); below
   /// noise_sigma: every frame noise_sigma.
@@ -46,6 +50,10 @@ struct RenderedFrameOptions {
   /// --gradient [0, 0.9]; and width, height >= 16, focal_px > 0.
   void Check() const;
 };
+
+/// A uniform number in [0, 1) from a seed, a frame and a stream (SplitMix64): what each
+/// frame's effects and an evaluation's other draws are made of, reproducible from the seed.
+double Uniform01(std::uint64_t seed, int frame, std::uint64_t stream);
 
 /// The renderer's options for `options`: a centred camera with focal_px and kdu, noise, blur,
 /// and the scene (without its background).

@@ -4,14 +4,17 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "app/accuracy_frames.h"
 #include "app/atomic_file.h"
 #include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/image_source.h"
+#include "app/sheet_views.h"
 #include "base/format.h"
 #include "calibration/calibrate.h"
 #include "calibration/chessboard.h"
@@ -32,11 +35,12 @@ void ParseChessboard(const std::string& text, ChessboardOptions* options) {
   options->rows = rows;
 }
 
-void PrintReport(const CalibrationResult& result) {
+// `points`: what a view's points are ("corners", "stripe points").
+void PrintReport(const CalibrationResult& result, const std::string& points) {
   for (const CalibrationViewReport& view : result.views) {
     if (view.used) {
-      std::cout << view.name << ": " << view.points << " corners, RMS " << Fixed(view.rms_px, 3)
-                << " px, tilt " << Fixed(view.tilt_deg, 1) << " deg\n";
+      std::cout << view.name << ": " << view.points << " " << points << ", RMS "
+                << Fixed(view.rms_px, 3) << " px, tilt " << Fixed(view.tilt_deg, 1) << " deg\n";
     } else {
       std::cout << view.name << ": not used: " << view.rejected << '\n';
     }
@@ -59,44 +63,76 @@ void PrintReport(const CalibrationResult& result) {
 
 int RunCalibrate(int argc, char** argv) {
   CLI::App cli{
-      "Calibrates the camera from views of a printed chessboard: px, py, u0, v0 and ViSP's "
+      "Calibrates the camera from views of the printed line target (default: four-line-a3, as "
+      "`oalservo target` writes it) or of a printed chessboard: px, py, u0, v0 and ViSP's "
       "radial distortion (kud, kdu), with each view's reprojection RMS and the parameters' "
       "standard deviations, written as a ViSP camera file (camera.xml) that detect, pose, "
       "evaluate and servo read.",
       "oalservo calibrate"};
   std::vector<std::string> inputs;
-  std::string chessboard_text, out_path, name = "Camera";
+  std::string chessboard_text, out_path, name = "Camera", config_path;
+  std::string target_name = FourLineA3Target().name;
   ChessboardOptions chessboard;
   bool no_distortion = false;
   cli.add_option("INPUT", inputs,
-                 "images, directories of images, printf patterns or videos of the chessboard "
+                 "images, directories of images, printf patterns or videos of the target "
                  "(10-30 views, tilted 20-45 deg in different directions, some near the "
                  "image's corners)")
       ->required();
-  cli.add_option("--chessboard", chessboard_text,
-                 "inner corners of the chessboard, COLUMNSxROWS (e.g. 9x6 for a board of 10 x "
-                 "7 squares)")
-      ->required();
-  cli.add_option("--square", chessboard.square_m, "side of a square as printed, metres")
-      ->required();
+  CLI::Option* target_option =
+      cli.add_option("--target", target_name, "the printed line target: " + TargetNameList())
+          ->capture_default_str();
+  CLI::Option* config_option =
+      cli.add_option("--config", config_path,
+                     "YAML config whose 'target:' is the printed target (its 'detector:', "
+                     "'pose:' and 'tracking:' find it)")
+          ->check(CLI::ExistingFile);
+  CLI::Option* chessboard_option =
+      cli.add_option("--chessboard", chessboard_text,
+                     "a chessboard instead: its inner corners, COLUMNSxROWS (e.g. 9x6 for a "
+                     "board of 10 x 7 squares)");
+  CLI::Option* square_option =
+      cli.add_option("--square", chessboard.square_m, "side of a square as printed, metres");
   cli.add_option("--out", out_path, "the ViSP camera file to write")->required();
   cli.add_option("--name", name, "the camera's name in the file")->capture_default_str();
   cli.add_flag("--no-distortion", no_distortion,
                "a distortion-free model (perspectiveProjWithoutDistortion)");
+  chessboard_option->excludes(target_option)->excludes(config_option)->needs(square_option);
+  square_option->needs(chessboard_option);
   cli.footer(
-      "Example:\n"
+      "Examples:\n"
+      "  oalservo calibrate shots/ --out camera.xml                    # the A3 sheet\n"
+      "  oalservo calibrate shots/ --target four-line-a4 --out camera.xml\n"
       "  oalservo calibrate shots/ --chessboard 9x6 --square 0.025 --out camera.xml\n"
-      "Print the chessboard at 100 % and measure a square; hold it flat. Views in which the "
-      "whole board is not found are listed and left out.");
+      "Print at 100 % and check the scale bar (or measure a square); lay the sheet flat. The "
+      "line target needs its four crossings in view; the stripes' points, which must lie on "
+      "straight lines, tell the lens. Views in which the target is not found are listed and "
+      "left out.");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
-  ParseChessboard(chessboard_text, &chessboard);
-  CheckInOptionWords([&] { chessboard.Check(); }, {{"ChessboardOptions::square_m", "--square"}});
+  const bool use_chessboard = chessboard_option->count() > 0;
+  AppConfig config;
+  LineTarget target;
+  if (use_chessboard) {
+    ParseChessboard(chessboard_text, &chessboard);
+    CheckInOptionWords([&] { chessboard.Check(); }, {{"ChessboardOptions::square_m", "--square"}});
+  } else {
+    if (!config_path.empty()) {
+      config =
+          LoadAccuracyConfig(config_path, "calibrate", {"target", "detector", "pose", "tracking"},
+                             "a calibration needs only the printed target");
+    }
+    target = AccuracyTarget(target_name, target_option->count() > 0, config_path, config);
+  }
+  const std::string what = use_chessboard
+                               ? "the whole chessboard (" + chessboard_text + " inner corners)"
+                               : "the target " + target.name;
 
   // The output before the work: a bad --out fails now, and the file appears only whole.
   const std::filesystem::path out(out_path);
   PrepareOutputFile(out, "--out");
 
   std::vector<CalibrationView> views;
+  std::optional<SheetViewFinder> sheet;
   int width = 0, height = 0;
   for (const std::string& input : inputs) {
     std::vector<std::string> warnings;
@@ -111,11 +147,14 @@ int RunCalibrate(int argc, char** argv) {
                                  std::to_string(width) + "x" + std::to_string(height) +
                                  ": one calibration is for one image size");
       }
-      std::optional<CalibrationView> view = FindChessboard(frame.view(), chessboard, frame.source);
-      if (view) {
-        views.push_back(std::move(*view));
+      if (use_chessboard) {
+        std::optional<CalibrationView> view =
+            FindChessboard(frame.view(), chessboard, frame.source);
+        views.push_back(view ? std::move(*view) : CalibrationView{frame.source, {}, {}});
       } else {
-        views.push_back(CalibrationView{frame.source, {}});
+        if (!sheet)
+          sheet.emplace(target, width, height, config.detector, config.pose, config.tracking);
+        views.push_back(sheet->Find(frame.view(), frame.source));
       }
     }
   }
@@ -125,19 +164,18 @@ int RunCalibrate(int argc, char** argv) {
   options.width = width;
   options.height = height;
   options.estimate_distortion = !no_distortion;
-  options.min_points_per_view = chessboard.columns * chessboard.rows;
+  if (use_chessboard) options.min_points_per_view = chessboard.columns * chessboard.rows;
   std::vector<CalibrationView> found;
   for (CalibrationView& view : views) {
-    if (view.points.empty()) {
-      std::cout << view.name << ": not used: the whole chessboard (" << chessboard.columns << "x"
-                << chessboard.rows << " inner corners) was not found\n";
+    if (view.points.empty() && view.lines.empty()) {
+      std::cout << view.name << ": not used: " << what << " was not found\n";
     } else {
       found.push_back(std::move(view));
     }
   }
   if (static_cast<int>(found.size()) < options.min_views) {
     throw std::runtime_error(std::to_string(found.size()) + " of " + std::to_string(views.size()) +
-                             " images show the whole chessboard, at least " +
+                             " images show " + what + ", at least " +
                              std::to_string(options.min_views) + " needed: nothing written to " +
                              out_path);
   }
@@ -147,7 +185,7 @@ int RunCalibrate(int argc, char** argv) {
   } catch (const std::runtime_error& error) {
     throw std::runtime_error(std::string(error.what()) + "\nnothing written to " + out_path);
   }
-  PrintReport(result);
+  PrintReport(result, use_chessboard ? "corners" : "stripe points");
   SaveCameraFile(out_path, result.camera, name, static_cast<unsigned>(width),
                  static_cast<unsigned>(height));
   std::cout << "wrote " << out_path << " (camera '" << name << "', " << width << "x" << height

@@ -272,13 +272,6 @@ void ReadDetectorSection(const YAML::Node& section, const std::string& file, App
 // ------------------------------------------------------------------------------------------
 // `target:`: a shipped target by name, or a full description (config/four-line-board.yaml).
 
-// "four-line-a3, four-line-a4, ...": the names `target.name` takes (scene/scene.h).
-std::string ShippedTargets() {
-  std::string list;
-  for (const std::string& name : TargetNames()) list += (list.empty() ? "" : ", ") + name;
-  return list;
-}
-
 std::string Number(double value) {
   std::ostringstream text;
   text << value;
@@ -408,18 +401,18 @@ void ReadTargetSection(const YAML::Node& section, const std::string& file, AppCo
           At(file, entry.first) + ": key 'target." + key +
           "' needs a full target description: give 'lines' too, or only 'name' for a shipped "
           "target (" +
-          ShippedTargets() + ")");
+          TargetNameList() + ")");
     }
     if (lines.count("name") == 0) {
       throw std::runtime_error(At(file, section) + ": section 'target' needs 'name' (" +
-                               ShippedTargets() + ") or a full description with 'lines'");
+                               TargetNameList() + ") or a full description with 'lines'");
     }
     try {
       config->target = TargetByName(target.name);
     } catch (const std::invalid_argument&) {
       throw std::runtime_error(file + ":" + std::to_string(lines.at("name")) +
                                ": 'target.name' = '" + target.name + "' is not a shipped target (" +
-                               ShippedTargets() +
+                               TargetNameList() +
                                "); describe it in full with board_width_m, board_height_m and "
                                "lines");
     }

@@ -320,10 +320,8 @@ int RunDemo(int argc, char** argv) {
       "oalservo demo");
   cli.add_option("--out", options.out_dir, "output directory (created if missing)")
       ->capture_default_str();
-  std::string names;
-  for (const std::string& name : TargetNames()) names += (names.empty() ? "" : ", ") + name;
   cli.add_option("--target", options.target,
-                 "built-in target: " + names +
+                 "built-in target: " + TargetNameList() +
                      " (a sheet lies on a photograph of a bench; the board fills the view)")
       ->capture_default_str();
   AddSeedOption(cli, &options.seed, "seed of the pose and the noise, >= 0");

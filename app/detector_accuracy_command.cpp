@@ -67,18 +67,10 @@ int RunDetectAccuracy(int argc, char** argv) {
       "oalservo detect-accuracy"};
   AccuracyOptions options;
   std::string config_path, out_path, target_name = "four-line-board";
-  CLI::Option* target = cli.add_option(
-                               "--target", target_name,
-                               "a built-in target: " +
-                                   [] {
-                                     std::string list;
-                                     for (const std::string& name : TargetNames()) {
-                                       list += (list.empty() ? "" : ", ") + name;
-                                     }
-                                     return list;
-                                   }() +
-                                   " (a sheet: on photographs of a bench, as "
-                                   "pose-accuracy)")
+  CLI::Option* target = cli.add_option("--target", target_name,
+                                       "a built-in target: " + TargetNameList() +
+                                           " (a sheet: on photographs of a bench, as "
+                                           "pose-accuracy)")
                             ->capture_default_str();
   AddRenderedFrameOptions(cli, &options, "lens distortion (ViSP kdu; 0.33 = cheap wide lens)");
   cli.add_option("--gradient", options.illumination_gradient, "illumination fall-off, 0..0.9")

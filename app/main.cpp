@@ -10,6 +10,7 @@
 #include <opencv2/core/utils/logger.hpp>
 #include <string>
 
+#include "app/calibrate_accuracy_command.h"
 #include "app/calibrate_command.h"
 #include "app/command_line.h"
 #include "app/compare_command.h"
@@ -53,7 +54,10 @@ constexpr oal::Command kCommands[] = {
      "evaluate the tracker and the pose on recorded videos: JSON, annotated video, HTML report"},
     {"demo", &oal::RunDemo, "render, detect and compare one frame of a cheap camera"},
     {"calibrate", &oal::RunCalibrate,
-     "camera intrinsics and distortion from chessboard views, as a ViSP camera file"},
+     "camera intrinsics and distortion from views of the printed target or a chessboard, as a "
+     "ViSP camera file"},
+    {"calibrate-accuracy", &oal::RunCalibrateAccuracy,
+     "accuracy of calibrate from the printed target on rendered views of known cameras"},
     {"hand-eye", &oal::RunHandEye,
      "the camera's mounting on the arm (eMc): move through stations, or from recorded pairs"},
     {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},

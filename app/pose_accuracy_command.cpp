@@ -144,17 +144,9 @@ int RunPoseAccuracy(int argc, char** argv) {
   cli.add_option("--gradient", options.illumination_gradient,
                  "illumination fall-off across the image, [0, 0.9]")
       ->capture_default_str();
-  CLI::Option* target = cli.add_option(
-                               "--target", target_name,
-                               "a built-in target: " +
-                                   [] {
-                                     std::string list;
-                                     for (const std::string& name : TargetNames()) {
-                                       list += (list.empty() ? "" : ", ") + name;
-                                     }
-                                     return list;
-                                   }())
-                            ->capture_default_str();
+  CLI::Option* target =
+      cli.add_option("--target", target_name, "a built-in target: " + TargetNameList())
+          ->capture_default_str();
   cli.add_option("--min-distance", options.sampling.min_distance_m,
                  "metres (default: the target's)");
   cli.add_option("--max-distance", options.sampling.max_distance_m,

@@ -240,13 +240,6 @@ void WriteFrame(const fs::path& dir, int index, const RenderedFrame& frame, cons
   WriteFileAtomically(dir / FrameName(index, ".json"), truth.dump(2) + "\n");
 }
 
-// "four-line-a3, four-line-a4, ...": the names --target takes (and "four-line", older).
-std::string TargetNameList() {
-  std::string list;
-  for (const std::string& name : TargetNames()) list += (list.empty() ? "" : ", ") + name;
-  return list;
-}
-
 // The target and scene to render: the config's `target:` and `scene:` sections if a config
 // is given, else the target by name on a plain surface.
 AppConfig ConfigOf(const RenderCommandOptions& options) {

@@ -103,14 +103,8 @@ int RunServoAccuracy(int argc, char** argv) {
   std::vector<std::string> laws;
   cli.add_option("--config", config_path, "YAML configuration (as for oalservo servo)")
       ->check(CLI::ExistingFile);
-  cli.add_option(
-      "--target", target_name, "a built-in target instead of the configuration's (" + [] {
-        std::string list;
-        for (const std::string& name : TargetNames()) {
-          list += (list.empty() ? "" : ", ") + name;
-        }
-        return list;
-      }() + ")");
+  cli.add_option("--target", target_name,
+                 "a built-in target instead of the configuration's (" + TargetNameList() + ")");
   cli.add_option("--background", background,
                  "image of the surface the target lies on, instead of the configuration's "
                  "scene.background");

@@ -757,9 +757,7 @@ void TargetCommandOptions::Check() const {
   if (!target.empty()) {
     const std::vector<std::string>& names = TargetNames();
     if (target != "four-line" && std::find(names.begin(), names.end(), target) == names.end()) {
-      std::string list;
-      for (const std::string& known : names) list += (list.empty() ? "" : ", ") + known;
-      throw std::invalid_argument("--target = " + target + ": it is one of " + list);
+      throw std::invalid_argument("--target = " + target + ": it is one of " + TargetNameList());
     }
   }
   CheckPageName(page);
@@ -797,8 +795,7 @@ TargetDrawing WriteTargetSvg(const TargetCommandOptions& options) {
 
 int RunTarget(int argc, char** argv) {
   TargetCommandOptions options;
-  std::string names;
-  for (const std::string& name : TargetNames()) names += (names.empty() ? "" : ", ") + name;
+  const std::string names = TargetNameList();
   CLI::App cli(
       "Write a printable, true-scale SVG of a line target on one page (1 unit = 1 mm): the "
       "stripes in black, and, small and grey and at least 5 mm clear of every stripe and of the "

@@ -4,14 +4,20 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "base/check.h"
 #include "base/format.h"
+#include "calibration/plane_lines.h"
 
 namespace oal {
 namespace {
+
+using plane_lines::OnPlane;
+using plane_lines::PlaneLine;
+using plane_lines::Snap;
 
 constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 
@@ -21,6 +27,15 @@ constexpr double kLooseFocalFraction = 0.003;
 constexpr double kLoosePrincipalPx = 1.5;
 constexpr double kLooseK1 = 0.01;
 
+// Points on lines are paired with plane points again after each solve until none moves by
+// more than this (metres), or this many solves.
+constexpr double kPairingSettledM = 1e-6;
+constexpr int kMaxPairingRounds = 40;
+// A line point farther from its line than this many robust standard deviations of them all is
+// left out, but not nearer than the floor (pixels).
+constexpr double kOutlierSigmas = 4.0;
+constexpr double kOutlierFloorPx = 0.3;
+
 // The view's plane tilt from its rotation vector: the angle between the plane's normal (its z
 // axis) and the optical axis.
 double TiltDeg(const cv::Mat& rvec) {
@@ -28,6 +43,103 @@ double TiltDeg(const cv::Mat& rvec) {
   cv::Rodrigues(rvec, rotation);
   const double cos_tilt = std::fabs(rotation.at<double>(2, 2));
   return std::acos(std::min(1.0, cos_tilt)) * kDegPerRad;
+}
+
+// Each seen point of a view's lines paired with a plane point of its line: where the
+// homography (first pairing) or the solved camera and view pose (later ones) take it back to
+// the plane, moved across onto the line. Pairing again after each solve converges to the
+// points' fit across their lines: along a line, the pairing leaves no residual.
+struct LinePairing {
+  std::vector<cv::Point2d> seen;     // distorted pixels
+  std::vector<std::size_t> line_of;  // index in the view's lines
+  std::vector<cv::Point2d> paired;   // plane, metres
+};
+
+LinePairing PairThroughHomography(const CalibrationView& view, const cv::Matx33d& plane_to_image) {
+  LinePairing pairing;
+  const cv::Matx33d image_to_plane = plane_to_image.inv();
+  for (std::size_t l = 0; l < view.lines.size(); ++l) {
+    const PlaneLine line = OnPlane(view.lines[l]);
+    for (const Point2d& p : view.lines[l].seen) {
+      const cv::Vec3d q = image_to_plane * cv::Vec3d(p.u, p.v, 1.0);
+      pairing.seen.emplace_back(p.u, p.v);
+      pairing.line_of.push_back(l);
+      pairing.paired.push_back(Snap(line, cv::Point2d(q[0] / q[2], q[1] / q[2])));
+    }
+  }
+  return pairing;
+}
+
+// Pairs again through the solved camera: each seen point's ray meets the plane of the view.
+// Returns how far the farthest paired point moved, metres.
+double PairThroughCamera(const CalibrationView& view, const cv::Mat& camera_matrix,
+                         const cv::Mat& distortion, const cv::Mat& rvec, const cv::Mat& tvec,
+                         LinePairing* pairing) {
+  if (pairing->seen.empty()) return 0.0;
+  std::vector<cv::Point2d> ideal;
+  cv::undistortPoints(pairing->seen, ideal, camera_matrix, distortion);
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  const cv::Matx33d plane_from_camera = rotation.t();
+  const cv::Vec3d centre = -(plane_from_camera * cv::Vec3d(tvec));
+  double moved = 0.0;
+  for (std::size_t k = 0; k < ideal.size(); ++k) {
+    const cv::Vec3d ray = plane_from_camera * cv::Vec3d(ideal[k].x, ideal[k].y, 1.0);
+    if (std::fabs(ray[2]) < 1e-12) continue;
+    const double s = -centre[2] / ray[2];
+    const cv::Point2d q(centre[0] + s * ray[0], centre[1] + s * ray[1]);
+    const cv::Point2d snapped = Snap(OnPlane(view.lines[pairing->line_of[k]]), q);
+    moved = std::max(moved, cv::norm(snapped - pairing->paired[k]));
+    pairing->paired[k] = snapped;
+  }
+  return moved;
+}
+
+// Drops the line points the solved camera leaves farther from their lines than kOutlierSigmas
+// robust standard deviations of all of them (a speck beside a stripe, a shadow's edge), but
+// never nearer than kOutlierFloorPx: noise alone stays. Returns how many it dropped.
+int DropOutliers(const std::vector<const CalibrationView*>& views, const cv::Mat& camera_matrix,
+                 const cv::Mat& distortion, const std::vector<cv::Mat>& rvecs,
+                 const std::vector<cv::Mat>& tvecs, std::vector<LinePairing>* pairings) {
+  std::vector<std::vector<double>> residuals(views.size());
+  std::vector<double> all;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    LinePairing& pairing = (*pairings)[i];
+    if (pairing.seen.empty()) continue;
+    std::vector<cv::Point3d> object;
+    for (const cv::Point2d& q : pairing.paired) object.emplace_back(q.x, q.y, 0.0);
+    std::vector<cv::Point2d> projected;
+    cv::projectPoints(object, rvecs[i], tvecs[i], camera_matrix, distortion, projected);
+    for (std::size_t k = 0; k < projected.size(); ++k) {
+      residuals[i].push_back(cv::norm(projected[k] - pairing.seen[k]));
+    }
+    all.insert(all.end(), residuals[i].begin(), residuals[i].end());
+  }
+  if (all.empty()) return 0;
+  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+  const double limit = std::max(kOutlierFloorPx, kOutlierSigmas * 1.4826 * all[all.size() / 2]);
+  int dropped = 0;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    LinePairing& pairing = (*pairings)[i];
+    LinePairing kept;
+    for (std::size_t k = 0; k < pairing.seen.size(); ++k) {
+      if (residuals[i][k] > limit) {
+        ++dropped;
+        continue;
+      }
+      kept.seen.push_back(pairing.seen[k]);
+      kept.line_of.push_back(pairing.line_of[k]);
+      kept.paired.push_back(pairing.paired[k]);
+    }
+    pairing = std::move(kept);
+  }
+  return dropped;
+}
+
+int SeenPoints(const CalibrationView& view) {
+  std::size_t count = view.points.size();
+  for (const CalibrationLine& line : view.lines) count += line.seen.size();
+  return static_cast<int>(count);
 }
 
 }  // namespace
@@ -83,25 +195,30 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
                             const CalibrationOptions& options) {
   options.Check();
   CalibrationResult result;
-  std::vector<std::vector<cv::Point3f>> object_points;
-  std::vector<std::vector<cv::Point2f>> image_points;
+  std::vector<const CalibrationView*> used_views;
   std::vector<std::size_t> used;  // index in `views` of each view handed to the solver
+  std::vector<LinePairing> pairings;
   for (std::size_t k = 0; k < views.size(); ++k) {
     const CalibrationView& view = views[k];
     CalibrationViewReport& report = result.views.emplace_back();
     report.name = view.name;
-    report.points = static_cast<int>(view.points.size());
+    report.points = SeenPoints(view);
     if (report.points < options.min_points_per_view) {
       report.rejected = std::to_string(report.points) + " target points (min_points_per_view = " +
                         std::to_string(options.min_points_per_view) + ")";
       continue;
     }
-    std::vector<cv::Point3f>& object = object_points.emplace_back();
-    std::vector<cv::Point2f>& image = image_points.emplace_back();
-    for (const CalibrationPoint& point : view.points) {
-      object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
-      image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
+    LinePairing& pairing = pairings.emplace_back();
+    if (!view.lines.empty()) {
+      const std::optional<cv::Matx33d> homography = plane_lines::FirstHomography(view);
+      if (!homography) {
+        report.rejected = "fewer than four of its lines' crossings and its points are known";
+        pairings.pop_back();
+        continue;
+      }
+      pairing = PairThroughHomography(view, *homography);
     }
+    used_views.push_back(&view);
     used.push_back(k);
   }
   if (static_cast<int>(used.size()) < options.min_views) {
@@ -122,10 +239,43 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   cv::Mat camera_matrix, distortion = cv::Mat::zeros(5, 1, CV_64F), sd_intrinsics, sd_extrinsics,
                          view_errors;
   std::vector<cv::Mat> rvecs, tvecs;
+  std::vector<std::vector<cv::Point2f>> image_points;
   const cv::TermCriteria stop(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12);
-  result.rms_px = cv::calibrateCamera(
-      object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
-      distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors, flags, stop);
+  const bool any_lines =
+      std::any_of(used_views.begin(), used_views.end(),
+                  [](const CalibrationView* view) { return !view->lines.empty(); });
+  for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
+    std::vector<std::vector<cv::Point3f>> object_points;
+    image_points.clear();
+    for (std::size_t i = 0; i < used_views.size(); ++i) {
+      std::vector<cv::Point3f>& object = object_points.emplace_back();
+      std::vector<cv::Point2f>& image = image_points.emplace_back();
+      for (const CalibrationPoint& point : used_views[i]->points) {
+        object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
+        image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
+      }
+      for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
+        object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
+                            static_cast<float>(pairings[i].paired[k].y), 0.0f);
+        image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
+                           static_cast<float>(pairings[i].seen[k].y));
+      }
+    }
+    result.rms_px = cv::calibrateCamera(
+        object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
+        distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors,
+        pairing_round == 0 ? flags : flags | cv::CALIB_USE_INTRINSIC_GUESS, stop);
+    if (!any_lines) break;
+    const int dropped = pairing_round == 0 ? 0
+                                           : DropOutliers(used_views, camera_matrix, distortion,
+                                                          rvecs, tvecs, &pairings);
+    double moved = 0.0;
+    for (std::size_t i = 0; i < used_views.size(); ++i) {
+      moved = std::max(moved, PairThroughCamera(*used_views[i], camera_matrix, distortion, rvecs[i],
+                                                tvecs[i], &pairings[i]));
+    }
+    if (moved < kPairingSettledM && dropped == 0) break;
+  }
 
   int tilted = 0;
   double largest_tilt = 0.0;

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "detector/line.h"
+
 namespace oal {
 
 /// A point of the target seen in one view.
@@ -24,15 +26,28 @@ struct CalibrationPoint {
   double x = 0.0, y = 0.0;  ///< where it is on the target's plane, metres (z = 0)
 };
 
+/// A straight line of the target seen in one view: points seen along it, and the line on the
+/// target's plane they lie on. Where along the line each point is, is not known: the line
+/// constrains the camera across itself only (a plumb line that also has a known place).
+struct CalibrationLine {
+  double x = 0.0, y = 0.0;    ///< a point of the line on the target's plane, metres
+  double dx = 1.0, dy = 0.0;  ///< its direction on the plane (any length > 0)
+  std::vector<Point2d> seen;  ///< distorted pixels of points on it (e.g. a stripe's middle)
+};
+
 struct CalibrationView {
   std::string name;  ///< for messages: a file name, "video.mp4#12"
   std::vector<CalibrationPoint> points;
+  /// Lines of the target (e.g. the four-line sheet's stripes). A view of lines alone needs
+  /// four of them crossing in at least four points on the plane.
+  std::vector<CalibrationLine> lines;
 };
 
 struct CalibrationOptions {
-  int width = 0, height = 0;     ///< the views' image size, pixels; > 0
-  int min_views = 3;             ///< usable views needed. Range [3, 1000].
-  int min_points_per_view = 12;  ///< fewer: the view is not used. Range [6, 100000].
+  int width = 0, height = 0;  ///< the views' image size, pixels; > 0
+  int min_views = 3;          ///< usable views needed. Range [3, 1000].
+  /// Fewer known points and points on lines together: the view is not used. Range [6, 100000].
+  int min_points_per_view = 12;
   /// A view tilted less than this from facing the camera constrains the focal length poorly;
   /// at least min_tilted_views views must tilt more. Degrees, range [0, 80].
   double min_tilt_deg = 10.0;

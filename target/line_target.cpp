@@ -95,6 +95,12 @@ const std::vector<std::string>& TargetNames() {
   return names;
 }
 
+std::string TargetNameList() {
+  std::string list;
+  for (const std::string& name : TargetNames()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 LineTarget TargetByName(const std::string& name) {
   if (name == "two-line") return TwoLineTarget();
   if (name == "four-line-board" || name == "four-line") return FourLineTarget();

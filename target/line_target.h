@@ -43,6 +43,8 @@ LineTarget FourLineLetterTarget();
 /// The built-in targets' names, the default first: "four-line-a3", "four-line-a4",
 /// "four-line-letter", "four-line-board", "two-line".
 const std::vector<std::string>& TargetNames();
+/// TargetNames() joined for messages and help: "four-line-a3, four-line-a4, ...".
+std::string TargetNameList();
 /// One of TargetNames() ("four-line" is kept as a name of "four-line-board"); throws
 /// std::invalid_argument listing them otherwise.
 LineTarget TargetByName(const std::string& name);

@@ -1,0 +1,55 @@
+// `oalservo calibrate-accuracy`: camera calibration from the printed line target on rendered
+// views of known cameras (fixed seeds): each camera drawn (focal length, principal point off
+// centre, lens), its views rendered on the evaluation bench, found as `calibrate` finds them,
+// calibrated, and compared with the truth.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "app/accuracy_frames.h"
+#include "calibration/calibrate.h"
+
+namespace oal {
+
+struct CalibrateAccuracyOptions : RenderedFrameOptions {
+  LineTarget target = FourLineA3Target();
+  int cameras = 5;  ///< cameras drawn, [1, 1000]; RenderedFrameOptions::frames: views of each
+  double min_focal_px = 600.0, max_focal_px = 900.0;  ///< px drawn in; py within 1 % of it
+  double max_centre_offset_px = 20.0;                 ///< u0, v0 this far from the centre
+  double min_kdu = 0.0, max_kdu = 0.35;               ///< the lens drawn in
+  /// The views: the camera aimed near the sheet's middle from its near to far distances,
+  /// tilted min..max_tilt_deg in any direction, any roll, the crossings in view.
+  PoseSampling sampling;
+  double min_tilt_deg = 15.0;
+  DetectorOptions detector;
+  PoseOptions pose;
+  TargetTrackerOptions tracking;
+
+  /// Throws std::invalid_argument naming the option and its range.
+  void Check() const;
+};
+
+/// One camera's calibration against its truth.
+struct CameraCalibrationTrial {
+  vpCameraParameters truth, found;
+  int views = 0, used = 0;
+  double rms_px = 0.0;
+  std::string failed;  ///< why the calibration refused (then `found` is unset)
+  double px_error_pct() const;
+  double py_error_pct() const;
+  double u0_error_px() const;
+  double v0_error_px() const;
+  /// |kdu found - kdu true| relative to the true kdu, or absolute when below 0.005 (the issue's
+  /// "within 3 % or 0.005 absolute"): as a fraction of the allowance, <= 1 passes.
+  double kdu_error() const;
+  double kdu_error_abs() const;
+};
+
+std::vector<CameraCalibrationTrial> EvaluateCalibration(
+    const CalibrateAccuracyOptions& options,
+    const std::function<void(int done, int total)>& progress = {});
+
+}  // namespace oal

@@ -1,0 +1,9 @@
+#pragma once
+
+namespace oal {
+
+/// `oalservo calibrate-accuracy`: calibration from the printed line target on rendered views of
+/// known cameras (app/calibrate_accuracy.h), printed as a table and optionally written as JSON.
+int RunCalibrateAccuracy(int argc, char** argv);
+
+}  // namespace oal

@@ -1,0 +1,42 @@
+#include "app/sheet_views.h"
+
+#include <array>
+
+#include "calibration/sheet_view.h"
+
+namespace oal {
+namespace {
+
+// Focal lengths tried, as fractions of the image's width: a 60 deg lens first, then wider and
+// narrower ones (a USB camera's lens is 50-110 deg across).
+constexpr std::array<double, 4> kGuessedFocalPerWidth = {0.9, 0.65, 1.3, 1.9};
+// A feature point this far from its stripe's straight line still counts: an unknown lens bends
+// a stripe a few pixels away from its chord.
+constexpr double kStripeTolerancePx = 6.0;
+
+}  // namespace
+
+SheetViewFinder::SheetViewFinder(const LineTarget& target, int width, int height,
+                                 const DetectorOptions& detector, const PoseOptions& pose,
+                                 const TargetTrackerOptions& tracking)
+    : target_(target) {
+  for (const double focal_per_width : kGuessedFocalPerWidth) {
+    vpCameraParameters guess;
+    guess.initPersProjWithoutDistortion(focal_per_width * width, focal_per_width * width,
+                                        0.5 * (width - 1), 0.5 * (height - 1));
+    trackers_.emplace_back(target, guess, detector, pose, tracking);
+  }
+}
+
+CalibrationView SheetViewFinder::Find(const GrayImageView& image, const std::string& name) {
+  for (TargetPoseTracker& tracker : trackers_) {
+    tracker.Reset();
+    tracker.Track(image);
+    const std::array<std::vector<Point2d>, 4> stripes = tracker.StripePoints(kStripeTolerancePx);
+    if (stripes[0].empty()) continue;
+    return SheetView(target_, {stripes.begin(), stripes.end()}, name);
+  }
+  return CalibrationView{name, {}, {}};
+}
+
+}  // namespace oal
