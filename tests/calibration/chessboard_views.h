@@ -87,7 +87,7 @@ inline std::vector<CalibrationView> RenderedViews(const vpCameraParameters& came
     const vpImage<unsigned char> image = RenderChessboard(camera, poses[k], 100 + k);
     const std::string name = "view " + std::to_string(k);
     std::optional<CalibrationView> view = FindChessboard(ViewOf(image), TestChessboard(), name);
-    views.push_back(view ? *view : CalibrationView{name, {}});
+    views.push_back(view ? *view : CalibrationView{name, {}, {}});
   }
   return views;
 }
