@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/accuracy_frames.h"
@@ -18,6 +19,7 @@
 #include "base/format.h"
 #include "calibration/calibrate.h"
 #include "calibration/chessboard.h"
+#include "calibration/view_selector.h"
 
 namespace oal {
 namespace {
@@ -59,6 +61,101 @@ void PrintReport(const CalibrationResult& result, const std::string& points) {
   for (const std::string& advice : result.advice) Warn("calibrate", advice);
 }
 
+// Finds the calibration target in a frame: the chessboard or the line target.
+class ViewFinder {
+ public:
+  ViewFinder(std::optional<ChessboardOptions> chessboard, LineTarget target, AppConfig config)
+      : chessboard_(std::move(chessboard)),
+        target_(std::move(target)),
+        config_(std::move(config)) {}
+
+  CalibrationView Find(const Frame& frame) {
+    if (chessboard_) {
+      std::optional<CalibrationView> view =
+          FindChessboard(frame.view(), *chessboard_, frame.source);
+      return view ? std::move(*view) : CalibrationView{frame.source, {}, {}};
+    }
+    if (!sheet_) {
+      sheet_.emplace(target_, frame.gray.cols, frame.gray.rows, config_.detector, config_.pose,
+                     config_.tracking);
+    }
+    return sheet_->Find(frame.view(), frame.source);
+  }
+
+ private:
+  std::optional<ChessboardOptions> chessboard_;
+  LineTarget target_;
+  AppConfig config_;
+  std::optional<SheetViewFinder> sheet_;
+};
+
+// What the user is told when the live selection's verdict changes.
+std::string LiveStatus(ViewSelector::Verdict verdict, const ViewSelector& selector) {
+  switch (verdict) {
+    case ViewSelector::Verdict::kNoTarget:
+      return "looking for the target";
+    case ViewSelector::Verdict::kMoving:
+      return "hold the target still";
+    case ViewSelector::Verdict::kTooLike:
+      return "like view " + std::to_string(selector.similar_to() + 1) +
+             ": move to a new pose (tilt the other way, towards another corner, nearer or "
+             "farther)";
+    case ViewSelector::Verdict::kTaken:
+      break;
+  }
+  return "";
+}
+
+// The frames of `inputs`, all the same size (*width x *height from the first), each with the
+// target found or not. With `live`, only those the selection takes, up to `wanted`, stopping
+// early at a stop signal.
+std::vector<CalibrationView> CollectViews(const std::vector<std::string>& inputs,
+                                          ViewFinder* finder, bool live, int wanted, int* width,
+                                          int* height) {
+  std::vector<CalibrationView> views;
+  std::optional<ViewSelector> selector;
+  std::optional<StopSignalScope> stop;
+  if (live) stop.emplace();
+  std::string status;
+  for (const std::string& input : inputs) {
+    std::vector<std::string> warnings;
+    const std::unique_ptr<ImageSource> source = OpenImageSource(input, &warnings);
+    for (const std::string& warning : warnings) Warn("calibrate", warning);
+    Frame frame;
+    while (!(stop && stop->interrupted()->load()) && source->Next(&frame)) {
+      if (*width == 0) *width = frame.gray.cols, *height = frame.gray.rows;
+      if (frame.gray.cols != *width || frame.gray.rows != *height) {
+        throw std::runtime_error(frame.source + ": " + std::to_string(frame.gray.cols) + "x" +
+                                 std::to_string(frame.gray.rows) + " pixels, the first view " +
+                                 std::to_string(*width) + "x" + std::to_string(*height) +
+                                 ": one calibration is for one image size");
+      }
+      CalibrationView view = finder->Find(frame);
+      if (!live) {
+        views.push_back(std::move(view));
+        continue;
+      }
+      if (!selector) selector.emplace(*width, *height);
+      const ViewSelector::Verdict verdict = selector->Offer(view);
+      if (verdict == ViewSelector::Verdict::kTaken) {
+        views.push_back(std::move(view));
+        std::cout << "view " << views.size() << " of " << wanted << " taken: " << frame.source
+                  << std::endl;
+        status.clear();
+        if (static_cast<int>(views.size()) == wanted) return views;
+      } else if (const std::string now = LiveStatus(verdict, *selector); now != status) {
+        status = now;
+        std::cout << "  " << status << std::endl;
+      }
+    }
+  }
+  if (stop && stop->signal_number() != 0) {
+    std::cout << StopSignalName(stop->signal_number()) << ": " << views.size()
+              << " views taken, calibrating with them\n";
+  }
+  return views;
+}
+
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
@@ -73,7 +170,8 @@ int RunCalibrate(int argc, char** argv) {
   std::string chessboard_text, out_path, name = "Camera", config_path;
   std::string target_name = FourLineA3Target().name;
   ChessboardOptions chessboard;
-  bool no_distortion = false;
+  bool no_distortion = false, live = false;
+  int wanted_views = 20;
   cli.add_option("INPUT", inputs,
                  "images, directories of images, printf patterns or videos of the target "
                  "(10-30 views, tilted 20-45 deg in different directions, some near the "
@@ -97,6 +195,15 @@ int RunCalibrate(int argc, char** argv) {
   cli.add_option("--name", name, "the camera's name in the file")->capture_default_str();
   cli.add_flag("--no-distortion", no_distortion,
                "a distortion-free model (perspectiveProjWithoutDistortion)");
+  CLI::Option* live_option = cli.add_flag(
+      "--live", live,
+      "take a view only when the target has held still for a few frames and stands apart "
+      "from the views taken, up to --views, saying each time what to do (a camera: "
+      "/dev/video0; a video works too); Ctrl-C calibrates with the views taken");
+  cli.add_option("--views", wanted_views, "with --live: the views to take")
+      ->check(CLI::Range(3, 1000))
+      ->capture_default_str()
+      ->needs(live_option);
   chessboard_option->excludes(target_option)->excludes(config_option)->needs(square_option);
   square_option->needs(chessboard_option);
   cli.footer(
@@ -104,6 +211,7 @@ int RunCalibrate(int argc, char** argv) {
       "  oalservo calibrate shots/ --out camera.xml                    # the A3 sheet\n"
       "  oalservo calibrate shots/ --target four-line-a4 --out camera.xml\n"
       "  oalservo calibrate shots/ --chessboard 9x6 --square 0.025 --out camera.xml\n"
+      "  oalservo calibrate /dev/video0 --live --out camera.xml     # move the sheet, hold, ...\n"
       "Print at 100 % and check the scale bar (or measure a square); lay the sheet flat. The "
       "line target needs its four crossings in view; the stripes' points, which must lie on "
       "straight lines, tell the lens. Views in which the target is not found are listed and "
@@ -131,32 +239,15 @@ int RunCalibrate(int argc, char** argv) {
   const std::filesystem::path out(out_path);
   PrepareOutputFile(out, "--out");
 
-  std::vector<CalibrationView> views;
-  std::optional<SheetViewFinder> sheet;
+  ViewFinder finder(use_chessboard ? std::optional<ChessboardOptions>(chessboard) : std::nullopt,
+                    target, config);
   int width = 0, height = 0;
-  for (const std::string& input : inputs) {
-    std::vector<std::string> warnings;
-    const std::unique_ptr<ImageSource> source = OpenImageSource(input, &warnings);
-    for (const std::string& warning : warnings) Warn("calibrate", warning);
-    Frame frame;
-    while (source->Next(&frame)) {
-      if (width == 0) width = frame.gray.cols, height = frame.gray.rows;
-      if (frame.gray.cols != width || frame.gray.rows != height) {
-        throw std::runtime_error(frame.source + ": " + std::to_string(frame.gray.cols) + "x" +
-                                 std::to_string(frame.gray.rows) + " pixels, the first view " +
-                                 std::to_string(width) + "x" + std::to_string(height) +
-                                 ": one calibration is for one image size");
-      }
-      if (use_chessboard) {
-        std::optional<CalibrationView> view =
-            FindChessboard(frame.view(), chessboard, frame.source);
-        views.push_back(view ? std::move(*view) : CalibrationView{frame.source, {}, {}});
-      } else {
-        if (!sheet)
-          sheet.emplace(target, width, height, config.detector, config.pose, config.tracking);
-        views.push_back(sheet->Find(frame.view(), frame.source));
-      }
-    }
+  std::vector<CalibrationView> views =
+      CollectViews(inputs, &finder, live, wanted_views, &width, &height);
+  if (live && static_cast<int>(views.size()) < CalibrationOptions().min_views) {
+    throw std::runtime_error(std::to_string(views.size()) + " views taken from " + inputs.front() +
+                             ", at least " + std::to_string(CalibrationOptions().min_views) +
+                             " needed: nothing written to " + out_path);
   }
   if (views.empty()) throw std::runtime_error("no image in " + inputs.front());
 

@@ -2,6 +2,7 @@
 // the command table, --help and --version; each command lives in app/<name>_command.cpp,
 // whose Run* function parses its arguments and calls a plain function that tests call
 // directly. To add a command: include its header and add one row to kCommands.
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -69,8 +70,12 @@ void PrintUsage(std::ostream& out) {
   out << "oalservo " << OAL_VERSION << ": OAL Hough line detection and visual servoing\n\n"
       << "Usage: oalservo <command> [options]\n"
       << "       oalservo --help | --version\n\nCommands:\n";
+  std::size_t width = 0;  // the longest name and two spaces: every name stands apart
+  for (const oal::Command& command : kCommands)
+    width = std::max(width, std::strlen(command.name) + 2);
   for (const oal::Command& command : kCommands) {
-    out << "  " << std::left << std::setw(18) << command.name << command.help << '\n';
+    out << "  " << std::left << std::setw(static_cast<int>(width)) << command.name << command.help
+        << '\n';
   }
   out << "\nRun 'oalservo <command> --help' for the options of a command.\n";
 }

@@ -107,9 +107,7 @@ LineTarget TargetByName(const std::string& name) {
   if (name == "four-line-a3") return FourLineA3Target();
   if (name == "four-line-a4") return FourLineA4Target();
   if (name == "four-line-letter") return FourLineLetterTarget();
-  std::string list;
-  for (const std::string& known : TargetNames()) list += (list.empty() ? "" : ", ") + known;
-  throw std::invalid_argument("target '" + name + "' is not one of: " + list);
+  throw std::invalid_argument("target '" + name + "' is not one of: " + TargetNameList());
 }
 
 }  // namespace oal

@@ -6,9 +6,13 @@
 #include <visp3/io/vpImageIo.h>
 
 #include <filesystem>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 #include <string>
 
+#include "app/accuracy_frames.h"
 #include "app/camera_file.h"
+#include "scene/bench_scene.h"
 #include "tests/app/command_test_util.h"
 #include "tests/app/test_util.h"
 #include "tests/calibration/chessboard_views.h"
@@ -50,6 +54,139 @@ TEST(CalibrateCommand, WritesACameraFileThatTheOtherCommandsRead) {
   EXPECT_EQ(file.height, 480u);
 }
 
+// `views` views of the A3 sheet lying on the bench photographs, through `camera`, tilted
+// 15-45 deg, as PGM files in dir/sheet.
+std::string WriteSheetShots(const TestDir& dir, const vpCameraParameters& camera, int views) {
+  const std::string shots = dir / "sheet";
+  std::filesystem::create_directories(shots);
+  const LineTarget target = FourLineA3Target();
+  RenderedFrameOptions options;
+  options.camera = camera;
+  options.seed = 5;
+  options.noise_sigma = 4.0;
+  options.blur_sigma_px = 1.0;
+  options.scene = BenchScene();
+  options.backgrounds = DefaultBenchPhotos();
+  const EvaluationScenes scenes(target, options);
+  PoseSampling sampling = SheetSampling(target);
+  sampling.max_tilt_deg = 45.0;
+  std::uint64_t state = 11;
+  for (int k = 0; k < views; ++k) {
+    vpHomogeneousMatrix cMo = SamplePose(scenes.For(k), sampling, &state);
+    while (std::acos(std::fabs(cMo[2][2])) < vpMath::rad(15.0)) {
+      cMo = SamplePose(scenes.For(k), sampling, &state);
+    }
+    const RenderedFrame frame = scenes.For(k).Render(cMo, 100 + k, scenes.EffectsFor(k));
+    vpImageIo::write(frame.image,
+                     shots + "/sheet" + (k < 10 ? "0" : "") + std::to_string(k) + ".pgm");
+  }
+  return shots;
+}
+
+TEST(CalibrateCommand, CalibratesFromThePrintedSheetOnABench) {
+  if (!std::filesystem::exists("/usr/share/visp-images-data/ViSP-images/Klimt/Klimt.pgm")) {
+    GTEST_SKIP() << "Debian's visp-images-data (the bench photographs) is not installed";
+  }
+  const TestDir dir;
+  const vpCameraParameters truth = CameraWithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
+  const std::string shots = WriteSheetShots(dir, truth, 14);
+  // A blank frame among them: listed as not used, the others calibrate.
+  vpImageIo::write(vpImage<unsigned char>(480, 640, 128), shots + "/zz-blank.pgm");
+  const OalservoRun run =
+      RunOalservo(dir, "calibrate '" + shots + "' --out '" + (dir / "camera.xml") + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.out.find("zz-blank.pgm: not used: the target four-line-a3 was not found"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("stripe points, RMS"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("of 15 views"), std::string::npos) << run.out;
+  const CameraFile file = LoadCameraFile(dir / "camera.xml", "Camera");
+  EXPECT_NEAR(file.camera.get_px(), truth.get_px(), 0.005 * truth.get_px());
+  EXPECT_NEAR(file.camera.get_py(), truth.get_py(), 0.005 * truth.get_py());
+  EXPECT_NEAR(file.camera.get_u0(), truth.get_u0(), 3.0);
+  EXPECT_NEAR(file.camera.get_v0(), truth.get_v0(), 3.0);
+  EXPECT_NEAR(file.camera.get_kdu(), 0.2, 0.02);
+}
+
+// A video of the sheet moved from pose to pose and held still at each: --live takes one view
+// per pose held, and calibrates with them when the video ends.
+TEST(CalibrateCommand, LiveTakesAViewWhereTheSheetIsHeldStill) {
+  if (!std::filesystem::exists("/usr/share/visp-images-data/ViSP-images/Klimt/Klimt.pgm")) {
+    GTEST_SKIP() << "Debian's visp-images-data (the bench photographs) is not installed";
+  }
+  const TestDir dir;
+  const std::string video = dir / "moving.avi";
+  const vpCameraParameters truth = CameraWithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
+  {
+    cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, {640, 480});
+    if (!writer.isOpened()) GTEST_SKIP() << "OpenCV cannot write MJPG AVI files here";
+    const LineTarget target = FourLineA3Target();
+    RenderedFrameOptions options;
+    options.camera = truth;
+    options.noise_sigma = 3.0;
+    options.blur_sigma_px = 0.8;
+    options.scene = BenchScene();
+    options.backgrounds = {DefaultBenchPhotos().front()};
+    const EvaluationScenes scenes(target, options);
+    PoseSampling sampling = SheetSampling(target);
+    sampling.max_tilt_deg = 40.0;
+    std::uint64_t state = 21, noise = 1;
+    const auto write = [&](const vpHomogeneousMatrix& cMo) {
+      cv::Mat colour;
+      const RenderedFrame frame = scenes.For(0).Render(cMo, noise++);
+      cv::Mat gray(480, 640, CV_8UC1, const_cast<unsigned char*>(frame.image.bitmap));
+      cv::cvtColor(gray, colour, cv::COLOR_GRAY2BGR);
+      writer.write(colour);
+    };
+    for (int held = 0; held < 5; ++held) {
+      for (int moving = 0; moving < 3; ++moving) write(SamplePose(scenes.For(0), sampling, &state));
+      const vpHomogeneousMatrix still = SamplePose(scenes.For(0), sampling, &state);
+      for (int k = 0; k < 7; ++k) write(still);
+    }
+  }
+  const OalservoRun run =
+      RunOalservo(dir, "calibrate '" + video + "' --live --out '" + (dir / "camera.xml") + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.out.find("view 5 of 20 taken: " + video + "#"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("view 6 of 20"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("hold the target still"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("(camera 'Camera', 640x480, 5 of 5 views)"), std::string::npos) << run.out;
+  const CameraFile file = LoadCameraFile(dir / "camera.xml", "Camera");
+  EXPECT_NEAR(file.camera.get_px(), truth.get_px(), 0.03 * truth.get_px());
+}
+
+TEST(CalibrateCommand, TargetOptionsThatDoNotGoTogetherAreUsageErrors) {
+  const TestDir dir;
+  const std::string out = dir / "camera.xml";
+  OalservoRun run =
+      RunOalservo(dir, "calibrate '" + dir.path().string() + "' --square 0.02 --out '" + out + "'");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--square requires --chessboard"), std::string::npos) << run.err;
+  run = RunOalservo(dir, "calibrate '" + dir.path().string() +
+                             "' --target four-line-a3 --chessboard 9x6 --square 0.02 --out '" +
+                             out + "'");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--target excludes --chessboard"), std::string::npos) << run.err;
+  run = RunOalservo(dir, "calibrate '" + dir.path().string() + "' --target a3 --out '" + out + "'");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("--target: target 'a3' is not one of: four-line-a3, four-line-a4"),
+            std::string::npos)
+      << run.err;
+  const std::string config = dir / "extra.yaml";
+  test::WriteText(config,
+                  test::ReadText(std::string(OAL_SOURCE_DIR) + "/config/four-line-a3.yaml") +
+                      "camera:\n  px: 600\n");
+  run = RunOalservo(
+      dir, "calibrate '" + dir.path().string() + "' --config '" + config + "' --out '" + out + "'");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("section 'camera' is not used by oalservo calibrate"), std::string::npos)
+      << run.err;
+  run = RunOalservo(dir, "calibrate '" + dir.path().string() + "' --views 10 --out '" + out + "'");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--views requires --live"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(CalibrateCommand, BadInputIsAClearErrorAndWritesNothing) {
   const TestDir dir;
   const std::string out = dir / "camera.xml";
@@ -76,8 +213,8 @@ TEST(CalibrateCommand, BadInputIsAClearErrorAndWritesNothing) {
   run = RunOalservo(dir,
                     "calibrate '" + blank + "' --chessboard 9x6 --square 0.02 --out '" + out + "'");
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("0 of 3 images show the whole chessboard, at least 3 needed: nothing "
-                         "written to"),
+  EXPECT_NE(run.err.find("0 of 3 images show the whole chessboard (9x6 inner corners), at least 3 "
+                         "needed: nothing written to"),
             std::string::npos)
       << run.err;
   EXPECT_NE(

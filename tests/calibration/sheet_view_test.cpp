@@ -1,0 +1,128 @@
+// Calibration from the printed four-line sheet (calibration/sheet_view.h, calibration/calibrate.h):
+// the points seen along each stripe, projected through a known lens, give the lens back; the
+// points that are not a stripe's own are left out; views that cannot place their lines on the
+// plane are refused with the reason.
+#include "calibration/sheet_view.h"
+
+#include <gtest/gtest.h>
+#include <visp3/core/vpMath.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "calibration/calibrate.h"
+#include "detector/lens.h"
+#include "target/line_target.h"
+#include "tests/calibration/sheet_views.h"
+
+namespace oal {
+namespace {
+
+using test::LookingAtTheSheet;
+using test::SeenAlongStripes;
+using test::VariedSheetPoses;
+
+CalibrationOptions Options640x480() {
+  CalibrationOptions options;
+  options.width = 640;
+  options.height = 480;
+  return options;
+}
+
+TEST(SheetView, KeepsEachStripesOwnPointsAndLeavesOutTheCrossingsAndSpecks) {
+  const LineTarget target = FourLineA3Target();
+  const vpCameraParameters camera = CameraWithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
+  std::mt19937 random(1);
+  std::vector<std::vector<Point2d>> seen =
+      SeenAlongStripes(target, camera, LookingAtTheSheet(0.5, 15.0, -10.0, 20.0), 0.0, &random);
+  const std::size_t first_stripe_points = seen[0].size();
+  // A speck beside stripe 0, 3 cm off it on the plane: about 40 px at this distance.
+  Point2d speck = seen[0][seen[0].size() / 4];
+  speck.u += 40.0;
+  seen[0].push_back(speck);
+  const CalibrationView view = SheetView(target, seen, "shot.png");
+  EXPECT_EQ(view.name, "shot.png");
+  ASSERT_EQ(view.lines.size(), 4u);
+  EXPECT_TRUE(view.points.empty());
+  // Around each of its two crossings stripe 0 loses the points within the other stripe's
+  // half width plus 8 mm, about 3 cm of its length (7 points); the speck goes too.
+  EXPECT_LT(view.lines[0].seen.size(), first_stripe_points - 4);
+  EXPECT_GT(view.lines[0].seen.size(), first_stripe_points / 2);
+  for (const Point2d& p : view.lines[0].seen) {
+    EXPECT_FALSE(p.u == speck.u && p.v == speck.v) << "the speck was kept";
+  }
+  EXPECT_DOUBLE_EQ(view.lines[0].x, target.lines[0].x1_m);
+  EXPECT_DOUBLE_EQ(view.lines[0].dy, target.lines[0].y2_m - target.lines[0].y1_m);
+}
+
+TEST(SheetView, FewerThanFourCrossingsGiveAViewWithoutLines) {
+  const LineTarget target = FourLineA3Target();
+  const vpCameraParameters camera = CameraWithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
+  std::mt19937 random(2);
+  std::vector<std::vector<Point2d>> seen =
+      SeenAlongStripes(target, camera, LookingAtTheSheet(0.5, 20.0, 0.0, 0.0), 0.1, &random);
+  seen[3].clear();  // three stripes of the '#' cross in two points
+  EXPECT_TRUE(SheetView(target, seen, "three.png").lines.empty());
+  SheetViewOptions bad;
+  bad.min_points_per_stripe = 1;
+  EXPECT_THROW(SheetView(target, seen, "x", bad), std::invalid_argument);
+}
+
+TEST(CalibrateFromTheSheet, RecoversTheIntrinsicsAndViSPsDistortionFromTheStripes) {
+  const std::vector<std::pair<LineTarget, double>> cases = {{FourLineA3Target(), 0.3},
+                                                            {FourLineA4Target(), 0.0}};
+  for (const auto& [target, kdu] : cases) {
+    SCOPED_TRACE(target.name + ", kdu " + std::to_string(kdu));
+    const vpCameraParameters truth = CameraWithKdu(720.0, 716.0, 333.0, 229.0, kdu, 640, 480);
+    const double scale = target.board_width_m / 0.42;  // the A4 sheet is seen from nearer
+    std::mt19937 random(7);
+    std::vector<CalibrationView> views;
+    for (const vpHomogeneousMatrix& pose : VariedSheetPoses()) {
+      vpHomogeneousMatrix cMo = pose;
+      cMo[2][3] *= scale;
+      views.push_back(SheetView(target, SeenAlongStripes(target, truth, cMo, 0.2, &random),
+                                "view" + std::to_string(views.size())));
+    }
+    const CalibrationResult result = Calibrate(views, Options640x480());
+    EXPECT_NEAR(result.camera.get_px(), truth.get_px(), 0.003 * truth.get_px());
+    EXPECT_NEAR(result.camera.get_py(), truth.get_py(), 0.003 * truth.get_py());
+    EXPECT_NEAR(result.camera.get_u0(), truth.get_u0(), 1.5);
+    EXPECT_NEAR(result.camera.get_v0(), truth.get_v0(), 1.5);
+    EXPECT_NEAR(result.camera.get_kdu(), kdu, std::max(0.03 * kdu, 0.005));
+    EXPECT_LT(result.rms_px, 0.3);
+    for (const CalibrationViewReport& view : result.views) {
+      EXPECT_TRUE(view.used) << view.name << ": " << view.rejected;
+    }
+  }
+}
+
+TEST(CalibrateFromTheSheet, AViewWhoseLinesCannotBePlacedIsRefusedWithTheReason) {
+  const LineTarget target = FourLineA3Target();
+  CalibrationView view{"two-stripes.png", {}, {}};
+  for (std::size_t k = 0; k < 2; ++k) {
+    CalibrationLine line;
+    line.x = target.lines[k].x1_m;
+    line.y = target.lines[k].y1_m;
+    line.dx = target.lines[k].x2_m - target.lines[k].x1_m;
+    line.dy = target.lines[k].y2_m - target.lines[k].y1_m;
+    for (int i = 0; i < 20; ++i) line.seen.push_back(Point2d{100.0 + 10.0 * i, 50.0 + 3.0 * k});
+    view.lines.push_back(line);
+  }
+  try {
+    Calibrate({view, view, view}, Options640x480());
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("0 usable views of 3"), std::string::npos) << message;
+    EXPECT_NE(message.find("two-stripes.png: fewer than four of its lines' crossings"),
+              std::string::npos)
+        << message;
+  }
+}
+
+}  // namespace
+}  // namespace oal
