@@ -35,6 +35,12 @@ constexpr int kMaxPairingRounds = 40;
 // left out, but not nearer than the floor (pixels).
 constexpr double kOutlierSigmas = 4.0;
 constexpr double kOutlierFloorPx = 0.3;
+// A view whose points fit this many times worse than the median view's, and worse than the
+// floor (pixels), is left out.
+constexpr double kViewOutlierRatio = 2.0;
+constexpr double kViewOutlierFloorPx = 0.3;
+// Outliers are sought once no point moves by more than this (metres) between two solves.
+constexpr double kOutliersAfterM = 5e-5;
 
 // The view's plane tilt from its rotation vector: the angle between the plane's normal (its z
 // axis) and the optical axis.
@@ -136,6 +142,40 @@ int DropOutliers(const std::vector<const CalibrationView*>& views, const cv::Mat
   return dropped;
 }
 
+// Marks the view whose points fit worst when they fit kViewOutlierRatio times worse than the
+// median view's, and worse than kViewOutlierFloorPx: it disagrees with the others as a whole.
+// `view_errors` are the solve's per-view RMS of the views `used` (indices in result->views).
+bool MarkDisagreeingView(const cv::Mat& view_errors, const std::vector<std::size_t>& used,
+                         CalibrationResult* result) {
+  if (used.size() < 3) return false;
+  std::vector<double> rms;
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    rms.push_back(view_errors.at<double>(static_cast<int>(i)));
+  }
+  const std::size_t worst =
+      static_cast<std::size_t>(std::max_element(rms.begin(), rms.end()) - rms.begin());
+  std::vector<double> sorted = rms;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  if (rms[worst] <= kViewOutlierFloorPx || rms[worst] <= kViewOutlierRatio * median) return false;
+  result->views[used[worst]].rejected = "its points disagree with the other views' (RMS " +
+                                        Fixed(rms[worst], 2) + " px, the views' median " +
+                                        Fixed(median, 2) + " px)";
+  return true;
+}
+
+// Throws, naming each view left out and why, when fewer than `min_views` are left.
+void RequireEnoughViews(const CalibrationResult& result, std::size_t used, int min_views) {
+  if (static_cast<int>(used) >= min_views) return;
+  std::ostringstream message;
+  message << used << " usable view" << (used == 1 ? "" : "s") << " of " << result.views.size()
+          << ", at least " << min_views << " needed";
+  for (const CalibrationViewReport& report : result.views) {
+    if (!report.rejected.empty()) message << "\n  " << report.name << ": " << report.rejected;
+  }
+  throw std::runtime_error(message.str());
+}
+
 int SeenPoints(const CalibrationView& view) {
   std::size_t count = view.points.size();
   for (const CalibrationLine& line : view.lines) count += line.seen.size();
@@ -221,15 +261,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     used_views.push_back(&view);
     used.push_back(k);
   }
-  if (static_cast<int>(used.size()) < options.min_views) {
-    std::ostringstream message;
-    message << used.size() << " usable view" << (used.size() == 1 ? "" : "s") << " of "
-            << views.size() << ", at least " << options.min_views << " needed";
-    for (const CalibrationViewReport& report : result.views) {
-      if (!report.rejected.empty()) message << "\n  " << report.name << ": " << report.rejected;
-    }
-    throw std::runtime_error(message.str());
-  }
+  RequireEnoughViews(result, used.size(), options.min_views);
 
   // Two radial terms: enough to follow a lens that ViSP's one-term model in either direction
   // describes (the inverse of one term is a series), so that px, py, u0, v0 are not bent to
@@ -244,7 +276,37 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   const bool any_lines =
       std::any_of(used_views.begin(), used_views.end(),
                   [](const CalibrationView* view) { return !view->lines.empty(); });
+  // Each view's first pairing, from its homography: where the solve starts over when a view
+  // is left out, so that nothing the left-out view did to the others (their points cut as
+  // outliers, their pairing) remains.
+  const std::vector<LinePairing> first_pairings = pairings;
+  const std::vector<std::size_t> all_used = used;
   for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
+    // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
+    // not flat or printed stretched) is left out: the outlier cut has left it too few points,
+    // or its points fit far worse than the other views'.
+    bool left_out = false;
+    for (std::size_t i = used_views.size(); i-- > 0;) {
+      const std::size_t points = used_views[i]->points.size() + pairings[i].seen.size();
+      std::string& rejected = result.views[used[i]].rejected;
+      if (rejected.empty() && static_cast<int>(points) >= options.min_points_per_view) continue;
+      if (rejected.empty()) {
+        rejected = "its points disagree with the other views' (" + std::to_string(points) + " of " +
+                   std::to_string(result.views[used[i]].points) + " kept)";
+      }
+      used_views.erase(used_views.begin() + static_cast<std::ptrdiff_t>(i));
+      used.erase(used.begin() + static_cast<std::ptrdiff_t>(i));
+      left_out = true;
+    }
+    RequireEnoughViews(result, used.size(), options.min_views);
+    if (left_out) {
+      pairings.clear();
+      for (std::size_t i = 0; i < used.size(); ++i) {
+        pairings.push_back(first_pairings[static_cast<std::size_t>(
+            std::find(all_used.begin(), all_used.end(), used[i]) - all_used.begin())]);
+      }
+      pairing_round = 0;
+    }
     std::vector<std::vector<cv::Point3f>> object_points;
     image_points.clear();
     for (std::size_t i = 0; i < used_views.size(); ++i) {
@@ -265,15 +327,20 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
         object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
         distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors,
         pairing_round == 0 ? flags : flags | cv::CALIB_USE_INTRINSIC_GUESS, stop);
-    if (!any_lines) break;
-    const int dropped = pairing_round == 0 ? 0
-                                           : DropOutliers(used_views, camera_matrix, distortion,
-                                                          rvecs, tvecs, &pairings);
     double moved = 0.0;
-    for (std::size_t i = 0; i < used_views.size(); ++i) {
+    for (std::size_t i = 0; i < used_views.size() && any_lines; ++i) {
       moved = std::max(moved, PairThroughCamera(*used_views[i], camera_matrix, distortion, rvecs[i],
                                                 tvecs[i], &pairings[i]));
     }
+    // Only once the pairing has nearly settled are the views and points that fit badly
+    // outliers: before, the lens is not yet right, and the points it bends most, near the
+    // image's edges, would go first and bias kdu low. A view that disagrees as a whole goes
+    // first, before the point cut could whittle it down to its points that happen to fit.
+    if (moved >= kOutliersAfterM) continue;
+    if (MarkDisagreeingView(view_errors, used, &result)) continue;
+    const int dropped =
+        any_lines ? DropOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
+                  : 0;
     if (moved < kPairingSettledM && dropped == 0) break;
   }
 

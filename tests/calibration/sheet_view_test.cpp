@@ -100,6 +100,33 @@ TEST(CalibrateFromTheSheet, RecoversTheIntrinsicsAndViSPsDistortionFromTheStripe
   }
 }
 
+TEST(CalibrateFromTheSheet, AViewWhosePointsDisagreeWithTheOthersIsLeftOut) {
+  const LineTarget target = FourLineA3Target();
+  const vpCameraParameters truth = CameraWithKdu(720.0, 716.0, 333.0, 229.0, 0.15, 640, 480);
+  std::mt19937 random(9);
+  std::vector<CalibrationView> views;
+  for (const vpHomogeneousMatrix& pose : VariedSheetPoses()) {
+    views.push_back(SheetView(target, SeenAlongStripes(target, truth, pose, 0.2, &random),
+                              "view" + std::to_string(views.size())));
+  }
+  // A sheet printed stretched (a printer's "fit to page" on one axis): its vertical stripes
+  // are 8 % farther apart than the target says, which no camera pose explains.
+  LineTarget larger = target;
+  for (TargetLine& line : larger.lines) line.x1_m *= 1.08, line.x2_m *= 1.08;
+  views.push_back(SheetView(
+      target,
+      SeenAlongStripes(larger, truth, LookingAtTheSheet(0.45, 30.0, 10.0, 50.0), 0.2, &random),
+      "scaled.png"));
+  const CalibrationResult result = Calibrate(views, Options640x480());
+  ASSERT_EQ(result.views.size(), 13u);
+  EXPECT_FALSE(result.views.back().used);
+  EXPECT_NE(result.views.back().rejected.find("its points disagree with the other views'"),
+            std::string::npos)
+      << result.views.back().rejected;
+  EXPECT_NEAR(result.camera.get_px(), truth.get_px(), 0.003 * truth.get_px());
+  EXPECT_NEAR(result.camera.get_kdu(), 0.15, 0.03 * 0.15);
+}
+
 TEST(CalibrateFromTheSheet, AViewWhoseLinesCannotBePlacedIsRefusedWithTheReason) {
   const LineTarget target = FourLineA3Target();
   CalibrationView view{"two-stripes.png", {}, {}};
