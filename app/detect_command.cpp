@@ -1,7 +1,10 @@
 #include "app/detect_command.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -15,7 +18,10 @@
 #include "app/frame_command.h"
 #include "app/image_source.h"
 #include "app/json_io.h"
+#include "app/lens_estimate.h"
 #include "detector/detector.h"
+#include "detector/line_fit.h"
+#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {
@@ -46,8 +52,23 @@ std::optional<CameraFile> LoadCamera(const DetectCommandOptions& options) {
   return LoadCameraFile(options.camera_path, options.camera_name);
 }
 
+// The second largest bend of the four strongest lines, as `pose` measures lines 1-4 (a lens
+// the camera model misses bends every line away from the principal point; one bent line alone
+// is a stray point near it); empty with fewer than four lines.
+std::optional<double> Straightness(const std::vector<DetectedLine>& lines,
+                                   const OalDetector& detector) {
+  if (lines.size() < 4) return std::nullopt;
+  std::array<double, 4> bends{};
+  for (std::size_t k = 0; k < bends.size(); ++k) {
+    bends[k] = std::fabs(LineSagitta(lines[k].line, detector.feature_points(),
+                                     2.0 * detector.options().support_tolerance_px));
+  }
+  std::sort(bends.begin(), bends.end());
+  return bends[2];
+}
+
 Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,
-               const std::vector<DetectedLine>& lines) {
+               const std::vector<DetectedLine>& lines, std::optional<double> straightness_px) {
   Json json_lines = Json::array();
   for (const DetectedLine& line : lines) json_lines.push_back(DetectedLineJson(line));
   return Json{{"frame", index},
@@ -59,6 +80,7 @@ Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,
               // detect scans the paper's concentric borders of the whole image (as `pose`
               // writes it: an empty region is the whole image); `pose` scans the target's.
               {"scan", Json{{"mode", "image"}, {"region", Json::array()}}},
+              {"straightness_px", straightness_px ? Json(*straightness_px) : Json()},
               {"lines", std::move(json_lines)}};
 }
 
@@ -81,7 +103,10 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
       const std::vector<DetectedLine>& lines = run->detector.Detect(frame.view());
       const auto stop = std::chrono::steady_clock::now();
       const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
-      WriteJsonLine(sink, FrameJson(summary->frames, frame, time_us, undistorted, lines),
+      const std::optional<double> straightness = Straightness(lines, run->detector);
+      if (straightness && run->camera) summary->straightness_px.push_back(*straightness);
+      WriteJsonLine(sink,
+                    FrameJson(summary->frames, frame, time_us, undistorted, lines, straightness),
                     flush_each);
       if (!options.annotate_dir.empty()) {
         WritePng(AnnotationPath(options, "lines", summary->frames),
@@ -113,6 +138,14 @@ DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& ou
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
+  const LensCheck lens = CheckLens(summary.straightness_px);
+  if (lens.mismatch) {
+    summary.warnings.push_back(LensMismatchWarning(
+        lens, "'" + options.camera_path + "'",
+        "Calibrate the camera (oalservo calibrate), or check the file is this camera's at this "
+        "resolution",
+        "the four strongest lines"));
+  }
   return summary;
 }
 

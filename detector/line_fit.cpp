@@ -76,4 +76,36 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
   return stats;
 }
 
+double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
+                   double tolerance_px) {
+  const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
+  double t_min = HUGE_VAL, t_max = -HUGE_VAL;
+  int n = 0;
+  for (const FramePoint& point : points) {
+    if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) > tolerance_px) continue;
+    const double t = -point.p.u * s + point.p.v * c;
+    t_min = std::min(t_min, t);
+    t_max = std::max(t_max, t);
+    ++n;
+  }
+  if (n < 6 || !(t_max - t_min > 1.0)) return 0.0;
+  const double middle = 0.5 * (t_min + t_max), half = 0.5 * (t_max - t_min);
+  // Least squares d = a + b x + k x^2 over x in [-1, 1]: k is the sagitta.
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, d0 = 0, d1 = 0, d2 = 0;
+  for (const FramePoint& point : points) {
+    const double d = point.p.u * c + point.p.v * s - line.rho_px;
+    if (std::fabs(d) > tolerance_px) continue;
+    const double x = (-point.p.u * s + point.p.v * c - middle) / half, x2 = x * x;
+    s0 += 1.0, s1 += x, s2 += x2, s3 += x2 * x, s4 += x2 * x2;
+    d0 += d, d1 += x * d, d2 += x2 * d;
+  }
+  auto det3 = [](double a, double b, double cc, double d, double e, double f, double g, double h,
+                 double i) {
+    return a * (e * i - f * h) - b * (d * i - f * g) + cc * (d * h - e * g);
+  };
+  const double det = det3(s0, s1, s2, s1, s2, s3, s2, s3, s4);
+  if (!(std::fabs(det) > 1e-12)) return 0.0;
+  return det3(s0, s1, d0, s1, s2, d1, s2, s3, d2) / det;
+}
+
 }  // namespace oal

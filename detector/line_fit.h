@@ -50,4 +50,12 @@ LineParams RefitLine(const LineParams& line, const std::vector<FramePoint>& poin
 SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint>& points,
                             double tolerance_px);
 
+/// How far the feature points within `tolerance_px` of `line` bend away from it: the sagitta
+/// (pixels) of the parabola fitted to their distances from the line over the stretch they
+/// cover, signed (positive towards the line's normal). The parabola averages the points' noise
+/// out, where their RMS distance would add it in: a straight stripe seen through a lens the
+/// camera model misses shows as a bend. 0 with fewer than 6 points.
+double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
+                   double tolerance_px);
+
 }  // namespace oal

@@ -40,41 +40,6 @@ bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
   return true;
 }
 
-// How far a line's feature points bend away from it: the sagitta (pixels) of the parabola
-// fitted to their distances from the line along the stretch they cover, signed (positive
-// towards the line's normal). The parabola averages the points' noise out, where their RMS
-// distance would add it in. 0 with fewer than 6 points within tolerance_px.
-double Sagitta(const LineParams& line, const std::vector<FramePoint>& points, double tolerance_px) {
-  const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
-  double t_min = HUGE_VAL, t_max = -HUGE_VAL;
-  int n = 0;
-  for (const FramePoint& point : points) {
-    if (std::fabs(point.p.u * c + point.p.v * s - line.rho_px) > tolerance_px) continue;
-    const double t = -point.p.u * s + point.p.v * c;
-    t_min = std::min(t_min, t);
-    t_max = std::max(t_max, t);
-    ++n;
-  }
-  if (n < 6 || !(t_max - t_min > 1.0)) return 0.0;
-  const double middle = 0.5 * (t_min + t_max), half = 0.5 * (t_max - t_min);
-  // Least squares d = a + b x + k x^2 over x in [-1, 1]: k is the sagitta.
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, d0 = 0, d1 = 0, d2 = 0;
-  for (const FramePoint& point : points) {
-    const double d = point.p.u * c + point.p.v * s - line.rho_px;
-    if (std::fabs(d) > tolerance_px) continue;
-    const double x = (-point.p.u * s + point.p.v * c - middle) / half, x2 = x * x;
-    s0 += 1.0, s1 += x, s2 += x2, s3 += x2 * x, s4 += x2 * x2;
-    d0 += d, d1 += x * d, d2 += x2 * d;
-  }
-  auto det3 = [](double a, double b, double cc, double d, double e, double f, double g, double h,
-                 double i) {
-    return a * (e * i - f * h) - b * (d * i - f * g) + cc * (d * h - e * g);
-  };
-  const double det = det3(s0, s1, s2, s1, s2, s3, s2, s3, s4);
-  if (!(std::fabs(det) > 1e-12)) return 0.0;
-  return det3(s0, s1, d0, s1, s2, d1, s2, s3, d2) / det;
-}
-
 // Translation (metres) and rotation (degrees) between two poses.
 void PoseDifference(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double* metres,
                     double* degrees) {
@@ -349,7 +314,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   for (int k = 0; k < 4; ++k) {
     const DetectedLine& line =
         lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
-    bends[static_cast<std::size_t>(k)] = std::fabs(Sagitta(
+    bends[static_cast<std::size_t>(k)] = std::fabs(LineSagitta(
         line.line, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px));
   }
   std::sort(bends.begin(), bends.end());
