@@ -18,10 +18,8 @@
 #include "app/frame_command.h"
 #include "app/image_source.h"
 #include "app/json_io.h"
-#include "app/lens_estimate.h"
 #include "detector/detector.h"
 #include "detector/line_fit.h"
-#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {
@@ -54,7 +52,10 @@ std::optional<CameraFile> LoadCamera(const DetectCommandOptions& options) {
 
 // The second largest bend of the four strongest lines, as `pose` measures lines 1-4 (a lens
 // the camera model misses bends every line away from the principal point; one bent line alone
-// is a stray point near it); empty with fewer than four lines.
+// is a stray point near it); empty with fewer than four lines. Not a lens check by itself:
+// detect knows no target, and among the strongest lines of a cluttered scene some are not
+// straight edges (a line of text, points of two objects); pose, evaluate and servo check the
+// lens on the target's lines 1-4.
 std::optional<double> Straightness(const std::vector<DetectedLine>& lines,
                                    const OalDetector& detector) {
   if (lines.size() < 4) return std::nullopt;
@@ -104,7 +105,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
       const auto stop = std::chrono::steady_clock::now();
       const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
       const std::optional<double> straightness = Straightness(lines, run->detector);
-      if (straightness && run->camera) summary->straightness_px.push_back(*straightness);
+      if (straightness) summary->straightness_px.push_back(*straightness);
       WriteJsonLine(sink,
                     FrameJson(summary->frames, frame, time_us, undistorted, lines, straightness),
                     flush_each);
@@ -138,14 +139,6 @@ DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& ou
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
-  const LensCheck lens = CheckLens(summary.straightness_px);
-  if (lens.mismatch) {
-    summary.warnings.push_back(LensMismatchWarning(
-        lens, "'" + options.camera_path + "'",
-        "Calibrate the camera (oalservo calibrate), or check the file is this camera's at this "
-        "resolution",
-        "the four strongest lines"));
-  }
   return summary;
 }
 

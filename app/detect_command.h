@@ -40,10 +40,9 @@ struct DetectCommandOptions : FrameCommandOptions {
 struct DetectSummary {
   int frames = 0;
   int lines = 0;
-  /// For the user (skipped files, camera size mismatch, a camera file that leaves the lines
-  /// bent); the caller prints them.
+  /// For the user (skipped files, camera size mismatch); the caller prints them.
   std::vector<std::string> warnings;
-  /// Each frame's straightness (with a camera file and at least four lines).
+  /// Each frame's straightness_px (frames with at least four lines).
   std::vector<double> straightness_px;
 };
 

@@ -58,8 +58,8 @@ ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameter
 }
 
 std::string LensMismatchWarning(const LensCheck& lens, const std::string& corrected_by,
-                                const std::string& remedy, const std::string& lines) {
-  return lines + " still bend by " + Fixed(lens.median_px, 2) + " px (median of " +
+                                const std::string& remedy) {
+  return "lines 1-4 still bend by " + Fixed(lens.median_px, 2) + " px (median of " +
          std::to_string(lens.frames) +
          " frames; a camera file that matches the lens leaves under 0.1 px) after " + corrected_by +
          " corrects them: it does not describe this lens (its distortion, or the resolution it "

@@ -54,10 +54,10 @@ ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameter
                              const NextFrame& next, int frames = kLensFrames,
                              int max_read = kMaxLensFramesRead);
 
-/// The lens check's warning: "`lines` still bend by ... after `corrected_by` corrects them:
+/// The lens check's warning: "lines 1-4 still bend by ... after `corrected_by` corrects them:
 /// ... this lens ... `remedy`".
 std::string LensMismatchWarning(const LensCheck& lens, const std::string& corrected_by,
-                                const std::string& remedy, const std::string& lines = "lines 1-4");
+                                const std::string& remedy);
 
 /// `pinhole` with the estimated lens (kud and kdu).
 vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens);

@@ -39,8 +39,10 @@ constexpr double kOutlierFloorPx = 0.3;
 // floor (pixels), is left out.
 constexpr double kViewOutlierRatio = 2.0;
 constexpr double kViewOutlierFloorPx = 0.3;
-// Outliers are sought once no point moves by more than this (metres) between two solves.
+// Outliers are sought once no point moves by more than this (metres) between two solves, or
+// from this round on: a pairing that still creeps then is kept moving by the outliers.
 constexpr double kOutliersAfterM = 5e-5;
+constexpr int kOutliersByRound = 10;
 
 // The view's plane tilt from its rotation vector: the angle between the plane's normal (its z
 // axis) and the optical axis.
@@ -336,7 +338,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     // outliers: before, the lens is not yet right, and the points it bends most, near the
     // image's edges, would go first and bias kdu low. A view that disagrees as a whole goes
     // first, before the point cut could whittle it down to its points that happen to fit.
-    if (moved >= kOutliersAfterM) continue;
+    if (moved >= kOutliersAfterM && pairing_round < kOutliersByRound) continue;
     if (MarkDisagreeingView(view_errors, used, &result)) continue;
     const int dropped =
         any_lines ? DropOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)

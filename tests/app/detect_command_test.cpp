@@ -141,9 +141,9 @@ TEST(Detect, CameraWithoutDistortionKeepsImageCoordinates) {
   EXPECT_EQ(ParseJsonLines(out.str()).at(0).at("coordinates"), "image");
 }
 
-// The lens check: with the camera file of the lens the four strongest lines come out straight;
-// with a file that ignores the lens they bend, each frame says by how much, and detect warns.
-TEST(Detect, SaysWhenTheCameraFileLeavesTheLinesBent) {
+// Each frame says how much its four strongest lines bend: on the 2 m board (lines across the
+// image) under 0.2 px with the camera file of the lens, more without its distortion.
+TEST(Detect, EachFrameSaysHowMuchItsStrongestLinesBend) {
   test::TestDir dir;
   RenderCommandOptions render = test::ScaledRender(dir / "wide", 5, 7, 640, 480);
   render.kdu = 0.3;
@@ -155,18 +155,13 @@ TEST(Detect, SaysWhenTheCameraFileLeavesTheLinesBent) {
   options.inputs = {wide};
   options.camera_path = wide + "/camera.xml";
   std::ostringstream right;
-  const DetectSummary matching = DetectImages(options, right);
-  EXPECT_TRUE(matching.warnings.empty()) << matching.warnings.front();
-  ASSERT_EQ(matching.straightness_px.size(), 5u);
+  EXPECT_EQ(DetectImages(options, right).straightness_px.size(), 5u);
   for (const json& frame : ParseJsonLines(right.str())) {
     EXPECT_LT(frame.at("straightness_px").get<double>(), 0.2) << frame.at("source");
   }
   options.camera_path = pinhole + "/camera.xml";
   std::ostringstream wrong;
-  const DetectSummary missing = DetectImages(options, wrong);
-  ASSERT_EQ(missing.warnings.size(), 1u);
-  EXPECT_THAT(missing.warnings[0], HasSubstr("the four strongest lines still bend by"));
-  EXPECT_THAT(missing.warnings[0], HasSubstr(pinhole + "/camera.xml"));
+  DetectImages(options, wrong);
   for (const json& frame : ParseJsonLines(wrong.str())) {
     EXPECT_GT(frame.at("straightness_px").get<double>(), 0.5) << frame.at("source");
   }
