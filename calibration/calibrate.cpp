@@ -61,6 +61,11 @@ struct LinePairing {
   std::vector<cv::Point2d> seen;     // distorted pixels
   std::vector<std::size_t> line_of;  // index in the view's lines
   std::vector<cv::Point2d> paired;   // plane, metres
+  std::vector<char> outlier;         // left out of the solve, for now (MarkOutliers)
+
+  std::size_t kept() const {
+    return seen.size() - static_cast<std::size_t>(std::count(outlier.begin(), outlier.end(), 1));
+  }
 };
 
 LinePairing PairThroughHomography(const CalibrationView& view, const cv::Matx33d& plane_to_image) {
@@ -73,6 +78,7 @@ LinePairing PairThroughHomography(const CalibrationView& view, const cv::Matx33d
       pairing.seen.emplace_back(p.u, p.v);
       pairing.line_of.push_back(l);
       pairing.paired.push_back(Snap(line, cv::Point2d(q[0] / q[2], q[1] / q[2])));
+      pairing.outlier.push_back(0);
     }
   }
   return pairing;
@@ -103,10 +109,12 @@ double PairThroughCamera(const CalibrationView& view, const cv::Mat& camera_matr
   return moved;
 }
 
-// Drops the line points the solved camera leaves farther from their lines than kOutlierSigmas
-// robust standard deviations of all of them (a speck beside a stripe, a shadow's edge), but
-// never nearer than kOutlierFloorPx: noise alone stays. Returns how many it dropped.
-int DropOutliers(const std::vector<const CalibrationView*>& views, const cv::Mat& camera_matrix,
+// Marks as outliers the line points the solved camera leaves farther from their lines than
+// kOutlierSigmas robust standard deviations of all of them (a speck beside a stripe, a
+// shadow's edge), but never nearer than kOutlierFloorPx: noise alone stays. Every point is
+// judged again each time, so that one judged by a camera not yet right comes back. Returns how
+// many points changed sides.
+int MarkOutliers(const std::vector<const CalibrationView*>& views, const cv::Mat& camera_matrix,
                  const cv::Mat& distortion, const std::vector<cv::Mat>& rvecs,
                  const std::vector<cv::Mat>& tvecs, std::vector<LinePairing>* pairings) {
   std::vector<std::vector<double>> residuals(views.size());
@@ -126,22 +134,16 @@ int DropOutliers(const std::vector<const CalibrationView*>& views, const cv::Mat
   if (all.empty()) return 0;
   std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
   const double limit = std::max(kOutlierFloorPx, kOutlierSigmas * 1.4826 * all[all.size() / 2]);
-  int dropped = 0;
+  int changed = 0;
   for (std::size_t i = 0; i < views.size(); ++i) {
     LinePairing& pairing = (*pairings)[i];
-    LinePairing kept;
     for (std::size_t k = 0; k < pairing.seen.size(); ++k) {
-      if (residuals[i][k] > limit) {
-        ++dropped;
-        continue;
-      }
-      kept.seen.push_back(pairing.seen[k]);
-      kept.line_of.push_back(pairing.line_of[k]);
-      kept.paired.push_back(pairing.paired[k]);
+      const char outlier = residuals[i][k] > limit ? 1 : 0;
+      changed += outlier != pairing.outlier[k];
+      pairing.outlier[k] = outlier;
     }
-    pairing = std::move(kept);
   }
-  return dropped;
+  return changed;
 }
 
 // Marks the view whose points fit worst when they fit kViewOutlierRatio times worse than the
@@ -289,7 +291,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     // or its points fit far worse than the other views'.
     bool left_out = false;
     for (std::size_t i = used_views.size(); i-- > 0;) {
-      const std::size_t points = used_views[i]->points.size() + pairings[i].seen.size();
+      const std::size_t points = used_views[i]->points.size() + pairings[i].kept();
       std::string& rejected = result.views[used[i]].rejected;
       if (rejected.empty() && static_cast<int>(points) >= options.min_points_per_view) continue;
       if (rejected.empty()) {
@@ -319,6 +321,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
         image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
       }
       for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
+        if (pairings[i].outlier[k]) continue;
         object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
                             static_cast<float>(pairings[i].paired[k].y), 0.0f);
         image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
@@ -340,10 +343,10 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     // first, before the point cut could whittle it down to its points that happen to fit.
     if (moved >= kOutliersAfterM && pairing_round < kOutliersByRound) continue;
     if (MarkDisagreeingView(view_errors, used, &result)) continue;
-    const int dropped =
-        any_lines ? DropOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
+    const int changed =
+        any_lines ? MarkOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
                   : 0;
-    if (moved < kPairingSettledM && dropped == 0) break;
+    if (moved < kPairingSettledM && changed == 0) break;
   }
 
   int tilted = 0;
