@@ -42,8 +42,8 @@ struct CameraCalibrationTrial {
   double py_error_pct() const;
   double u0_error_px() const;
   double v0_error_px() const;
-  /// |kdu found - kdu true| relative to the true kdu, or absolute when below 0.005 (the issue's
-  /// "within 3 % or 0.005 absolute"): as a fraction of the allowance, <= 1 passes.
+  /// |kdu found - kdu true| as a fraction of its allowance, the larger of 3 % of the true kdu
+  /// and 0.005 (a lens with almost no distortion is judged absolutely): <= 1 passes.
   double kdu_error() const;
   double kdu_error_abs() const;
 };
