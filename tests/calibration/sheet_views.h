@@ -35,7 +35,7 @@ inline std::vector<vpHomogeneousMatrix> VariedSheetPoses() {
   return poses;
 }
 
-// Points every 4 mm along each stripe's centre line, through `camera` from `cMo`, with pixel
+// Points every 6 mm along each stripe's centre line, through `camera` from `cMo`, with pixel
 // noise of `sigma_px`; those outside the image are not seen.
 inline std::vector<std::vector<Point2d>> SeenAlongStripes(const LineTarget& target,
                                                           const vpCameraParameters& camera,
@@ -46,7 +46,7 @@ inline std::vector<std::vector<Point2d>> SeenAlongStripes(const LineTarget& targ
   for (std::size_t k = 0; k < target.lines.size(); ++k) {
     const TargetLine& stripe = target.lines[k];
     const double length = std::hypot(stripe.x2_m - stripe.x1_m, stripe.y2_m - stripe.y1_m);
-    for (double s = 0.0; s <= length; s += 0.004) {
+    for (double s = 0.0; s <= length; s += 0.006) {
       const double t = s / length;
       const vpColVector o{stripe.x1_m + t * (stripe.x2_m - stripe.x1_m),
                           stripe.y1_m + t * (stripe.y2_m - stripe.y1_m), 0.0, 1.0};
