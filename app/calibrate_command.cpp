@@ -173,7 +173,8 @@ int RunCalibrate(int argc, char** argv) {
   bool no_distortion = false, live = false;
   int wanted_views = 20;
   cli.add_option("INPUT", inputs,
-                 "images, directories of images, printf patterns or videos of the target "
+                 "images, directories of images, printf patterns, videos or a camera "
+                 "(/dev/video0, with --live) showing the target "
                  "(10-30 views, tilted 20-45 deg in different directions, some near the "
                  "image's corners)")
       ->required();
@@ -211,7 +212,7 @@ int RunCalibrate(int argc, char** argv) {
       "  oalservo calibrate shots/ --out camera.xml                    # the A3 sheet\n"
       "  oalservo calibrate shots/ --target four-line-a4 --out camera.xml\n"
       "  oalservo calibrate shots/ --chessboard 9x6 --square 0.025 --out camera.xml\n"
-      "  oalservo calibrate /dev/video0 --live --out camera.xml     # move the sheet, hold, ...\n"
+      "  oalservo calibrate /dev/video0 --live --out camera.xml        # move, hold, move...\n"
       "Print at 100 % and check the scale bar (or measure a square); lay the sheet flat. The "
       "line target needs its four crossings in view; the stripes' points, which must lie on "
       "straight lines, tell the lens. Views in which the target is not found are listed and "
