@@ -1,10 +1,7 @@
 #include "app/detect_command.h"
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <array>
 #include <chrono>
-#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -50,22 +47,16 @@ std::optional<CameraFile> LoadCamera(const DetectCommandOptions& options) {
   return LoadCameraFile(options.camera_path, options.camera_name);
 }
 
-// The second largest bend of the four strongest lines, as `pose` measures lines 1-4 (a lens
-// the camera model misses bends every line away from the principal point; one bent line alone
-// is a stray point near it); empty with fewer than four lines. Not a lens check by itself:
-// detect knows no target, and among the strongest lines of a cluttered scene some are not
-// straight edges (a line of text, points of two objects); pose, evaluate and servo check the
-// lens on the target's lines 1-4.
+// StraightnessOfFour of the four strongest lines, as `pose` measures lines 1-4; empty with
+// fewer than four lines. Not a lens check by itself: detect knows no target, and among the
+// strongest lines of a cluttered scene some are not straight edges (a line of text, points of
+// two objects); pose, evaluate and servo check the lens on the target's lines 1-4.
 std::optional<double> Straightness(const std::vector<DetectedLine>& lines,
                                    const OalDetector& detector) {
   if (lines.size() < 4) return std::nullopt;
-  std::array<double, 4> bends{};
-  for (std::size_t k = 0; k < bends.size(); ++k) {
-    bends[k] = std::fabs(LineSagitta(lines[k].line, detector.feature_points(),
-                                     2.0 * detector.options().support_tolerance_px));
-  }
-  std::sort(bends.begin(), bends.end());
-  return bends[2];
+  return StraightnessOfFour({lines[0].line, lines[1].line, lines[2].line, lines[3].line},
+                            detector.feature_points(),
+                            2.0 * detector.options().support_tolerance_px);
 }
 
 Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,

@@ -283,8 +283,8 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   // Each view's first pairing, from its homography: where the solve starts over when a view
   // is left out, so that nothing the left-out view did to the others (their points cut as
   // outliers, their pairing) remains.
-  const std::vector<LinePairing> first_pairings = pairings;
-  const std::vector<std::size_t> all_used = used;
+  std::vector<LinePairing> first_pairings(views.size());  // by index in `views`
+  for (std::size_t i = 0; i < used.size(); ++i) first_pairings[used[i]] = pairings[i];
   for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
     // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
     // not flat or printed stretched) is left out: the outlier cut has left it too few points,
@@ -305,10 +305,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     RequireEnoughViews(result, used.size(), options.min_views);
     if (left_out) {
       pairings.clear();
-      for (std::size_t i = 0; i < used.size(); ++i) {
-        pairings.push_back(first_pairings[static_cast<std::size_t>(
-            std::find(all_used.begin(), all_used.end(), used[i]) - all_used.begin())]);
-      }
+      for (const std::size_t k : used) pairings.push_back(first_pairings[k]);
       pairing_round = 0;
     }
     std::vector<std::vector<cv::Point3f>> object_points;

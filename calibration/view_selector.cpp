@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include "base/check.h"
@@ -11,18 +12,14 @@
 namespace oal {
 namespace {
 
-double MeanCornerDistance(const std::array<Point2d, 4>& a, const std::array<Point2d, 4>& b) {
-  double sum = 0.0;
-  for (std::size_t k = 0; k < a.size(); ++k) sum += std::hypot(a[k].u - b[k].u, a[k].v - b[k].v);
-  return sum / static_cast<double>(a.size());
-}
-
-double LargestCornerMotion(const std::array<Point2d, 4>& a, const std::array<Point2d, 4>& b) {
-  double largest = 0.0;
+// How far each corner of `b` lies from the same corner of `a`, pixels.
+std::array<double, 4> CornerDistances(const std::array<Point2d, 4>& a,
+                                      const std::array<Point2d, 4>& b) {
+  std::array<double, 4> distances{};
   for (std::size_t k = 0; k < a.size(); ++k) {
-    largest = std::max(largest, std::hypot(a[k].u - b[k].u, a[k].v - b[k].v));
+    distances[k] = std::hypot(a[k].u - b[k].u, a[k].v - b[k].v);
   }
-  return largest;
+  return distances;
 }
 
 }  // namespace
@@ -75,13 +72,20 @@ ViewSelector::Verdict ViewSelector::Offer(const CalibrationView& view) {
     still_for_ = 0;
     return Verdict::kNoTarget;
   }
-  const bool still = last_ && LargestCornerMotion(*last_, *outline) <= options_.still_px;
+  const auto largest_motion = [&] {
+    const std::array<double, 4> moved = CornerDistances(*last_, *outline);
+    return *std::max_element(moved.begin(), moved.end());
+  };
+  const bool still = last_ && largest_motion() <= options_.still_px;
   still_for_ = still ? still_for_ + 1 : 0;
   last_ = outline;
   // still_frames frames in a row means still_frames - 1 steps without motion.
   if (still_for_ + 1 < options_.still_frames) return Verdict::kMoving;
   for (std::size_t k = 0; k < taken_.size(); ++k) {
-    if (MeanCornerDistance(taken_[k], *outline) < options_.min_difference * diagonal_) {
+    const std::array<double, 4> apart = CornerDistances(taken_[k], *outline);
+    const double mean_apart =
+        std::accumulate(apart.begin(), apart.end(), 0.0) / static_cast<double>(apart.size());
+    if (mean_apart < options_.min_difference * diagonal_) {
       similar_to_ = static_cast<int>(k);
       return Verdict::kTooLike;
     }

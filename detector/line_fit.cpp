@@ -108,4 +108,14 @@ double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points
   return det3(s0, s1, d0, s1, s2, d1, s2, s3, d2) / det;
 }
 
+double StraightnessOfFour(const std::array<LineParams, 4>& lines,
+                          const std::vector<FramePoint>& points, double tolerance_px) {
+  std::array<double, 4> bends{};
+  for (std::size_t k = 0; k < bends.size(); ++k) {
+    bends[k] = std::fabs(LineSagitta(lines[k], points, tolerance_px));
+  }
+  std::sort(bends.begin(), bends.end());
+  return bends[2];
+}
+
 }  // namespace oal

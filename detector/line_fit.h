@@ -2,6 +2,7 @@
 // by total least squares, and score it by how many of those points lie on it.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -57,5 +58,12 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
 /// camera model misses shows as a bend. 0 with fewer than 6 points.
 double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
                    double tolerance_px);
+
+/// How straight four lines are, pixels: the second largest of their bends (|LineSagitta|). A
+/// lens the camera model misses bends every line that does not pass through the principal
+/// point, and a '#' has two on either side of it; one bent line alone is a stray point near it
+/// (a printed mark, the sheet's edge).
+double StraightnessOfFour(const std::array<LineParams, 4>& lines,
+                          const std::vector<FramePoint>& points, double tolerance_px);
 
 }  // namespace oal

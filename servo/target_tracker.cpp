@@ -307,18 +307,12 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     frame_.message = frame_.pose.message;
     return false;
   }
-  // The second largest bend of the four: a lens the model misses bends every line that does
-  // not pass through the principal point, and the '#' has two on either side of it; one bent
-  // line alone is a stray point near it (a printed mark, the sheet's edge).
-  std::array<double, 4> bends{};
-  for (int k = 0; k < 4; ++k) {
-    const DetectedLine& line =
-        lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
-    bends[static_cast<std::size_t>(k)] = std::fabs(LineSagitta(
-        line.line, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px));
+  std::array<LineParams, 4> identified;
+  for (std::size_t k = 0; k < identified.size(); ++k) {
+    identified[k] = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
   }
-  std::sort(bends.begin(), bends.end());
-  frame_.straightness_px = bends[2];
+  frame_.straightness_px = StraightnessOfFour(identified, detector_.feature_points(),
+                                              2.0 * detector_.options().support_tolerance_px);
   for (int k = 0; k < 4; ++k) {
     const DetectedLine& line =
         lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
