@@ -3,7 +3,6 @@
 #include "servo/pose.h"
 
 #include <visp3/core/vpException.h>
-#include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpPoint.h>
 #include <visp3/core/vpRzyxVector.h>
 #include <visp3/vision/vpPose.h>
@@ -167,27 +166,58 @@ struct Corners {
   }
 };
 
+// The rotation and translation of vpExponentialMap::direct(v) (v = [translation; theta-u],
+// over a unit time), on fixed-size matrices: it allocates nothing.
+void TwistExp(const Eigen::Matrix<double, 6, 1>& v, Eigen::Matrix3d* rotation,
+              Eigen::Vector3d* translation) {
+  const Eigen::Vector3d u = v.tail<3>();
+  const double theta = u.norm();
+  Eigen::Matrix3d skew;
+  skew << 0.0, -u.z(), u.y(), u.z(), 0.0, -u.x(), -u.y(), u.x(), 0.0;
+  // sin(t)/t, (1 - cos(t))/t², (1 - sin(t)/t)/t², by their series near 0.
+  double sinc = 1.0, mcosc = 0.5, msinc = 1.0 / 6.0;
+  if (theta > 1e-6) {
+    const double t2 = theta * theta;
+    sinc = std::sin(theta) / theta;
+    mcosc = (1.0 - std::cos(theta)) / t2;
+    msinc = (1.0 - sinc) / t2;
+  }
+  *rotation = Eigen::Matrix3d::Identity() + sinc * skew + mcosc * skew * skew;
+  const Eigen::Matrix3d V =
+      sinc * Eigen::Matrix3d::Identity() + mcosc * skew + msinc * u * u.transpose();
+  *translation = V * v.head<3>();
+}
+
 // Gauss-Newton refinement of cMo on the four corners, the model of vpPose::VIRTUAL_VS (same
 // reprojection error in normalised coordinates, same camera-frame update
 // cMo <- exp(v)^-1 · cMo), on fixed-size matrices: the previous-pose path runs it on every
-// frame of a loop, where vpPose's per-iteration allocations cost more than the arithmetic.
-// False when a corner falls behind the camera or the normal equations are singular.
+// frame of a loop, where vpPose's (and ViSP's matrices') allocations cost more than the
+// arithmetic. False when a corner falls behind the camera or the normal equations are
+// singular.
 bool RefineOnCorners(const HashTarget& hash, const std::array<vpColVector, 4>& corners_m,
                      vpHomogeneousMatrix* cMo) {
   constexpr int kMaxIterations = 20;
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R(r, c) = (*cMo)[r][c];
+    t(r) = (*cMo)[r][3];
+  }
+  double measured[4][2];
+  for (int k = 0; k < 4; ++k) {
+    measured[k][0] = corners_m[k][0];
+    measured[k][1] = corners_m[k][1];
+  }
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
     Eigen::Matrix<double, 8, 6> L;
     Eigen::Matrix<double, 8, 1> e;
-    const vpHomogeneousMatrix& M = *cMo;
     for (int k = 0; k < 4; ++k) {
-      const double X = hash.corner[k].x, Y = hash.corner[k].y;
-      const double xc = M[0][0] * X + M[0][1] * Y + M[0][3];
-      const double yc = M[1][0] * X + M[1][1] * Y + M[1][3];
-      const double zc = M[2][0] * X + M[2][1] * Y + M[2][3];
-      if (!(zc > 0.0)) return false;
-      const double x = xc / zc, y = yc / zc, iz = 1.0 / zc;
-      e(2 * k) = x - corners_m[k][0];
-      e(2 * k + 1) = y - corners_m[k][1];
+      const Eigen::Vector3d p =
+          R.col(0) * hash.corner[k].x + R.col(1) * hash.corner[k].y + t;  // object z = 0
+      if (!(p.z() > 0.0)) return false;
+      const double iz = 1.0 / p.z(), x = p.x() * iz, y = p.y() * iz;
+      e(2 * k) = x - measured[k][0];
+      e(2 * k + 1) = y - measured[k][1];
       L.row(2 * k) << -iz, 0.0, x * iz, x * y, -(1.0 + x * x), y;
       L.row(2 * k + 1) << 0.0, -iz, y * iz, 1.0 + y * y, -x * y, -x;
     }
@@ -196,12 +226,31 @@ bool RefineOnCorners(const HashTarget& hash, const std::array<vpColVector, 4>& c
     if (solver.info() != Eigen::Success) return false;
     const Eigen::Matrix<double, 6, 1> v = -solver.solve(L.transpose() * e);
     if (!v.allFinite()) return false;
-    vpColVector twist(6);
-    for (int i = 0; i < 6; ++i) twist[i] = v(i);
-    *cMo = vpExponentialMap::direct(twist).inverse() * *cMo;
+    Eigen::Matrix3d step_rotation;
+    Eigen::Vector3d step_translation;
+    TwistExp(v, &step_rotation, &step_translation);
+    // exp(v)^-1 · cMo
+    R = step_rotation.transpose() * R;
+    t = step_rotation.transpose() * (t - step_translation);
     if (v.norm() < 1e-12) break;
   }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) (*cMo)[r][c] = R(r, c);
+    (*cMo)[r][3] = t(r);
+  }
   return IsFinite(*cMo);
+}
+
+// Step 4's refinement from `*cMo`: RefineOnCorners, or vpPose's virtual visual servoing on
+// the same corners (`pose` holds them) where it fails.
+bool Refine(const HashTarget& hash, const std::array<vpColVector, 4>& corners_m, vpPose* pose,
+            vpHomogeneousMatrix* cMo) {
+  vpHomogeneousMatrix refined = *cMo;
+  if (RefineOnCorners(hash, corners_m, &refined)) {
+    *cMo = refined;
+    return true;
+  }
+  return Compute(pose, vpPose::VIRTUAL_VS, cMo);
 }
 
 PoseResult Fail(PoseResult result, const std::string& message) {
@@ -275,12 +324,12 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
     // pose: seen from the linear pose, one refinement after them suffices.
     const vpHomogeneousMatrix linear = cMo;
     corners.Set(&linear, &result, &pose);
-    if (Compute(&pose, vpPose::VIRTUAL_VS, &cMo)) {
+    if (Refine(hash, result.corners_m, &pose, &cMo)) {
       residual_px = ResidualPx(cMo, hash, result.corners_m, camera);
     }
     if (have_previous) {
       vpHomogeneousMatrix seeded = *previous_cMo;
-      if (Compute(&pose, vpPose::VIRTUAL_VS, &seeded)) {
+      if (Refine(hash, result.corners_m, &pose, &seeded)) {
         const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
         if (std::isfinite(seeded_px) && seeded_px <= residual_px + options.previous_tolerance_px) {
           cMo = seeded;
@@ -321,8 +370,9 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
       return Fail(std::move(result), message.str());
     }
   }
-  const vpHomogeneousMatrix oMc = cMo.inverse();
-  if (!(oMc[2][3] < 0.0)) {
+  // The camera's object z, the third row of oMc = cMo^-1's translation -cRo^T cto.
+  const double camera_z = -(cMo[0][2] * cMo[0][3] + cMo[1][2] * cMo[1][3] + cMo[2][2] * cMo[2][3]);
+  if (!(camera_z < 0.0)) {
     return Fail(std::move(result), "pose sees the back of the board (camera at object z >= 0)");
   }
   if (residual_px > options.max_residual_px) {

@@ -4,8 +4,10 @@
 //   step 2  roll from the orientation of line 1, over 0-360 deg      PoseResult::line1_roll_deg
 //   step 3  the four intersections -> vpPose (Dementhon, Lagrange,   EstimatePose()
 //           lower residual kept; corners corrected for the perspective
-//           shift of wide stripes' middles; refined by virtual visual
-//           servoing, also from the previous pose if given)
+//           shift of wide stripes' middles; refined by Gauss-Newton on
+//           the corners, virtual visual servoing's model and update on
+//           fixed-size matrices (vpPose's where that fails), also from
+//           the previous pose if given)
 //   step 4  the position; the paper's plane angles (Eq. 5) reported  PoseResult::plane_angle_deg
 //
 // Target. A LineTarget (target/line_target.h) whose lines 1 and 3 are parallel, lines 2 and 4 are
@@ -141,7 +143,8 @@ struct PoseOptions {
   double previous_accept_px = 0.5;
   /// Compute PoseResult::covariance (one more short refinement, ~8 us). Range: bool.
   bool compute_covariance = true;
-  /// Iterations of vpPose's virtual visual servoing. Range [1, 1000].
+  /// Iterations of vpPose's virtual visual servoing (the covariance's, and the refinement's
+  /// where the fixed-size one fails). Range [1, 1000].
   int vvs_max_iterations = 200;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.

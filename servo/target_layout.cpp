@@ -1,9 +1,10 @@
 #include "servo/target_layout.h"
 
-#include <visp3/core/vpException.h>
 #include <visp3/core/vpPixelMeterConversion.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,40 @@ constexpr double kFarPx = 1e5;
 
 double Cross(const Point2d& a, const Point2d& b) {
   return a.u * b.v - a.v * b.u;
+}
+
+// The homography taking four plane points exactly onto four image points, solved with
+// Eigen's LU on its eight unknowns, the ninth fixed by h(origin) having third coordinate 1
+// (`origin` lies inside the quadrilateral, so in front of the camera); nullopt when the
+// points are degenerate (three in a line). vpHomography::DLT's SVD, meant for many points,
+// cost more than the rest of a sheet candidate.
+std::optional<vpHomography> FourPointHomography(const std::array<Point2d, 4>& plane,
+                                                const std::array<Point2d, 4>& image,
+                                                const Point2d& origin) {
+  Eigen::Matrix<double, 8, 8> a;
+  Eigen::Matrix<double, 8, 1> b;
+  for (int k = 0; k < 4; ++k) {
+    const double X = plane[static_cast<std::size_t>(k)].u - origin.u;
+    const double Y = plane[static_cast<std::size_t>(k)].v - origin.v;
+    const double x = image[static_cast<std::size_t>(k)].u, y = image[static_cast<std::size_t>(k)].v;
+    a.row(2 * k) << X, Y, 1.0, 0.0, 0.0, 0.0, -x * X, -x * Y;
+    a.row(2 * k + 1) << 0.0, 0.0, 0.0, X, Y, 1.0, -y * X, -y * Y;
+    b(2 * k) = x;
+    b(2 * k + 1) = y;
+  }
+  const Eigen::FullPivLU<Eigen::Matrix<double, 8, 8>> lu(a);
+  if (!lu.isInvertible()) return std::nullopt;
+  const Eigen::Matrix<double, 8, 1> h = lu.solve(b);
+  if (!h.allFinite()) return std::nullopt;
+  // From the origin-centred plane coordinates back to the plane's: H · translate(-origin).
+  const double centred[3][3] = {{h(0), h(1), h(2)}, {h(3), h(4), h(5)}, {h(6), h(7), 1.0}};
+  vpHomography result;
+  for (int r = 0; r < 3; ++r) {
+    result[r][0] = centred[r][0];
+    result[r][1] = centred[r][1];
+    result[r][2] = centred[r][2] - centred[r][0] * origin.u - centred[r][1] * origin.v;
+  }
+  return result;
 }
 
 // Whether the four points turn the same way at every corner, enclosing more than a pixel.
@@ -177,10 +212,12 @@ bool PlaneProjector::Project(const Point2d& plane, Point2d* pixel) const {
     if (kdu_ < 0.0 && rho > (2.0 / 3.0) / std::sqrt(-3.0 * kdu_)) return false;
     const double e = kdu_ * rho2;
     double r = std::fabs(e) < 0.1 ? rho * (1.0 - e + 3.0 * e * e) : rho / (1.0 + e);
+    // Newton converges quadratically here: the error left after a step is about
+    // 3 |kdu| r step² (f'' / 2 f'), so a step under 1e-7 leaves one far under 1e-12.
     for (int i = 0; i < 50; ++i) {
       const double step = (kdu_ * r * r * r + r - rho) / (3.0 * kdu_ * r * r + 1.0);
       r -= step;
-      if (std::fabs(step) <= 1e-12 * (1.0 + r)) break;
+      if (std::fabs(step) <= 1e-7 * (1.0 + r)) break;
     }
     scale = r / rho;
   }
@@ -227,35 +264,24 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
 
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
                                                  const vpCameraParameters& camera) {
-  std::vector<double> x_image(4), y_image(4), x_plane(4), y_plane(4);
+  std::array<Point2d, 4> image;
   for (int k = 0; k < 4; ++k) {
-    vpPixelMeterConversion::convertPoint(camera, cell.corners[static_cast<std::size_t>(k)].u,
-                                         cell.corners[static_cast<std::size_t>(k)].v,
-                                         x_image[static_cast<std::size_t>(k)],
-                                         y_image[static_cast<std::size_t>(k)]);
-    if (!std::isfinite(x_image[static_cast<std::size_t>(k)]) ||
-        !std::isfinite(y_image[static_cast<std::size_t>(k)])) {
-      return std::nullopt;
-    }
+    const Point2d& corner = cell.corners[static_cast<std::size_t>(k)];
+    Point2d& normalised = image[static_cast<std::size_t>(k)];
+    vpPixelMeterConversion::convertPoint(camera, corner.u, corner.v, normalised.u, normalised.v);
+    if (!std::isfinite(normalised.u) || !std::isfinite(normalised.v)) return std::nullopt;
   }
   std::optional<vpHomography> best;
   double best_cost = HUGE_VAL;
   for (int shift = 0; shift < 2; ++shift) {
+    std::array<Point2d, 4> plane;
     for (int k = 0; k < 4; ++k) {
-      const Point2d& corner = layout.middle_cell[static_cast<std::size_t>((k + 4 - shift) % 4)];
-      x_plane[static_cast<std::size_t>(k)] = corner.u;
-      y_plane[static_cast<std::size_t>(k)] = corner.v;
+      plane[static_cast<std::size_t>(k)] =
+          layout.middle_cell[static_cast<std::size_t>((k + 4 - shift) % 4)];
     }
-    vpHomography h;
-    try {
-      vpHomography::DLT(x_plane, y_plane, x_image, y_image, h, true);
-    } catch (const vpException&) {
-      continue;
-    }
-    // Scaled so that the cell lies in front (positive third coordinate).
-    const double w = h[2][0] * layout.origin.u + h[2][1] * layout.origin.v + h[2][2];
-    if (!(std::fabs(w) > 0.0) || !std::isfinite(w)) continue;
-    if (w < 0.0) h = h * -1.0;
+    std::optional<vpHomography> found = FourPointHomography(plane, image, layout.origin);
+    if (!found) continue;
+    const vpHomography& h = *found;  // the cell in front: third coordinate 1 at the origin
     const double h1[3] = {h[0][0], h[1][0], h[2][0]}, h2[3] = {h[0][1], h[1][1], h[2][1]};
     const double n1 = std::sqrt(h1[0] * h1[0] + h1[1] * h1[1] + h1[2] * h1[2]);
     const double n2 = std::sqrt(h2[0] * h2[0] + h2[1] * h2[1] + h2[2] * h2[2]);
