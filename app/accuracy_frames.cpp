@@ -10,11 +10,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/atomic_file.h"
 #include "app/command_line.h"
-#include "app/image_source.h"
-#include "app/json_io.h"
 #include "base/check.h"
+#include "io/atomic_file.h"
+#include "io/image_source.h"
+#include "io/json_io.h"
 
 namespace oal {
 namespace {

@@ -130,7 +130,7 @@ AppConfig LoadAccuracyConfig(const std::string& path, const std::string& command
 void CheckReportFile(const std::string& out_path);
 
 /// Writes `json` (indented) atomically to out_path, if set; then prints `table` on stdout with
-/// WriteText of app/json_io.h (a failed stdout is an error, reported after the file is safe).
+/// WriteText of io/json_io.h (a failed stdout is an error, reported after the file is safe).
 void PrintAccuracyReport(const std::string& table, const nlohmann::json& json,
                          const std::string& out_path);
 

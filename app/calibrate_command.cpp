@@ -11,15 +11,15 @@
 #include <vector>
 
 #include "app/accuracy_frames.h"
-#include "app/atomic_file.h"
-#include "app/camera_file.h"
 #include "app/command_line.h"
-#include "app/image_source.h"
 #include "app/sheet_views.h"
 #include "base/format.h"
 #include "calibration/calibrate.h"
 #include "calibration/chessboard.h"
 #include "calibration/view_selector.h"
+#include "io/atomic_file.h"
+#include "io/camera_file.h"
+#include "io/image_source.h"
 
 namespace oal {
 namespace {

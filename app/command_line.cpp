@@ -16,7 +16,7 @@
 #include <mutex>
 #include <stdexcept>
 
-#include "app/atomic_file.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 

@@ -19,19 +19,19 @@
 #include <stdexcept>
 
 #include "app/accuracy_frames.h"  // ConfigHasSection
-#include "app/annotate.h"
-#include "app/atomic_file.h"
-#include "app/camera_file.h"
 #include "app/config.h"
 #include "app/detector_accuracy.h"
 #include "app/frame_command.h"  // CompanionFile
-#include "app/image_source.h"
 #include "app/truth_file.h"
 #include "base/check.h"
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "detector/tracker.h"
+#include "io/annotate.h"
+#include "io/atomic_file.h"
+#include "io/camera_file.h"
+#include "io/image_source.h"
 #include "scene/scene.h"
 #include "servo/target_tracker.h"
 

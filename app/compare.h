@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "app/json_io.h"
 #include "detector/line.h"
 #include "detector/options.h"
+#include "io/json_io.h"
 
 namespace oal {
 

@@ -6,7 +6,7 @@
 
 #include "app/command_line.h"
 #include "app/compare.h"
-#include "app/json_io.h"
+#include "io/json_io.h"
 
 namespace oal {
 

@@ -21,8 +21,8 @@
 #include <utility>
 #include <vector>
 
-#include "app/camera_file.h"
-#include "app/image_source.h"
+#include "io/camera_file.h"
+#include "io/image_source.h"
 
 namespace oal {
 namespace {

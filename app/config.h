@@ -162,7 +162,7 @@ struct SourceConfig {
   SourceType type = SourceType::kSimulated;
   std::string device = "/dev/video0";  ///< v4l2: the device; its size is camera.width/height
   int fps = 0;                         ///< v4l2: 25 or 50 (vpV4l2Grabber's rates); 0: driver's
-  /// replay: what to play (app/image_source.h); relative paths are relative to the config file.
+  /// replay: what to play (io/image_source.h); relative paths are relative to the config file.
   std::string path;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.

@@ -14,14 +14,14 @@
 #include <stdexcept>
 
 #include "app/accuracy_frames.h"
-#include "app/annotate.h"
-#include "app/atomic_file.h"
 #include "app/command_line.h"
-#include "app/image_source.h"
-#include "app/json_io.h"
 #include "app/render_command.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
+#include "io/annotate.h"
+#include "io/atomic_file.h"
+#include "io/image_source.h"
+#include "io/json_io.h"
 #include "scene/scene.h"
 #include "servo/target_tracker.h"
 

@@ -7,16 +7,16 @@
 #include <optional>
 #include <stdexcept>
 
-#include "app/annotate.h"
-#include "app/atomic_file.h"
-#include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/frame_command.h"
-#include "app/image_source.h"
-#include "app/json_io.h"
 #include "detector/detector.h"
 #include "detector/line_fit.h"
+#include "io/annotate.h"
+#include "io/atomic_file.h"
+#include "io/camera_file.h"
+#include "io/image_source.h"
+#include "io/json_io.h"
 
 namespace oal {
 namespace {

@@ -11,9 +11,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/atomic_file.h"
-#include "app/image_source.h"
 #include "base/check.h"
+#include "io/atomic_file.h"
+#include "io/image_source.h"
 
 namespace oal {
 namespace {

@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/edge_reference.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 

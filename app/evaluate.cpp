@@ -25,15 +25,11 @@
 #include <thread>
 #include <tuple>
 
-#include "app/annotate.h"
-#include "app/atomic_file.h"
-#include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/compare.h"
 #include "app/config.h"
 #include "app/detector_accuracy.h"
 #include "app/frame_command.h"
-#include "app/image_source.h"
 #include "app/lens_estimate.h"
 #include "app/report.h"
 #include "app/truth_file.h"
@@ -41,6 +37,10 @@
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "detector/tracker.h"
+#include "io/annotate.h"
+#include "io/atomic_file.h"
+#include "io/camera_file.h"
+#include "io/image_source.h"
 #include "scene/bench_scene.h"  // IsSheet
 #include "servo/pose.h"
 #include "servo/target_tracker.h"

@@ -2,11 +2,11 @@
 // robot is servoed with them (docs/EVALUATE.md has the user's guide and the file formats).
 //
 // Inputs. Each INPUT is a video OpenCV reads, an image sequence (a directory of images or a
-// printf pattern, app/image_source.h), a single image, or a directory of these: a directory
+// printf pattern, io/image_source.h), a single image, or a directory of these: a directory
 // holding at least one image is one image sequence; any other directory stands for its
 // entries, sorted by name: each video file and each subdirectory holding images is one
 // input, every other entry is skipped and listed in the report (but the companion files,
-// IsCompanionFile in app/image_source.h: camera.xml, truth JSON and CSV). No input at all is
+// IsCompanionFile in io/image_source.h: camera.xml, truth JSON and CSV). No input at all is
 // an error. The inputs, in that order, are numbered 0, 1, ...; `--shard I/N` keeps those
 // whose number is I modulo N.
 //
@@ -25,7 +25,7 @@
 //   index.html, run.json the inputs of the run (index-I-of-N.html, run-I-of-N.json with
 //                        --shard), links to the reports; failed inputs and skipped files
 //
-// Every file is written under a temporary name and renamed (app/atomic_file.h). Timings live
+// Every file is written under a temporary name and renamed (io/atomic_file.h). Timings live
 // only in timing.jsonl, timing.json and the reports' timing block, so every other file is
 // byte-identical between runs with any --jobs (tests compare them).
 //
@@ -39,7 +39,7 @@
 #include <string>
 #include <vector>
 
-#include "app/json_io.h"
+#include "io/json_io.h"
 
 namespace oal {
 

@@ -2,7 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "app/image_source.h"
+#include "io/image_source.h"
 
 namespace oal {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "app/atomic_file.h"
+#include "io/atomic_file.h"
 
 namespace CLI {
 class App;
@@ -21,7 +21,7 @@ class ImageSource;
 
 /// The inputs and outputs of a command over image sources; each command adds its own options.
 struct FrameCommandOptions {
-  /// Image, directory, printf pattern, video or /dev/videoN (app/image_source.h); read one
+  /// Image, directory, printf pattern, video or /dev/videoN (io/image_source.h); read one
   /// after the other.
   std::vector<std::string> inputs;
   /// Camera to read from the command's camera file; empty: the first camera of the file.

@@ -14,15 +14,15 @@
 #include <string>
 #include <vector>
 
-#include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
-#include "app/image_source.h"
 #include "app/servo_command.h"
 #include "app/servo_rig.h"
 #include "base/format.h"
 #include "base/parse.h"
 #include "calibration/hand_eye_routine.h"
+#include "io/atomic_file.h"
+#include "io/image_source.h"
 #include "robots/safe_robot.h"
 #include "servo/target_layout.h"
 

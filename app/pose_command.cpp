@@ -14,16 +14,16 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/annotate.h"
-#include "app/atomic_file.h"
-#include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/frame_command.h"
-#include "app/image_source.h"
-#include "app/json_io.h"
 #include "app/lens_estimate.h"
 #include "detector/detector.h"
+#include "io/annotate.h"
+#include "io/atomic_file.h"
+#include "io/camera_file.h"
+#include "io/image_source.h"
+#include "io/json_io.h"
 #include "scene/scene.h"
 #include "servo/pose.h"
 #include "servo/target_tracker.h"

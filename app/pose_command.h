@@ -20,7 +20,7 @@
 // not identified); corners_px (corner k = line k+1 ∩ line k+2, in `coordinates`:
 // "undistorted" when the detector corrects distortion, else "image") is null until the lines
 // are identified. Angles are PoseResult's. scan says where the target was looked for
-// (ScanJson, app/json_io.h: mode "target" or "image"; source "prior", "middle-cell", "image"
+// (ScanJson, io/json_io.h: mode "target" or "image"; source "prior", "middle-cell", "image"
 // or "none"; region the outermost border scanned, empty for the whole image);
 // stripe_agreement is the model check's worst fraction over lines 1-4 (null when no pose was
 // estimated).

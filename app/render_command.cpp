@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "app/accuracy_frames.h"  // AddSeedOption
-#include "app/atomic_file.h"
-#include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
-#include "app/json_io.h"
 #include "base/check.h"
+#include "io/atomic_file.h"
+#include "io/camera_file.h"
+#include "io/json_io.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "app/json_io.h"
+#include "io/json_io.h"
 
 namespace oal {
 

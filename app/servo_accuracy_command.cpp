@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/detector_accuracy.h"  // Quantile
 #include "app/fault_campaign.h"
 #include "app/servo_accuracy.h"
 #include "app/servo_command.h"
 #include "app/servo_output.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 namespace {

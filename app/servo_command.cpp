@@ -12,10 +12,10 @@
 #include <thread>
 #include <vector>
 
-#include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/servo_default_config.h"
 #include "app/servo_output.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 namespace {

@@ -18,12 +18,12 @@
 #include <utility>
 #include <vector>
 
-#include "app/image_source.h"
 #include "app/lens_estimate.h"  // LensMismatchWarning
 #include "app/servo_rig.h"
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
+#include "io/image_source.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"

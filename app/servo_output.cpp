@@ -28,9 +28,9 @@
 #include <thread>
 #include <vector>
 
-#include "app/annotate.h"
-#include "app/atomic_file.h"
 #include "base/format.h"
+#include "io/annotate.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 namespace {

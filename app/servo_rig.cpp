@@ -6,10 +6,10 @@
 #include <stdexcept>
 #include <utility>
 
-#include "app/image_source.h"
 #include "app/lens_estimate.h"
 #include "app/servo_loop.h"  // Table3Columns
 #include "base/format.h"
+#include "io/image_source.h"
 #include "robots/scorbot_kinematics.h"
 #include "robots/scorbot_robot.h"
 #include "robots/simulated_camera.h"
@@ -56,7 +56,7 @@ class RenderedCamera : public LoopCamera {
   RenderedFrame frame_;
 };
 
-// A V4L2 camera or a recording (app/image_source.h).
+// A V4L2 camera or a recording (io/image_source.h).
 class SourceCamera : public LoopCamera {
  public:
   explicit SourceCamera(std::unique_ptr<ImageSource> source) : source_(std::move(source)) {}

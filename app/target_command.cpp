@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "app/atomic_file.h"
 #include "app/command_line.h"
 #include "app/config.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 namespace {

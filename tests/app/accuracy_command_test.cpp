@@ -16,7 +16,7 @@
 #include "app/pose_accuracy.h"
 #include "app/pose_accuracy_command.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

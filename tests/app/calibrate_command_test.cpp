@@ -11,11 +11,11 @@
 #include <string>
 
 #include "app/accuracy_frames.h"
-#include "app/camera_file.h"
+#include "io/camera_file.h"
 #include "scene/bench_scene.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
 #include "tests/calibration/chessboard_views.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

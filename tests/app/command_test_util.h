@@ -15,7 +15,7 @@
 
 #include "app/config.h"
 #include "app/render_command.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal::test {
 

@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/camera_file.h"
+#include "io/camera_file.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "app/command_line.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -16,7 +16,7 @@
 
 #include "app/edge_reference_command.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -23,13 +23,13 @@
 #include <string>
 #include <vector>
 
-#include "app/camera_file.h"
 #include "app/command_line.h"
 #include "app/render_command.h"
 #include "app/report.h"
 #include "app/truth_file.h"
+#include "io/camera_file.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -15,7 +15,7 @@
 #include "app/servo_command.h"
 #include "servo_test_util.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

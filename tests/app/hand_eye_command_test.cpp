@@ -13,7 +13,7 @@
 #include "app/servo_command.h"
 #include "robots/robot.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "app/camera_file.h"
 #include "app/command_line.h"
+#include "io/camera_file.h"
 #include "scene/scene.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -20,7 +20,7 @@
 #include "robots/scorbot_kinematics.h"
 #include "servo_test_util.h"
 #include "tests/app/command_test_util.h"
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

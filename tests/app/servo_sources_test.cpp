@@ -21,7 +21,7 @@
 #include "app/servo_output.h"
 #include "scene/scene.h"
 #include "servo_test_util.h"
-#include "test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

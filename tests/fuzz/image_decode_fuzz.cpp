@@ -4,7 +4,7 @@
 #include <exception>
 #include <vector>
 
-#include "app/image_source.h"
+#include "io/image_source.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // Larger inputs only slow the search down: the decoders' state machines are reached early.

@@ -1,4 +1,4 @@
-#include "app/image_source.h"
+#include "io/image_source.h"
 
 #include <visp3/core/vpConfig.h>
 #include <visp3/core/vpException.h>

@@ -1,4 +1,4 @@
-#include "app/json_io.h"
+#include "io/json_io.h"
 
 #include <visp3/core/vpThetaUVector.h>
 #include <visp3/core/vpTranslationVector.h>

@@ -1,4 +1,4 @@
-#include "app/atomic_file.h"
+#include "io/atomic_file.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "app/camera_file.h"
+#include "io/camera_file.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "tests/app/test_util.h"
+#include "tests/test_util.h"
 
 namespace oal {
 namespace {

@@ -1,4 +1,4 @@
-#include "app/camera_file.h"
+#include "io/camera_file.h"
 
 #include <libxml/parser.h>
 #include <libxml/tree.h>
@@ -14,7 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "app/atomic_file.h"
+#include "io/atomic_file.h"
 
 namespace oal {
 namespace {

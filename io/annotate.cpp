@@ -1,4 +1,4 @@
-#include "app/annotate.h"
+#include "io/annotate.h"
 
 #include <visp3/core/vpMeterPixelConversion.h>
 
