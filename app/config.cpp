@@ -1085,7 +1085,7 @@ void CheckStartInWorkspace(const AppConfig& config, const std::string& file) {
   const vpHomogeneousMatrix wMx = robot.safety.workspace_frame == RobotFrame::kCamera
                                       ? robot.start_wMc
                                       : robot.start_wMc * config.camera.eMc.inverse();
-  const std::string why = OutsideWorkspace(robot.safety, wMx.getTranslationVector());
+  const std::string why = robot.safety.OutsideWorkspace(wMx.getTranslationVector());
   if (why.empty()) return;
   // Lead with a line of this file: the start's if it set it, else the box's.
   const auto in_file = [&](const std::string& origin) { return origin.rfind(file + ":", 0) == 0; };
@@ -1160,20 +1160,6 @@ std::string Num(double value) {
 std::string AppConfig::Origin(const std::string& key) const {
   const auto origin = origins.find(key);
   return origin == origins.end() ? "" : origin->second;
-}
-
-std::string OutsideWorkspace(const SafetyOptions& safety, const vpTranslationVector& p) {
-  if (!safety.workspace_enabled) return "";
-  constexpr const char* kAxis[3] = {"x", "y", "z"};
-  for (std::size_t i = 0; i < 3; ++i) {
-    const double lo = safety.workspace_min_m[i], hi = safety.workspace_max_m[i];
-    const double value = p[static_cast<unsigned>(i)];
-    if (!(value >= lo && value <= hi)) {
-      return std::string(kAxis[i]) + " = " + Num(value) + " m is outside [" + Num(lo) + ", " +
-             Num(hi) + "] m";
-    }
-  }
-  return "";
 }
 
 void SceneConfig::ApplyTo(RenderOptions* render) const {
@@ -1324,36 +1310,6 @@ std::optional<SourceType> SourceTypeFromString(const std::string& word) {
 
 std::optional<DisplayMode> DisplayModeFromString(const std::string& word) {
   return FromWord(word, {DisplayMode::kAuto, DisplayMode::kOn, DisplayMode::kOff});
-}
-
-int ServoLoopOptions::IterationLimit(bool replay) const {
-  if (max_iterations > 0) return max_iterations;
-  if (replay) return std::numeric_limits<int>::max();
-  return law.mode == ServoMode::kVelocity ? 300 : 30;
-}
-
-void ServoLoopOptions::Check() const {
-  law.Check();
-  if (max_iterations < 0 || max_iterations > 1000000) {
-    Violated("ServoLoopOptions::max_iterations", Num(max_iterations),
-             "0 <= max_iterations <= 1000000 (0: the law's own limit)");
-  }
-  if (!(max_time_s > 0.0) || !std::isfinite(max_time_s)) {
-    Violated("ServoLoopOptions::max_time_s", Num(max_time_s), "max_time_s > 0");
-  }
-  if (!(max_pose_jump_m > 0.0) || !std::isfinite(max_pose_jump_m)) {
-    Violated("ServoLoopOptions::max_pose_jump_m", Num(max_pose_jump_m), "max_pose_jump_m > 0");
-  }
-  if (!(max_pose_jump_deg > 0.0 && max_pose_jump_deg <= 180.0)) {
-    Violated("ServoLoopOptions::max_pose_jump_deg", Num(max_pose_jump_deg),
-             "0 < max_pose_jump_deg <= 180");
-  }
-  if (!(max_step_m > 0.0) || !std::isfinite(max_step_m)) {
-    Violated("ServoLoopOptions::max_step_m", Num(max_step_m), "max_step_m > 0");
-  }
-  if (!(max_step_deg > 0.0 && max_step_deg <= 180.0)) {
-    Violated("ServoLoopOptions::max_step_deg", Num(max_step_deg), "0 < max_step_deg <= 180");
-  }
 }
 
 std::string TargetYaml(const LineTarget& target) {

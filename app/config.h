@@ -55,6 +55,7 @@
 #include <string>
 
 #include "detector/options.h"
+#include "loop/servo_loop.h"
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/scorbot_robot.h"
@@ -129,29 +130,6 @@ struct RobotConfig {
   SafetyOptions safety;           ///< velocity limits, workspace box, reach tolerances
   ScorbotOptions scorbot;         ///< `robot.scorbot:` (its eMc comes from camera.eMc)
   ScorbotSimOptions simulator;    ///< `robot.scorbot.simulator:` (port: simulator)
-
-  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
-  void Check() const;
-};
-
-/// `servo:` the law and the loop's stop conditions.
-struct ServoLoopOptions {
-  ServoOptions law;
-  /// Frames processed before iteration-limit, [0, 1e6]; 0: the law's own (IterationLimit).
-  int max_iterations = 0;
-  double max_time_s = 60.0;        ///< wall time before time-limit, s, > 0
-  double max_pose_jump_m = 0.05;   ///< estimate vs odometry prediction, m, > 0
-  double max_pose_jump_deg = 5.0;  ///< ... and degrees, (0, 180]
-  /// The largest position move (point-and-go, exponential) the loop commands: a larger step
-  /// stops the run (limit) before the robot moves. m, > 0.
-  double max_step_m = 0.5;
-  double max_step_deg = 60.0;  ///< ... and degrees, (0, 180]
-
-  /// The iteration limit in force: max_iterations when set; else none for a replay (it runs
-  /// to its end), 300 frames for the velocity law (its error falls by e in 1/gain s: from
-  /// 0.1 m to 1 mm takes about 120 periods of 40 ms at gain 1/s) and 30 for the position
-  /// laws (a few moves, each two frames).
-  int IterationLimit(bool replay) const;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
@@ -235,11 +213,11 @@ struct AppConfig {
   SceneConfig scene;       ///< `scene:`
   CameraConfig camera;     ///< `camera:`
   RobotConfig robot;       ///< `robot:`
-  ServoLoopOptions servo;  ///< `servo:`
+  ServoLoopOptions servo;  ///< `servo:` (loop/servo_loop.h)
   /// `goal: {cdMo: POSE}`: the target in the goal camera frame (default 0.5 m ahead).
   vpHomogeneousMatrix goal_cdMo = vpHomogeneousMatrix(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);
   /// `goal: {image: FILE}`: a taught goal, the pose seen in this image (relative to the config
-  /// file); replaces goal_cdMo when the loop starts (TeachGoal in servo_loop.h). Empty: none.
+  /// file); replaces goal_cdMo when the loop starts (TeachGoal in app/servo_run.h). Empty: none.
   std::string goal_image;
   std::string goal_image_origin;  ///< "FILE:LINE" of goal.image, for messages
   SourceConfig source;            ///< `source:`
@@ -254,11 +232,6 @@ struct AppConfig {
   /// origins[key], or "" when no file set it.
   std::string Origin(const std::string& key) const;
 };
-
-/// Why the point `p` (the origin of safety.workspace_frame in the world frame, m) lies outside
-/// the workspace box of `safety`, e.g. "z = 1.2 m is outside [0.1, 1] m"; "" when it is inside
-/// or the box is disabled.
-std::string OutsideWorkspace(const SafetyOptions& safety, const vpTranslationVector& p);
 
 /// The servo command reads the same file: all sections live in AppConfig.
 using ServoAppConfig = AppConfig;

@@ -30,7 +30,6 @@
 #include "app/config.h"
 #include "app/detector_accuracy.h"
 #include "app/frame_command.h"
-#include "app/lens_estimate.h"
 #include "app/report.h"
 #include "app/truth_file.h"
 #include "base/format.h"
@@ -41,6 +40,7 @@
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
+#include "loop/lens_estimate.h"
 #include "scene/bench_scene.h"  // IsSheet
 #include "servo/pose.h"
 #include "servo/target_tracker.h"

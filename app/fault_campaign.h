@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "app/config.h"
-#include "app/servo_loop.h"
+#include "app/servo_run.h"
 
 namespace oal {
 

@@ -109,10 +109,11 @@ std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix
   }
   CheckServoConfig(config);
   *configured_eMc = config.camera.eMc;
-  LoopModel model(config);
-  TargetPoseTracker tracker = model.Tracker();
+  const ServoSetup setup = ServoSetupOf(config);
+  vpCameraParameters model_camera = setup.camera;  // with the lens, once told
+  TargetPoseTracker tracker = MakeTracker(setup);
   std::vector<std::string> warnings;
-  const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &warnings);
+  const std::unique_ptr<FrameSource> frames = OpenFrames(config, &warnings);
   for (const std::string& warning : warnings) Warn("hand-eye", warning);
   RobotRig rig = OpenConfiguredRobot(config, nullptr);
   SafeRobot robot(*rig.driver, config.robot.safety);
@@ -132,13 +133,13 @@ std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix
 
   if (config.camera.estimate_distortion) {
     std::string why;
-    if (!TellTheLens(config, robot, *frames, &model, &tracker, std::cout, &why)) {
+    if (!TellTheLens(setup, robot, *frames, &model_camera, &tracker, std::cout, &why)) {
       throw std::runtime_error("cannot tell the lens: " + why + "; the arm did not move");
     }
   }
   int frame_count = 0;
   const MeasureTarget measure = [&](std::string* why) -> std::optional<vpHomogeneousMatrix> {
-    const RobotPose camera = TrueCameraPose(robot, config);
+    const RobotPose camera = TrueCameraPose(robot, config.camera.true_eMc);
     cv::Mat gray;
     if (!camera.result.ok() ||
         !frames->Grab(camera.pose.inverse() * config.target_wMo, frame_count++, &gray)) {
@@ -163,7 +164,7 @@ std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix
       robot, config.camera.eMc, measure, settings.routine,
       [](const std::string& line) { std::cout << line << '\n'
                                               << std::flush; },
-      CrossingsInView(config.target, model.camera, config.camera.width, config.camera.height),
+      CrossingsInView(config.target, model_camera, config.camera.width, config.camera.height),
       signals.interrupted());
   if (!settings.record_path.empty()) {
     std::ostringstream csv;

@@ -8,8 +8,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "app/lens_estimate.h"
 #include "detector/lens.h"
+#include "loop/lens_estimate.h"
 
 namespace oal {
 namespace {

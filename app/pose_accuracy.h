@@ -36,7 +36,7 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
   double line_offset_px = 2.0;
   /// The tracker is not told the lens: kdu is estimated from the target's stripes in the first
   /// 10 frames (of poses drawn apart from the evaluated ones) a pinhole tracker finds it in,
-  /// then used for every frame (app/lens_estimate.h).
+  /// then used for every frame (loop/lens_estimate.h).
   bool estimate_distortion = false;
 
   /// The paper's board (its first evaluation): 0.3-1.0 m, tilt up to 40 deg, any roll, every

@@ -12,8 +12,8 @@
 
 #include "app/command_line.h"
 #include "app/servo_command.h"
-#include "app/servo_loop.h"
 #include "app/servo_rig.h"
+#include "app/servo_run.h"
 #include "base/check.h"
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"

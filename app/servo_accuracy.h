@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "app/config.h"
-#include "app/servo_loop.h"
+#include "app/servo_run.h"
 #include "servo/pbvs.h"
 
 namespace oal {

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 // must stop can be reached only through process-wide state, and of that a handler may touch
 // lock-free atomics only (RequestEmergencyStop() stores to one).
 //   g_robot: the running SafeRobot, registered by the loop's on_robot hook once it runs and
-//     set back to null before it is destroyed (StopGuard in app/servo_loop.cpp, on every path
+//     set back to null before it is destroyed (StopGuard in loop/servo_loop.cpp, on every path
 //     out of RunServo);
 //   g_stops_in_flight: handlers between their load of g_robot and their last use of it. The
 //     signal may be delivered to another thread (the Controller-A simulator's) while the loop

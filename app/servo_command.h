@@ -1,18 +1,17 @@
 // `oalservo servo [--config FILE] [--out DIR] [--mode LAW] [--display auto|on|off]`: visual
-// servoing to a goal pose with the camera in the loop (app/servo_loop.h). With no --config it
-// runs the built-in default, equal to config/servo-sim.yaml: a simulated free-flying camera,
-// the exponential law, delta 0.8. Prints one row per iteration in the form of the paper's
-// Table 3 (iteration, X, Y, Z mm, pitch, roll deg of the camera in the base frame, translation
-// error mm, rotation error deg, status), then the outcome, and writes into the output
-// directory (config output.directory, or --out) servo.csv, servo-error.png and, without a
-// window, the annotated frames (app/servo_output.h), each atomically. A vpDisplayX window
-// shows the frames when a display exists (output.display; with auto, an X display that cannot
-// be reached gives a warning and no window). Ctrl-C, SIGTERM, SIGHUP, or a click in the
-// window, stops the robot (SafeRobot::RequestEmergencyStop) and ends the run with status
-// interrupted, the outputs written as for any other end.
-// Before the source and the robot are opened the output directory is checked writable and a
-// window opened; an earlier run's outputs are replaced only once the robot is connected (a run
-// that cannot connect writes nothing).
+// servoing to a goal pose with the camera in the loop (loop/servo_loop.h, run from a configuration
+// by app/servo_run.h). With no --config it runs the built-in default, equal to
+// config/servo-sim.yaml: a simulated free-flying camera, the exponential law, delta 0.8. Prints one
+// row per iteration in the form of the paper's Table 3 (iteration, X, Y, Z mm, pitch, roll deg of
+// the camera in the base frame, translation error mm, rotation error deg, status), then the
+// outcome, and writes into the output directory (config output.directory, or --out) servo.csv,
+// servo-error.png and, without a window, the annotated frames (app/servo_output.h), each
+// atomically. A vpDisplayX window shows the frames when a display exists (output.display; with
+// auto, an X display that cannot be reached gives a warning and no window). Ctrl-C, SIGTERM,
+// SIGHUP, or a click in the window, stops the robot (SafeRobot::RequestEmergencyStop) and ends the
+// run with status interrupted, the outputs written as for any other end. Before the source and the
+// robot are opened the output directory is checked writable and a window opened; an earlier run's
+// outputs are replaced only once the robot is connected (a run that cannot connect writes nothing).
 // Exit status: 0 converged (or a replay played to its end), 1 any other outcome or an error,
 // 2 a bad command line.
 #pragma once
@@ -24,7 +23,7 @@
 
 #include "app/command_line.h"
 #include "app/config.h"
-#include "app/servo_loop.h"
+#include "app/servo_run.h"
 
 namespace oal {
 

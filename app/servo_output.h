@@ -1,7 +1,7 @@
 // What `oalservo servo` shows and writes besides the table: the pose-error plot, the
 // annotated frames of a headless run and the live vpDisplayX window.
 //
-//   DIR/servo.csv          one row per iteration (WriteServoCsv, servo_loop.h)
+//   DIR/servo.csv          one row per iteration (WriteServoCsv, loop/servo_loop.h)
 //   DIR/servo-error.png    translation (mm) and rotation (deg) error per iteration, estimated
 //                          and (simulation) true, against the tolerances, drawn by gnuplot
 //   DIR/frames/iter_NNNN.png  each iteration's frame with the identified lines 1-4, the
@@ -19,7 +19,7 @@
 #include <opencv2/core/mat.hpp>
 #include <string>
 
-#include "app/servo_loop.h"
+#include "app/servo_run.h"
 
 namespace oal {
 

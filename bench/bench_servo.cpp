@@ -50,7 +50,7 @@ void Iteration(benchmark::State& state, const DetectorOptions& detector_options)
   pose_options.lines_undistorted = detector.Undistorts();
   pose_options.image_width = 640;
   pose_options.image_height = 480;
-  pose_options.compute_covariance = false;  // as in the loop (app/servo_loop.cpp)
+  pose_options.compute_covariance = false;  // as in the loop (loop/servo_loop.cpp)
   const ServoOptions law;
   const LineTarget target = FourLineTarget();
   const vpHomogeneousMatrix cdMo(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);
@@ -62,7 +62,7 @@ void Iteration(benchmark::State& state, const DetectorOptions& detector_options)
     const std::vector<DetectedLine>& lines =
         detector.Detect(ViewOf(inputs.frames[frame].image), seeds);
     const PoseResult pose = EstimatePose(lines, target, pose_options, previous);
-    // Four seeds, as in the loop (app/servo_loop.cpp seeds the target's lines projected from
+    // Four seeds, as in the loop (loop/servo_loop.cpp seeds the target's lines projected from
     // the predicted pose; here the lines found, which costs the detector the same).
     seeds.clear();
     if (pose.status == PoseStatus::kOk) {

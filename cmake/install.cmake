@@ -1,16 +1,18 @@
 # `cmake --install build [--prefix DIR]`: the oalservo executable in bin/, the example
 # configurations in share/oalservo/config/, and the libraries (base, detector, target, scene,
-# servo, robots) with their headers and a CMake package, so that another project can write
+# servo, robots, calibration, io, loop) with their headers and a CMake package, so that
+# another project can write
 #
 #   find_package(oalservo 0.1 REQUIRED)
-#   target_link_libraries(my_node PRIVATE oal::detector oal::servo)
+#   target_link_libraries(my_node PRIVATE oal::detector oal::servo oal::loop)
 #
-# and include "detector/tracker.h", "servo/pose.h", ... as this repository does. The app
-# library (files, YAML, command line) is the executable's own and is not installed.
+# and include "detector/tracker.h", "servo/pose.h", "loop/servo_loop.h", ... as this
+# repository does. The app library (YAML, command line) is the executable's own and is not
+# installed.
 include(CMakePackageConfigHelpers)
 
 set(OAL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/oalservo)
-foreach(folder base detector target scene servo robots)
+foreach(folder base detector target scene servo robots calibration io loop)
   set_target_properties(oal_${folder} PROPERTIES EXPORT_NAME ${folder})
   install(TARGETS oal_${folder} EXPORT oalservoTargets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -147,20 +147,34 @@ vpHomogeneousMatrix SafeRobot::BoxFramePose(RobotFrame frame,
   return wMx * robot_.eMc();                                              // wMc = wMe * eMc
 }
 
-RobotResult SafeRobot::CheckInBox(const vpHomogeneousMatrix& wMb, const std::string& what) const {
-  if (!options_.workspace_enabled) return RobotResult::Ok();
+int SafetyOptions::AxisOutsideWorkspace(const vpTranslationVector& p) const {
+  if (!workspace_enabled) return -1;
   for (unsigned i = 0; i < 3; ++i) {
-    const double p = wMb[i][3];
-    const double lo = options_.workspace_min_m[i];
-    const double hi = options_.workspace_max_m[i];
-    if (!(p >= lo && p <= hi)) {
-      std::ostringstream s;
-      s << what << " would take the " << ToString(options_.workspace_frame) << " to " << kBoxAxis[i]
-        << " = " << p << " m, outside the workspace box [" << lo << ", " << hi << "] m";
-      return RobotResult::Fail(RobotStatus::kWorkspace, s.str());
-    }
+    if (!(p[i] >= workspace_min_m[i] && p[i] <= workspace_max_m[i])) return static_cast<int>(i);
   }
-  return RobotResult::Ok();
+  return -1;
+}
+
+std::string SafetyOptions::OutsideWorkspace(const vpTranslationVector& p) const {
+  const int axis = AxisOutsideWorkspace(p);
+  if (axis < 0) return "";
+  const auto i = static_cast<std::size_t>(axis);
+  std::ostringstream s;
+  s << kBoxAxis[i] << " = " << p[static_cast<unsigned>(axis)] << " m is outside ["
+    << workspace_min_m[i] << ", " << workspace_max_m[i] << "] m";
+  return s.str();
+}
+
+RobotResult SafeRobot::CheckInBox(const vpHomogeneousMatrix& wMb, const std::string& what) const {
+  const vpTranslationVector p = wMb.getTranslationVector();
+  const int axis = options_.AxisOutsideWorkspace(p);
+  if (axis < 0) return RobotResult::Ok();
+  const auto i = static_cast<std::size_t>(axis);
+  std::ostringstream s;
+  s << what << " would take the " << ToString(options_.workspace_frame) << " to " << kBoxAxis[i]
+    << " = " << p[static_cast<unsigned>(axis)] << " m, outside the workspace box ["
+    << options_.workspace_min_m[i] << ", " << options_.workspace_max_m[i] << "] m";
+  return RobotResult::Fail(RobotStatus::kWorkspace, s.str());
 }
 
 RobotResult SafeRobot::CheckPathInBox(RobotFrame frame, const vpHomogeneousMatrix& from,

@@ -37,6 +37,7 @@
 
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
+#include <visp3/core/vpTranslationVector.h>
 
 #include <array>
 #include <atomic>
@@ -69,6 +70,12 @@ struct SafetyOptions {
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
+  /// The first axis (0 x, 1 y, 2 z) on which `p`, a position of workspace_frame in the world
+  /// frame, m, lies outside the workspace box; -1 when it is inside or the box is disabled.
+  int AxisOutsideWorkspace(const vpTranslationVector& p) const;
+  /// Why `p` lies outside the box, e.g. "z = 1.2 m is outside [0.1, 1] m"; "" when it is
+  /// inside or the box is disabled.
+  std::string OutsideWorkspace(const vpTranslationVector& p) const;
 };
 
 enum class SafeRobotState {

@@ -14,8 +14,8 @@
 
 #include "app/config.h"
 #include "app/scorbot_sim_command.h"
-#include "app/servo_loop.h"
 #include "app/servo_rig.h"
+#include "app/servo_run.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/scorbot_kinematics.h"
 #include "servo_test_util.h"

@@ -1,5 +1,6 @@
-// The servo loop with the simulated robot and camera in the loop (app/servo_loop.h), its
-// configuration sections and the built-in default (app/servo_command.h).
+// The servo loop with the simulated robot and camera in the loop (loop/servo_loop.h, run from a
+// configuration by app/servo_run.h), its configuration sections and the built-in default
+// (app/servo_command.h).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
@@ -22,7 +23,7 @@
 #include "app/config.h"
 #include "app/servo_command.h"
 #include "app/servo_default_config.h"
-#include "app/servo_loop.h"
+#include "app/servo_run.h"
 #include "robots/simulated_camera.h"
 #include "scene/scene.h"
 #include "servo_test_util.h"
@@ -366,20 +367,6 @@ TEST(ServoLoop, PointAndGoAndVelocityLawsConvergeToo) {
     }
     EXPECT_LT(report.iterations.back().true_translation_error_mm, 5.0) << ToString(mode);
   }
-}
-
-TEST(ServoLoopOptions, EachLawHasItsOwnIterationLimit) {
-  ServoLoopOptions loop;
-  loop.law.mode = ServoMode::kExponential;
-  EXPECT_EQ(loop.IterationLimit(false), 30);
-  loop.law.mode = ServoMode::kPointAndGo;
-  EXPECT_EQ(loop.IterationLimit(false), 30);
-  loop.law.mode = ServoMode::kVelocity;
-  EXPECT_EQ(loop.IterationLimit(false), 300);
-  EXPECT_GT(loop.IterationLimit(true), 1000000) << "a replay runs to its end";
-  loop.max_iterations = 7;
-  EXPECT_EQ(loop.IterationLimit(false), 7);
-  EXPECT_EQ(loop.IterationLimit(true), 7);
 }
 
 // The frame after a move disagrees with the odometry: the image slid by 40 px (~65 mm at 0.5 m).

@@ -1,4 +1,4 @@
-#include "app/servo_loop.h"
+#include "loop/servo_loop.h"
 
 #include <visp3/core/vpMath.h>
 #include <visp3/core/vpRotationMatrix.h>
@@ -11,19 +11,16 @@
 #include <iomanip>
 #include <limits>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
-#include "app/lens_estimate.h"  // LensMismatchWarning
-#include "app/servo_rig.h"
+#include "loop/lens_estimate.h"  // LensMismatchWarning
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
-#include "io/image_source.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"
@@ -37,7 +34,7 @@ namespace {
 // handler never sees a destroyed robot.
 class StopGuard {
  public:
-  StopGuard(SafeRobot& robot, const ServoRunHooks& hooks) : robot_(robot), hooks_(hooks) {
+  StopGuard(SafeRobot& robot, const ServoLoopHooks& hooks) : robot_(robot), hooks_(hooks) {
     if (!hooks_.on_robot) return;
     try {
       hooks_.on_robot(&robot_);
@@ -69,7 +66,7 @@ class StopGuard {
   }
 
   SafeRobot& robot_;
-  const ServoRunHooks& hooks_;
+  const ServoLoopHooks& hooks_;
   bool stopped_ = false;
 };
 
@@ -129,24 +126,14 @@ ServoRunStatus StatusOfRefusal(const RobotResult& result, const SafeRobot& robot
   return ServoRunStatus::kError;
 }
 
-// The configured robot, wrapped by the hooks' wrapper.
-RobotRig OpenRobot(const ServoAppConfig& config, std::function<void(int poll)> on_poll,
-                   const ServoRunHooks& hooks) {
-  RobotRig rig = OpenConfiguredRobot(config, std::move(on_poll));
-  if (hooks.wrap_driver) rig.driver = hooks.wrap_driver(std::move(rig.driver));
-  return rig;
-}
-
 // Why the loop ends, for the report.
 struct Stop {
   ServoRunStatus status;
   std::string message;
 };
 
-// The combinations of sections the loop cannot run, before anything moves.
-
 // Who asked for a stop, for "interrupted by ...".
-std::string InterruptedBy(const ServoRunHooks& hooks) {
+std::string InterruptedBy(const ServoLoopHooks& hooks) {
   return hooks.interrupt_reason ? hooks.interrupt_reason() : "Ctrl-C or a stop from the window";
 }
 
@@ -158,7 +145,7 @@ std::string Counted(int count, const std::string& noun) {
 // Step 1 (after the operator's stop): the time and the iteration limits. A recording that
 // ends where the iteration limit does was played to its end: end-of-input.
 std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int iteration,
-                                 std::chrono::steady_clock::time_point start, LoopCamera& frames) {
+                                 std::chrono::steady_clock::time_point start, FrameSource& frames) {
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (elapsed_s > loop.max_time_s) {
@@ -181,8 +168,8 @@ std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int it
 }
 
 // The frame of this iteration, of the camera's size; a stop when there is none.
-// `on_grab` (ServoRunHooks) sees the frame before it is checked.
-std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
+// `on_grab` (ServoLoopHooks) sees the frame before it is checked.
+std::optional<Stop> Grab(FrameSource& frames, int width, int height,
                          const vpHomogeneousMatrix& true_cMo, int iteration,
                          const std::function<void(int, cv::Mat*)>& on_grab, cv::Mat* gray) {
   bool have_frame = false;
@@ -202,28 +189,33 @@ std::optional<Stop> Grab(LoopCamera& frames, const CameraConfig& camera,
                                             std::to_string(iteration) + ": " + frames.Name() +
                                             " gave an empty frame"};
   }
-  if (gray->cols != camera.width || gray->rows != camera.height) {
+  if (gray->cols != width || gray->rows != height) {
     return Stop{ServoRunStatus::kError,
                 frames.Name() + " gives " + std::to_string(gray->cols) + "x" +
                     std::to_string(gray->rows) + " frames but camera.width x camera.height is " +
-                    std::to_string(camera.width) + "x" + std::to_string(camera.height)};
+                    std::to_string(width) + "x" + std::to_string(height)};
   }
   return std::nullopt;
 }
 
 // The table row of a camera pose: the Table 3 columns (the Scorbot's own X Y Z P R) and, in
 // simulation, the true error to the goal; the estimate's columns are filled in later.
-ServoIteration RowAt(const ServoAppConfig& config, const RobotRig& rig, int iteration,
+ServoIteration RowAt(const LoopRobot& robot, bool knows_truth, int iteration,
                      const vpHomogeneousMatrix& wMc, const vpHomogeneousMatrix& true_cMo,
                      const vpHomogeneousMatrix& cdMo) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   ServoIteration row;
   row.iteration = iteration;
-  const PoseColumns at = rig.columns(wMc);
+  PoseColumns at;
+  if (robot.columns) {
+    at = robot.columns(wMc);
+  } else {
+    Table3Columns(wMc, &at.x_mm, &at.y_mm, &at.z_mm, &at.pitch_deg, &at.roll_deg, &at.yaw_deg);
+  }
   row.x_mm = at.x_mm, row.y_mm = at.y_mm, row.z_mm = at.z_mm;
   row.pitch_deg = at.pitch_deg, row.roll_deg = at.roll_deg, row.yaw_deg = at.yaw_deg;
   row.true_translation_error_mm = row.true_rotation_error_deg = kNaN;
-  if (config.source.type == SourceType::kSimulated) {
+  if (knows_truth) {
     const PoseDistance truth = Distance(cdMo * true_cMo.inverse(), vpHomogeneousMatrix());
     row.true_translation_error_mm = truth.translation_m * 1e3;
     row.true_rotation_error_deg = vpMath::deg(truth.rotation_rad);
@@ -278,7 +270,7 @@ std::optional<Stop> PoseStop(const TargetFrame& tracked,
 // A motion that failed: refused before it began (`started` false: the robot did not move),
 // or stopped on its way.
 Stop RefusalStop(const RobotResult& moved, bool started, const SafeRobot& robot, int iteration,
-                 const ServoRunHooks& hooks) {
+                 const ServoLoopHooks& hooks) {
   const ServoRunStatus status = StatusOfRefusal(moved, robot);
   const std::string move = "the move of iteration " + std::to_string(iteration);
   if (status == ServoRunStatus::kInterrupted) {
@@ -324,7 +316,7 @@ void WarnIfOutsideWorkspace(SafeRobot& robot, std::ostream& log) {
   const SafetyOptions& safety = robot.options();
   const RobotPose at = robot.GetPosition(safety.workspace_frame);
   if (!at.result.ok()) return;  // the loop's first read reports it
-  const std::string why = OutsideWorkspace(safety, at.pose.getTranslationVector());
+  const std::string why = safety.OutsideWorkspace(at.pose.getTranslationVector());
   if (why.empty()) return;
   log << "oalservo servo: warning: the robot starts outside the workspace box: the "
       << ToString(safety.workspace_frame) << "'s " << why
@@ -384,95 +376,126 @@ void WriteServoCsv(const ServoRunReport& report, std::ostream& out) {
   }
 }
 
-vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
-  const std::string where = config.goal_image_origin + ": goal.image '" + config.goal_image + "'";
-  const cv::Mat gray = cv::imread(config.goal_image, cv::IMREAD_GRAYSCALE);
-  if (gray.empty()) throw std::runtime_error(where + ": cannot read or decode the image");
-  if (gray.cols != config.camera.width || gray.rows != config.camera.height) {
+
+int ServoLoopOptions::IterationLimit(bool replay) const {
+  if (max_iterations > 0) return max_iterations;
+  if (replay) return std::numeric_limits<int>::max();
+  return law.mode == ServoMode::kVelocity ? 300 : 30;
+}
+
+void ServoLoopOptions::Check() const {
+  law.Check();
+  RequireOption(max_iterations >= 0 && max_iterations <= 1000000, "ServoLoopOptions::max_iterations",
+                max_iterations, "0 <= max_iterations <= 1000000 (0: the law's own limit)");
+  RequireOption(max_time_s > 0.0 && std::isfinite(max_time_s), "ServoLoopOptions::max_time_s",
+                max_time_s, "max_time_s > 0");
+  RequireOption(max_pose_jump_m > 0.0 && std::isfinite(max_pose_jump_m),
+                "ServoLoopOptions::max_pose_jump_m", max_pose_jump_m, "max_pose_jump_m > 0");
+  RequireOption(max_pose_jump_deg > 0.0 && max_pose_jump_deg <= 180.0,
+                "ServoLoopOptions::max_pose_jump_deg", max_pose_jump_deg,
+                "0 < max_pose_jump_deg <= 180");
+  RequireOption(max_step_m > 0.0 && std::isfinite(max_step_m), "ServoLoopOptions::max_step_m",
+                max_step_m, "max_step_m > 0");
+  RequireOption(max_step_deg > 0.0 && max_step_deg <= 180.0, "ServoLoopOptions::max_step_deg",
+                max_step_deg, "0 < max_step_deg <= 180");
+}
+
+TargetPoseTracker MakeTracker(const ServoSetup& setup) {
+  // The tracker sets the camera, the undistortion and the image size from its own.
+  PoseOptions pose = setup.pose;
+  pose.compute_covariance = false;  // the loop does not use it
+  return TargetPoseTracker(setup.target, setup.camera, setup.detector, pose, setup.tracking);
+}
+
+vpHomogeneousMatrix TeachGoal(const ServoSetup& setup, const cv::Mat& gray,
+                              const std::string& where) {
+  if (gray.cols != setup.width || gray.rows != setup.height) {
     throw std::runtime_error(where + " is " + std::to_string(gray.cols) + "x" +
                              std::to_string(gray.rows) + " but camera.width x camera.height is " +
-                             std::to_string(config.camera.width) + "x" +
-                             std::to_string(config.camera.height));
+                             std::to_string(setup.width) + "x" + std::to_string(setup.height));
   }
-  TargetPoseTracker tracker = LoopModel(config).Tracker();
+  TargetPoseTracker tracker = MakeTracker(setup);
   const TargetFrame& found = tracker.Track(ViewOf(gray));
   if (found.status != TargetStatus::kOk) {
     const bool pose_failed = found.pose.status != PoseStatus::kOk;
-    throw std::runtime_error(where + ": no pose of target '" + config.target.name + "' in it: " +
+    throw std::runtime_error(where + ": no pose of target '" + setup.target.name + "' in it: " +
                              (pose_failed ? ToString(found.pose.status) : ToString(found.status)) +
                              (found.message.empty() ? "" : " (" + found.message + ")"));
   }
   return found.pose.cMo;
 }
 
-void CheckServoConfig(const ServoAppConfig& config) {
-  config.camera.Check();
-  config.robot.Check();
-  config.servo.Check();
-  config.source.Check();
-  if (config.source.type == SourceType::kV4l2 && config.robot.type == RobotType::kSimulated) {
-    throw std::invalid_argument(
-        "source.type v4l2 needs a real robot carrying the camera (robot.type is simulated, "
-        "whose motion the camera would not see); to watch a camera without moving anything use "
-        "source: {type: replay, path: " +
-        config.source.device + "}");
-  }
-  if (config.camera.estimate_distortion && !config.camera.correct_distortion) {
-    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
-                                " tells the lens to correct it, but camera.correct_distortion "
-                                "is false: give one of them");
-  }
-  if (config.camera.estimate_distortion && config.source.type != SourceType::kSimulated &&
-      config.camera.kdu != 0.0) {
-    throw std::invalid_argument(KeyAt(config, "camera.estimate_distortion") +
-                                " tells the lens from the stripes, but the camera gives kdu " +
-                                Number(config.camera.kdu) + " (" + KeyAt(config, "camera.kdu") +
-                                "): give one of them");
-  }
-  if (config.camera.true_eMc && config.source.type != SourceType::kSimulated) {
-    throw std::invalid_argument(KeyAt(config, "camera.true_eMc") +
-                                " is the mounting of a simulated camera; source.type is " +
-                                ToString(config.source.type) + ": remove it");
-  }
+RobotPose TrueCameraPose(SafeRobot& robot, const std::optional<vpHomogeneousMatrix>& true_eMc) {
+  if (!true_eMc) return robot.GetPosition(RobotFrame::kCamera);
+  RobotPose wMe = robot.GetPosition(RobotFrame::kEndEffector);
+  if (wMe.result.ok()) wMe.pose = wMe.pose * *true_eMc;
+  return wMe;
 }
 
-ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
-                        const ServoRunHooks& hooks) {
-  // Everything checked, and the goal taught, before the robot moves.
-  CheckServoConfig(config);
-  const bool velocity_law = config.servo.law.mode == ServoMode::kVelocity;
-  LoopModel model(config);
-  TargetPoseTracker tracker = model.Tracker();
-  std::vector<std::string> source_warnings;
-  const std::unique_ptr<LoopCamera> frames = OpenLoopCamera(config, &source_warnings);
-  for (const std::string& warning : source_warnings) log << "warning: " << warning << '\n';
-  const bool moves_robot = config.source.type != SourceType::kReplay;
+bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames,
+                 vpCameraParameters* camera, TargetPoseTracker* tracker, std::ostream& log,
+                 std::string* why) {
+  // The frames read, the robot still: their noise seeds apart from the loop's.
+  constexpr int kLensFrameIndex = 1000000;
+  cv::Mat gray;
+  int read = 0;
+  std::string pose_error;
+  const ToldLens told = TellLensFromStripes(*tracker, *camera, [&](GrayImageView* view) {
+    const RobotPose at = TrueCameraPose(robot, setup.true_eMc);
+    if (!at.result.ok()) {
+      pose_error = "the camera's pose cannot be read: " + at.result.message;
+      return false;
+    }
+    if (!frames.Grab(at.pose.inverse() * setup.wMo, kLensFrameIndex + read++, &gray)) {
+      return false;
+    }
+    *view = ViewOf(gray);
+    return true;
+  });
+  if (!told.lens) {
+    *why = pose_error.empty() ? told.why : pose_error;
+    return false;
+  }
+  const PlumbLineResult& lens = *told.lens;
+  *camera = WithLens(*camera, lens);
+  ServoSetup with_lens = setup;
+  with_lens.camera = *camera;
+  *tracker = MakeTracker(with_lens);
+  log << "lens told from the stripes of " << told.frames << " frames: kdu " << Fixed(lens.kdu, 4)
+      << " +- " << Fixed(lens.kdu_sd, 4) << " (kud " << Fixed(lens.kud, 4) << ")"
+      << " (they bent " << Fixed(lens.rms_before_px, 2) << " px RMS, "
+      << Fixed(lens.rms_after_px, 2) << " px corrected)\n";
+  return true;
+}
 
-  int move_iteration = -1;  // the iteration whose move runs, for Hooks::on_move_poll
-  const RobotRig rig = OpenRobot(
-      config,
-      [&hooks, &move_iteration](int poll) {
-        if (hooks.on_move_poll) hooks.on_move_poll(move_iteration, poll);
-      },
-      hooks);
+ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const LoopRobot& rig,
+                            std::ostream& log, const ServoLoopHooks& hooks) {
+  // Everything checked, and the goal taught, before the robot moves.
+  setup.loop.Check();
+  if (rig.driver == nullptr) throw std::invalid_argument("RunServoLoop: no robot driver");
+  const bool velocity_law = setup.loop.law.mode == ServoMode::kVelocity;
+  vpCameraParameters camera = setup.camera;
+  TargetPoseTracker tracker = MakeTracker(setup);
+  const bool moves_robot = !setup.open_loop;
   if (velocity_law && !rig.driver->Capabilities().velocity) {
     throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
                                 rig.driver->Name() +
                                 " takes position moves only: use exponential or point-and-go");
   }
-  SafeRobot robot(*rig.driver, config.robot.safety);
+  SafeRobot robot(*rig.driver, setup.safety);
 
   ServoRunReport report;
-  report.cdMo = config.goal_image.empty() ? config.goal_cdMo : TeachGoal(config);
-  if (!config.goal_image.empty()) {
+  const bool taught = !setup.goal_image.empty();
+  report.cdMo = taught ? TeachGoal(setup, setup.goal_image, setup.goal_image_name) : setup.cdMo;
+  if (taught) {
     const vpTranslationVector t = report.cdMo.getTranslationVector();
-    log << "goal taught from " << config.goal_image << ": target at (" << Fixed(t[0], 4) << ", "
-        << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
+    log << "goal taught from " << setup.goal_image_name << ": target at (" << Fixed(t[0], 4)
+        << ", " << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
   }
   if (!moves_robot) {
-    log << "replay of " << frames->Name() << ": open loop, the robot is not moved\n";
+    log << "replay of " << frames.Name() << ": open loop, the robot is not moved\n";
   }
-  const TableColumns columns{rig.has_yaw, config.source.type == SourceType::kSimulated};
+  const TableColumns columns{rig.has_yaw, frames.KnowsTruth()};
   std::optional<StopGuard> guard;  // from Connect() on
   bool moved_since_row = false;    // a motion was commanded after it
   auto finish = [&](Stop stop) {
@@ -483,13 +506,13 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (!report.iterations.empty()) report.iterations.back().status = ToString(stop.status);
     if (guard) {
       // Where the robot stopped: after a move since the last frame, one more row says so.
-      const RobotPose where = TrueCameraPose(robot, config);
+      const RobotPose where = TrueCameraPose(robot, setup.true_eMc);
       if (where.result.ok()) {
         report.final_wMc = where.pose;
         if (moved_since_row && !report.iterations.empty()) {
           ServoIteration row =
-              RowAt(config, rig, report.iterations.back().iteration + 1, where.pose,
-                    where.pose.inverse() * config.target_wMo, report.cdMo);
+              RowAt(rig, columns.truth, report.iterations.back().iteration + 1, where.pose,
+                    where.pose.inverse() * setup.wMo, report.cdMo);
           row.status = "stopped";
           LogRow(row, columns, log);
           report.iterations.push_back(row);
@@ -514,13 +537,13 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
   report.started = true;
   if (hooks.on_started) hooks.on_started();
 
-  if (config.camera.estimate_distortion) {
+  if (setup.estimate_distortion) {
     std::string why;
-    if (!TellTheLens(config, robot, *frames, &model, &tracker, log, &why)) {
+    if (!TellTheLens(setup, robot, frames, &camera, &tracker, log, &why)) {
       return finish({ServoRunStatus::kError, "cannot tell the lens: " + why});
     }
   }
-  const ServoLoopOptions& loop = config.servo;
+  const ServoLoopOptions& loop = setup.loop;
   const auto start = std::chrono::steady_clock::now();
   const int iteration_limit = loop.IterationLimit(!moves_robot);
   std::optional<vpHomogeneousMatrix> previous_cMo;
@@ -545,22 +568,22 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
                                                        " after " + std::to_string(iteration) +
                                                        " iterations"});
     }
-    if (std::optional<Stop> stop = LimitReached(loop, iteration_limit, iteration, start, *frames)) {
+    if (std::optional<Stop> stop = LimitReached(loop, iteration_limit, iteration, start, frames)) {
       return finish(*stop);
     }
 
-    const RobotPose read = TrueCameraPose(robot, config);
+    const RobotPose read = TrueCameraPose(robot, setup.true_eMc);
     if (!read.result.ok()) {
       return finish(
           {ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message});
     }
     const vpHomogeneousMatrix wMc = read.pose;
-    const vpHomogeneousMatrix true_cMo = wMc.inverse() * config.target_wMo;
-    if (std::optional<Stop> stop =
-            Grab(*frames, config.camera, true_cMo, iteration, hooks.on_grab, &gray)) {
+    const vpHomogeneousMatrix true_cMo = wMc.inverse() * setup.wMo;
+    if (std::optional<Stop> stop = Grab(frames, setup.width, setup.height, true_cMo, iteration,
+                                        hooks.on_grab, &gray)) {
       return finish(*stop);
     }
-    report.iterations.push_back(RowAt(config, rig, iteration, wMc, true_cMo, report.cdMo));
+    report.iterations.push_back(RowAt(rig, columns.truth, iteration, wMc, true_cMo, report.cdMo));
     moved_since_row = false;
     ServoIteration& current = report.iterations.back();
 
@@ -599,8 +622,8 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
       if (step->status == ServoStatus::kConverged) current.status = "converged";
     }
     if (hooks.on_frame) {
-      hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, model.camera,
-                                config.target, report.cdMo, tracker.detector().Undistorts()});
+      hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, camera,
+                                setup.target, report.cdMo, tracker.detector().Undistorts()});
     }
     std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);
@@ -629,7 +652,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     // Only a motion the robot began counts as a move: a velocity cycle it took, a position
     // move it was polled in (a refusal before StartMove leaves the robot where it was).
     moved_since_row = true;
-    move_iteration = iteration;
+    if (hooks.on_move) hooks.on_move(iteration);
     RobotResult moved;
     bool started = false;
     if (velocity_law) {

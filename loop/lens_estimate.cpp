@@ -1,4 +1,4 @@
-#include "app/lens_estimate.h"
+#include "loop/lens_estimate.h"
 
 #include <stdexcept>
 #include <utility>

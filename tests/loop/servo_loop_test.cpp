@@ -1,0 +1,160 @@
+// The servo loop as a library: a setup of plain values, frames rendered in the loop or read
+// from files, the simulated camera as the robot; no configuration file, no command line.
+#include "loop/servo_loop.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "io/image_source.h"
+#include "loop/frame_source.h"
+#include "robots/simulated_camera.h"
+#include "scene/scene.h"
+#include "tests/test_util.h"
+
+namespace oal {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The A3 sheet at the world's origin, the goal 0.5 m in front of it, the start 0.6 m away,
+// a little to the side and turned.
+ServoSetup SheetSetup(ServoMode mode) {
+  ServoSetup setup;
+  setup.target = FourLineA3Target();
+  const RenderOptions render;
+  setup.camera = render.camera;
+  setup.width = render.width;
+  setup.height = render.height;
+  setup.loop.law.mode = mode;
+  setup.cdMo = vpHomogeneousMatrix(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);
+  return setup;
+}
+
+const vpHomogeneousMatrix kStartcMo(0.03, -0.02, 0.6, vpMath::rad(4.0), vpMath::rad(-3.0),
+                                    vpMath::rad(25.0));
+
+SimulatedCameraOptions StartingAt(const vpHomogeneousMatrix& cMo, const vpHomogeneousMatrix& wMo) {
+  SimulatedCameraOptions options;
+  options.wMc = wMo * cMo.inverse();
+  return options;
+}
+
+TEST(ServoLoopOptions, EachLawHasItsOwnIterationLimit) {
+  ServoLoopOptions loop;
+  loop.law.mode = ServoMode::kExponential;
+  EXPECT_EQ(loop.IterationLimit(false), 30);
+  loop.law.mode = ServoMode::kPointAndGo;
+  EXPECT_EQ(loop.IterationLimit(false), 30);
+  loop.law.mode = ServoMode::kVelocity;
+  EXPECT_EQ(loop.IterationLimit(false), 300);
+  EXPECT_GT(loop.IterationLimit(true), 1000000) << "a replay runs to its end";
+  loop.max_iterations = 7;
+  EXPECT_EQ(loop.IterationLimit(false), 7);
+  EXPECT_EQ(loop.IterationLimit(true), 7);
+}
+
+TEST(ServoLoopOptions, CheckNamesTheField) {
+  ServoLoopOptions loop;
+  loop.max_step_deg = 200.0;
+  try {
+    loop.Check();
+    FAIL() << "max_step_deg 200 accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("ServoLoopOptions::max_step_deg = 200"));
+  }
+}
+
+TEST(RunServoLoop, EachPositionLawReachesTheGoalOnTheRenderedSheet) {
+  for (const ServoMode mode : {ServoMode::kPointAndGo, ServoMode::kExponential}) {
+    const ServoSetup setup = SheetSetup(mode);
+    SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+    RenderedFrames frames(setup.target, RenderOptions());
+    std::ostringstream log;
+    const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+    ASSERT_EQ(report.status, ServoRunStatus::kConverged) << ToString(mode) << ": " << report.message;
+    EXPECT_TRUE(report.robot_stopped);
+    EXPECT_TRUE(report.started);
+    // The truth: where the camera really is against the goal.
+    const vpHomogeneousMatrix true_cMo = report.final_wMc.inverse() * setup.wMo;
+    const vpHomogeneousMatrix error = setup.cdMo * true_cMo.inverse();
+    EXPECT_LT(error.getTranslationVector().frobeniusNorm(), 2e-3) << ToString(mode);
+    // The rendered frames know the truth: the table shows it.
+    EXPECT_THAT(log.str(), HasSubstr("true mm"));
+    EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
+  }
+}
+
+TEST(RunServoLoop, ATargetOutOfViewStopsTheRunAndTheRobotNeverMoves) {
+  const ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
+  // Looking away: the sheet 0.8 m to the side, out of the view.
+  const SimulatedCameraOptions away =
+      StartingAt(vpHomogeneousMatrix(0.8, 0.0, 0.6, 0.0, 0.0, 0.0), setup.wMo);
+  SimulatedCamera robot(away);
+  const vpHomogeneousMatrix start = away.wMc;
+  RenderedFrames frames(setup.target, RenderOptions());
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 0"));
+  EXPECT_EQ(report.moves, 0);
+  const vpHomogeneousMatrix end = robot.GetPosition(RobotFrame::kCamera).pose;
+  EXPECT_LT((end.getTranslationVector() - start.getTranslationVector()).frobeniusNorm(), 1e-12);
+}
+
+TEST(RunServoLoop, AnOpenLoopReplayComputesTheLawAndNeverMovesTheRobot) {
+  const test::TestDir dir;
+  const ServoSetup goal_setup = SheetSetup(ServoMode::kPointAndGo);
+  SceneRenderer renderer(goal_setup.target, RenderOptions());
+  for (int k = 0; k < 3; ++k) {
+    const RenderedFrame frame = renderer.Render(kStartcMo, 10 + static_cast<std::uint64_t>(k));
+    const cv::Mat gray(static_cast<int>(frame.image.getHeight()),
+                       static_cast<int>(frame.image.getWidth()), CV_8UC1, frame.image.bitmap);
+    ASSERT_TRUE(cv::imwrite(dir / ("frame_000" + std::to_string(k) + ".png"), gray));
+  }
+  ServoSetup setup = goal_setup;
+  setup.open_loop = true;
+  SimulatedCamera robot;
+  RecordedFrames frames(OpenImageSource(dir.path().string()));
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kEndOfInput) << report.message;
+  EXPECT_EQ(report.moves, 0);
+  ASSERT_EQ(report.iterations.size(), 3u);
+  for (const ServoIteration& row : report.iterations) {
+    // The law saw the pose: 0.1 m and 25 deg from the goal; the truth is not known.
+    EXPECT_NEAR(row.translation_error_mm, 1e3 * (setup.cdMo * kStartcMo.inverse())
+                                                     .getTranslationVector()
+                                                     .frobeniusNorm(),
+                1.0);
+    EXPECT_TRUE(std::isnan(row.true_translation_error_mm));
+  }
+  EXPECT_THAT(log.str(), HasSubstr("open loop, the robot is not moved"));
+  EXPECT_THAT(log.str(), ::testing::Not(HasSubstr("true mm")));
+}
+
+TEST(RecordedFrames, AnUnreadableFrameIsReportedWhereItIsTakenNotAsTheEnd) {
+  const test::TestDir dir;
+  const cv::Mat grey(48, 64, CV_8UC1, cv::Scalar(128));
+  ASSERT_TRUE(cv::imwrite(dir / "frame_0000.png", grey));
+  {
+    std::ofstream broken(dir / "frame_0001.png");
+    broken << "not a PNG";
+  }
+  RecordedFrames frames(OpenImageSource(dir.path().string()));
+  cv::Mat gray;
+  ASSERT_TRUE(frames.Grab(vpHomogeneousMatrix(), 0, &gray));
+  EXPECT_EQ(gray.cols, 64);
+  EXPECT_FALSE(frames.AtEnd()) << "an unreadable frame is not the end";
+  EXPECT_THROW(frames.Grab(vpHomogeneousMatrix(), 1, &gray), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace oal
