@@ -740,6 +740,31 @@ std::optional<CameraFile> CameraFor(const RunContext& run, const PlannedInput& i
 // 2 x `capacity` frames are kept: at that, every other one is dropped and from then on only
 // every second frame recorded (then every fourth...), so a long input's plots cost bounded
 // memory; frames.jsonl keeps every frame.
+// A frame's status; its number is what the report's status plot draws.
+enum class FrameStatus : int {
+  kUnreadable = -1,
+  kLost = 0,      ///< no line held
+  kPartial = 1,   ///< some lines held, fewer than the target's
+  kDetected = 2,  ///< the target's lines held, no pose
+  kPose = 3,      ///< a pose
+};
+
+std::string ToString(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::kUnreadable:
+      return "unreadable";
+    case FrameStatus::kLost:
+      return "lost";
+    case FrameStatus::kPartial:
+      return "partial";
+    case FrameStatus::kDetected:
+      return "detected";
+    case FrameStatus::kPose:
+      return "pose";
+  }
+  return "unreadable";
+}
+
 struct Series {
   struct Track {
     int id = 0;
@@ -751,7 +776,7 @@ struct Series {
   };
   struct Row {
     int frame = 0;
-    int status = -1;
+    FrameStatus status = FrameStatus::kUnreadable;
     std::optional<double> held, pose_ok, pose_t_mm, pose_r_deg;
     double decode_us = 0;
     std::optional<double> track_us, pose_us;
@@ -820,7 +845,7 @@ struct Series {
       };
     };
     return Json{{"frame", Column([](const Row& r) { return Json(r.frame); })},
-                {"status", Column([](const Row& r) { return Json(r.status); })},
+                {"status", Column([](const Row& r) { return Json(static_cast<int>(r.status)); })},
                 {"held", Column([](const Row& r) { return Optional(r.held); })},
                 {"pose_ok", Column([](const Row& r) { return Optional(r.pose_ok); })},
                 {"rho", Keyed(tracks, track_value(&Track::rho_px))},
@@ -836,9 +861,6 @@ struct Series {
                 {"pose_us", Column([](const Row& r) { return Optional(r.pose_us); })}};
   }
 };
-
-// Frame status: 3 pose ok, 2 target detected (no pose), 1 some lines, 0 none, -1 unreadable.
-const char* kStatusNames[] = {"unreadable", "lost", "partial", "detected", "pose"};
 
 Json TrackJson(const TrackedLine& track) {
   return Json{{"id", track.id},
@@ -873,6 +895,59 @@ struct PoseJump {
   double rotation_deg = 0.0, translation_mm = 0.0;
   bool relabelled = false;  ///< the same four tracks, identified as other target lines
 };
+
+// What a frame's thumbnail is chosen by.
+struct FrameJudgement {
+  FrameStatus status = FrameStatus::kLost;
+  std::size_t held = 0;              ///< lines held
+  const PoseResult* pose = nullptr;  ///< none without a camera
+  std::optional<PoseJump> jump;
+  int missed = 0;                                       ///< truth lines not found
+  double worst_offset_px = 0.0;                         ///< of the truth lines found
+  std::optional<std::pair<double, double>> pose_error;  ///< mm, deg
+  bool truth_known = false;
+};
+
+// How bad a frame is, for the thumbnails (lost > partial > pose jump > no pose > truth
+// errors), and why, in words.
+void Judge(const FrameJudgement& frame, double* badness, std::string* why_text) {
+  std::ostringstream why;
+  *badness = 0.0;
+  if (frame.status == FrameStatus::kLost || frame.status == FrameStatus::kPartial) {
+    const bool lost = frame.status == FrameStatus::kLost;
+    *badness += lost ? 1000.0 : 500.0;
+    why << (lost ? "no line held" : std::to_string(frame.held) + " lines held") << "; ";
+  }
+  const bool pose_ok = frame.pose != nullptr && frame.pose->status == PoseStatus::kOk;
+  if (frame.pose != nullptr && !pose_ok) {
+    *badness += 100.0;
+    why << "pose " << ToString(frame.pose->status) << "; ";
+  }
+  if (frame.jump) {
+    *badness += 200.0;
+    why << "pose jumped " << std::round(frame.jump->rotation_deg * 10.0) / 10.0
+        << " deg from frame " << frame.jump->from_frame
+        << (frame.jump->relabelled ? " (lines relabelled)" : "") << "; ";
+  }
+  if (frame.missed > 0) {
+    *badness += 50.0 * frame.missed;
+    why << frame.missed << " truth line(s) missed; ";
+  }
+  if (frame.worst_offset_px > 0.0) {
+    *badness += frame.worst_offset_px;
+    why << "line offset " << std::round(frame.worst_offset_px * 100.0) / 100.0 << " px; ";
+  }
+  if (frame.pose_error) {
+    *badness += frame.pose_error->first / 10.0 + frame.pose_error->second;
+    why << "pose error " << std::round(frame.pose_error->first * 10.0) / 10.0 << " mm, "
+        << std::round(frame.pose_error->second * 100.0) / 100.0 << " deg; ";
+  } else if (pose_ok && !frame.truth_known) {
+    *badness += frame.pose->residual_px;
+    why << "residual " << std::round(frame.pose->residual_px * 100.0) / 100.0 << " px; ";
+  }
+  *why_text = why.str();
+  if (why_text->size() >= 2) why_text->resize(why_text->size() - 2);
+}
 
 std::optional<PoseJump> JumpFrom(const std::optional<TrustedPose>& trusted, int frame,
                                  const vpHomogeneousMatrix& cMo, const std::array<int, 4>& tracks) {
@@ -1068,7 +1143,7 @@ class InputEvaluation {
     WriteJsonLine(frames,
                   Json{{"frame", frame.index},
                        {"source", frame.source},
-                       {"status", "unreadable"},
+                       {"status", ToString(FrameStatus::kUnreadable)},
                        {"error", frame.error}},
                   false);
     WriteJsonLine(timing, Json{{"frame", frame.index}, {"decode_us", frame.decode_us}}, false);
@@ -1118,6 +1193,100 @@ class InputEvaluation {
     return pose;
   }
 
+  // A frame's lines and pose against its truth, counted in the tally; the lines' errors also
+  // into `plotted`.
+  struct TruthComparison {
+    Json json;  ///< null when the frame has no truth
+    double worst_offset_px = 0.0;
+    int missed = 0;
+    std::optional<std::pair<double, double>> pose_error;  ///< mm, deg
+  };
+  TruthComparison CompareWithTruth(const FrameTruth& truth, const TrackedFrame& out, bool pose_ok,
+                                   std::vector<Series::TruthLine>* plotted) {
+    TruthComparison result;
+    if (!truth.known) return result;
+    ++tally_.truth_frames;
+    Json lines = Json::array();
+    for (const LineError& e :
+         MatchTruth(truth.lines, out.held, out.ids, undistorter_, truth_.kind() == "json")) {
+      const bool found = e.track >= 0;
+      ++tally_.truth_lines;
+      tally_.found_lines += found;
+      result.missed += !found;
+      if (found) {
+        tally_.angle_deg.push_back(e.angle_deg);
+        tally_.offset_px.push_back(e.offset_px);
+        result.worst_offset_px = std::max(result.worst_offset_px, e.offset_px);
+      }
+      lines.push_back(Json{{"line", e.line},
+                           {"track", e.track},
+                           {"angle_deg", found ? Json(e.angle_deg) : Json()},
+                           {"offset_px", found ? Json(e.offset_px) : Json()}});
+      Series::TruthLine line;
+      line.line = e.line;
+      if (found) line.offset_px = e.offset_px, line.angle_deg = e.angle_deg;
+      plotted->push_back(line);
+    }
+    Json pose_error_json;
+    if (pose_ok && truth.cMo) {
+      result.pose_error = PoseError(out.pose->cMo, *truth.cMo);
+      ++tally_.pose_truth_frames;
+      tally_.pose_t_mm.push_back(result.pose_error->first);
+      tally_.pose_r_deg.push_back(result.pose_error->second);
+      pose_error_json = Json{{"translation_mm", result.pose_error->first},
+                             {"rotation_deg", result.pose_error->second}};
+    }
+    result.json = Json{{"lines", std::move(lines)}, {"pose", std::move(pose_error_json)}};
+    return result;
+  }
+
+  // The frame's pose from the lines held (or the target tracker's), checked for a jump from
+  // the last trusted pose, counted; its JSON.
+  Json PoseOfFrame(const vpImage<unsigned char>& image, int index, const PoseOptions& pose_options,
+                   TrackedFrame* out, std::optional<PoseJump>* jump) {
+    // The last trusted pose (ok, no jump) of at most kJumpFrames before seeds the pose: the
+    // previous frame's, or across frames without one the one before them; it holds the
+    // identity of lines 1-4 (PoseOptions::previous_max_deg). A pose turned by 180 degrees
+    // never becomes the seed.
+    std::optional<vpHomogeneousMatrix> seed;
+    if (trusted_ && index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
+    out->pose = target_tracker_ ? TargetPose(image, out->held)
+                                : EstimatePose(out->held, run_.config.target, pose_options, seed);
+    if (out->pose->status == PoseStatus::kOk) {
+      const std::array<int, 4> identified = IdentifiedTracks(*out->pose, out->ids);
+      *jump = JumpFrom(trusted_, index, out->pose->cMo, identified);
+      if (*jump) {
+        ++tally_.pose_jumps;
+        if (tally_.jump_frames.size() < kListedJumps) tally_.jump_frames.push_back(index);
+      } else {
+        trusted_ = TrustedPose{index, out->pose->cMo, identified};
+      }
+    }
+    const std::optional<double> straightness =
+        target_tracker_ ? std::optional<double>(straightness_px_) : std::nullopt;
+    if (straightness && out->pose->status == PoseStatus::kOk) {
+      tally_.straightness_px.push_back(*straightness);
+    }
+    return PoseFrameJson(*out->pose, out->ids, *jump, straightness);
+  }
+
+  // A readable frame in the tally: detected, posed, and the episodes of loss.
+  void CountFrame(bool detected, bool pose_ok, const std::optional<PoseResult>& pose) {
+    ++tally_.frames;
+    ++tally_.readable;
+    tally_.detected += detected;
+    tally_.pose_ok += pose_ok;
+    if (pose) ++tally_.pose_status[ToString(pose->status)];
+    if (detected) {
+      tally_.ever_detected = true;
+      tally_.current_lost = 0;
+    } else if (tally_.ever_detected) {
+      if (tally_.was_detected) ++tally_.lost_episodes;
+      tally_.longest_lost = std::max(tally_.longest_lost, ++tally_.current_lost);
+    }
+    tally_.was_detected = detected;
+  }
+
   TrackedFrame Process(DecodedFrame& frame, OalLineTracker* tracker, PoseOptions pose_options,
                        std::ostream& frames, std::ostream& timing, SampleStats* track_times,
                        SampleStats* pose_times) {
@@ -1156,30 +1325,7 @@ class InputEvaluation {
     if (camera_) {
       pose_options.image_width = w;
       pose_options.image_height = h;
-      // The last trusted pose (ok, no jump) of at most kJumpFrames before seeds the pose: the
-      // previous frame's, or across frames without one the one before them; it holds the
-      // identity of lines 1-4 (PoseOptions::previous_max_deg). A pose turned by 180 degrees
-      // never becomes the seed.
-      std::optional<vpHomogeneousMatrix> seed;
-      if (trusted_ && frame.index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
-      out.pose = target_tracker_ ? TargetPose(image, out.held)
-                                 : EstimatePose(out.held, run_.config.target, pose_options, seed);
-      if (out.pose->status == PoseStatus::kOk) {
-        const std::array<int, 4> identified = IdentifiedTracks(*out.pose, out.ids);
-        jump = JumpFrom(trusted_, frame.index, out.pose->cMo, identified);
-        if (jump) {
-          ++tally_.pose_jumps;
-          if (tally_.jump_frames.size() < kListedJumps) tally_.jump_frames.push_back(frame.index);
-        } else {
-          trusted_ = TrustedPose{frame.index, out.pose->cMo, identified};
-        }
-      }
-      const std::optional<double> straightness =
-          target_tracker_ ? std::optional<double>(straightness_px_) : std::nullopt;
-      if (straightness && out.pose->status == PoseStatus::kOk) {
-        tally_.straightness_px.push_back(*straightness);
-      }
-      pose_json = PoseFrameJson(*out.pose, out.ids, jump, straightness);
+      pose_json = PoseOfFrame(image, frame.index, pose_options, &out, &jump);
     }
     const Clock::time_point t3 = Clock::now();
     const double track_us = Us(t1 - t0), pose_us = Us(t3 - t2);
@@ -1189,107 +1335,39 @@ class InputEvaluation {
     // Status and counters.
     const bool pose_ok = out.pose && out.pose->status == PoseStatus::kOk;
     const bool detected = held.size() >= run_.target_lines;
-    const int status = pose_ok ? 3 : detected ? 2 : held.empty() ? 0 : 1;
-    ++tally_.frames;
-    ++tally_.readable;
-    tally_.detected += detected;
-    tally_.pose_ok += pose_ok;
-    if (out.pose) ++tally_.pose_status[ToString(out.pose->status)];
-    if (detected) {
-      tally_.ever_detected = true;
-      tally_.current_lost = 0;
-    } else if (tally_.ever_detected) {
-      if (tally_.was_detected) ++tally_.lost_episodes;
-      tally_.longest_lost = std::max(tally_.longest_lost, ++tally_.current_lost);
-    }
-    tally_.was_detected = detected;
+    const FrameStatus status = pose_ok        ? FrameStatus::kPose
+                               : detected     ? FrameStatus::kDetected
+                               : held.empty() ? FrameStatus::kLost
+                                              : FrameStatus::kPartial;
+    CountFrame(detected, pose_ok, out.pose);
 
-    // Truth.
     const FrameTruth truth = truth_.Get(frame.source, frame.index, w, h);
-    Json truth_json;
-    double worst_offset = 0.0;
-    int missed = 0;
-    std::optional<std::pair<double, double>> pose_error;
     Series::Row row;
-    if (truth.known) {
-      ++tally_.truth_frames;
-      Json lines = Json::array();
-      for (const LineError& e :
-           MatchTruth(truth.lines, out.held, out.ids, undistorter_, truth_.kind() == "json")) {
-        const bool found = e.track >= 0;
-        ++tally_.truth_lines;
-        tally_.found_lines += found;
-        missed += !found;
-        if (found) {
-          tally_.angle_deg.push_back(e.angle_deg);
-          tally_.offset_px.push_back(e.offset_px);
-          worst_offset = std::max(worst_offset, e.offset_px);
-        }
-        lines.push_back(Json{{"line", e.line},
-                             {"track", e.track},
-                             {"angle_deg", found ? Json(e.angle_deg) : Json()},
-                             {"offset_px", found ? Json(e.offset_px) : Json()}});
-        Series::TruthLine plotted;
-        plotted.line = e.line;
-        if (found) plotted.offset_px = e.offset_px, plotted.angle_deg = e.angle_deg;
-        row.truth.push_back(plotted);
-      }
-      Json pose_error_json;
-      if (pose_ok && truth.cMo) {
-        pose_error = PoseError(out.pose->cMo, *truth.cMo);
-        ++tally_.pose_truth_frames;
-        tally_.pose_t_mm.push_back(pose_error->first);
-        tally_.pose_r_deg.push_back(pose_error->second);
-        pose_error_json =
-            Json{{"translation_mm", pose_error->first}, {"rotation_deg", pose_error->second}};
-      }
-      truth_json = Json{{"lines", std::move(lines)}, {"pose", std::move(pose_error_json)}};
-    }
+    const TruthComparison compared = CompareWithTruth(truth, out, pose_ok, &row.truth);
+    const Json& truth_json = compared.json;
+    const double worst_offset = compared.worst_offset_px;
+    const int missed = compared.missed;
+    const std::optional<std::pair<double, double>>& pose_error = compared.pose_error;
 
-    // How bad the frame is, for the thumbnails: lost > partial > pose jump > no pose > truth
-    // errors.
-    std::ostringstream why;
-    out.badness = 0.0;
-    if (status <= 1) {
-      out.badness += status == 0 ? 1000.0 : 500.0;
-      why << (status == 0 ? "no line held" : std::to_string(held.size()) + " lines held") << "; ";
-    }
-    if (camera_ && !pose_ok) {
-      out.badness += 100.0;
-      why << "pose " << ToString(out.pose->status) << "; ";
-    }
-    if (jump) {
-      out.badness += 200.0;
-      why << "pose jumped " << std::round(jump->rotation_deg * 10.0) / 10.0 << " deg from frame "
-          << jump->from_frame << (jump->relabelled ? " (lines relabelled)" : "") << "; ";
-    }
-    if (missed > 0) {
-      out.badness += 50.0 * missed;
-      why << missed << " truth line(s) missed; ";
-    }
-    if (worst_offset > 0.0) {
-      out.badness += worst_offset;
-      why << "line offset " << std::round(worst_offset * 100.0) / 100.0 << " px; ";
-    }
-    if (pose_error) {
-      out.badness += pose_error->first / 10.0 + pose_error->second;
-      why << "pose error " << std::round(pose_error->first * 10.0) / 10.0 << " mm, "
-          << std::round(pose_error->second * 100.0) / 100.0 << " deg; ";
-    } else if (pose_ok && !truth.known) {
-      out.badness += out.pose->residual_px;
-      why << "residual " << std::round(out.pose->residual_px * 100.0) / 100.0 << " px; ";
-    }
-    out.why = why.str();
-    if (out.why.size() >= 2) out.why.resize(out.why.size() - 2);
+    FrameJudgement judgement;
+    judgement.status = status;
+    judgement.held = held.size();
+    judgement.pose = camera_ ? &*out.pose : nullptr;
+    judgement.jump = jump;
+    judgement.missed = missed;
+    judgement.worst_offset_px = worst_offset;
+    judgement.pose_error = pose_error;
+    judgement.truth_known = truth.known;
+    Judge(judgement, &out.badness, &out.why);
 
     WriteJsonLine(frames,
                   Json{{"frame", frame.index},
                        {"source", frame.source},
-                       {"status", kStatusNames[status + 1]},
+                       {"status", ToString(status)},
                        {"held", held.size()},
                        {"tracks", std::move(tracks)},
                        {"pose", std::move(pose_json)},
-                       {"truth", std::move(truth_json)}},
+                       {"truth", truth_json}},
                   false);
     WriteJsonLine(timing,
                   Json{{"frame", frame.index},

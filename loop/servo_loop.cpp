@@ -17,10 +17,10 @@
 #include <utility>
 #include <vector>
 
-#include "loop/lens_estimate.h"  // LensMismatchWarning
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
+#include "loop/lens_estimate.h"  // LensMismatchWarning
 #include "scene/scene.h"
 #include "servo/pbvs.h"
 #include "servo/pose.h"
@@ -190,10 +190,10 @@ std::optional<Stop> Grab(FrameSource& frames, int width, int height,
                                             " gave an empty frame"};
   }
   if (gray->cols != width || gray->rows != height) {
-    return Stop{ServoRunStatus::kError,
-                frames.Name() + " gives " + std::to_string(gray->cols) + "x" +
-                    std::to_string(gray->rows) + " frames but camera.width x camera.height is " +
-                    std::to_string(width) + "x" + std::to_string(height)};
+    return Stop{ServoRunStatus::kError, frames.Name() + " gives " + std::to_string(gray->cols) +
+                                            "x" + std::to_string(gray->rows) +
+                                            " frames but camera.width x camera.height is " +
+                                            std::to_string(width) + "x" + std::to_string(height)};
   }
   return std::nullopt;
 }
@@ -376,7 +376,6 @@ void WriteServoCsv(const ServoRunReport& report, std::ostream& out) {
   }
 }
 
-
 int ServoLoopOptions::IterationLimit(bool replay) const {
   if (max_iterations > 0) return max_iterations;
   if (replay) return std::numeric_limits<int>::max();
@@ -385,8 +384,9 @@ int ServoLoopOptions::IterationLimit(bool replay) const {
 
 void ServoLoopOptions::Check() const {
   law.Check();
-  RequireOption(max_iterations >= 0 && max_iterations <= 1000000, "ServoLoopOptions::max_iterations",
-                max_iterations, "0 <= max_iterations <= 1000000 (0: the law's own limit)");
+  RequireOption(max_iterations >= 0 && max_iterations <= 1000000,
+                "ServoLoopOptions::max_iterations", max_iterations,
+                "0 <= max_iterations <= 1000000 (0: the law's own limit)");
   RequireOption(max_time_s > 0.0 && std::isfinite(max_time_s), "ServoLoopOptions::max_time_s",
                 max_time_s, "max_time_s > 0");
   RequireOption(max_pose_jump_m > 0.0 && std::isfinite(max_pose_jump_m),
@@ -489,8 +489,8 @@ ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const 
   report.cdMo = taught ? TeachGoal(setup, setup.goal_image, setup.goal_image_name) : setup.cdMo;
   if (taught) {
     const vpTranslationVector t = report.cdMo.getTranslationVector();
-    log << "goal taught from " << setup.goal_image_name << ": target at (" << Fixed(t[0], 4)
-        << ", " << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
+    log << "goal taught from " << setup.goal_image_name << ": target at (" << Fixed(t[0], 4) << ", "
+        << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
   }
   if (!moves_robot) {
     log << "replay of " << frames.Name() << ": open loop, the robot is not moved\n";
@@ -510,9 +510,8 @@ ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const 
       if (where.result.ok()) {
         report.final_wMc = where.pose;
         if (moved_since_row && !report.iterations.empty()) {
-          ServoIteration row =
-              RowAt(rig, columns.truth, report.iterations.back().iteration + 1, where.pose,
-                    where.pose.inverse() * setup.wMo, report.cdMo);
+          ServoIteration row = RowAt(rig, columns.truth, report.iterations.back().iteration + 1,
+                                     where.pose, where.pose.inverse() * setup.wMo, report.cdMo);
           row.status = "stopped";
           LogRow(row, columns, log);
           report.iterations.push_back(row);
@@ -579,8 +578,8 @@ ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const 
     }
     const vpHomogeneousMatrix wMc = read.pose;
     const vpHomogeneousMatrix true_cMo = wMc.inverse() * setup.wMo;
-    if (std::optional<Stop> stop = Grab(frames, setup.width, setup.height, true_cMo, iteration,
-                                        hooks.on_grab, &gray)) {
+    if (std::optional<Stop> stop =
+            Grab(frames, setup.width, setup.height, true_cMo, iteration, hooks.on_grab, &gray)) {
       return finish(*stop);
     }
     report.iterations.push_back(RowAt(rig, columns.truth, iteration, wMc, true_cMo, report.cdMo));
@@ -622,8 +621,8 @@ ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const 
       if (step->status == ServoStatus::kConverged) current.status = "converged";
     }
     if (hooks.on_frame) {
-      hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, camera,
-                                setup.target, report.cdMo, tracker.detector().Undistorts()});
+      hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, camera, setup.target,
+                                report.cdMo, tracker.detector().Undistorts()});
     }
     std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);

@@ -67,8 +67,8 @@ struct ServoSetup {
   PoseOptions pose;  ///< its camera and image size are the setup's
   TargetTrackerOptions tracking;
   ServoLoopOptions loop;
-  SafetyOptions safety;    ///< the safety runner's limits (robots/safe_robot.h)
-  vpHomogeneousMatrix wMo;  ///< the target in the world (robot base) frame
+  SafetyOptions safety;      ///< the safety runner's limits (robots/safe_robot.h)
+  vpHomogeneousMatrix wMo;   ///< the target in the world (robot base) frame
   vpHomogeneousMatrix cdMo;  ///< the goal: the target in the goal camera frame
   /// A taught goal instead of cdMo: the target's pose in this frame (of the camera's size),
   /// found with the setup's camera and tracker before anything moves; `goal_image_name` names
@@ -90,7 +90,8 @@ TargetPoseTracker MakeTracker(const ServoSetup& setup);
 /// The pose of the target in `gray` (of the setup's size) with the setup's camera and tracker.
 /// Throws std::runtime_error starting with `where` when the frame has another size or shows
 /// no pose.
-vpHomogeneousMatrix TeachGoal(const ServoSetup& setup, const cv::Mat& gray, const std::string& where);
+vpHomogeneousMatrix TeachGoal(const ServoSetup& setup, const cv::Mat& gray,
+                              const std::string& where);
 
 /// A robot's position as the log's and servo.csv's columns show it.
 struct PoseColumns {

@@ -79,7 +79,8 @@ TEST(RunServoLoop, EachPositionLawReachesTheGoalOnTheRenderedSheet) {
     RenderedFrames frames(setup.target, RenderOptions());
     std::ostringstream log;
     const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
-    ASSERT_EQ(report.status, ServoRunStatus::kConverged) << ToString(mode) << ": " << report.message;
+    ASSERT_EQ(report.status, ServoRunStatus::kConverged)
+        << ToString(mode) << ": " << report.message;
     EXPECT_TRUE(report.robot_stopped);
     EXPECT_TRUE(report.started);
     // The truth: where the camera really is against the goal.
@@ -130,9 +131,8 @@ TEST(RunServoLoop, AnOpenLoopReplayComputesTheLawAndNeverMovesTheRobot) {
   ASSERT_EQ(report.iterations.size(), 3u);
   for (const ServoIteration& row : report.iterations) {
     // The law saw the pose: 0.1 m and 25 deg from the goal; the truth is not known.
-    EXPECT_NEAR(row.translation_error_mm, 1e3 * (setup.cdMo * kStartcMo.inverse())
-                                                     .getTranslationVector()
-                                                     .frobeniusNorm(),
+    EXPECT_NEAR(row.translation_error_mm,
+                1e3 * (setup.cdMo * kStartcMo.inverse()).getTranslationVector().frobeniusNorm(),
                 1.0);
     EXPECT_TRUE(std::isnan(row.true_translation_error_mm));
   }
