@@ -468,203 +468,265 @@ bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames,
   return true;
 }
 
-ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const LoopRobot& rig,
-                            std::ostream& log, const ServoLoopHooks& hooks) {
-  // Everything checked, and the goal taught, before the robot moves.
-  setup.loop.Check();
-  if (rig.driver == nullptr) throw std::invalid_argument("RunServoLoop: no robot driver");
-  const bool velocity_law = setup.loop.law.mode == ServoMode::kVelocity;
-  vpCameraParameters camera = setup.camera;
-  TargetPoseTracker tracker = MakeTracker(setup);
-  const bool moves_robot = !setup.open_loop;
-  if (velocity_law && !rig.driver->Capabilities().velocity) {
-    throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
-                                rig.driver->Name() +
-                                " takes position moves only: use exponential or point-and-go");
-  }
-  SafeRobot robot(*rig.driver, setup.safety);
+namespace {
 
-  ServoRunReport report;
-  const bool taught = !setup.goal_image.empty();
-  report.cdMo = taught ? TeachGoal(setup, setup.goal_image, setup.goal_image_name) : setup.cdMo;
-  if (taught) {
-    const vpTranslationVector t = report.cdMo.getTranslationVector();
-    log << "goal taught from " << setup.goal_image_name << ": target at (" << Fixed(t[0], 4) << ", "
-        << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
+// One run of the loop, in its steps: Prepare (before the robot is touched), Begin (connect,
+// enable, the lens), then one Iterate per frame until a Stop, and Finish (the stop sent, the
+// last row, the report) on every way out.
+class ServoRun {
+ public:
+  ServoRun(const ServoSetup& setup, FrameSource& frames, const LoopRobot& rig, std::ostream& log,
+           const ServoLoopHooks& hooks)
+      : setup_(setup),
+        frames_(frames),
+        rig_(rig),
+        log_(log),
+        hooks_(hooks),
+        camera_(setup.camera),
+        tracker_(MakeTracker(setup)),
+        robot_(*rig.driver, setup.safety),
+        columns_{rig.has_yaw, frames.KnowsTruth()} {}
+
+  ServoRunReport Run() {
+    Prepare();
+    if (std::optional<Stop> stop = Begin()) return Finish(*stop);
+    const auto start = std::chrono::steady_clock::now();
+    const int iteration_limit = setup_.loop.IterationLimit(setup_.open_loop);
+    log_ << "frame 0 finds the target; frame 1, the robot still, confirms it; then each frame "
+            "commands one move. Errors to the goal: est by the estimated pose"
+         << (columns_.truth ? ", true by the simulation's truth" : "") << ".\n";
+    LogHeader(columns_, log_);
+    for (int iteration = 0;; ++iteration) {
+      if (std::optional<Stop> stop = Interrupted(iteration)) return Finish(*stop);
+      if (std::optional<Stop> stop =
+              LimitReached(setup_.loop, iteration_limit, iteration, start, frames_)) {
+        return Finish(*stop);
+      }
+      if (std::optional<Stop> stop = Iterate(iteration)) return Finish(*stop);
+    }
   }
-  if (!moves_robot) {
-    log << "replay of " << frames.Name() << ": open loop, the robot is not moved\n";
+
+ private:
+  // What is checked, and the goal taught, before the robot is touched.
+  void Prepare() {
+    const bool velocity_law = setup_.loop.law.mode == ServoMode::kVelocity;
+    if (velocity_law && !rig_.driver->Capabilities().velocity) {
+      throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
+                                  rig_.driver->Name() +
+                                  " takes position moves only: use exponential or point-and-go");
+    }
+    const bool taught = !setup_.goal_image.empty();
+    report_.cdMo =
+        taught ? TeachGoal(setup_, setup_.goal_image, setup_.goal_image_name) : setup_.cdMo;
+    if (taught) {
+      const vpTranslationVector t = report_.cdMo.getTranslationVector();
+      log_ << "goal taught from " << setup_.goal_image_name << ": target at (" << Fixed(t[0], 4)
+           << ", " << Fixed(t[1], 4) << ", " << Fixed(t[2], 4) << ") m in the goal camera\n";
+    }
+    if (setup_.open_loop) {
+      log_ << "replay of " << frames_.Name() << ": open loop, the robot is not moved\n";
+    }
   }
-  const TableColumns columns{rig.has_yaw, frames.KnowsTruth()};
-  std::optional<StopGuard> guard;  // from Connect() on
-  bool moved_since_row = false;    // a motion was commanded after it
-  auto finish = [&](Stop stop) {
-    report.status = stop.status;
-    const RobotResult stopped = guard ? guard->Stop() : robot.Stop();
-    report.robot_stopped = stopped.ok();
-    report.message = std::move(stop.message) + StopOutcome(stopped, stop.status, guard.has_value());
-    if (!report.iterations.empty()) report.iterations.back().status = ToString(stop.status);
-    if (guard) {
-      // Where the robot stopped: after a move since the last frame, one more row says so.
-      const RobotPose where = TrueCameraPose(robot, setup.true_eMc);
-      if (where.result.ok()) {
-        report.final_wMc = where.pose;
-        if (moved_since_row && !report.iterations.empty()) {
-          ServoIteration row = RowAt(rig, columns.truth, report.iterations.back().iteration + 1,
-                                     where.pose, where.pose.inverse() * setup.wMo, report.cdMo);
-          row.status = "stopped";
-          LogRow(row, columns, log);
-          report.iterations.push_back(row);
-        }
-      } else if (moved_since_row) {
-        report.message += "; position after the stop unknown: " + where.result.message;
+
+  // The robot connected and enabled, the run begun, the lens told when it is to be.
+  std::optional<Stop> Begin() {
+    if (RobotResult r = robot_.Connect(); !r.ok()) {
+      return Stop{ServoRunStatus::kError,
+                  "cannot connect the robot: " + r.message + rig_.connect_hint};
+    }
+    guard_.emplace(robot_, hooks_);
+    if (RobotResult r = robot_.Enable(); !r.ok()) {
+      return Stop{ServoRunStatus::kError, "cannot enable the robot: " + r.message};
+    }
+    WarnIfOutsideWorkspace(robot_, log_);
+    report_.started = true;
+    if (hooks_.on_started) hooks_.on_started();
+    if (setup_.estimate_distortion) {
+      std::string why;
+      if (!TellTheLens(setup_, robot_, frames_, &camera_, &tracker_, log_, &why)) {
+        return Stop{ServoRunStatus::kError, "cannot tell the lens: " + why};
       }
     }
-    if (guard) report.link_summary = rig.driver->LinkSummary(report.moves);
-    return report;
-  };
-
-  if (RobotResult r = robot.Connect(); !r.ok()) {
-    return finish(
-        {ServoRunStatus::kError, "cannot connect the robot: " + r.message + rig.connect_hint});
+    return std::nullopt;
   }
-  guard.emplace(robot, hooks);
-  if (RobotResult r = robot.Enable(); !r.ok()) {
-    return finish({ServoRunStatus::kError, "cannot enable the robot: " + r.message});
-  }
-  WarnIfOutsideWorkspace(robot, log);
-  report.started = true;
-  if (hooks.on_started) hooks.on_started();
 
-  if (setup.estimate_distortion) {
-    std::string why;
-    if (!TellTheLens(setup, robot, frames, &camera, &tracker, log, &why)) {
-      return finish({ServoRunStatus::kError, "cannot tell the lens: " + why});
-    }
+  // The operator's stop (the hook's flag, or the robot's emergency stop).
+  std::optional<Stop> Interrupted(int iteration) {
+    const bool interrupted = (hooks_.interrupt != nullptr && hooks_.interrupt->load()) ||
+                             robot_.EmergencyStopRequested();
+    if (!interrupted) return std::nullopt;
+    robot_.RequestEmergencyStop();
+    return Stop{ServoRunStatus::kInterrupted, "interrupted by " + InterruptedBy(hooks_) +
+                                                  " after " + std::to_string(iteration) +
+                                                  " iterations"};
   }
-  const ServoLoopOptions& loop = setup.loop;
-  const auto start = std::chrono::steady_clock::now();
-  const int iteration_limit = loop.IterationLimit(!moves_robot);
-  std::optional<vpHomogeneousMatrix> previous_cMo;
-  vpHomogeneousMatrix previous_wMc;
-  // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
-  bool confirmed = !moves_robot;
-  // The lens check over the first frames with a pose, said once: a camera file that misses
-  // the lens biases every pose, which the loop cannot see otherwise.
-  constexpr std::size_t kLensCheckFrames = 5;
-  std::vector<double> straightness;
-  cv::Mat gray;
-  log << "frame 0 finds the target; frame 1, the robot still, confirms it; then each frame "
-         "commands one move. Errors to the goal: est by the estimated pose"
-      << (columns.truth ? ", true by the simulation's truth" : "") << ".\n";
-  LogHeader(columns, log);
-  for (int iteration = 0;; ++iteration) {
-    const bool interrupted =
-        (hooks.interrupt != nullptr && hooks.interrupt->load()) || robot.EmergencyStopRequested();
-    if (interrupted) {
-      robot.RequestEmergencyStop();
-      return finish({ServoRunStatus::kInterrupted, "interrupted by " + InterruptedBy(hooks) +
-                                                       " after " + std::to_string(iteration) +
-                                                       " iterations"});
-    }
-    if (std::optional<Stop> stop = LimitReached(loop, iteration_limit, iteration, start, frames)) {
-      return finish(*stop);
-    }
 
-    const RobotPose read = TrueCameraPose(robot, setup.true_eMc);
+  // One frame: where the camera is, the frame, the pose and its checks, the law, the move.
+  std::optional<Stop> Iterate(int iteration) {
+    const RobotPose read = TrueCameraPose(robot_, setup_.true_eMc);
     if (!read.result.ok()) {
-      return finish(
-          {ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message});
+      return Stop{ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message};
     }
     const vpHomogeneousMatrix wMc = read.pose;
-    const vpHomogeneousMatrix true_cMo = wMc.inverse() * setup.wMo;
-    if (std::optional<Stop> stop =
-            Grab(frames, setup.width, setup.height, true_cMo, iteration, hooks.on_grab, &gray)) {
-      return finish(*stop);
+    const vpHomogeneousMatrix true_cMo = wMc.inverse() * setup_.wMo;
+    if (std::optional<Stop> stop = Grab(frames_, setup_.width, setup_.height, true_cMo, iteration,
+                                        hooks_.on_grab, &gray_)) {
+      return stop;
     }
-    report.iterations.push_back(RowAt(rig, columns.truth, iteration, wMc, true_cMo, report.cdMo));
-    moved_since_row = false;
-    ServoIteration& current = report.iterations.back();
+    report_.iterations.push_back(
+        RowAt(rig_, columns_.truth, iteration, wMc, true_cMo, report_.cdMo));
+    moved_since_row_ = false;
+    ServoIteration& current = report_.iterations.back();
 
     // Where the robot's motion since the last estimate puts the target.
     std::optional<vpHomogeneousMatrix> predicted_cMo;
-    if (previous_cMo) predicted_cMo = wMc.inverse() * previous_wMc * *previous_cMo;
+    if (previous_cMo_) predicted_cMo = wMc.inverse() * previous_wMc_ * *previous_cMo_;
     // The frame that confirms the first pose: the robot has not moved since the first frame.
-    const bool confirming = !confirmed && previous_cMo.has_value();
+    const bool confirming = !Confirmed() && previous_cMo_.has_value();
     // The prediction places the borders on the target and seeds the accumulator list and the
     // estimate: the lines' identities and the solution of the planar pose ambiguity carried
     // through the move (after a move that rolled the camera by 60 deg, the pose before it is
     // nearer a 90-deg-turned assignment of a near-square target's lines than the right one).
     // The confirming frame is found on its own, so that a wrong first pose cannot seed its
     // own confirmation.
-    if (confirming) tracker.Reset();
+    if (confirming) tracker_.Reset();
     const TargetFrame& tracked =
-        tracker.Track(ViewOf(gray), confirming ? std::nullopt : predicted_cMo);
+        tracker_.Track(ViewOf(gray_), confirming ? std::nullopt : predicted_cMo);
     const PoseResult& pose = tracked.pose;
-    if (tracked.status == TargetStatus::kOk && straightness.size() < kLensCheckFrames) {
-      straightness.push_back(tracked.straightness_px);
-      const LensCheck lens =
-          CheckLens(straightness, kLensMismatchPx, static_cast<int>(kLensCheckFrames));
-      if (lens.mismatch) {
-        log << "oalservo servo: warning: "
-            << LensMismatchWarning(lens, "the camera model",
-                                   "Calibrate the camera (oalservo calibrate), or set "
-                                   "camera.estimate_distortion")
-            << '\n';
-      }
-    }
+    CheckLensOnce(tracked);
     std::optional<ServoStep> step;
     if (tracked.status == TargetStatus::kOk) {
-      step = ComputeServoStep(pose.cMo, report.cdMo, loop.law);
+      step = ComputeServoStep(pose.cMo, report_.cdMo, setup_.loop.law);
       current.translation_error_mm = step->translation_error_m * 1e3;
       current.rotation_error_deg = vpMath::deg(step->rotation_error_rad);
       if (step->status == ServoStatus::kConverged) current.status = "converged";
     }
-    if (hooks.on_frame) {
-      hooks.on_frame(ServoFrame{gray, tracker.lines(), pose, tracked, current, camera, setup.target,
-                                report.cdMo, tracker.detector().Undistorts()});
+    if (hooks_.on_frame) {
+      hooks_.on_frame(ServoFrame{gray_, tracker_.lines(), pose, tracked, current, camera_,
+                                 setup_.target, report_.cdMo, tracker_.detector().Undistorts()});
     }
-    std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, loop, iteration, confirming);
+    std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, setup_.loop, iteration, confirming);
     if (stop) current.status = ToString(stop->status);
-    LogRow(current, columns, log);
-    if (stop) return finish(*stop);
-    previous_cMo = pose.cMo;
-    previous_wMc = wMc;
+    LogRow(current, columns_, log_);
+    if (stop) return stop;
+    previous_cMo_ = pose.cMo;
+    previous_wMc_ = wMc;
     if (step->status == ServoStatus::kConverged) {
-      return finish({ServoRunStatus::kConverged,
-                     "within the tolerances after " + Counted(report.moves, "move") + " (" +
-                         Counted(iteration + 1, "frame") + "): estimated error " +
-                         Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
-                         Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"});
+      return Stop{ServoRunStatus::kConverged,
+                  "within the tolerances after " + Counted(report_.moves, "move") + " (" +
+                      Counted(iteration + 1, "frame") + "): estimated error " +
+                      Fixed(step->translation_error_m * 1e3, 3) + " mm, " +
+                      Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"};
     }
-    if (!moves_robot) continue;
-    if (!confirmed) {
-      if (!confirming) continue;  // the first frame: the next one confirms its pose
-      confirmed = true;
+    if (setup_.open_loop) return std::nullopt;
+    if (!confirmed_) {
+      if (!confirming) return std::nullopt;  // the first frame: the next one confirms its pose
+      confirmed_ = true;
     }
+    return Move(iteration, wMc, *step);
+  }
+
+  // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
+  bool Confirmed() const { return setup_.open_loop || confirmed_; }
+
+  // The lens check over the first frames with a pose, said once: a camera file that misses
+  // the lens biases every pose, which the loop cannot see otherwise.
+  void CheckLensOnce(const TargetFrame& tracked) {
+    constexpr std::size_t kLensCheckFrames = 5;
+    if (tracked.status != TargetStatus::kOk || straightness_.size() >= kLensCheckFrames) return;
+    straightness_.push_back(tracked.straightness_px);
+    const LensCheck lens =
+        CheckLens(straightness_, kLensMismatchPx, static_cast<int>(kLensCheckFrames));
+    if (lens.mismatch) {
+      log_ << "oalservo servo: warning: "
+           << LensMismatchWarning(lens, "the camera model",
+                                  "Calibrate the camera (oalservo calibrate), or set "
+                                  "camera.estimate_distortion")
+           << '\n';
+    }
+  }
+
+  // The step commanded: a position move (checked for its size first) or a velocity cycle.
+  std::optional<Stop> Move(int iteration, const vpHomogeneousMatrix& wMc, const ServoStep& step) {
+    const bool velocity_law = setup_.loop.law.mode == ServoMode::kVelocity;
     if (!velocity_law) {
-      if (std::optional<Stop> too_large = StepTooLarge(*step, loop, iteration)) {
-        return finish(*too_large);
+      if (std::optional<Stop> too_large = StepTooLarge(step, setup_.loop, iteration)) {
+        return too_large;
       }
     }
-
     // Only a motion the robot began counts as a move: a velocity cycle it took, a position
     // move it was polled in (a refusal before StartMove leaves the robot where it was).
-    moved_since_row = true;
-    if (hooks.on_move) hooks.on_move(iteration);
+    moved_since_row_ = true;
+    if (hooks_.on_move) hooks_.on_move(iteration);
     RobotResult moved;
     bool started = false;
     if (velocity_law) {
-      moved = robot.SetVelocity(RobotFrame::kCamera, step->twist).result;
+      moved = robot_.SetVelocity(RobotFrame::kCamera, step.twist).result;
       started = moved.ok();
     } else {
-      const MoveReport move = robot.MovePosition(RobotFrame::kCamera, wMc * step->c_T_cnew);
+      const MoveReport move = robot_.MovePosition(RobotFrame::kCamera, wMc * step.c_T_cnew);
       moved = move.result;
       started = moved.ok() || move.polls > 0;
     }
-    if (started) ++report.moves;
-    if (!moved.ok()) return finish(RefusalStop(moved, started, robot, iteration, hooks));
+    if (started) ++report_.moves;
+    if (!moved.ok()) return RefusalStop(moved, started, robot_, iteration, hooks_);
+    return std::nullopt;
   }
+
+  // The robot stopped, and the report completed: after a move since the last frame, one more
+  // row says where it stopped.
+  ServoRunReport Finish(Stop stop) {
+    report_.status = stop.status;
+    const RobotResult stopped = guard_ ? guard_->Stop() : robot_.Stop();
+    report_.robot_stopped = stopped.ok();
+    report_.message =
+        std::move(stop.message) + StopOutcome(stopped, stop.status, guard_.has_value());
+    if (!report_.iterations.empty()) report_.iterations.back().status = ToString(stop.status);
+    if (guard_) {
+      const RobotPose where = TrueCameraPose(robot_, setup_.true_eMc);
+      if (where.result.ok()) {
+        report_.final_wMc = where.pose;
+        if (moved_since_row_ && !report_.iterations.empty()) {
+          ServoIteration row = RowAt(rig_, columns_.truth, report_.iterations.back().iteration + 1,
+                                     where.pose, where.pose.inverse() * setup_.wMo, report_.cdMo);
+          row.status = "stopped";
+          LogRow(row, columns_, log_);
+          report_.iterations.push_back(row);
+        }
+      } else if (moved_since_row_) {
+        report_.message += "; position after the stop unknown: " + where.result.message;
+      }
+      report_.link_summary = rig_.driver->LinkSummary(report_.moves);
+    }
+    return report_;
+  }
+
+  const ServoSetup& setup_;
+  FrameSource& frames_;
+  const LoopRobot& rig_;
+  std::ostream& log_;
+  const ServoLoopHooks& hooks_;
+  vpCameraParameters camera_;  ///< the setup's, with the lens once told
+  TargetPoseTracker tracker_;
+  SafeRobot robot_;
+  const TableColumns columns_;
+  ServoRunReport report_;
+  std::optional<StopGuard> guard_;  ///< from Connect() on; declared after robot_
+  bool moved_since_row_ = false;    ///< a motion was commanded after the last row
+  bool confirmed_ = false;          ///< the first pose confirmed by a second frame
+  std::optional<vpHomogeneousMatrix> previous_cMo_;
+  vpHomogeneousMatrix previous_wMc_;
+  std::vector<double> straightness_;
+  cv::Mat gray_;
+};
+
+}  // namespace
+
+ServoRunReport RunServoLoop(const ServoSetup& setup, FrameSource& frames, const LoopRobot& rig,
+                            std::ostream& log, const ServoLoopHooks& hooks) {
+  setup.loop.Check();
+  if (rig.driver == nullptr) throw std::invalid_argument("RunServoLoop: no robot driver");
+  return ServoRun(setup, frames, rig, log, hooks).Run();
 }
 
 }  // namespace oal
