@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/format.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
 
@@ -271,12 +272,6 @@ void ReadDetectorSection(const YAML::Node& section, const std::string& file, App
 
 // ------------------------------------------------------------------------------------------
 // `target:`: a shipped target by name, or a full description (config/four-line-board.yaml).
-
-std::string Number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
 
 // A point [x, y] in metres.
 struct PointValue {
@@ -1144,12 +1139,6 @@ YAML::Node LoadYaml(const std::string& text, const std::string& file) {
 
 namespace {
 
-std::string Num(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
-
 [[noreturn]] void Violated(const std::string& field, const std::string& value,
                            const std::string& constraint) {
   throw std::invalid_argument(field + " = " + value + ". Violated constraint: " + constraint);
@@ -1216,28 +1205,29 @@ vpCameraParameters CameraConfig::Camera() const {
 }
 
 void CameraConfig::Check() const {
-  if (!(px > 0.0) || !std::isfinite(px)) Violated("CameraConfig::px", Num(px), "px > 0");
-  if (!(py > 0.0) || !std::isfinite(py)) Violated("CameraConfig::py", Num(py), "py > 0");
-  if (!std::isfinite(u0)) Violated("CameraConfig::u0", Num(u0), "finite");
-  if (!std::isfinite(v0)) Violated("CameraConfig::v0", Num(v0), "finite");
+  if (!(px > 0.0) || !std::isfinite(px)) Violated("CameraConfig::px", Number(px), "px > 0");
+  if (!(py > 0.0) || !std::isfinite(py)) Violated("CameraConfig::py", Number(py), "py > 0");
+  if (!std::isfinite(u0)) Violated("CameraConfig::u0", Number(u0), "finite");
+  if (!std::isfinite(v0)) Violated("CameraConfig::v0", Number(v0), "finite");
   // The same range as every command line's --kdu.
   if (!(kdu > -1.0 && kdu < 1.0)) {
-    Violated("CameraConfig::kdu", Num(kdu), "-1 < kdu < 1");
+    Violated("CameraConfig::kdu", Number(kdu), "-1 < kdu < 1");
   }
   if (width < 16 || width > 8192)
-    Violated("CameraConfig::width", Num(width), "16 <= width <= 8192");
+    Violated("CameraConfig::width", Number(width), "16 <= width <= 8192");
   if (height < 16 || height > 8192) {
-    Violated("CameraConfig::height", Num(height), "16 <= height <= 8192");
+    Violated("CameraConfig::height", Number(height), "16 <= height <= 8192");
   }
   if (!(noise >= 0.0 && noise <= 100.0)) {
-    Violated("CameraConfig::noise", Num(noise), "0 <= noise <= 100");
+    Violated("CameraConfig::noise", Number(noise), "0 <= noise <= 100");
   }
-  if (!(blur >= 0.0 && blur <= 20.0)) Violated("CameraConfig::blur", Num(blur), "0 <= blur <= 20");
+  if (!(blur >= 0.0 && blur <= 20.0))
+    Violated("CameraConfig::blur", Number(blur), "0 <= blur <= 20");
 }
 
 void RobotConfig::Check() const {
   if (!(sampling_time_s > 0.0 && sampling_time_s <= 1.0)) {
-    Violated("RobotConfig::sampling_time_s", Num(sampling_time_s), "0 < sampling_time_s <= 1");
+    Violated("RobotConfig::sampling_time_s", Number(sampling_time_s), "0 < sampling_time_s <= 1");
   }
   safety.Check();
   if (type == RobotType::kScorbot) {
@@ -1250,7 +1240,7 @@ void SourceConfig::Check() const {
   if (type == SourceType::kV4l2 && device.empty())
     Violated("SourceConfig::device", "''", "a device path");
   if (fps != 0 && fps != 25 && fps != 50) {
-    Violated("SourceConfig::fps", Num(fps), "fps is 0 (the driver's), 25 or 50");
+    Violated("SourceConfig::fps", Number(fps), "fps is 0 (the driver's), 25 or 50");
   }
   if (type == SourceType::kReplay && path.empty()) {
     Violated("SourceConfig::path", "''", "a video, directory or pattern to replay");

@@ -53,10 +53,7 @@ std::string ShellQuoted(const std::string& text) {
 
 // Errors as "nan": gnuplot leaves such points out.
 std::string Value(double value) {
-  if (!std::isfinite(value)) return "nan";
-  std::ostringstream text;
-  text << std::setprecision(9) << value;
-  return text.str();
+  return std::isfinite(value) ? Number(value, 9) : "nan";
 }
 
 // Frames the run took (the row after a stop has no frame).

@@ -8,17 +8,9 @@
 #include <vector>
 
 #include "app/servo_rig.h"
+#include "base/format.h"
 
 namespace oal {
-namespace {
-
-std::string Number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
-
-}  // namespace
 
 vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
   const std::string where = config.goal_image_origin + ": goal.image '" + config.goal_image + "'";

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdio>
+#include <sstream>
 #include <string>
 
 namespace oal {
@@ -11,6 +12,15 @@ inline std::string Fixed(double value, int digits) {
   char text[64];
   std::snprintf(text, sizeof text, "%.*f", digits, value);
   return text;
+}
+
+/// `value` as a stream prints it, with `significant` significant digits: Number(0.5) is
+/// "0.5", Number(1e-6) "1e-06", Number(2.0 / 3.0, 3) "0.667".
+inline std::string Number(double value, int significant = 6) {
+  std::ostringstream text;
+  text.precision(significant);
+  text << value;
+  return text.str();
 }
 
 }  // namespace oal

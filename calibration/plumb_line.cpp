@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "base/check.h"
+#include "base/format.h"
 #include "detector/lens.h"  // FitKud
 
 namespace oal {
@@ -111,13 +112,6 @@ double RmsPx(const std::vector<Line>& lines, double kdu, double scale_px) {
   return n > 0 ? std::sqrt(sum / n) : 0.0;
 }
 
-std::string Number(double value) {
-  std::ostringstream text;
-  text.precision(3);
-  text << value;
-  return text.str();
-}
-
 }  // namespace
 
 void PlumbLineOptions::Check() const {
@@ -174,11 +168,11 @@ PlumbLineResult EstimateRadialDistortion(const std::vector<std::vector<Point2d>>
   if (!(step.information > 0) || !(result.kdu_sd < 0.05)) {
     throw std::runtime_error(
         "the lines pass too near the image's centre to show the lens (kdu +- " +
-        Number(result.kdu_sd) + "): view the target off-centre, its stripes reaching the edges");
+        Number(result.kdu_sd, 3) + "): view the target off-centre, its stripes reaching the edges");
   }
   if (step.kdu < options.kdu_min || step.kdu > options.kdu_max) {
-    throw std::runtime_error("kdu came out at " + Number(step.kdu) + ", outside [" +
-                             Number(options.kdu_min) + ", " + Number(options.kdu_max) +
+    throw std::runtime_error("kdu came out at " + Number(step.kdu, 3) + ", outside [" +
+                             Number(options.kdu_min, 3) + ", " + Number(options.kdu_max, 3) +
                              "]: the points are not of straight lines through this camera");
   }
   result.kdu = step.kdu;

@@ -70,12 +70,6 @@ class StopGuard {
   bool stopped_ = false;
 };
 
-std::string Number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
-
 // The table's header and rows; `yaw`: with the yaw column (not for the 5-axis Scorbot).
 // The console's table: one row per frame (Table 3's columns); the estimated error to the goal
 // and, in a simulation, the true one beside it; "-" where a value is unknown (no pose, or the

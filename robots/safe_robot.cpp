@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "base/check.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -19,12 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point from) {
   return std::chrono::duration<double>(Clock::now() - from).count();
-}
-
-std::string Str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 constexpr const char* kAxisName[6] = {"vx", "vy", "vz", "wx", "wy", "wz"};
@@ -42,7 +37,7 @@ void SafetyOptions::Check() const {
     RequireOption(std::isfinite(workspace_min_m[i]) && std::isfinite(workspace_max_m[i]) &&
                       workspace_min_m[i] < workspace_max_m[i],
                   p + "workspace_min_m/workspace_max_m [" + kBoxAxis[i] + "]",
-                  Str(workspace_min_m[i]) + " / " + Str(workspace_max_m[i]),
+                  Number(workspace_min_m[i]) + " / " + Number(workspace_max_m[i]),
                   "finite and min < max");
   }
   RequireOption(move_timeout_s > 0 && std::isfinite(move_timeout_s), p + "move_timeout_s",
@@ -273,8 +268,8 @@ CycleReport SafeRobot::SetVelocity(RobotFrame frame, const vpColVector& v) {
     if (report.result.ok() && options_.max_cycle_s > 0 &&
         report.duration_s > options_.max_cycle_s) {
       RobotResult why = RobotResult::Fail(
-          RobotStatus::kTimeout,
-          "cycle took " + Str(report.duration_s) + " s > max_cycle_s " + Str(options_.max_cycle_s));
+          RobotStatus::kTimeout, "cycle took " + Number(report.duration_s) + " s > max_cycle_s " +
+                                     Number(options_.max_cycle_s));
       Latch(why);
       report.result = std::move(why);
     }
@@ -364,7 +359,7 @@ MoveReport SafeRobot::MovePosition(RobotFrame frame, const vpHomogeneousMatrix& 
     if (report.polls >= max_polls) {
       return fail(RobotResult::Fail(
           RobotStatus::kTimeout,
-          "move not finished after " + Str(options_.move_timeout_s) + " s (move_timeout_s)"));
+          "move not finished after " + Number(options_.move_timeout_s) + " s (move_timeout_s)"));
     }
     const MoveProgress progress = robot_.PollMove();
     ++report.polls;
@@ -380,16 +375,16 @@ MoveReport SafeRobot::MovePosition(RobotFrame frame, const vpHomogeneousMatrix& 
     if (options_.max_cycle_s > 0 && cycle_s > options_.max_cycle_s) {
       return fail(RobotResult::Fail(
           RobotStatus::kTimeout,
-          "cycle took " + Str(cycle_s) + " s > max_cycle_s " + Str(options_.max_cycle_s)));
+          "cycle took " + Number(cycle_s) + " s > max_cycle_s " + Number(options_.max_cycle_s)));
     }
     if (progress.done) break;
   }
   const PoseDistance d = Distance(report.target, report.reached);
   if (d.translation_m > options_.reach_tolerance_m ||
       d.rotation_rad > options_.reach_tolerance_rad) {
-    return fail(RobotResult::Fail(RobotStatus::kError,
-                                  "move ended " + Str(d.translation_m * 1e3) + " mm and " +
-                                      Str(vpMath::deg(d.rotation_rad)) + " deg from its target"));
+    return fail(RobotResult::Fail(
+        RobotStatus::kError, "move ended " + Number(d.translation_m * 1e3) + " mm and " +
+                                 Number(vpMath::deg(d.rotation_rad)) + " deg from its target"));
   }
   report.result = RobotResult::Ok();
   report.duration_s = Seconds(move_start);

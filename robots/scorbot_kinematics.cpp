@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "base/check.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {
@@ -49,10 +50,7 @@ vpColVector Cross(const vpColVector& a, const vpColVector& b) {
 }
 
 std::string FormatDeg(double rad) {
-  std::ostringstream s;
-  s.precision(4);
-  s << Deg(rad);
-  return s.str();
+  return Number(Deg(rad), 4);
 }
 
 // The vertical plane through the base axis and the TCP of wMe, in which a 5-axis arm's tool
