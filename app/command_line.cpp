@@ -1,6 +1,5 @@
 #include "app/command_line.h"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -14,7 +13,9 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <stdexcept>
+#include <streambuf>
 
 #include "io/atomic_file.h"
 
@@ -137,33 +138,64 @@ void Warn(const std::string& command, const std::string& message) {
 
 namespace {
 
-std::mutex quiet_mutex;
-int quiet_count = 0;      // QuietStderr objects alive
-int quiet_saved_fd = -1;  // the real stderr while they live
+thread_local int quiet_depth = 0;  // QuietStderr objects alive on this thread
+
+// std::cerr's buffer once installed: the original one, but for what a quiet thread writes.
+class QuietableBuffer : public std::streambuf {
+ public:
+  explicit QuietableBuffer(std::streambuf* target) : target_(target) {}
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (quiet_depth > 0 || traits_type::eq_int_type(c, traits_type::eof())) {
+      return traits_type::not_eof(c);
+    }
+    return target_->sputc(traits_type::to_char_type(c));
+  }
+  std::streamsize xsputn(const char* text, std::streamsize n) override {
+    return quiet_depth > 0 ? n : target_->sputn(text, n);
+  }
+  int sync() override { return target_->pubsync(); }
+
+ private:
+  std::streambuf* target_;
+};
+
+// C's stderr once installed: writes go to the original stream, but for a quiet thread's.
+ssize_t QuietableWrite(void* original, const char* data, size_t size) {
+  if (quiet_depth > 0) return static_cast<ssize_t>(size);
+  FILE* stream = static_cast<FILE*>(original);
+  const size_t written = std::fwrite(data, 1, size, stream);
+  std::fflush(stream);
+  return written == 0 && size > 0 ? -1 : static_cast<ssize_t>(written);
+}
 
 }  // namespace
 
+void InstallQuietableStderr() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::cerr.flush();
+    std::fflush(stderr);
+    // Never destroyed: std::cerr may be written to until the very end of the process.
+    alignas(QuietableBuffer) static unsigned char storage[sizeof(QuietableBuffer)];
+    std::cerr.rdbuf(::new (storage) QuietableBuffer(std::cerr.rdbuf()));
+    cookie_io_functions_t io{};
+    io.write = QuietableWrite;
+    FILE* quietable = ::fopencookie(stderr, "w", io);
+    if (quietable == nullptr) return;  // stderr stays as it is: nothing is dropped
+    std::setvbuf(quietable, nullptr, _IONBF, 0);
+    stderr = quietable;
+  });
+}
+
 QuietStderr::QuietStderr() {
-  std::lock_guard<std::mutex> lock(quiet_mutex);
-  if (quiet_count++ > 0) return;
-  std::cerr.flush();
-  std::fflush(stderr);
-  quiet_saved_fd = ::dup(2);
-  const int null = ::open("/dev/null", O_WRONLY);
-  if (quiet_saved_fd >= 0 && null >= 0) ::dup2(null, 2);
-  if (null >= 0) ::close(null);
+  InstallQuietableStderr();
+  ++quiet_depth;
 }
 
 QuietStderr::~QuietStderr() {
-  std::lock_guard<std::mutex> lock(quiet_mutex);
-  if (--quiet_count > 0) return;
-  std::cerr.flush();
-  std::fflush(stderr);
-  if (quiet_saved_fd >= 0) {
-    ::dup2(quiet_saved_fd, 2);
-    ::close(quiet_saved_fd);
-    quiet_saved_fd = -1;
-  }
+  --quiet_depth;
 }
 
 std::string MarkupEscaped(const std::string& text) {

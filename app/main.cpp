@@ -113,6 +113,8 @@ int main(int argc, char** argv) {
   // its error level unless OPENCV_FFMPEG_LOGLEVEL says otherwise (left to the user if set:
   // e.g. 24 for FFmpeg's warnings). -8 is AV_LOG_QUIET.
   ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", /*overwrite=*/0);
+  // Before any thread: compare and evaluate silence ViSP's messages on their own thread only.
+  oal::InstallQuietableStderr();
   if (argc < 2) {
     PrintUsage(std::cerr);
     return oal::kExitUsage;
