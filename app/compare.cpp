@@ -893,6 +893,143 @@ std::unique_ptr<LineMethod> TargetMethod(const CompareOptions& options, AppConfi
 
 }  // namespace
 
+namespace {
+
+// The truth --truth names: a CSV's line rows by frame number, or a directory of frame JSON
+// files; `source` says which ("csv", "json"; left empty without --truth).
+struct GivenTruth {
+  std::map<int, std::vector<TargetLineTruth>> csv;
+  std::string json_dir;  ///< "" = next to the images
+};
+
+GivenTruth OpenGivenTruth(const CompareOptions& options, bool camera_given, std::string* source) {
+  GivenTruth given;
+  const bool truth_is_csv = !options.truth.empty() && fs::path(options.truth).extension() == ".csv";
+  if (truth_is_csv) {
+    if (camera_given) {
+      throw std::invalid_argument(
+          "--camera with a CSV truth: the CSV gives image-coordinate lines only, while --camera "
+          "makes our lines undistorted; drop one of them");
+    }
+    given.csv = LoadTruthCsv(options.truth);
+    if (given.csv.empty()) {
+      throw std::runtime_error("truth " + options.truth +
+                               " has no line row (frame,line,rho,theta): it matches no frame");
+    }
+    *source = "csv";
+  } else if (!options.truth.empty()) {
+    if (!fs::is_directory(options.truth)) {
+      throw std::runtime_error("truth '" + options.truth +
+                               "' is neither a .csv file nor a directory of frame JSON files");
+    }
+    given.json_dir = options.truth;
+    *source = "json";
+  }
+  return given;
+}
+
+// A CSV truth that matches none of the input's frames is an error; one that misses some, a
+// warning naming them.
+void CheckCsvCoverage(const CompareOptions& options,
+                      const std::map<int, std::vector<TargetLineTruth>>& csv,
+                      const std::vector<int>& frames_seen, const std::vector<int>& without_truth,
+                      std::vector<std::string>* warnings) {
+  std::vector<int> truth_frames;
+  for (const auto& [number, rows] : csv) truth_frames.push_back(number);
+  const std::size_t without = without_truth.size();
+  if (without == frames_seen.size()) {
+    throw std::runtime_error("truth " + options.truth + " matches no frame of " + options.input +
+                             ": its rows are for frames " + FrameRanges(truth_frames) +
+                             ", the input's frames are " + FrameRanges(frames_seen) +
+                             " (frame = the last number in the file name)");
+  }
+  if (without > 0) {
+    warnings->push_back(std::to_string(without) + " of " + std::to_string(frames_seen.size()) +
+                        " frames have no row in truth " + options.truth + " (frames " +
+                        FrameRanges(without_truth) + "): scored as frames without target lines");
+  }
+}
+
+// The figures (first, middle, and the frame worst for us: most lines missed, then the most
+// spurious lines; fetched by a second pass over the input), compare.md and compare.json in
+// --out, each written atomically, all committed together.
+void WriteComparisonFiles(const CompareOptions& options,
+                          const std::vector<std::unique_ptr<LineMethod>>& methods,
+                          const std::vector<std::vector<TargetLineTruth>>& truth_per_frame,
+                          const std::optional<CameraFile>& camera, CompareReport* out) {
+  CompareReport& report = *out;
+  const bool has_truth = report.truth_source != "none";
+  std::vector<int> chosen{0, report.frames / 2};
+  if (has_truth) {
+    const MethodResult& us = report.methods[0];
+    int worst = 0;
+    for (int f = 1; f < report.frames; ++f) {
+      if (us.missed_per_frame[static_cast<std::size_t>(f)] >
+          us.missed_per_frame[static_cast<std::size_t>(worst)]) {
+        worst = f;
+      }
+    }
+    chosen.push_back(worst);
+  } else {
+    chosen.push_back(report.frames - 1);
+  }
+  std::sort(chosen.begin(), chosen.end());
+  chosen.erase(std::unique(chosen.begin(), chosen.end()), chosen.end());
+  if (static_cast<int>(chosen.size()) > options.figures)
+    chosen.resize(static_cast<std::size_t>(options.figures));
+
+  fs::create_directories(options.out_dir);
+  const fs::path dir(options.out_dir);
+  std::vector<std::unique_ptr<AtomicFile>> files;
+  if (!chosen.empty()) {
+    std::vector<bool> undistorted;
+    for (const auto& method : methods) undistorted.push_back(method->Undistorted());
+    std::unique_ptr<ImageSource> again = OpenImageSource(options.input);
+    Frame frame;
+    for (int f = 0; f <= chosen.back() && again->Next(&frame); ++f) {
+      if (!std::binary_search(chosen.begin(), chosen.end(), f)) continue;
+      const cv::Mat figure = Figure(frame.gray, f, report, truth_per_frame, undistorted, camera);
+      std::vector<unsigned char> png;
+      if (!cv::imencode(".png", figure, png)) {
+        throw std::runtime_error("cannot encode " + (dir / FigureName(f)).string());
+      }
+      files.push_back(std::make_unique<AtomicFile>(dir / FigureName(f)));
+      files.back()->stream().write(reinterpret_cast<const char*>(png.data()),
+                                   static_cast<std::streamsize>(png.size()));
+      report.figures.push_back((dir / FigureName(f)).string());
+    }
+  }
+  files.push_back(std::make_unique<AtomicFile>(dir / "compare.md"));
+  files.back()->stream() << CompareMarkdown(report);
+  files.push_back(std::make_unique<AtomicFile>(dir / "compare.json"));
+  files.back()->stream() << CompareJson(report).dump(2) << '\n';
+  for (auto& file : files) file->Commit();
+}
+
+// The methods compared, ours first (without truth its lines are the targets of the
+// trackers): the OAL detector and tracker, vpMeLine, OpenCV's detectors, the target tracker
+// when the configuration has a target, and the caller's.
+std::vector<std::unique_ptr<LineMethod>> ComparedMethods(
+    const CompareOptions& options, const AppConfig& config, const std::optional<CameraFile>& camera,
+    bool stripes, CompareReport* report, std::vector<std::unique_ptr<LineMethod>> extra_methods) {
+  std::vector<std::unique_ptr<LineMethod>> methods;
+  methods.push_back(std::make_unique<OalMethod>(config.detector, camera));
+  methods.push_back(std::make_unique<OalTrackerMethod>(config.detector, camera));
+  methods.push_back(std::make_unique<VpMeLineMethod>(options.me, stripes));
+  using Kind = OpenCvMethod::Kind;
+  for (Kind kind : {Kind::kHoughCanny, Kind::kHoughOtsu, Kind::kHoughP, Kind::kLsd, Kind::kFld}) {
+    methods.push_back(std::make_unique<OpenCvMethod>(kind, stripes, config.detector.polarity,
+                                                     report->max_stripe_width_px, config.detector));
+  }
+  if (auto target = TargetMethod(options, config, camera, &report->warnings)) {
+    methods.push_back(std::move(target));
+  }
+  for (auto& extra : extra_methods) methods.push_back(std::move(extra));
+  return methods;
+}
+
+}  // namespace
+
 CompareReport RunComparison(const CompareOptions& options,
                             std::vector<std::unique_ptr<LineMethod>> extra_methods) {
   options.Check();
@@ -904,30 +1041,9 @@ CompareReport RunComparison(const CompareOptions& options,
   std::optional<CameraFile> camera;
   if (!options.camera_path.empty()) camera = LoadCameraFile(options.camera_path);
 
-  // Truth source.
-  std::map<int, std::vector<TargetLineTruth>> csv;
-  std::string json_dir;  // "" = next to the images
-  const bool truth_is_csv = !options.truth.empty() && fs::path(options.truth).extension() == ".csv";
-  if (truth_is_csv) {
-    if (camera) {
-      throw std::invalid_argument(
-          "--camera with a CSV truth: the CSV gives image-coordinate lines only, while --camera "
-          "makes our lines undistorted; drop one of them");
-    }
-    csv = LoadTruthCsv(options.truth);
-    if (csv.empty()) {
-      throw std::runtime_error("truth " + options.truth +
-                               " has no line row (frame,line,rho,theta): it matches no frame");
-    }
-    report.truth_source = "csv";
-  } else if (!options.truth.empty()) {
-    if (!fs::is_directory(options.truth)) {
-      throw std::runtime_error("truth '" + options.truth +
-                               "' is neither a .csv file nor a directory of frame JSON files");
-    }
-    json_dir = options.truth;
-    report.truth_source = "json";
-  }
+  const GivenTruth given = OpenGivenTruth(options, camera.has_value(), &report.truth_source);
+  const std::map<int, std::vector<TargetLineTruth>>& csv = given.csv;
+  const std::string& json_dir = given.json_dir;
 
   // Unexpected files skipped in a directory, and files after a pattern's gap, are warned
   // about (the truth JSON and camera.xml are expected there: no warning).
@@ -984,22 +1100,9 @@ CompareReport RunComparison(const CompareOptions& options,
     report.max_stripe_width_px = widest > 0.0 ? 1.5 * widest + 2.0 : 30.0;
   }
 
-  // The methods, ours first (without truth its lines are the targets of the trackers).
-  std::vector<std::unique_ptr<LineMethod>> methods;
-  auto oal = std::make_unique<OalMethod>(config.detector, camera);
-  OalMethod* ours = oal.get();
-  methods.push_back(std::move(oal));
-  methods.push_back(std::make_unique<OalTrackerMethod>(config.detector, camera));
-  methods.push_back(std::make_unique<VpMeLineMethod>(options.me, stripes));
-  using Kind = OpenCvMethod::Kind;
-  for (Kind kind : {Kind::kHoughCanny, Kind::kHoughOtsu, Kind::kHoughP, Kind::kLsd, Kind::kFld}) {
-    methods.push_back(std::make_unique<OpenCvMethod>(kind, stripes, config.detector.polarity,
-                                                     report.max_stripe_width_px, config.detector));
-  }
-  if (auto target = TargetMethod(options, config, camera, &report.warnings)) {
-    methods.push_back(std::move(target));
-  }
-  for (auto& extra : extra_methods) methods.push_back(std::move(extra));
+  std::vector<std::unique_ptr<LineMethod>> methods =
+      ComparedMethods(options, config, camera, stripes, &report, std::move(extra_methods));
+  const OalMethod* ours = static_cast<const OalMethod*>(methods.front().get());
   for (const auto& method : methods) {
     MethodResult result;
     result.name = method->Name();
@@ -1076,70 +1179,11 @@ CompareReport RunComparison(const CompareOptions& options,
     }
   }
   if (report.truth_source == "csv") {
-    std::vector<int> truth_frames;
-    for (const auto& [number, rows] : csv) truth_frames.push_back(number);
-    const std::size_t without = csv_frames_without_truth.size();
-    if (without == csv_frames_seen.size()) {
-      throw std::runtime_error("truth " + options.truth + " matches no frame of " + options.input +
-                               ": its rows are for frames " + FrameRanges(truth_frames) +
-                               ", the input's frames are " + FrameRanges(csv_frames_seen) +
-                               " (frame = the last number in the file name)");
-    }
-    if (without > 0) {
-      report.warnings.push_back(
-          std::to_string(without) + " of " + std::to_string(csv_frames_seen.size()) +
-          " frames have no row in truth " + options.truth + " (frames " +
-          FrameRanges(csv_frames_without_truth) + "): scored as frames without target lines");
-    }
+    CheckCsvCoverage(options, csv, csv_frames_seen, csv_frames_without_truth, &report.warnings);
   }
   if (options.out_dir.empty()) return report;
 
-  // Figures: first, middle, and the frame worst for us (most lines missed, then the largest
-  // number of spurious lines); a second pass over the input fetches them.
-  std::vector<int> chosen{0, report.frames / 2};
-  if (has_truth) {
-    const MethodResult& us = report.methods[0];
-    int worst = 0;
-    for (int f = 1; f < report.frames; ++f) {
-      if (us.missed_per_frame[static_cast<std::size_t>(f)] >
-          us.missed_per_frame[static_cast<std::size_t>(worst)]) {
-        worst = f;
-      }
-    }
-    chosen.push_back(worst);
-  } else {
-    chosen.push_back(report.frames - 1);
-  }
-  std::sort(chosen.begin(), chosen.end());
-  chosen.erase(std::unique(chosen.begin(), chosen.end()), chosen.end());
-  if (static_cast<int>(chosen.size()) > options.figures)
-    chosen.resize(static_cast<std::size_t>(options.figures));
-
-  fs::create_directories(options.out_dir);
-  const fs::path dir(options.out_dir);
-  std::vector<std::unique_ptr<AtomicFile>> files;
-  if (!chosen.empty()) {
-    std::vector<bool> undistorted;
-    for (const auto& method : methods) undistorted.push_back(method->Undistorted());
-    std::unique_ptr<ImageSource> again = OpenImageSource(options.input);
-    for (int f = 0; f <= chosen.back() && again->Next(&frame); ++f) {
-      if (!std::binary_search(chosen.begin(), chosen.end(), f)) continue;
-      const cv::Mat figure = Figure(frame.gray, f, report, truth_per_frame, undistorted, camera);
-      std::vector<unsigned char> png;
-      if (!cv::imencode(".png", figure, png)) {
-        throw std::runtime_error("cannot encode " + (dir / FigureName(f)).string());
-      }
-      files.push_back(std::make_unique<AtomicFile>(dir / FigureName(f)));
-      files.back()->stream().write(reinterpret_cast<const char*>(png.data()),
-                                   static_cast<std::streamsize>(png.size()));
-      report.figures.push_back((dir / FigureName(f)).string());
-    }
-  }
-  files.push_back(std::make_unique<AtomicFile>(dir / "compare.md"));
-  files.back()->stream() << CompareMarkdown(report);
-  files.push_back(std::make_unique<AtomicFile>(dir / "compare.json"));
-  files.back()->stream() << CompareJson(report).dump(2) << '\n';
-  for (auto& file : files) file->Commit();
+  WriteComparisonFiles(options, methods, truth_per_frame, camera, &report);
   return report;
 }
 
