@@ -142,16 +142,16 @@ vpHomogeneousMatrix SafeRobot::BoxFramePose(RobotFrame frame,
   return wMx * robot_.eMc();                                              // wMc = wMe * eMc
 }
 
-int SafetyOptions::AxisOutsideWorkspace(const vpTranslationVector& p) const {
+int SafetyOptions::AxisOutsideWorkspace(const std::array<double, 3>& p) const {
   if (!workspace_enabled) return -1;
-  for (unsigned i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < 3; ++i) {
     if (!(p[i] >= workspace_min_m[i] && p[i] <= workspace_max_m[i])) return static_cast<int>(i);
   }
   return -1;
 }
 
 std::string SafetyOptions::OutsideWorkspace(const vpTranslationVector& p) const {
-  const int axis = AxisOutsideWorkspace(p);
+  const int axis = AxisOutsideWorkspace({p[0], p[1], p[2]});
   if (axis < 0) return "";
   const auto i = static_cast<std::size_t>(axis);
   std::ostringstream s;
@@ -161,14 +161,15 @@ std::string SafetyOptions::OutsideWorkspace(const vpTranslationVector& p) const 
 }
 
 RobotResult SafeRobot::CheckInBox(const vpHomogeneousMatrix& wMb, const std::string& what) const {
-  const vpTranslationVector p = wMb.getTranslationVector();
+  // Read in place: the path check calls this for every sample of a move.
+  const std::array<double, 3> p{wMb[0][3], wMb[1][3], wMb[2][3]};
   const int axis = options_.AxisOutsideWorkspace(p);
   if (axis < 0) return RobotResult::Ok();
   const auto i = static_cast<std::size_t>(axis);
   std::ostringstream s;
   s << what << " would take the " << ToString(options_.workspace_frame) << " to " << kBoxAxis[i]
-    << " = " << p[static_cast<unsigned>(axis)] << " m, outside the workspace box ["
-    << options_.workspace_min_m[i] << ", " << options_.workspace_max_m[i] << "] m";
+    << " = " << p[i] << " m, outside the workspace box [" << options_.workspace_min_m[i] << ", "
+    << options_.workspace_max_m[i] << "] m";
   return RobotResult::Fail(RobotStatus::kWorkspace, s.str());
 }
 

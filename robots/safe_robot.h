@@ -72,7 +72,7 @@ struct SafetyOptions {
   void Check() const;
   /// The first axis (0 x, 1 y, 2 z) on which `p`, a position of workspace_frame in the world
   /// frame, m, lies outside the workspace box; -1 when it is inside or the box is disabled.
-  int AxisOutsideWorkspace(const vpTranslationVector& p) const;
+  int AxisOutsideWorkspace(const std::array<double, 3>& p) const;
   /// Why `p` lies outside the box, e.g. "z = 1.2 m is outside [0.1, 1] m"; "" when it is
   /// inside or the box is disabled.
   std::string OutsideWorkspace(const vpTranslationVector& p) const;
