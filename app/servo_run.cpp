@@ -11,12 +11,24 @@
 #include "base/format.h"
 
 namespace oal {
+namespace {
+
+// goal.image read into the setup, with the name its messages give it ("FILE:LINE: goal.image
+// 'x.png'"); throws std::runtime_error saying so when it cannot be read.
+void ReadGoalImage(const ServoAppConfig& config, ServoSetup* setup) {
+  setup->goal_image_name = config.goal_image_origin + ": goal.image '" + config.goal_image + "'";
+  setup->goal_image = cv::imread(config.goal_image, cv::IMREAD_GRAYSCALE);
+  if (setup->goal_image.empty()) {
+    throw std::runtime_error(setup->goal_image_name + ": cannot read or decode the image");
+  }
+}
+
+}  // namespace
 
 vpHomogeneousMatrix TeachGoal(const ServoAppConfig& config) {
-  const std::string where = config.goal_image_origin + ": goal.image '" + config.goal_image + "'";
-  const cv::Mat gray = cv::imread(config.goal_image, cv::IMREAD_GRAYSCALE);
-  if (gray.empty()) throw std::runtime_error(where + ": cannot read or decode the image");
-  return TeachGoal(ServoSetupOf(config), gray, where);
+  ServoSetup setup = ServoSetupOf(config);
+  ReadGoalImage(config, &setup);
+  return TeachGoal(setup, setup.goal_image, setup.goal_image_name);
 }
 
 void CheckServoConfig(const ServoAppConfig& config) {
@@ -63,13 +75,7 @@ ServoRunReport RunServo(const ServoAppConfig& config, std::ostream& log,
     if (hooks.on_move_poll) hooks.on_move_poll(move_iteration, poll);
   });
   if (hooks.wrap_driver) rig.driver = hooks.wrap_driver(std::move(rig.driver));
-  if (!config.goal_image.empty()) {
-    setup.goal_image_name = config.goal_image_origin + ": goal.image '" + config.goal_image + "'";
-    setup.goal_image = cv::imread(config.goal_image, cv::IMREAD_GRAYSCALE);
-    if (setup.goal_image.empty()) {
-      throw std::runtime_error(setup.goal_image_name + ": cannot read or decode the image");
-    }
-  }
+  if (!config.goal_image.empty()) ReadGoalImage(config, &setup);
   ServoLoopHooks loop_hooks = hooks;
   loop_hooks.on_move = [&hooks, &move_iteration](int iteration) {
     move_iteration = iteration;
