@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "app/accuracy_frames.h"
+#include "app/evaluation_config.h"
 #include "calibration/calibrate.h"
 
 namespace oal {

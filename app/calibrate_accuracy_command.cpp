@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/accuracy_frames.h"
 #include "app/calibrate_accuracy.h"
 #include "app/command_line.h"
+#include "app/evaluation_config.h"
 #include "base/format.h"
 
 namespace oal {

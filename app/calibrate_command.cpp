@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "app/accuracy_frames.h"
 #include "app/command_line.h"
+#include "app/evaluation_config.h"
 #include "app/sheet_views.h"
 #include "base/format.h"
 #include "calibration/calibrate.h"

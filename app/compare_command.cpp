@@ -5,14 +5,17 @@
 #include <optional>
 
 #include "app/command_line.h"
-#include "app/compare.h"
+#include "app/evaluation_config.h"
+#include "eval/compare.h"
 #include "io/json_io.h"
+#include "io/quiet_stderr.h"
 
 namespace oal {
 
 int RunCompare(int argc, char** argv) {
   CompareOptions options;
   std::string target_kind = "auto";
+  std::string config_path;
   bool verbose = false;
   CLI::App cli(
       "Run our OAL detector, ViSP's vpMeLine and OpenCV's line detectors on the same frames "
@@ -25,7 +28,7 @@ int RunCompare(int argc, char** argv) {
   cli.add_option("--truth", options.truth,
                  "truth: a directory of frame_NNNN.json files, or a CSV with rows "
                  "frame,line,rho,theta (default: the .json next to each image)");
-  cli.add_option("--config", options.config_path, "YAML configuration of our detector")
+  cli.add_option("--config", config_path, "YAML configuration of our detector")
       ->check(CLI::ExistingFile);
   cli.add_option("--camera", options.camera_path,
                  "ViSP camera XML: our detector undistorts its points and is scored against the "
@@ -64,6 +67,7 @@ int RunCompare(int argc, char** argv) {
                                                 {"VpMeLineOptions::range_px", "--me-range"},
                                                 {"VpMeLineOptions::threshold", "--me-threshold"},
                                                 {"VpMeLineOptions::sample_step_px", "--me-step"}});
+  options.setup = TrackerSetupOf(config_path, {options.input});
   CompareReport report;
   {
     std::optional<QuietStderr> quiet;

@@ -932,10 +932,10 @@ void ReadTrackingSection(const YAML::Node& section, const std::string& file, App
 }
 
 // ------------------------------------------------------------------------------------------
-// `scene:`: SceneConfig.
+// `scene:`: SceneOptions.
 
-const std::vector<Field<SceneConfig>>& SceneFields() {
-  using O = SceneConfig;
+const std::vector<Field<SceneOptions>>& SceneFields() {
+  using O = SceneOptions;
   static const std::vector<Field<O>> fields = {
       {"background",
        [](const Value& value, O* scene) {
@@ -970,19 +970,19 @@ const std::vector<Field<SceneConfig>>& SceneFields() {
 // The scene's values are checked by RenderOptions::Check(): through a render of its own,
 // named by the keys (RenderOptions' fields are the keys but for the units at the edge).
 struct SceneCheck {
-  const SceneConfig& scene;
+  const SceneOptions& scene;
   void Check() const {
     if (scene.seed < 0) {
-      throw std::invalid_argument("SceneConfig::seed = " + std::to_string(scene.seed) +
+      throw std::invalid_argument("SceneOptions::seed = " + std::to_string(scene.seed) +
                                   ". Violated constraint: seed >= 0");
     }
     RequireOption(scene.background_gain >= 0.0 && scene.background_gain <= 4.0,
-                  "SceneConfig::background_gain", scene.background_gain,
+                  "SceneOptions::background_gain", scene.background_gain,
                   "0 <= background_gain <= 4");
-    RequireOption(std::fabs(scene.background_offset) <= 255.0, "SceneConfig::background_offset",
+    RequireOption(std::fabs(scene.background_offset) <= 255.0, "SceneOptions::background_offset",
                   scene.background_offset, "-255 <= background_offset <= 255");
     RenderOptions render;
-    SceneConfig without_image = scene;
+    SceneOptions without_image = scene;
     without_image.background.clear();  // read when used, with its own message
     without_image.ApplyTo(&render);
     try {
@@ -991,15 +991,15 @@ struct SceneCheck {
       std::string message = error.what();
       // "RenderOptions::shadow_angle_rad = ..." -> the key the user wrote.
       const std::string prefix = "RenderOptions::";
-      if (message.rfind(prefix, 0) == 0) message = "SceneConfig::" + message.substr(prefix.size());
+      if (message.rfind(prefix, 0) == 0) message = "SceneOptions::" + message.substr(prefix.size());
       for (const auto& [field, key] :
            {std::pair<const char*, const char*>{"illumination_gradient", "gradient"},
             {"gradient_angle_rad", "gradient_angle_deg"},
             {"shadow_angle_rad", "shadow_angle_deg"},
             {"scene_seed", "seed"}}) {
-        const std::string from = std::string("SceneConfig::") + field + " ";
+        const std::string from = std::string("SceneOptions::") + field + " ";
         if (message.rfind(from, 0) == 0)
-          message = std::string("SceneConfig::") + key + message.substr(from.size() - 1);
+          message = std::string("SceneOptions::") + key + message.substr(from.size() - 1);
       }
       throw std::invalid_argument(message);
     }
@@ -1008,7 +1008,7 @@ struct SceneCheck {
 
 void ReadSceneSection(const YAML::Node& section, const std::string& file, AppConfig* config) {
   Lines lines;
-  SceneConfig scene = config->scene;
+  SceneOptions scene = config->scene;
   ReadFields(section, file, "scene", SceneFields(), "", &scene, &lines);
   CheckAt(SceneCheck{scene}, file, "scene", lines);
   config->scene = std::move(scene);
@@ -1149,49 +1149,6 @@ namespace {
 std::string AppConfig::Origin(const std::string& key) const {
   const auto origin = origins.find(key);
   return origin == origins.end() ? "" : origin->second;
-}
-
-void SceneConfig::ApplyTo(RenderOptions* render) const {
-  constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-  render->background_texel_m = background_texel_m;
-  render->background_grey = background_grey;
-  render->illumination_gradient = gradient;
-  render->gradient_angle_rad = gradient_angle_deg * kRadPerDeg;
-  render->vignetting = vignetting;
-  render->hot_spot_gain = hot_spot_gain;
-  render->hot_spot_u = hot_spot_u;
-  render->hot_spot_v = hot_spot_v;
-  render->hot_spot_sigma = hot_spot_sigma;
-  render->shadow_darkness = shadow_darkness;
-  render->shadow_offset_m = shadow_offset_m;
-  render->shadow_angle_rad = shadow_angle_deg * kRadPerDeg;
-  render->shadow_softness_m = shadow_softness_m;
-  render->paper_texture_grey = paper_texture_grey;
-  render->annotations = annotations;
-  render->clutter_sheets = clutter_sheets;
-  render->clutter_objects = clutter_objects;
-  render->clutter_reach_m = clutter_reach_m;
-  render->scene_seed = static_cast<std::uint64_t>(seed);
-  render->background.reset();
-  if (background.empty()) return;
-  const std::string where = (background_origin.empty() ? "" : background_origin + ": ") +
-                            "scene.background '" + background + "'";
-  try {
-    render->background = Surface(ReadGrayImage(background));
-  } catch (const std::runtime_error& error) {
-    throw std::runtime_error(where + ": " + error.what());
-  }
-}
-
-std::shared_ptr<const vpImage<unsigned char>> SceneConfig::Surface(
-    std::shared_ptr<const vpImage<unsigned char>> photo) const {
-  if (background_gain == 1.0 && background_offset == 0.0) return photo;
-  auto surface = std::make_shared<vpImage<unsigned char>>(*photo);
-  for (unsigned int i = 0; i < surface->getSize(); ++i) {
-    const long grey = std::lround(background_gain * surface->bitmap[i] + background_offset);
-    surface->bitmap[i] = static_cast<unsigned char>(std::clamp(grey, 0L, 255L));
-  }
-  return surface;
 }
 
 vpCameraParameters CameraConfig::Camera() const {

@@ -23,7 +23,7 @@
 //                            # command (--camera, the detector, the frame), not from here
 //
 //   tracking: {scan: image}  # oal::TargetTrackerOptions (config/pose.yaml documents the keys)
-//   scene:                   # SceneConfig: what a rendered camera sees around the target
+//   scene:                   # SceneOptions: what a rendered camera sees around the target
 //     background: bench.png  # (config/servo-sim.yaml, config/scene-dark-table.yaml)
 //
 // The servo app's sections (config/servo-sim.yaml documents every key):
@@ -55,6 +55,7 @@
 #include <string>
 
 #include "detector/options.h"
+#include "io/scene_options.h"
 #include "loop/servo_loop.h"
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"
@@ -160,47 +161,6 @@ struct OutputConfig {
   void Check() const;
 };
 
-/// `scene:` the world a rendered camera sees around the target (the simulated camera of
-/// `servo`, and `render`, `demo` and the accuracy commands given --config): the surface the
-/// sheet lies on, its light, its shadow, what is printed beside the target and what else lies
-/// on the bench (scene/scene.h RenderOptions states each effect).
-struct SceneConfig {
-  /// An image of the surface (relative paths: relative to the config file); empty: a uniform
-  /// grey surface of background_grey.
-  std::string background;
-  std::string background_origin;      ///< "FILE:LINE" of scene.background, for messages
-  double background_texel_m = 0.002;  ///< one background pixel on the plane, m, (0, 1]
-  int background_grey = 90;           ///< [0, 255]
-  /// The background image's greys become background_gain * grey + background_offset (clipped
-  /// to [0, 255]): a darker, paler or flatter surface from the same photograph.
-  double background_gain = 1.0;     ///< [0, 4]
-  double background_offset = 0.0;   ///< grey levels, [-255, 255]
-  double gradient = 0.0;            ///< light falls linearly by this across the image, [0, 0.9]
-  double gradient_angle_deg = 0.0;  ///< its direction, degrees, finite
-  double vignetting = 0.0;          ///< radial fall-off, [0, 0.9]
-  double hot_spot_gain = 0.0;       ///< [0, 2]
-  double hot_spot_u = 0.5, hot_spot_v = 0.5;  ///< fractions of width, height, [-2, 3]
-  double hot_spot_sigma = 0.4;                ///< fraction of the diagonal, [0.01, 10]
-  double shadow_darkness = 0.0;               ///< [0, 0.95]
-  double shadow_offset_m = 0.006;             ///< [0, 0.1]
-  double shadow_angle_deg = 45.0;             ///< finite
-  double shadow_softness_m = 0.003;           ///< [0, 0.05]
-  double paper_texture_grey = 0.0;            ///< [0, 20]
-  bool annotations = false;                   ///< the target's printed marks
-  int clutter_sheets = 0;                     ///< [0, 10]
-  int clutter_objects = 0;                    ///< [0, 50]
-  double clutter_reach_m = 0.3;               ///< (0, 10]
-  int seed = 1;                               ///< the clutter's layout, >= 0
-
-  /// Copies the effects into `render` and reads the background image. Throws
-  /// std::runtime_error "FILE:LINE: scene.background ..." when it cannot be read, and
-  /// std::invalid_argument for values RenderOptions::Check() rejects.
-  void ApplyTo(RenderOptions* render) const;
-  /// `photo` with background_gain and background_offset applied (itself when they are 1, 0).
-  std::shared_ptr<const vpImage<unsigned char>> Surface(
-      std::shared_ptr<const vpImage<unsigned char>> photo) const;
-};
-
 /// Everything a configuration file can set. A new section is a member here plus one row in
 /// config.cpp's section table.
 struct AppConfig {
@@ -210,7 +170,7 @@ struct AppConfig {
   PoseOptions pose;  ///< `pose:`; its camera, lines_undistorted and image size stay as given
   /// `tracking:` where the target is looked for in each frame (servo/target_tracker.h).
   TargetTrackerOptions tracking;
-  SceneConfig scene;       ///< `scene:`
+  SceneOptions scene;      ///< `scene:`
   CameraConfig camera;     ///< `camera:`
   RobotConfig robot;       ///< `robot:`
   ServoLoopOptions servo;  ///< `servo:` (loop/servo_loop.h)

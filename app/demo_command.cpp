@@ -13,8 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/accuracy_frames.h"
 #include "app/command_line.h"
+#include "app/evaluation_config.h"
 #include "app/render_command.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
@@ -184,7 +184,7 @@ SheetScene MakeSheetScene(const LineTarget& target) {
   scene.render.camera = RenderCamera(640, 480, 600.0, 0.15);
   scene.render.noise_sigma = 4.0;
   scene.render.blur_sigma_px = 1.0;
-  const SceneConfig bench = BenchScene();
+  const SceneOptions bench = BenchScene();
   bench.ApplyTo(&scene.render);
   std::vector<std::string> photos;
   try {

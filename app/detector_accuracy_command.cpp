@@ -6,10 +6,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/accuracy_frames.h"
 #include "app/command_line.h"
 #include "app/config.h"
-#include "app/detector_accuracy.h"
+#include "app/evaluation_config.h"
+#include "base/statistics.h"
+#include "eval/detector_accuracy.h"
 
 namespace oal {
 namespace {

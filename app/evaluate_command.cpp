@@ -4,7 +4,8 @@
 #include <iostream>
 
 #include "app/command_line.h"
-#include "app/evaluate.h"
+#include "app/evaluation_config.h"
+#include "eval/evaluate.h"
 
 namespace oal {
 
@@ -12,6 +13,7 @@ int RunEvaluate(int argc, char** argv) {
   EvaluateOptions options;
   std::string shard;
   bool no_video = false;
+  std::string config_path;
   CLI::App cli(
       "Evaluate the line tracker and the pose on recorded videos or image sequences: per-frame "
       "JSON Lines, a summary (detection rate, lost-track episodes, pose availability, errors "
@@ -24,7 +26,7 @@ int RunEvaluate(int argc, char** argv) {
                  "of videos and image directories")
       ->required();
   cli.add_option("--out", options.out_dir, "output directory (created if missing)")->required();
-  cli.add_option("--config", options.config_path,
+  cli.add_option("--config", config_path,
                  "YAML configuration: detector, target and pose sections (default: the "
                  "target.yaml `oalservo render` writes next to its frames, else the A3 sheet)")
       ->check(CLI::ExistingFile);
@@ -74,6 +76,7 @@ int RunEvaluate(int argc, char** argv) {
     }
   }
   options.write_video = !no_video;
+  options.setup = TrackerSetupOf(config_path, options.inputs);
   const EvaluateResult result = Evaluate(options, FrameProgress("evaluate: frame"));
   int failed = 0, resumed = 0;
   for (const InputOutcome& input : result.inputs) {

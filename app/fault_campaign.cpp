@@ -24,10 +24,10 @@
 #include <thread>
 #include <utility>
 
-#include "app/detector_accuracy.h"  // Quantile
 #include "app/servo_command.h"
 #include "app/servo_rig.h"
 #include "base/check.h"
+#include "base/statistics.h"
 #include "robots/scorbot_controller_sim.h"
 
 namespace oal {

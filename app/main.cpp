@@ -28,6 +28,7 @@
 #include "app/servo_accuracy_command.h"
 #include "app/servo_command.h"
 #include "app/target_command.h"
+#include "io/quiet_stderr.h"
 
 #ifndef OAL_VERSION
 #define OAL_VERSION "unknown"

@@ -7,12 +7,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/accuracy_frames.h"
 #include "app/command_line.h"
 #include "app/config.h"
-#include "app/detector_accuracy.h"  // Quantile
-#include "app/pose_accuracy.h"
+#include "app/evaluation_config.h"
 #include "base/format.h"
+#include "base/statistics.h"
+#include "eval/pose_accuracy.h"
 #include "servo/pose.h"
 
 namespace oal {

@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "app/accuracy_frames.h"  // AddSeedOption
 #include "app/command_line.h"
 #include "app/config.h"
+#include "app/evaluation_config.h"  // AddSeedOption
 #include "base/check.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
@@ -36,9 +36,9 @@ std::string FrameName(int index, const char* extension) {
 
 // The render of the options: the config's scene (if any), then the command line's camera,
 // noise, blur and light; --background replaces the scene's surface.
-RenderOptions ToRenderOptions(const RenderCommandOptions& options, const SceneConfig& scene) {
+RenderOptions ToRenderOptions(const RenderCommandOptions& options, const SceneOptions& scene) {
   RenderOptions render;
-  SceneConfig surface = scene;
+  SceneOptions surface = scene;
   if (!options.background_image.empty()) {
     surface.background = options.background_image;
     surface.background_origin = "--background";
@@ -253,9 +253,9 @@ AppConfig ConfigOf(const RenderCommandOptions& options) {
 // fall-off, shadow, marks, clutter) or --background; the scene's gradient, when it sets one,
 // replaces the sequence's.
 RenderOptions SequenceRenderOptions(const RenderCommandOptions& options, const Sequence& sequence,
-                                    const SceneConfig& scene) {
+                                    const SceneOptions& scene) {
   RenderOptions render = sequence.options;
-  SceneConfig surface = scene;
+  SceneOptions surface = scene;
   if (!options.background_image.empty()) {
     surface.background = options.background_image;
     surface.background_origin = "--background";

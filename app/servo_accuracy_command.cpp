@@ -11,11 +11,11 @@
 #include <sstream>
 
 #include "app/command_line.h"
-#include "app/detector_accuracy.h"  // Quantile
 #include "app/fault_campaign.h"
 #include "app/servo_accuracy.h"
 #include "app/servo_command.h"
 #include "app/servo_output.h"
+#include "base/statistics.h"
 #include "io/atomic_file.h"
 
 namespace oal {

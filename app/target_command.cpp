@@ -16,6 +16,7 @@
 
 #include "app/command_line.h"
 #include "app/config.h"
+#include "base/format.h"
 #include "io/atomic_file.h"
 
 namespace oal {

@@ -23,4 +23,32 @@ inline std::string Number(double value, int significant = 6) {
   return text.str();
 }
 
+/// `text` with & < > " ' escaped, for HTML and XML (SVG) text and attribute values.
+inline std::string MarkupEscaped(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace oal

@@ -1,6 +1,6 @@
 # `cmake --install build [--prefix DIR]`: the oalservo executable in bin/, the example
 # configurations in share/oalservo/config/, and the libraries (base, detector, target, scene,
-# servo, robots, calibration, io, loop) with their headers and a CMake package, so that
+# servo, robots, calibration, io, loop, eval) with their headers and a CMake package, so that
 # another project can write
 #
 #   find_package(oalservo 0.1 REQUIRED)
@@ -12,7 +12,7 @@
 include(CMakePackageConfigHelpers)
 
 set(OAL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/oalservo)
-foreach(folder base detector target scene servo robots calibration io loop)
+foreach(folder base detector target scene servo robots calibration io loop eval)
   set_target_properties(oal_${folder} PROPERTIES EXPORT_NAME ${folder})
   install(TARGETS oal_${folder} EXPORT oalservoTargets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

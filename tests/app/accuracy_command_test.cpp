@@ -13,8 +13,8 @@
 
 #include "app/command_line.h"
 #include "app/detector_accuracy_command.h"
-#include "app/pose_accuracy.h"
 #include "app/pose_accuracy_command.h"
+#include "eval/pose_accuracy.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
 

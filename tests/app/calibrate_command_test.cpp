@@ -10,7 +10,7 @@
 #include <opencv2/videoio.hpp>
 #include <string>
 
-#include "app/accuracy_frames.h"
+#include "app/evaluation_config.h"
 #include "io/camera_file.h"
 #include "scene/bench_scene.h"
 #include "tests/app/command_test_util.h"

@@ -1,4 +1,4 @@
-#include "app/compare.h"
+#include "eval/compare.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -12,8 +12,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "app/evaluation_config.h"
 #include "app/render_command.h"
-#include "app/truth_file.h"
+#include "eval/truth_file.h"
 #include "io/camera_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
@@ -24,6 +25,12 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using ::testing::HasSubstr;
+
+// RunComparison as `oalservo compare` runs it: the target from the target.yaml beside the frames.
+CompareReport RunAsTheCommand(CompareOptions options) {
+  options.setup = TrackerSetupOf("", {options.input});
+  return RunComparison(options);
+}
 
 constexpr int kFrames = 6;
 const char* const kMethods[] = {"oal",
@@ -52,7 +59,7 @@ bool AnyContains(const std::vector<std::string>& texts, const std::string& part)
 
 // The message RunComparison throws with, or "" if it succeeds.
 std::string CompareError(const CompareOptions& options) {
-  return test::ErrorMessageOf([&] { RunComparison(options); });
+  return test::ErrorMessageOf([&] { RunAsTheCommand(options); });
 }
 
 TEST(Compare, RenderedSequenceGivesOneRowPerMethod) {
@@ -60,7 +67,7 @@ TEST(Compare, RenderedSequenceGivesOneRowPerMethod) {
   CompareOptions options;
   options.input = RenderShort(dir);
   options.out_dir = dir / "out";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_EQ(report.truth_source, "json");
   EXPECT_EQ(report.frames, kFrames);
   ASSERT_EQ(report.methods.size(), std::size(kMethods));
@@ -131,7 +138,7 @@ TEST(Compare, ASheetSequenceAddsTheTargetTrackersRow) {
   CompareOptions options;
   options.input = test::RenderChecked(render);
   options.camera_path = dir / "sheet/camera.xml";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   ASSERT_EQ(report.methods.size(), std::size(kMethods) + 1);
   const MethodResult& target = report.methods.back();
   EXPECT_EQ(target.name, "oal-target");
@@ -146,7 +153,7 @@ TEST(Compare, ATargetWithoutACameraIsWarnedAbout) {
   test::TestDir dir;
   CompareOptions options;
   options.input = RenderShort(dir);
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_EQ(report.methods.size(), std::size(kMethods));
   EXPECT_TRUE(AnyContains(report.warnings, "give the camera file (--camera)"))
       << ::testing::PrintToString(report.warnings);
@@ -170,7 +177,7 @@ TEST(Compare, CsvTruthIsReadAndScored) {
   CompareOptions options;
   options.input = data;
   options.truth = dir / "truth.csv";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_EQ(report.truth_source, "csv");
   EXPECT_EQ(report.methods[0].truth_lines, kFrames * 4);
   EXPECT_EQ(report.methods[0].frames_all_found, kFrames);
@@ -230,7 +237,7 @@ TEST(Compare, WithoutTruthOnlyTimes) {
   }
   CompareOptions options;
   options.input = dir / "images";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_EQ(report.truth_source, "none");
   EXPECT_EQ(report.frames, 3);
   EXPECT_THAT(CompareMarkdown(report), HasSubstr("| vpMeLine |"));
@@ -282,7 +289,7 @@ TEST(Compare, FramesWithoutCsvTruthAreWarnedAbout) {
   options.target_kind = TargetKind::kEdges;
   test::WriteText(dir / "truth.csv", "frame,line,rho,theta\n0,0,31.5,0\n2,0,31.5,0\n");
   options.truth = dir / "truth.csv";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_EQ(report.frames, 4);
   EXPECT_EQ(report.methods[0].truth_lines, 2);
   const std::string expected = "2 of 4 frames have no row in truth " + options.truth;
@@ -321,7 +328,7 @@ TEST(Compare, TinyImagesGiveAWarningNamingFrameAndSize) {
     options.out_dir = dir / "out";
     const std::string size = std::to_string(width) + "x" + std::to_string(height) + " px";
     CompareReport report;
-    ASSERT_NO_THROW(report = RunComparison(options)) << size;
+    ASSERT_NO_THROW(report = RunAsTheCommand(options)) << size;
     EXPECT_EQ(report.frames, 2);
     // Some OpenCV method cannot run on such an image: a warning, no raw assertion.
     EXPECT_TRUE(AnyContains(report.warnings, "could not run on 2 frames (first: frame 0 '"))
@@ -337,7 +344,7 @@ TEST(Compare, APatternWithAGapIsWarnedAbout) {
   fs::remove(fs::path(images) / "frame_0002.png");
   CompareOptions options;
   options.input = images + "/frame_%04d.png";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_EQ(report.frames, 2);
   EXPECT_TRUE(AnyContains(report.warnings, "the sequence ends at the missing file"))
       << ::testing::PrintToString(report.warnings);
@@ -351,14 +358,14 @@ TEST(Compare, CameraForAnotherImageSizeIsWarnedAbout) {
   CompareOptions options;
   options.input = WriteEdgeImages(dir / "images", 2, 64, 48);
   options.camera_path = dir / "camera.xml";
-  const CompareReport report = RunComparison(options);
+  const CompareReport report = RunAsTheCommand(options);
   EXPECT_TRUE(AnyContains(report.warnings, "calibrated for 640x480"))
       << ::testing::PrintToString(report.warnings);
   EXPECT_TRUE(AnyContains(report.warnings, "is 64x48"));
 
   // The right size: no such warning.
   SaveCameraFile(dir / "camera.xml", camera, "cam", 64, 48);
-  EXPECT_FALSE(AnyContains(RunComparison(options).warnings, "calibrated for"));
+  EXPECT_FALSE(AnyContains(RunAsTheCommand(options).warnings, "calibrated for"));
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "app/evaluate.h"
+#include "eval/evaluate.h"
 
 #include <fcntl.h>
 #include <gmock/gmock.h>
@@ -28,10 +28,12 @@
 #include <vector>
 
 #include "app/command_line.h"
+#include "app/evaluation_config.h"
 #include "app/render_command.h"
-#include "app/report.h"
-#include "app/truth_file.h"
+#include "eval/report.h"
+#include "eval/truth_file.h"
 #include "io/camera_file.h"
+#include "io/quiet_stderr.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
 
@@ -118,6 +120,7 @@ EvaluateOptions Options(const std::vector<std::string>& inputs, const std::strin
   options.inputs = inputs;
   options.out_dir = out;
   options.thumbnails = 3;
+  options.setup = TrackerSetupOf("", inputs);  // as `oalservo evaluate` reads it
   return options;
 }
 
@@ -136,76 +139,6 @@ std::map<std::string, std::string> DeterministicFiles(const fs::path& dir) {
     files[fs::relative(entry.path(), dir).string()] = std::move(bytes);
   }
   return files;
-}
-
-TEST(TruthFile, ReadsLineAndPoseRowsAndRejectsBadOnes) {
-  test::TestDir dir;
-  test::WriteText(dir / "t.csv",
-                  "frame,line,rho,theta\n# comment\n\n3,0,10.5,0.25\n3,1,-4,3.5\n"
-                  "3,pose,0.1,0.2,0.5,0,0,0.3\n");
-  const TruthCsv truth = LoadTruthCsvWithPoses(dir / "t.csv");
-  ASSERT_EQ(truth.lines.at(3).size(), 2u);
-  EXPECT_DOUBLE_EQ(truth.lines.at(3)[0].image_line.rho_px, 10.5);
-  EXPECT_NEAR(truth.lines.at(3)[1].image_line.theta_rad, 3.5 - kPi, 1e-12);
-  const vpHomogeneousMatrix& cMo = truth.poses.at(3);
-  EXPECT_DOUBLE_EQ(cMo[2][3], 0.5);
-  EXPECT_NEAR(vpThetaUVector(cMo.getRotationMatrix())[2], 0.3, 1e-12);
-
-  test::WriteText(dir / "bad.csv", "1,0,2\n");
-  EXPECT_THAT([&] { LoadTruthCsvWithPoses(dir / "bad.csv"); },
-              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("bad.csv:1: expected")));
-  test::WriteText(dir / "twice.csv", "1,pose,0,0,1,0,0,0\n1,pose,0,0,1,0,0,0\n");
-  EXPECT_THAT([&] { LoadTruthCsvWithPoses(dir / "twice.csv"); },
-              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("twice.csv:2: the pose")));
-}
-
-// What the process writes on descriptor 2 while `write` runs, through std::cerr and C's stderr.
-std::string CapturedStderr(const std::string& path, const std::function<void()>& write) {
-  std::cerr.flush();
-  std::fflush(stderr);
-  const int saved = ::dup(2);
-  const int file = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  EXPECT_GE(saved, 0);
-  EXPECT_GE(file, 0);
-  ::dup2(file, 2);
-  ::close(file);
-  write();
-  std::cerr.flush();
-  std::fflush(stderr);
-  ::dup2(saved, 2);
-  ::close(saved);
-  return test::ReadText(path);
-}
-
-TEST(EvaluateSharedHelpers, QuietStderrSilencesItsOwnThreadOnly) {
-  const test::TestDir dir;
-  const std::string written = CapturedStderr(dir / "stderr.txt", [] {
-    {
-      const QuietStderr quiet;
-      {
-        const QuietStderr nested;  // as a comparison inside an evaluation would
-        std::cerr << "quiet cerr\n";
-      }
-      std::fprintf(stderr, "quiet stdio\n");
-      vpERROR_TRACE("quiet visp");  // vpMeLine's way: std::cerr and C's stderr
-      // Another thread (another evaluate job) meanwhile: heard.
-      std::thread other([] {
-        std::cerr << "other cerr\n";
-        std::fprintf(stderr, "other stdio\n");
-      });
-      other.join();
-    }
-    std::cerr << "after cerr\n";
-    std::fprintf(stderr, "after stdio\n");
-  });
-  EXPECT_THAT(written, Not(HasSubstr("quiet")));
-  EXPECT_THAT(written, HasSubstr("other cerr\nother stdio\n"));
-  EXPECT_THAT(written, HasSubstr("after cerr\nafter stdio\n"));
-}
-
-TEST(EvaluateSharedHelpers, MarkupEscapedEscapesTheFiveCharacters) {
-  EXPECT_EQ(MarkupEscaped("a<b>&\"c\"'d'"), "a&lt;b&gt;&amp;&quot;c&quot;&apos;d&apos;");
-  EXPECT_EQ(MarkupEscaped("plain é"), "plain é");
 }
 
 std::atomic<int> g_sigint_callbacks{0};

@@ -4,8 +4,7 @@
 #include <exception>
 #include <string>
 
-#include "app/compare.h"
-#include "app/truth_file.h"
+#include "eval/truth_file.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

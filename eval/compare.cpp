@@ -1,4 +1,5 @@
-#include "app/compare.h"
+
+#include "eval/compare.h"
 
 #include <visp3/me/vpMe.h>
 #include <visp3/me/vpMeLine.h>
@@ -18,16 +19,14 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/accuracy_frames.h"  // ConfigHasSection
-#include "app/config.h"
-#include "app/detector_accuracy.h"
-#include "app/frame_command.h"  // CompanionFile
-#include "app/truth_file.h"
 #include "base/check.h"
 #include "base/format.h"
+#include "base/statistics.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "detector/tracker.h"
+#include "eval/opencv_methods.h"
+#include "eval/truth_file.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
@@ -39,567 +38,6 @@ namespace oal {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr double kRadToDeg = 180.0 / kPi;
-
-// ---------------------------------------------------------------------------------------
-// Line geometry helpers (image pixels, detector/line.h convention).
-
-// The point of `line` nearest to `p`.
-Point2d Foot(const LineParams& line, const Point2d& p) {
-  const double distance = line.SignedDistance(p.u, p.v);
-  return {p.u - distance * std::cos(line.theta_rad), p.v - distance * std::sin(line.theta_rad)};
-}
-
-// Distance from `b` of the point of `a` nearest to `centre`: how far apart two nearly
-// parallel lines are where it matters (rho alone depends on where the origin is).
-double DistanceAt(const LineParams& a, const LineParams& b, const Point2d& centre) {
-  const Point2d foot = Foot(a, centre);
-  return std::fabs(b.SignedDistance(foot.u, foot.v));
-}
-
-// The line half way between two nearly parallel lines.
-LineParams Midline(const LineParams& a, const LineParams& b, const Point2d& centre) {
-  const Point2d fa = Foot(a, centre), fb = Foot(b, centre);
-  double theta_b = b.theta_rad;
-  if (theta_b - a.theta_rad > kPi / 2) theta_b -= kPi;
-  if (a.theta_rad - theta_b > kPi / 2) theta_b += kPi;
-  const double theta = 0.5 * (a.theta_rad + theta_b);
-  const double u = 0.5 * (fa.u + fb.u), v = 0.5 * (fa.v + fb.v);
-  return Normalized(u * std::cos(theta) + v * std::sin(theta), theta);
-}
-
-// Angle (degrees) and offset (larger distance of the chord ends a, b from `line`).
-std::pair<double, double> ErrorOf(const LineParams& line, const LineParams& truth, const Point2d& a,
-                                  const Point2d& b) {
-  return {
-      AngleBetween(line, truth) * kRadToDeg,
-      std::max(std::fabs(line.SignedDistance(a.u, a.v)), std::fabs(line.SignedDistance(b.u, b.v)))};
-}
-
-// Drops lines within `angle_deg` and `distance_px` of a better (earlier) line.
-std::vector<LineParams> Deduplicated(const std::vector<LineParams>& lines, double angle_deg,
-                                     double distance_px, const Point2d& centre) {
-  std::vector<LineParams> kept;
-  for (const LineParams& line : lines) {
-    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const LineParams& k) {
-      return AngleBetween(k, line) * kRadToDeg <= angle_deg &&
-             DistanceAt(k, line, centre) <= distance_px;
-    });
-    if (!duplicate) kept.push_back(line);
-  }
-  return kept;
-}
-
-// Pairs the edge lines of stripes into centre lines (see compare.h).
-std::vector<LineParams> PairedEdges(const std::vector<LineParams>& lines, double max_width_px,
-                                    const Point2d& centre) {
-  constexpr double kPairAngleDeg = 2.0, kMinWidthPx = 1.0;
-  std::vector<bool> used(lines.size(), false);
-  std::vector<LineParams> out;
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    if (used[i]) continue;
-    used[i] = true;
-    std::size_t best = lines.size();
-    double best_distance = max_width_px;
-    for (std::size_t j = i + 1; j < lines.size(); ++j) {
-      if (used[j] || AngleBetween(lines[i], lines[j]) * kRadToDeg > kPairAngleDeg) continue;
-      const double distance = DistanceAt(lines[i], lines[j], centre);
-      if (distance >= kMinWidthPx && distance <= best_distance) {
-        best = j;
-        best_distance = distance;
-      }
-    }
-    if (best == lines.size()) {
-      out.push_back(lines[i]);
-    } else {
-      used[best] = true;
-      out.push_back(Midline(lines[i], lines[best], centre));
-    }
-  }
-  return out;
-}
-
-// Segments (x1, y1, x2, y2) merged into lines, ranked by total length (see compare.h).
-std::vector<LineParams> MergedSegments(const std::vector<cv::Vec4f>& segments) {
-  constexpr double kAngleDeg = 1.5, kDistancePx = 1.5;
-  struct Cluster {
-    LineParams line;
-    double length = 0.0;
-    double sw = 0.0, su = 0.0, sv = 0.0, suu = 0.0, suv = 0.0, svv = 0.0;  // weighted moments
-    void Add(const Point2d& p, double w) {
-      sw += w;
-      su += w * p.u;
-      sv += w * p.v;
-      suu += w * p.u * p.u;
-      suv += w * p.u * p.v;
-      svv += w * p.v * p.v;
-    }
-    void Refit() {
-      const double mu = su / sw, mv = sv / sw;
-      const double cuu = suu / sw - mu * mu, cuv = suv / sw - mu * mv, cvv = svv / sw - mv * mv;
-      // The normal is the eigenvector of the smaller eigenvalue of the covariance.
-      const double direction = 0.5 * std::atan2(2.0 * cuv, cuu - cvv);
-      const double theta = direction + kPi / 2;
-      line = Normalized(mu * std::cos(theta) + mv * std::sin(theta), theta);
-    }
-  };
-  std::vector<std::pair<double, std::size_t>> order;
-  for (std::size_t i = 0; i < segments.size(); ++i) {
-    const cv::Vec4f& s = segments[i];
-    order.emplace_back(std::hypot(s[2] - s[0], s[3] - s[1]), i);
-  }
-  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a > b; });
-  std::vector<Cluster> clusters;
-  for (const auto& [length, index] : order) {
-    const cv::Vec4f& s = segments[index];
-    const Point2d a{s[0], s[1]}, b{s[2], s[3]};
-    if (length < 1e-6) continue;
-    const LineParams own = LineThrough(a, b);
-    Cluster* home = nullptr;
-    for (Cluster& cluster : clusters) {
-      if (AngleBetween(cluster.line, own) * kRadToDeg <= kAngleDeg &&
-          std::fabs(cluster.line.SignedDistance(a.u, a.v)) <= kDistancePx &&
-          std::fabs(cluster.line.SignedDistance(b.u, b.v)) <= kDistancePx) {
-        home = &cluster;
-        break;
-      }
-    }
-    if (home == nullptr) {
-      clusters.emplace_back();
-      home = &clusters.back();
-      home->line = own;
-    }
-    home->Add(a, 0.5 * length);
-    home->Add(b, 0.5 * length);
-    home->length += length;
-    home->Refit();
-  }
-  std::stable_sort(clusters.begin(), clusters.end(),
-                   [](const Cluster& x, const Cluster& y) { return x.length > y.length; });
-  std::vector<LineParams> lines;
-  for (const Cluster& cluster : clusters) lines.push_back(cluster.line);
-  return lines;
-}
-
-cv::Mat MatOf(const vpImage<unsigned char>& image) {
-  return cv::Mat(static_cast<int>(image.getHeight()), static_cast<int>(image.getWidth()), CV_8UC1,
-                 const_cast<unsigned char*>(image.bitmap));
-}
-
-// ---------------------------------------------------------------------------------------
-// The methods.
-
-class OalMethod : public LineMethod {
- public:
-  OalMethod(const DetectorOptions& options, const std::optional<CameraFile>& camera)
-      : detector_(camera ? OalDetector(options, camera->camera) : OalDetector(options)) {}
-  std::string Name() const override { return "oal"; }
-  bool Undistorted() const override { return detector_.Undistorts(); }
-  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
-    last_ = &detector_.Detect(image);
-    lines->clear();
-    for (const DetectedLine& line : *last_) lines->push_back(line.line);
-  }
-  const std::vector<DetectedLine>& last() const { return *last_; }
-
- private:
-  OalDetector detector_;
-  const std::vector<DetectedLine>* last_ = nullptr;
-};
-
-// The target tracker (servo/target_tracker.h): the four lines of the pose it accepts, in the
-// order of the target's lines; nothing in a frame without an accepted pose (a wrong pose is
-// refused, not scored). Its failures are the frames without a pose.
-class OalTargetMethod : public LineMethod {
- public:
-  OalTargetMethod(const AppConfig& config, const vpCameraParameters& camera)
-      : tracker_(config.target, camera, config.detector, PoseOf(config), config.tracking) {}
-  std::string Name() const override { return "oal-target"; }
-  bool Undistorted() const override { return tracker_.detector().Undistorts(); }
-  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
-    const TargetFrame& frame = tracker_.Track(ViewOf(image));
-    lines->clear();
-    if (frame.status != TargetStatus::kOk) {
-      ++failures_;
-      return;
-    }
-    for (const int index : frame.pose.line_index) {
-      lines->push_back(tracker_.lines()[static_cast<std::size_t>(index)].line);
-    }
-  }
-  int failures() const override { return failures_; }
-  int reinitialisations() const override { return 0; }
-
- private:
-  // The tracker sets the camera and each frame's size itself; scoring needs no covariance.
-  static PoseOptions PoseOf(const AppConfig& config) {
-    PoseOptions pose = config.pose;
-    pose.compute_covariance = false;
-    return pose;
-  }
-
-  TargetPoseTracker tracker_;
-  int failures_ = 0;
-};
-
-// Our temporal tracker: the lines it holds in each frame (lost ones excluded), best
-// supported first, as the detector ranks them. A user never re-initialises it; its
-// failures are the tracks it lost.
-class OalTrackerMethod : public LineMethod {
- public:
-  OalTrackerMethod(const DetectorOptions& options, const std::optional<CameraFile>& camera)
-      : tracker_(Options(options), camera ? camera->camera : vpCameraParameters()) {}
-  std::string Name() const override { return "oal-tracker"; }
-  bool Undistorted() const override { return tracker_.detector().Undistorts(); }
-  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
-    tracker_.track(image);
-    held_.clear();
-    for (const TrackedLine& track : tracker_.getLines()) {
-      if (track.status != TrackStatus::kLost) held_.push_back(&track.line);
-    }
-    std::stable_sort(held_.begin(), held_.end(), [](const DetectedLine* a, const DetectedLine* b) {
-      return a->support > b->support;
-    });
-    lines->clear();
-    for (const DetectedLine* line : held_) lines->push_back(line->line);
-  }
-  void AfterFrame(const vpImage<unsigned char>& /*image*/,
-                  const std::vector<TargetLineTruth>& /*targets*/, bool /*from_truth*/) override {
-    for (const TrackedLine& track : tracker_.getLines()) {
-      failures_ += track.status == TrackStatus::kLost && track.frames_lost == 1;
-    }
-  }
-  int failures() const override { return failures_; }
-  int reinitialisations() const override { return 0; }
-
- private:
-  static TrackerOptions Options(const DetectorOptions& detector) {
-    TrackerOptions options;
-    options.detector = detector;
-    return options;
-  }
-
-  OalLineTracker tracker_;
-  std::vector<const DetectedLine*> held_;
-  int failures_ = 0;
-};
-
-// The OpenCV methods, one class: they share the Canny edges, the segment merging and the
-// edge pairing.
-class OpenCvMethod : public LineMethod {
- public:
-  enum class Kind { kHoughCanny, kHoughOtsu, kHoughP, kLsd, kFld };
-
-  OpenCvMethod(Kind kind, bool stripes, Polarity polarity, double max_stripe_width_px,
-               const DetectorOptions& detector)
-      : kind_(kind),
-        stripes_(stripes),
-        polarity_(polarity),
-        max_stripe_width_px_(max_stripe_width_px),
-        duplicate_angle_deg_(detector.duplicate_angle_deg),
-        duplicate_r_px_(detector.duplicate_r_px) {
-    if (kind_ == Kind::kLsd) lsd_ = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
-    if (kind_ == Kind::kFld) fld_ = cv::ximgproc::createFastLineDetector();
-  }
-
-  std::string Name() const override {
-    switch (kind_) {
-      case Kind::kHoughCanny:
-        return "HoughLines (Canny)";
-      case Kind::kHoughOtsu:
-        return "HoughLines (Otsu)";
-      case Kind::kHoughP:
-        return "HoughLinesP (Canny)";
-      case Kind::kLsd:
-        return "LSD";
-      case Kind::kFld:
-        return "FastLineDetector";
-    }
-    return "?";
-  }
-
-  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
-    const cv::Mat view = MatOf(image);
-    const Point2d centre{0.5 * (view.cols - 1), 0.5 * (view.rows - 1)};
-    const int size = std::min(view.cols, view.rows);
-    const int hough_votes = std::max(20, size / 4);
-    std::vector<LineParams> found;
-    switch (kind_) {
-      case Kind::kHoughCanny: {
-        CannyEdges(view);
-        HoughPeaks(edges_, hough_votes, &found);
-        found = Deduplicated(found, 1.0, 1.5, centre);
-        break;
-      }
-      case Kind::kHoughOtsu: {
-        const int type =
-            polarity_ == Polarity::kLightLines ? cv::THRESH_BINARY : cv::THRESH_BINARY_INV;
-        cv::threshold(view, binary_, 0, 255, type | cv::THRESH_OTSU);
-        if (polarity_ == Polarity::kEdges) {  // the boundary of the binary image votes
-          cv::erode(binary_, eroded_, cv::Mat());
-          cv::subtract(binary_, eroded_, binary_);
-        }
-        HoughPeaks(binary_, hough_votes, &found);
-        *lines = Deduplicated(found, duplicate_angle_deg_, duplicate_r_px_, centre);
-        return;  // centre lines (stripes) or edges already: nothing to pair
-      }
-      case Kind::kHoughP: {
-        CannyEdges(view);
-        segments_.clear();
-        std::vector<cv::Vec4i> segments;
-        cv::HoughLinesP(edges_, segments, 1.0, CV_PI / 360.0, std::max(10, size / 8),
-                        std::max(10.0, size / 10.0), 5.0);
-        for (const cv::Vec4i& s : segments) segments_.emplace_back(s[0], s[1], s[2], s[3]);
-        found = MergedSegments(segments_);
-        break;
-      }
-      case Kind::kLsd:
-        segments_.clear();
-        lsd_->detect(view, segments_);
-        found = MergedSegments(segments_);
-        break;
-      case Kind::kFld:
-        segments_.clear();
-        fld_->detect(view, segments_);
-        found = MergedSegments(segments_);
-        break;
-    }
-    *lines = stripes_ ? PairedEdges(found, max_stripe_width_px_, centre) : std::move(found);
-  }
-
- private:
-  void CannyEdges(const cv::Mat& view) {
-    cv::GaussianBlur(view, blurred_, cv::Size(5, 5), 1.2);
-    cv::Canny(blurred_, edges_, 50, 150);
-  }
-  static void HoughPeaks(const cv::Mat& binary, int votes, std::vector<LineParams>* lines) {
-    std::vector<cv::Vec2f> peaks;  // sorted by votes, best first
-    cv::HoughLines(binary, peaks, 1.0, CV_PI / 360.0, votes);
-    lines->clear();
-    for (const cv::Vec2f& peak : peaks) lines->push_back(Normalized(peak[0], peak[1]));
-  }
-
-  Kind kind_;
-  bool stripes_;
-  Polarity polarity_;
-  double max_stripe_width_px_;
-  double duplicate_angle_deg_, duplicate_r_px_;
-  cv::Ptr<cv::LineSegmentDetector> lsd_;
-  cv::Ptr<cv::ximgproc::FastLineDetector> fld_;
-  cv::Mat blurred_, edges_, binary_, eroded_;
-  std::vector<cv::Vec4f> segments_;
-};
-
-// vpMeLine's a·i + b·j + c = 0 (i = row, j = column) in our convention. vpMeLine::getRho()
-// takes |c| and picks the sign from the grey levels on both sides (its theta spans
-// [0, 2 pi) to carry polarity), so the exact equation is read instead: rho_me = -c with
-// theta_me = atan2(b, a), converted by detector/line.h's FromMeLineConvention.
-LineParams LineOfMeLine(const vpMeLine& me_line) {
-  const double a = me_line.getA(), b = me_line.getB(), c = me_line.getC();
-  const double norm = std::hypot(a, b);
-  return FromMeLineConvention(LineParams{-c / norm, std::atan2(b, a)});
-}
-
-// ViSP 3.5 moving edges: one tracker per target edge, two per stripe (their midline).
-class VpMeLineMethod : public LineMethod {
- public:
-  VpMeLineMethod(const VpMeLineOptions& options, bool stripes)
-      : options_(options), stripes_(stripes) {
-    me_.setRange(static_cast<unsigned int>(options.range_px));
-    me_.setThreshold(options.threshold);
-    me_.setSampleStep(options.sample_step_px);
-    me_.setPointsToTrack(500);
-    me_.setMaskSize(5);
-    me_.setMaskNumber(180);
-  }
-  std::string Name() const override { return "vpMeLine"; }
-
-  void Start(const vpImage<unsigned char>& image, const std::vector<TargetLineTruth>& targets,
-             bool /*from_truth*/) override {
-    for (const TargetLineTruth& target : targets) {
-      tracks_.emplace_back();
-      tracks_.back().id = target.id;
-      Initialise(image, target, &tracks_.back());
-    }
-  }
-
-  void Process(const vpImage<unsigned char>& image, std::vector<LineParams>* lines) override {
-    lines->clear();
-    const Point2d centre{0.5 * (image.getWidth() - 1.0), 0.5 * (image.getHeight() - 1.0)};
-    for (Track& track : tracks_) {
-      if (!track.ok) continue;
-      try {
-        for (auto& edge : track.edges) edge->track(image);
-      } catch (const std::exception&) {
-        track.ok = false;
-        track.threw = true;
-        continue;
-      }
-      track.line = track.edges.size() == 2 ? Midline(LineOfMeLine(*track.edges[0]),
-                                                     LineOfMeLine(*track.edges[1]), centre)
-                                           : LineOfMeLine(*track.edges[0]);
-      lines->push_back(track.line);
-    }
-  }
-
-  void AfterFrame(const vpImage<unsigned char>& image, const std::vector<TargetLineTruth>& targets,
-                  bool from_truth) override {
-    const Point2d centre{0.5 * (image.getWidth() - 1.0), 0.5 * (image.getHeight() - 1.0)};
-    std::vector<bool> taken(targets.size(), false);
-    for (Track& track : tracks_) {
-      const TargetLineTruth* target = nullptr;
-      if (from_truth) {
-        for (std::size_t i = 0; i < targets.size(); ++i) {
-          if (targets[i].id == track.id) {
-            target = &targets[i];
-            taken[i] = true;
-          }
-        }
-      } else {  // our detections: the one nearest to the track's line
-        double best = 1e300;
-        for (std::size_t i = 0; i < targets.size(); ++i) {
-          if (taken[i]) continue;
-          const double cost = AngleBetween(targets[i].image_line, track.line) * kRadToDeg / 5.0 +
-                              DistanceAt(track.line, targets[i].image_line, centre) / 10.0;
-          if (cost < best) {
-            best = cost;
-            target = &targets[i];
-          }
-        }
-        if (target != nullptr) taken[static_cast<std::size_t>(target - targets.data())] = true;
-      }
-      bool failed = track.threw;
-      if (track.ok && from_truth && target != nullptr) {
-        const auto [angle, offset] =
-            ErrorOf(track.line, target->image_line, Foot(target->image_line, target->end_a),
-                    Foot(target->image_line, target->end_b));
-        failed = angle > options_.drift_angle_deg || offset > options_.drift_offset_px;
-      }
-      track.threw = false;
-      if (failed) ++failures_;
-      if (target == nullptr) {  // out of view: a user stops tracking it
-        track.ok = false;
-        continue;
-      }
-      if (failed || !track.ok) {
-        ++reinitialisations_;
-        Initialise(image, *target, &track);
-      }
-    }
-    if (!from_truth) return;
-    for (std::size_t i = 0; i < targets.size(); ++i) {  // lines coming into view
-      if (taken[i]) continue;
-      tracks_.emplace_back();
-      tracks_.back().id = targets[i].id;
-      ++reinitialisations_;
-      Initialise(image, targets[i], &tracks_.back());
-    }
-  }
-
-  int failures() const override { return failures_; }
-  int reinitialisations() const override { return reinitialisations_; }
-
- private:
-  struct Track {
-    int id = 0;
-    std::vector<std::unique_ptr<vpMeLine>> edges;
-    bool ok = false;
-    bool threw = false;
-    LineParams line;
-  };
-
-  // What a user clicks: two points on the line (its edges for a stripe), at 10 % and 90 %
-  // of its visible chord.
-  void Initialise(const vpImage<unsigned char>& image, const TargetLineTruth& target,
-                  Track* track) {
-    track->edges.clear();
-    track->ok = false;
-    track->line = target.image_line;
-    const Point2d a = Foot(target.image_line, target.end_a);
-    const Point2d b = Foot(target.image_line, target.end_b);
-    const Point2d p{a.u + 0.1 * (b.u - a.u), a.v + 0.1 * (b.v - a.v)};
-    const Point2d q{a.u + 0.9 * (b.u - a.u), a.v + 0.9 * (b.v - a.v)};
-    std::vector<double> offsets{0.0};
-    if (stripes_ && target.width_px >= 1.5)
-      offsets = {-0.5 * target.width_px, 0.5 * target.width_px};
-    const double nu = std::cos(target.image_line.theta_rad),
-                 nv = std::sin(target.image_line.theta_rad);
-    try {
-      for (double offset : offsets) {
-        auto edge = std::make_unique<vpMeLine>();
-        edge->setMe(&me_);
-        edge->setDisplay(vpMeSite::NONE);
-        const vpImagePoint ip1(p.v + offset * nv, p.u + offset * nu);
-        const vpImagePoint ip2(q.v + offset * nv, q.u + offset * nu);
-        edge->initTracking(image, ip1, ip2);
-        track->edges.push_back(std::move(edge));
-      }
-      track->ok = true;
-    } catch (const std::exception&) {
-      track->edges.clear();  // no line until the next re-initialisation
-    }
-  }
-
-  VpMeLineOptions options_;
-  bool stripes_;
-  vpMe me_;
-  std::vector<Track> tracks_;
-  int failures_ = 0;
-  int reinitialisations_ = 0;
-};
-
-// ---------------------------------------------------------------------------------------
-// Truth.
-
-[[noreturn]] void FileError(const std::string& path, int line, const std::string& message) {
-  throw std::runtime_error(path + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
-}
-
-}  // namespace
-
-int FrameNumber(const std::string& source, int position) {
-  const std::string name = fs::path(source).filename().string();
-  const auto last = name.find_last_of("0123456789");
-  if (last == std::string::npos) return position;
-  auto first = last;
-  while (first > 0 && std::isdigit(static_cast<unsigned char>(name[first - 1]))) --first;
-  if (last - first >= 9) return position;
-  return std::stoi(name.substr(first, last - first + 1));
-}
-
-std::vector<LineMatch> MatchLines(const std::vector<ReferenceLine>& references,
-                                  const std::vector<LineParams>& lines, double max_angle_deg,
-                                  double max_offset_px) {
-  struct Candidate {
-    double cost;
-    LineMatch match;
-  };
-  std::vector<Candidate> candidates;
-  for (std::size_t r = 0; r < references.size(); ++r) {
-    const ReferenceLine& reference = references[r];
-    for (std::size_t l = 0; l < lines.size(); ++l) {
-      const auto [angle, offset] =
-          ErrorOf(lines[l], reference.line, reference.end_a, reference.end_b);
-      if (angle <= max_angle_deg && offset <= max_offset_px) {
-        candidates.push_back(
-            {angle / max_angle_deg + offset / max_offset_px, {r, l, angle, offset}});
-      }
-    }
-  }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
-  std::vector<bool> reference_used(references.size(), false), line_used(lines.size(), false);
-  std::vector<LineMatch> matches;
-  for (const Candidate& c : candidates) {
-    if (reference_used[c.match.reference] || line_used[c.match.line]) continue;
-    reference_used[c.match.reference] = line_used[c.match.line] = true;
-    matches.push_back(c.match);
-  }
-  return matches;
-}
-
-namespace {
 
 // The visible chord of a line without one: its clip to the image.
 bool ClipChord(TargetLineTruth* truth, int width, int height) {
@@ -670,10 +108,6 @@ struct Scorer {
     }
   }
 };
-
-double Mean(const std::vector<double>& values) {
-  return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / values.size();
-}
 
 // ---------------------------------------------------------------------------------------
 // Figures.
@@ -801,18 +235,6 @@ TargetKind TargetKindFromString(const std::string& text) {
   throw std::invalid_argument("target kind '" + text + "' is not one of auto, stripes, edges");
 }
 
-void VpMeLineOptions::Check() const {
-  auto require = [](bool ok, const std::string& field, double value, const char* constraint) {
-    RequireOption(ok, "VpMeLineOptions::" + field, value, constraint);
-  };
-  require(range_px >= 1 && range_px <= 100, "range_px", range_px, "1 <= range_px <= 100");
-  require(threshold > 0.0, "threshold", threshold, "threshold > 0");
-  require(sample_step_px >= 1.0 && sample_step_px <= 100.0, "sample_step_px", sample_step_px,
-          "1 <= sample_step_px <= 100");
-  require(drift_angle_deg > 0.0, "drift_angle_deg", drift_angle_deg, "drift_angle_deg > 0");
-  require(drift_offset_px > 0.0, "drift_offset_px", drift_offset_px, "drift_offset_px > 0");
-}
-
 void CompareOptions::Check() const {
   auto require = [](bool ok, const std::string& field, double value, const char* constraint) {
     RequireOption(ok, "CompareOptions::" + field, value, constraint);
@@ -831,64 +253,21 @@ void CompareOptions::Check() const {
   }
 }
 
-std::map<int, std::vector<TargetLineTruth>> LoadTruthCsv(const std::string& path) {
-  return LoadTruthCsvWithPoses(path).lines;
-}
-
-std::vector<TargetLineTruth> LoadTruthJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) FileError(path, 0, "cannot open the truth file");
-  std::vector<TargetLineTruth> lines;
-  try {
-    const nlohmann::json json = nlohmann::json::parse(in);
-    auto line_of = [](const nlohmann::json& j) {
-      return Normalized(j.at("rho").get<double>(), j.at("theta").get<double>());
-    };
-    auto point_of = [](const nlohmann::json& j) {
-      return Point2d{j.at(0).get<double>(), j.at(1).get<double>()};
-    };
-    for (const nlohmann::json& line : json.at("lines")) {
-      if (!line.at("visible").get<bool>()) continue;
-      TargetLineTruth target;
-      target.id = line.at("index").get<int>();
-      target.image_line = line_of(line.at("distorted_fit"));
-      target.ideal_line = line_of(line.at("ideal"));
-      target.end_a = point_of(line.at("end_a"));
-      target.end_b = point_of(line.at("end_b"));
-      target.width_px = line.value("width_px", 0.0);
-      lines.push_back(target);
-    }
-  } catch (const nlohmann::json::exception& error) {
-    FileError(path, 0, std::string("malformed truth: ") + error.what());
-  }
-  return lines;
-}
-
 namespace {
 
-// The oal-target method when the frames show a known four-line target: the config's `target:`
-// section, else the target.yaml `oalservo render` writes next to its frames; it needs the
-// camera (--camera) for the pose. None otherwise (a warning says why when a target is known).
-std::unique_ptr<LineMethod> TargetMethod(const CompareOptions& options, AppConfig config,
+// The oal-target method when the frames show a known four-line target; it needs the camera
+// (--camera) for the pose. None otherwise (a warning says why when a target is known).
+std::unique_ptr<LineMethod> TargetMethod(const TrackerSetup& setup,
                                          const std::optional<CameraFile>& camera,
                                          std::vector<std::string>* warnings) {
-  std::string origin;
-  if (!options.config_path.empty() && ConfigHasSection(options.config_path, "target")) {
-    origin = options.config_path;
-  } else if (const auto companion = CompanionFile({options.input}, "target.yaml")) {
-    config.target = LoadConfig(*companion, AppConfig()).target;
-    origin = *companion;
-  } else {
-    return nullptr;
-  }
-  if (config.target.lines.size() != 4) return nullptr;
+  if (!setup.target || setup.target->lines.size() != 4) return nullptr;
   if (!camera) {
-    warnings->push_back("the target of " + origin +
+    warnings->push_back("the target of " + setup.target_origin +
                         " is not tracked (oal-target): give the camera file (--camera) for "
                         "its pose");
     return nullptr;
   }
-  return std::make_unique<OalTargetMethod>(config, camera->camera);
+  return MakeOalTargetMethod(setup, *setup.target, camera->camera);
 }
 
 }  // namespace
@@ -1008,20 +387,20 @@ void WriteComparisonFiles(const CompareOptions& options,
 
 // The methods compared, ours first (without truth its lines are the targets of the
 // trackers): the OAL detector and tracker, vpMeLine, OpenCV's detectors, the target tracker
-// when the configuration has a target, and the caller's.
+// when the setup names a four-line target, and the caller's.
 std::vector<std::unique_ptr<LineMethod>> ComparedMethods(
-    const CompareOptions& options, const AppConfig& config, const std::optional<CameraFile>& camera,
-    bool stripes, CompareReport* report, std::vector<std::unique_ptr<LineMethod>> extra_methods) {
+    const CompareOptions& options, const std::optional<CameraFile>& camera, bool stripes,
+    CompareReport* report, std::vector<std::unique_ptr<LineMethod>> extra_methods) {
   std::vector<std::unique_ptr<LineMethod>> methods;
-  methods.push_back(std::make_unique<OalMethod>(config.detector, camera));
-  methods.push_back(std::make_unique<OalTrackerMethod>(config.detector, camera));
-  methods.push_back(std::make_unique<VpMeLineMethod>(options.me, stripes));
-  using Kind = OpenCvMethod::Kind;
-  for (Kind kind : {Kind::kHoughCanny, Kind::kHoughOtsu, Kind::kHoughP, Kind::kLsd, Kind::kFld}) {
-    methods.push_back(std::make_unique<OpenCvMethod>(kind, stripes, config.detector.polarity,
-                                                     report->max_stripe_width_px, config.detector));
+  const DetectorOptions& detector = options.setup.detector;
+  methods.push_back(std::make_unique<OalMethod>(detector, camera));
+  methods.push_back(MakeOalTrackerMethod(detector, camera));
+  methods.push_back(MakeVpMeLineMethod(options.me, stripes));
+  for (const OpenCvLineDetector kind : kOpenCvLineDetectors) {
+    methods.push_back(
+        MakeOpenCvMethod(kind, stripes, detector.polarity, report->max_stripe_width_px, detector));
   }
-  if (auto target = TargetMethod(options, config, camera, &report->warnings)) {
+  if (auto target = TargetMethod(options.setup, camera, &report->warnings)) {
     methods.push_back(std::move(target));
   }
   for (auto& extra : extra_methods) methods.push_back(std::move(extra));
@@ -1035,9 +414,7 @@ CompareReport RunComparison(const CompareOptions& options,
   options.Check();
   CompareReport report;
   report.options = options;
-  AppConfig config;
-  if (!options.config_path.empty()) config = LoadConfig(options.config_path, config);
-  config.detector.Check();
+  options.setup.detector.Check();
   std::optional<CameraFile> camera;
   if (!options.camera_path.empty()) camera = LoadCameraFile(options.camera_path);
 
@@ -1089,8 +466,8 @@ CompareReport RunComparison(const CompareOptions& options,
   std::vector<TargetLineTruth> truth = truth_of(frame, 0);
   report.target_kind = options.target_kind;
   if (report.target_kind == TargetKind::kAuto) {
-    report.target_kind =
-        config.detector.polarity == Polarity::kEdges ? TargetKind::kEdges : TargetKind::kStripes;
+    report.target_kind = options.setup.detector.polarity == Polarity::kEdges ? TargetKind::kEdges
+                                                                             : TargetKind::kStripes;
   }
   const bool stripes = report.target_kind == TargetKind::kStripes;
   report.max_stripe_width_px = options.max_stripe_width_px;
@@ -1101,7 +478,7 @@ CompareReport RunComparison(const CompareOptions& options,
   }
 
   std::vector<std::unique_ptr<LineMethod>> methods =
-      ComparedMethods(options, config, camera, stripes, &report, std::move(extra_methods));
+      ComparedMethods(options, camera, stripes, &report, std::move(extra_methods));
   const OalMethod* ours = static_cast<const OalMethod*>(methods.front().get());
   for (const auto& method : methods) {
     MethodResult result;

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "app/accuracy_frames.h"
 #include "detector/options.h"
+#include "eval/rendered_frames.h"
 #include "scene/scene.h"
 #include "servo/pose.h"
 #include "servo/target_tracker.h"
@@ -61,8 +61,5 @@ struct AccuracyReport {
 /// Runs the evaluation; `progress(done, total)` is called after each frame if set.
 AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
                                         const std::function<void(int, int)>& progress = {});
-
-/// The q-quantile (0..1) of `values` (by nearest rank); 0 for an empty vector.
-double Quantile(std::vector<double> values, double q);
 
 }  // namespace oal

@@ -1,4 +1,4 @@
-#include "app/pose_accuracy.h"
+#include "eval/pose_accuracy.h"
 
 #include <visp3/core/vpRzyxVector.h>
 #include <visp3/core/vpThetaUVector.h>

@@ -1,4 +1,4 @@
-#include "app/report.h"
+#include "eval/report.h"
 
 #include <cstdlib>
 #include <fstream>
@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/command_line.h"
+#include "base/format.h"
 
 namespace oal {
 namespace {

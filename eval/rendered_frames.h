@@ -1,23 +1,19 @@
-// What the accuracy evaluations over rendered frames (`oalservo detect-accuracy`,
-// `oalservo pose-accuracy`) share: how the frames are rendered, and the command-line options,
-// JSON and output of their reports.
+// The rendered frames the accuracy evaluations run on (detect-accuracy, pose-accuracy,
+// calibrate-accuracy): how many, their seed, camera and degradations, the benches the target
+// lies on, and each frame's effects, reproducible from the seed.
 #pragma once
 
+#include <visp3/core/vpCameraParameters.h>
+
 #include <cstdint>
-#include <iosfwd>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "app/config.h"
-#include "scene/bench_scene.h"  // IsSheet, SheetSampling
+#include "io/scene_options.h"
 #include "scene/scene.h"
-
-namespace CLI {
-class App;
-class Option;
-}  // namespace CLI
+#include "target/line_target.h"
 
 namespace oal {
 
@@ -43,7 +39,7 @@ struct RenderedFrameOptions {
   std::vector<std::string> backgrounds;
   /// The surface, light, shadow, annotations and clutter (a config's `scene:`); its
   /// background is used when `backgrounds` is empty.
-  SceneConfig scene;
+  SceneOptions scene;
 
   /// Throws std::invalid_argument naming the command-line option and its range: --frames
   /// [1, 1000000], --kdu (-1, 1) (as `oalservo render`), --noise [0, 100], --blur [0, 20],
@@ -83,55 +79,13 @@ class EvaluationScenes {
 /// installed. Throws std::runtime_error saying so when it is not.
 std::vector<std::string> DefaultBenchPhotos();
 
-/// Adds --seed, described by `help`, with its default shown: an integer >= 0; a negative one
-/// is a usage error (CLI11 alone would turn -1 into 2^64 - 1). For every command with a seed.
-CLI::Option* AddSeedOption(CLI::App& cli, std::uint64_t* seed, const std::string& help);
-
-/// Adds --frames, --seed (AddSeedOption), --kdu (described by `kdu_help`), --noise and --blur.
-void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
-                             const std::string& kdu_help);
-
 /// `options` as JSON, the start of a report's "options" object (each command adds its own).
 nlohmann::json RenderedFrameJson(const RenderedFrameOptions& options);
-
-/// Whether the YAML file at `path` (read before, without error) has a top-level `section`.
-bool ConfigHasSection(const std::string& path, const std::string& section);
 
 /// The bench a sheet target is evaluated on unless a config's `scene:` says otherwise: the
 /// sheet printed with its annotations, its texture and soft shadow, two printed text sheets
 /// and four tools around it, light falling off towards the corners (the photographs under it
 /// are DefaultBenchPhotos()).
-SceneConfig BenchScene();
-
-/// The target of an accuracy command: the config's `target:` section when it has one (and
-/// `target_given` is false: both is an error naming them), else the built-in `target_name`
-/// (an unknown one is an error naming --target). `config_path` may be empty (no config).
-LineTarget AccuracyTarget(const std::string& target_name, bool target_given,
-                          const std::string& config_path, const AppConfig& config);
-
-/// The conditions a sheet target is evaluated in, where the command line (`cli`, after
-/// parsing) leaves them open: SheetSampling (but for --min-distance, --max-distance,
-/// --max-tilt-deg, --max-offset, --crossings-margin given), a cheap lens corrected with its
-/// camera file (kdu 0.15), noise 2-8 and blur 0.5-1.5 px drawn per frame, BenchScene()
-/// unless `scene_given` (a config's scene:), on DefaultBenchPhotos() unless a background is
-/// given. Nothing for the board.
-void ApplySheetDefaults(const CLI::App& cli, const LineTarget& target, bool scene_given,
-                        RenderedFrameOptions* options, PoseSampling* sampling);
-
-/// LoadConfig(path), and an error for any section of the file not in `used`: `command` would
-/// silently ignore it (target:, camera:...), so it is rejected with
-/// "FILE:LINE: section 'target' is not used by oalservo COMMAND (it reads: ...); NOTE".
-AppConfig LoadAccuracyConfig(const std::string& path, const std::string& command,
-                             const std::vector<std::string>& used, const std::string& note);
-
-/// Checks before any work that the report file --out can be written: its folder exists and a
-/// file can be created there (a temporary one, removed at once). Nothing when out_path is
-/// empty. Throws std::runtime_error naming --out.
-void CheckReportFile(const std::string& out_path);
-
-/// Writes `json` (indented) atomically to out_path, if set; then prints `table` on stdout with
-/// WriteText of io/json_io.h (a failed stdout is an error, reported after the file is safe).
-void PrintAccuracyReport(const std::string& table, const nlohmann::json& json,
-                         const std::string& out_path);
+SceneOptions BenchScene();
 
 }  // namespace oal

@@ -1,4 +1,4 @@
-#include "app/edge_reference.h"
+#include "eval/edge_reference.h"
 
 #include <visp3/core/vpImageConvert.h>
 

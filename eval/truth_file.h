@@ -10,7 +10,7 @@
 //                                              in the camera frame (ViSP's vpHomogeneousMatrix)
 //
 //   frame  the number in the frame's file name, its last run of digits (image.0001.pgm -> 1,
-//          frame_0007.png -> 7), or for a video its 0-based index (FrameNumber in compare.h)
+//          frame_0007.png -> 7), or for a video its 0-based index (FrameNumber)
 //   line   an integer >= 0 identifying the line across frames (the target line's index for
 //          the four-line target: 0-3 are lines 1-4)
 //   rho, theta   pixels and radians, u·cosθ + v·sinθ = ρ (detector/line.h), image
@@ -28,9 +28,23 @@
 #include <string>
 #include <vector>
 
-#include "app/compare.h"
+#include "eval/line_scoring.h"
 
 namespace oal {
+
+/// The frame number a truth CSV row names for the frame read from `source` at 0-based
+/// `position` in its input: the last run of digits in the file name (image.0001.pgm -> 1,
+/// frame_0007.png -> 7, video.avi#12 -> 12), else `position`.
+int FrameNumber(const std::string& source, int position);
+
+/// The line rows of a truth CSV (file comment): frame number -> its lines. Throws
+/// std::runtime_error "FILE:LINE: ..." for a missing file or a malformed row. Chord ends are
+/// left at zero (set per frame from the image size).
+std::map<int, std::vector<TargetLineTruth>> LoadTruthCsv(const std::string& path);
+
+/// The visible target lines of a frame_NNNN.json truth file (oalservo render). Throws
+/// std::runtime_error naming the file if it is missing or malformed.
+std::vector<TargetLineTruth> LoadTruthJson(const std::string& path);
 
 struct TruthCsv {
   std::map<int, std::vector<TargetLineTruth>> lines;  ///< frame number -> its lines

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "app/accuracy_frames.h"
 #include "detector/options.h"
+#include "eval/rendered_frames.h"
 #include "scene/bench_scene.h"  // SheetSampling
 #include "scene/scene.h"
 #include "servo/pose.h"

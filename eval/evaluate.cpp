@@ -1,4 +1,4 @@
-#include "app/evaluate.h"
+#include "eval/evaluate.h"
 
 #include <unistd.h>
 #include <visp3/core/vpImage.h>
@@ -25,21 +25,20 @@
 #include <thread>
 #include <tuple>
 
-#include "app/command_line.h"
-#include "app/compare.h"
-#include "app/config.h"
-#include "app/detector_accuracy.h"
-#include "app/frame_command.h"
-#include "app/report.h"
-#include "app/truth_file.h"
+#include "base/check.h"
 #include "base/format.h"
+#include "base/statistics.h"
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "detector/tracker.h"
+#include "eval/compare.h"
+#include "eval/report.h"
+#include "eval/truth_file.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
+#include "io/quiet_stderr.h"
 #include "loop/lens_estimate.h"
 #include "scene/bench_scene.h"  // IsSheet
 #include "servo/pose.h"
@@ -713,7 +712,8 @@ void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::
 // What every input shares.
 struct RunContext {
   const EvaluateOptions& options;
-  AppConfig config;
+  TrackerSetup setup;
+  LineTarget target;                 ///< setup.target, else the A3 sheet
   std::optional<CameraFile> camera;  ///< --camera
   std::string chart_js;
   std::size_t target_lines = 4;  ///< lines held for the target to count as detected
@@ -1031,7 +1031,7 @@ class InputEvaluation {
     const Clock::time_point start = Clock::now();
     fs::create_directories(dir_);
     TrackerOptions tracker_options;
-    tracker_options.detector = run_.config.detector;
+    tracker_options.detector = run_.setup.detector;
     OalLineTracker tracker = camera_ ? OalLineTracker(tracker_options, camera_->camera)
                                      : OalLineTracker(tracker_options);
     undistorts_ = tracker.detector().Undistorts();
@@ -1039,7 +1039,7 @@ class InputEvaluation {
       undistorted_by_ = camera_->camera;
       undistorter_.emplace(camera_->camera);
     }
-    PoseOptions pose_options = run_.config.pose;
+    PoseOptions pose_options = run_.setup.pose;
     if (camera_) {
       pose_options.camera = camera_->camera;
       pose_options.lines_undistorted = undistorts_;
@@ -1049,12 +1049,12 @@ class InputEvaluation {
     // stripes only where they reach far enough. The 2 m board's lines traverse the image, the
     // paper's condition the tracks are made for: its pose stays on them, as does any pose
     // with `tracking: {scan: image}`. The tracks stay the detection's measure either way.
-    if (camera_ && IsSheet(run_.config.target) && run_.config.target.lines.size() == 4 &&
-        run_.config.tracking.scan == ScanMode::kTarget) {
+    if (camera_ && IsSheet(run_.target) && run_.target.lines.size() == 4 &&
+        run_.setup.tracking.scan == ScanMode::kTarget) {
       PoseOptions target_pose = pose_options;
       target_pose.compute_covariance = false;
-      target_tracker_.emplace(run_.config.target, camera_->camera, run_.config.detector,
-                              target_pose, run_.config.tracking);
+      target_tracker_.emplace(run_.target, camera_->camera, run_.setup.detector, target_pose,
+                              run_.setup.tracking);
     }
 
     AtomicFile frames_file(dir_ / "frames.jsonl");
@@ -1251,7 +1251,7 @@ class InputEvaluation {
     std::optional<vpHomogeneousMatrix> seed;
     if (trusted_ && index - trusted_->frame <= kJumpFrames) seed = trusted_->cMo;
     out->pose = target_tracker_ ? TargetPose(image, out->held)
-                                : EstimatePose(out->held, run_.config.target, pose_options, seed);
+                                : EstimatePose(out->held, run_.target, pose_options, seed);
     if (out->pose->status == PoseStatus::kOk) {
       const std::array<int, 4> identified = IdentifiedTracks(*out->pose, out->ids);
       *jump = JumpFrom(trusted_, index, out->pose->cMo, identified);
@@ -1397,7 +1397,7 @@ class InputEvaluation {
 
   // Nearly nothing detected: what the detector looked for, and what to try.
   std::string LowDetectionHint(const Tally& t) const {
-    const DetectorOptions& detector = run_.config.detector;
+    const DetectorOptions& detector = run_.setup.detector;
     std::string looked_for =
         detector.polarity == Polarity::kEdges
             ? "straight light/dark edges"
@@ -1489,7 +1489,7 @@ class InputEvaluation {
   Json Compare() const {
     CompareOptions compare;
     compare.input = input_.spec;
-    compare.config_path = run_.options.config_path;
+    compare.setup = run_.setup;
     compare.max_frames = run_.options.max_frames;
     compare.out_dir = (dir_ / "compare").string();
     if (truth_.kind() == "csv") {
@@ -1664,20 +1664,14 @@ InputPlan PlanInputs(const std::vector<std::string>& inputs) {
 EvaluateResult Evaluate(const EvaluateOptions& options,
                         const std::function<void(int, int)>& progress) {
   options.Check();
-  RunContext run{options, AppConfig(), std::nullopt, LoadChartJs(), 4};
-  if (!options.config_path.empty()) {
-    run.config = LoadConfig(options.config_path, run.config);
-  } else if (const std::optional<std::string> target =
-                 CompanionFile(options.inputs, "target.yaml")) {
-    run.config = LoadConfig(*target, run.config);  // the target `oalservo render` drew
-  }
-  run.config.detector.Check();
+  RunContext run{options,      options.setup, options.setup.target.value_or(FourLineA3Target()),
+                 std::nullopt, LoadChartJs(), 4};
+  run.setup.detector.Check();
   if (!options.camera_path.empty()) run.camera = LoadCameraFile(options.camera_path);
-  run.target_lines = options.target_lines > 0
-                         ? static_cast<std::size_t>(options.target_lines)
-                         : std::max<std::size_t>(1, run.config.target.lines.size());
+  run.target_lines = options.target_lines > 0 ? static_cast<std::size_t>(options.target_lines)
+                                              : std::max<std::size_t>(1, run.target.lines.size());
   {
-    PoseOptions check = run.config.pose;
+    PoseOptions check = run.setup.pose;
     check.Check();
   }
   const InputPlan plan = PlanInputs(options.inputs);

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/oal_methods.h"
 #include "io/json_io.h"
 
 namespace oal {
@@ -46,16 +47,17 @@ namespace oal {
 struct EvaluateOptions {
   /// Videos, image sequences, or directories of these (file comment).
   std::vector<std::string> inputs;
-  /// YAML configuration: detector, target and pose sections (app/config.h); "": defaults.
-  std::string config_path;
+  /// Our detector, pose and tracking, and the target the inputs show (nothing: the A3 sheet,
+  /// four-line-a3); `oalservo evaluate` reads them from its configuration.
+  TrackerSetup setup;
   /// ViSP camera XML for every input; "": camera.xml next to each input if there is one,
   /// else the input gets no pose (tracking only, said in its summary).
   std::string camera_path;
-  /// Truth for the single input: a .csv (app/truth_file.h) or a directory of frame JSON
+  /// Truth for the single input: a .csv (eval/truth_file.h) or a directory of frame JSON
   /// files; "": per input, the renderer's JSON next to each image, or <video>.truth.csv next
   /// to a video. Given with several inputs it is an error.
   std::string truth_path;
-  /// Also run `oalservo compare`'s methods on each input (app/compare.h).
+  /// Also run `oalservo compare`'s methods on each input (eval/compare.h).
   bool compare = false;
   /// Inputs processed at once, [1, 64].
   int jobs = 1;
@@ -129,8 +131,8 @@ struct EvaluateResult {
 /// cannot be read fails alone: the others go on. `progress(done, total)` is called with the
 /// frames done over the shard's inputs (total: the frames the inputs announce; 0 unknown),
 /// from one thread at a time. Throws std::invalid_argument for bad options and
-/// std::runtime_error for no input at all (before anything is written), a bad configuration
-/// or camera file, a missing Chart.js (report.h) or an output that cannot be written.
+/// std::runtime_error for no input at all (before anything is written), a bad camera
+/// file, a missing Chart.js (report.h) or an output that cannot be written.
 EvaluateResult Evaluate(const EvaluateOptions& options,
                         const std::function<void(int done, int total)>& progress = {});
 

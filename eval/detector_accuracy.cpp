@@ -1,4 +1,4 @@
-#include "app/detector_accuracy.h"
+#include "eval/detector_accuracy.h"
 
 #include <algorithm>
 #include <chrono>
@@ -110,14 +110,6 @@ void AccuracyOptions::Check() const {
   tracking.Check();
   sampling.Check();
   target.Check();
-}
-
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const std::size_t k = static_cast<std::size_t>(
-      std::clamp(std::ceil(q * values.size()) - 1.0, 0.0, values.size() - 1.0));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
 }
 
 AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,

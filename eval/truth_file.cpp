@@ -1,6 +1,8 @@
-#include "app/truth_file.h"
+#include "eval/truth_file.h"
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -122,6 +124,49 @@ std::optional<vpHomogeneousMatrix> LoadTruthPoseJson(const std::string& path) {
   } catch (const nlohmann::json::exception& error) {
     Fail(path, 0, std::string("malformed truth: ") + error.what());
   }
+}
+
+int FrameNumber(const std::string& source, int position) {
+  const std::string name = std::filesystem::path(source).filename().string();
+  const auto last = name.find_last_of("0123456789");
+  if (last == std::string::npos) return position;
+  auto first = last;
+  while (first > 0 && std::isdigit(static_cast<unsigned char>(name[first - 1]))) --first;
+  if (last - first >= 9) return position;
+  return std::stoi(name.substr(first, last - first + 1));
+}
+
+std::map<int, std::vector<TargetLineTruth>> LoadTruthCsv(const std::string& path) {
+  return LoadTruthCsvWithPoses(path).lines;
+}
+
+std::vector<TargetLineTruth> LoadTruthJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) Fail(path, 0, "cannot open the truth file");
+  std::vector<TargetLineTruth> lines;
+  try {
+    const nlohmann::json json = nlohmann::json::parse(in);
+    auto line_of = [](const nlohmann::json& j) {
+      return Normalized(j.at("rho").get<double>(), j.at("theta").get<double>());
+    };
+    auto point_of = [](const nlohmann::json& j) {
+      return Point2d{j.at(0).get<double>(), j.at(1).get<double>()};
+    };
+    for (const nlohmann::json& line : json.at("lines")) {
+      if (!line.at("visible").get<bool>()) continue;
+      TargetLineTruth target;
+      target.id = line.at("index").get<int>();
+      target.image_line = line_of(line.at("distorted_fit"));
+      target.ideal_line = line_of(line.at("ideal"));
+      target.end_a = point_of(line.at("end_a"));
+      target.end_b = point_of(line.at("end_b"));
+      target.width_px = line.value("width_px", 0.0);
+      lines.push_back(target);
+    }
+  } catch (const nlohmann::json::exception& error) {
+    Fail(path, 0, std::string("malformed truth: ") + error.what());
+  }
+  return lines;
 }
 
 }  // namespace oal
