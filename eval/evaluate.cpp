@@ -1,6 +1,5 @@
 #include "eval/evaluate.h"
 
-#include <unistd.h>
 #include <visp3/core/vpImage.h>
 #include <visp3/core/vpThetaUVector.h>
 
@@ -9,15 +8,10 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -31,7 +25,11 @@
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "detector/tracker.h"
+#include "eval/annotated_output.h"
 #include "eval/compare.h"
+#include "eval/frame_decoder.h"
+#include "eval/input_truth.h"
+#include "eval/pipeline.h"
 #include "eval/report.h"
 #include "eval/truth_file.h"
 #include "io/annotate.h"
@@ -48,19 +46,11 @@ namespace oal {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 constexpr double kRadToDeg = 180.0 / kPi;
-// A truth line is found when a tracked line is within both bounds of it.
-constexpr double kMatchAngleDeg = 5.0;
-constexpr double kMatchOffsetPx = 10.0;
 constexpr std::size_t kQueueFrames = 8;         // decoded frames waiting for the tracker
-constexpr int kMaxConsecutiveUnreadable = 50;   // then the input is given up as ended
 constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
-constexpr int kThumbnailWidth = 320;
-constexpr double kVideoFps = 25.0;
-constexpr double kVideoQuality = 75.0;      // JPEG quality of the annotated video, [0, 100]
-constexpr std::size_t kPlottedTracks = 10;  // the tracks seen longest get a series
+constexpr std::size_t kPlottedTracks = 10;      // the tracks seen longest get a series
 // A pose is flagged as a jump when, against the last trusted pose of at most kJumpFrames
 // frames before, the same four tracks are identified as other target lines, or the rotation
 // exceeds kJumpRotationDeg (docs/EVALUATE.md, frames.jsonl).
@@ -68,74 +58,11 @@ constexpr int kJumpFrames = 10;
 constexpr double kJumpRotationDeg = 90.0;
 constexpr std::size_t kListedJumps = 100;  // jump frames named in the summary
 
-double Us(Clock::duration d) {
-  return std::chrono::duration<double, std::micro>(d).count();
-}
-
 // The options are named as the user gives them, on evaluate's command line.
 template <typename T>
 void Require(bool ok, const char* option, const T& value, const char* constraint) {
   RequireOption(ok, option, value, constraint);
 }
-
-// Count, mean, maximum and quantiles of a non-negative per-frame measure in bounded memory:
-// the first kExactSamples values are kept (a short input reports exact quantiles, by nearest
-// rank), beyond them a histogram of logarithmic bins 1 % wide, whose quantiles are within
-// 0.5 % of the exact ones: an hour of video costs what a minute does.
-class SampleStats {
- public:
-  void push_back(double value) {
-    ++count_;
-    sum_ += value;
-    max_ = count_ == 1 ? value : std::max(max_, value);
-    if (bins_.empty() && exact_.size() < kExactSamples) {
-      exact_.push_back(value);
-      return;
-    }
-    if (bins_.empty()) {
-      for (const double kept : exact_) Bin(kept);
-      std::vector<double>().swap(exact_);
-    }
-    Bin(value);
-  }
-  std::size_t size() const { return count_; }
-  double mean() const { return sum_ / static_cast<double>(count_); }
-  double max() const { return max_; }
-  double Quantile(double q) const {
-    if (bins_.empty()) return oal::Quantile(exact_, q);
-    const double rank =
-        std::clamp(std::ceil(q * static_cast<double>(count_)), 1.0, static_cast<double>(count_));
-    std::size_t seen = 0;
-    for (std::size_t i = 0; i < bins_.size(); ++i) {
-      seen += bins_[i];
-      if (static_cast<double>(seen) >= rank) {
-        return i == 0 ? 0.0 : std::min(max_, kSmallest * std::pow(kBinGrowth, i - 0.5));
-      }
-    }
-    return max_;
-  }
-
- private:
-  static constexpr std::size_t kExactSamples = 4096;
-  static constexpr double kSmallest = 1e-6;  // smaller values (and zero) share bin 0
-  static constexpr double kBinGrowth = 1.01;
-  static constexpr std::size_t kMaxBins = 8192;  // up to 1e-6 * 1.01^8192, about 1e29
-
-  void Bin(double value) {
-    std::size_t bin = 0;
-    if (value >= kSmallest) {
-      bin = 1 + static_cast<std::size_t>(
-                    std::min(std::log(value / kSmallest) / std::log(kBinGrowth), kMaxBins - 2.0));
-    }
-    if (bin >= bins_.size()) bins_.resize(bin + 1, 0);
-    ++bins_[bin];
-  }
-
-  std::size_t count_ = 0;
-  double sum_ = 0.0, max_ = 0.0;
-  std::vector<double> exact_;
-  std::vector<std::uint32_t> bins_;
-};
 
 // {count, mean, median, p95, max}; nulls for no values.
 Json Stats(const SampleStats& values) {
@@ -183,527 +110,6 @@ std::string BaseName(const std::string& spec) {
   }
   if (name.empty() || name[0] == '.') name = "input" + name;
   return name;
-}
-
-// ---------------------------------------------------------------------------------------
-// A bounded queue between two threads. Close() ends it: Pop() drains what is left, then
-// returns nothing; Push() returns false (the consumer gave up).
-template <typename T>
-class BoundedQueue {
- public:
-  explicit BoundedQueue(std::size_t capacity) : capacity_(capacity) {}
-
-  bool Push(T item) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    not_full_.wait(lock, [&] { return closed_ || items_.size() < capacity_; });
-    if (closed_) return false;
-    items_.push_back(std::move(item));
-    not_empty_.notify_one();
-    return true;
-  }
-  std::optional<T> Pop() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    not_empty_.wait(lock, [&] { return closed_ || !items_.empty(); });
-    if (items_.empty()) return std::nullopt;
-    T item = std::move(items_.front());
-    items_.pop_front();
-    not_full_.notify_one();
-    return item;
-  }
-  void Close() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    closed_ = true;
-    not_empty_.notify_all();
-    not_full_.notify_all();
-  }
-
- private:
-  std::size_t capacity_;
-  std::mutex mutex_;
-  std::condition_variable not_full_, not_empty_;
-  std::deque<T> items_;
-  bool closed_ = false;
-};
-
-// Joins a thread when leaving the scope, also on an exception.
-class Joined {
- public:
-  explicit Joined(std::thread thread) : thread_(std::move(thread)) {}
-  ~Joined() {
-    if (thread_.joinable()) thread_.join();
-  }
-  Joined(const Joined&) = delete;
-  Joined& operator=(const Joined&) = delete;
-  void Join() {
-    if (thread_.joinable()) thread_.join();
-  }
-
- private:
-  std::thread thread_;
-};
-
-// ---------------------------------------------------------------------------------------
-// Stage 1: decoding.
-
-struct DecodedFrame {
-  int index = 0;
-  cv::Mat gray;  ///< continuous, owned
-  std::string source;
-  std::string error;  ///< non-empty: the frame could not be read
-  double decode_us = 0.0;
-};
-
-struct DecodeStats {
-  double total_us = 0.0;
-  std::string stop_reason;  ///< why reading stopped early ("" at the end of the source)
-};
-
-void DecodeFrames(ImageSource* source, int max_frames, BoundedQueue<DecodedFrame>* queue,
-                  DecodeStats* stats) {
-  Frame frame;
-  int consecutive_errors = 0;
-  for (int index = 0; max_frames == 0 || index < max_frames; ++index) {
-    DecodedFrame item;
-    item.index = index;
-    bool more = true;
-    const Clock::time_point start = Clock::now();
-    frame.source.clear();  // a failing list of images names its file here
-    try {
-      more = source->Next(&frame);
-    } catch (const std::exception& error) {
-      item.error = error.what();
-    }
-    item.decode_us = Us(Clock::now() - start);
-    stats->total_us += item.decode_us;
-    if (!more) break;
-    if (item.error.empty()) {
-      item.gray = frame.gray.clone();  // the source may reuse its buffer for the next frame
-      item.source = frame.source;
-      consecutive_errors = 0;
-    } else {
-      item.source =
-          frame.source.empty() ? source->Name() + " frame " + std::to_string(index) : frame.source;
-      if (++consecutive_errors > kMaxConsecutiveUnreadable) {
-        stats->stop_reason = "gave up after " + std::to_string(kMaxConsecutiveUnreadable) +
-                             " consecutive unreadable frames";
-        break;
-      }
-    }
-    if (!queue->Push(std::move(item))) break;
-  }
-  queue->Close();
-}
-
-// ---------------------------------------------------------------------------------------
-// Truth.
-
-struct FrameTruth {
-  bool known = false;
-  std::vector<TargetLineTruth> lines;  ///< visible lines, image pixels
-  std::optional<vpHomogeneousMatrix> cMo;
-};
-
-// Where an input's truth comes from, and each frame's.
-class TruthReader {
- public:
-  TruthReader(const EvaluateOptions& options, const PlannedInput& input) {
-    if (!options.truth_path.empty()) {
-      if (fs::path(options.truth_path).extension() == ".csv") {
-        UseCsv(options.truth_path);
-      } else if (fs::is_directory(options.truth_path)) {
-        kind_ = "json";
-        json_dir_ = options.truth_path;
-      } else {
-        throw std::runtime_error("truth '" + options.truth_path +
-                                 "' is neither a .csv file nor a directory of frame JSON files");
-      }
-    } else if (HasVideoExtension(input.spec)) {
-      const fs::path csv = fs::path(input.spec).replace_extension(".truth.csv");
-      if (fs::is_regular_file(csv)) UseCsv(csv.string());
-    } else {
-      kind_ = "auto";  // JSON next to the images, decided at the first frame
-    }
-  }
-
-  const std::string& kind() const { return kind_; }
-  const std::string& path() const { return path_; }
-
-  FrameTruth Get(const std::string& source, int index, int width, int height) {
-    FrameTruth truth;
-    if (kind_ == "auto") {
-      kind_ = fs::is_regular_file(JsonPath(source)) ? "json" : "none";
-      if (kind_ == "json") path_ = fs::path(JsonPath(source)).parent_path().string();
-    }
-    if (kind_ == "json") {
-      const std::string path = JsonPath(source);
-      if (!fs::is_regular_file(path)) return truth;  // this frame has none
-      truth.known = true;
-      truth.lines = LoadTruthJson(path);
-      truth.cMo = LoadTruthPoseJson(path);
-    } else if (kind_ == "csv") {
-      truth.known = true;
-      const int number = FrameNumber(source, index);
-      const auto lines = csv_.lines.find(number);
-      if (lines != csv_.lines.end()) {
-        for (TargetLineTruth line : lines->second) {
-          if (ClipToRect(line.image_line, 0.0, 0.0, width - 1.0, height - 1.0, &line.end_a,
-                         &line.end_b)) {
-            truth.lines.push_back(line);
-          }
-        }
-      }
-      const auto pose = csv_.poses.find(number);
-      if (pose != csv_.poses.end()) truth.cMo = pose->second;
-    }
-    return truth;
-  }
-
- private:
-  void UseCsv(const std::string& path) {
-    kind_ = "csv";
-    path_ = path;
-    csv_ = LoadTruthCsvWithPoses(path);
-  }
-  std::string JsonPath(const std::string& source) const {
-    const fs::path image(source);
-    return json_dir_.empty() ? fs::path(image).replace_extension(".json").string()
-                             : (fs::path(json_dir_) / (image.stem().string() + ".json")).string();
-  }
-
-  std::string kind_ = "none";  ///< none, json, csv (auto until the first frame)
-  std::string path_;           ///< the CSV, or the JSON files' directory
-  std::string json_dir_;
-  TruthCsv csv_;
-};
-
-// One truth line against the tracked lines: the matched track's errors.
-struct LineError {
-  int line = 0;
-  int track = -1;  ///< -1: not found
-  double angle_deg = 0.0, offset_px = 0.0;
-};
-
-// Matches truth lines to tracked lines one to one, closest pairs first (angle / 5° +
-// offset / 10 px, both within bounds). The truth is compared in the tracker's coordinates:
-// undistorted pixels when it undistorts (the JSON's `ideal` line; a CSV line through its
-// undistorted chord ends), else image pixels.
-std::vector<LineError> MatchTruth(const std::vector<TargetLineTruth>& truth,
-                                  const std::vector<DetectedLine>& held,
-                                  const std::vector<int>& ids,
-                                  const std::optional<PointUndistorter>& undistorter, bool json) {
-  std::vector<ReferenceLine> references;
-  for (const TargetLineTruth& target : truth) {
-    ReferenceLine reference{target.image_line, target.end_a, target.end_b};
-    if (undistorter) {
-      reference.end_a = undistorter->Undistort(target.end_a);
-      reference.end_b = undistorter->Undistort(target.end_b);
-      reference.line = json ? target.ideal_line : LineThrough(reference.end_a, reference.end_b);
-    }
-    references.push_back(reference);
-  }
-  std::vector<LineParams> lines;
-  for (const DetectedLine& line : held) lines.push_back(line.line);
-  std::vector<LineError> errors(truth.size());
-  for (std::size_t t = 0; t < truth.size(); ++t) errors[t].line = truth[t].id;
-  for (const LineMatch& match : MatchLines(references, lines, kMatchAngleDeg, kMatchOffsetPx)) {
-    LineError& error = errors[match.reference];
-    error.track = ids[match.line];
-    error.angle_deg = match.angle_deg;
-    error.offset_px = match.offset_px;
-  }
-  return errors;
-}
-
-// Translation (mm) and rotation (degrees) between an estimated and a true cMo.
-std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
-                                    const vpHomogeneousMatrix& truth) {
-  const vpTranslationVector dt = cMo.getTranslationVector() - truth.getTranslationVector();
-  const vpThetaUVector tu(truth.getRotationMatrix().t() * cMo.getRotationMatrix());
-  return {1000.0 * std::sqrt(dt.sumSquare()),
-          kRadToDeg * std::sqrt(tu[0] * tu[0] + tu[1] * tu[1] + tu[2] * tu[2])};
-}
-
-// ---------------------------------------------------------------------------------------
-// Stage 3: the annotated video and the worst frames.
-
-struct TrackedFrame {
-  int index = 0;
-  cv::Mat gray;
-  std::vector<DetectedLine> held;  ///< the lines held, best supported first
-  std::vector<int> ids;            ///< their track ids
-  std::optional<PoseResult> pose;  ///< none without a camera
-  double badness = 0.0;            ///< worst frames first (EvaluateInput)
-  std::string why;
-};
-
-// The `capacity` worst frames, at least kThumbnailSpacingFrames frames apart, chosen as frames
-// stream by: the same frames in the same order give the same choice.
-class WorstFrames {
- public:
-  explicit WorstFrames(std::size_t capacity) : capacity_(capacity) {}
-
-  bool Wants(int frame, double badness) const {
-    if (capacity_ == 0 || badness <= 0.0) return false;
-    double near = -1.0;
-    for (const Thumbnail& kept : kept_) {
-      if (std::abs(kept.frame - frame) < kThumbnailSpacingFrames) {
-        near = std::max(near, badness_.at(kept.frame));
-      }
-    }
-    if (near >= 0.0) return badness > near;
-    return kept_.size() < capacity_ || badness > Weakest()->second;
-  }
-  void Add(Thumbnail thumbnail, double badness) {
-    const int frame = thumbnail.frame;
-    kept_.erase(std::remove_if(kept_.begin(), kept_.end(),
-                               [&](const Thumbnail& kept) {
-                                 return std::abs(kept.frame - frame) < kThumbnailSpacingFrames;
-                               }),
-                kept_.end());
-    if (kept_.size() >= capacity_) {
-      const int weakest = Weakest()->first;
-      kept_.erase(std::remove_if(kept_.begin(), kept_.end(),
-                                 [&](const Thumbnail& kept) { return kept.frame == weakest; }),
-                  kept_.end());
-    }
-    badness_[frame] = badness;
-    kept_.push_back(std::move(thumbnail));
-  }
-  /// Worst first (ties: earlier frame first).
-  std::vector<Thumbnail> Sorted() const {
-    std::vector<Thumbnail> sorted = kept_;
-    std::sort(sorted.begin(), sorted.end(), [&](const Thumbnail& a, const Thumbnail& b) {
-      const double ba = badness_.at(a.frame), bb = badness_.at(b.frame);
-      return ba != bb ? ba > bb : a.frame < b.frame;
-    });
-    return sorted;
-  }
-  double BadnessOf(int frame) const { return badness_.at(frame); }
-
- private:
-  // The kept frame with the least badness (the latest of equals), as (frame, badness).
-  std::optional<std::pair<int, double>> Weakest() const {
-    std::optional<std::pair<int, double>> weakest;
-    for (const Thumbnail& kept : kept_) {
-      const double b = badness_.at(kept.frame);
-      if (!weakest || b < weakest->second ||
-          (b == weakest->second && kept.frame > weakest->first)) {
-        weakest = std::make_pair(kept.frame, b);
-      }
-    }
-    return weakest;
-  }
-
-  std::size_t capacity_;
-  std::vector<Thumbnail> kept_;
-  std::map<int, double> badness_;
-};
-
-const cv::Scalar kTrackColours[] = {{80, 80, 255},  {80, 255, 80},  {255, 160, 80}, {255, 80, 255},
-                                    {80, 255, 255}, {255, 255, 80}, {160, 80, 255}, {80, 160, 255}};
-
-// The size of the annotated video for a frame: `scale` of it, rounded to even sizes.
-cv::Size VideoSize(const cv::Size& frame, double scale) {
-  return cv::Size(std::max(2, 2 * cvRound(0.5 * scale * frame.width)),
-                  std::max(2, 2 * cvRound(0.5 * scale * frame.height)));
-}
-
-// Pixel coordinates of a frame scaled by (sx, sy): pixel centres at integers on both sides,
-// u' = sx (u + 0.5) - 0.5. Lines and cameras are moved into the scaled frame so that the
-// drawing is done at the output size (a quarter of the pixels at 0.5), not drawn at full
-// size and scaled.
-struct PixelScale {
-  double sx = 1.0, sy = 1.0;
-
-  // u cos + v sin = rho  ->  a u' + b v' = rho + (cos + sin) / 2 - (a + b) / 2.
-  LineParams Line(const LineParams& line) const {
-    const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
-    const double a = c / sx, b = s / sy, n = std::hypot(a, b);
-    return LineParams{(line.rho_px + 0.5 * (c + s) - 0.5 * (a + b)) / n, std::atan2(b, a)};
-  }
-  // The distortion coefficients are in normalised coordinates: unchanged.
-  vpCameraParameters Camera(const vpCameraParameters& camera) const {
-    vpCameraParameters scaled = camera;
-    const double u0 = sx * (camera.get_u0() + 0.5) - 0.5, v0 = sy * (camera.get_v0() + 0.5) - 0.5;
-    if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
-      scaled.initPersProjWithDistortion(sx * camera.get_px(), sy * camera.get_py(), u0, v0,
-                                        camera.get_kud(), camera.get_kdu());
-    } else {
-      scaled.initPersProjWithoutDistortion(sx * camera.get_px(), sy * camera.get_py(), u0, v0);
-    }
-    return scaled;
-  }
-};
-
-// The frame at `size` with every held track (thin, labelled #id), lines 1-4 and the target
-// frame's axes (AnnotatePose), and the frame number, drawn at that size.
-cv::Mat Annotate(const TrackedFrame& frame, const std::optional<CameraFile>& camera,
-                 const std::optional<vpCameraParameters>& undistorted_by, const cv::Size& size) {
-  const bool scaled = size != frame.gray.size();
-  const PixelScale scale{static_cast<double>(size.width) / frame.gray.cols,
-                         static_cast<double>(size.height) / frame.gray.rows};
-  cv::Mat gray = frame.gray;
-  std::vector<DetectedLine> held = frame.held;
-  std::optional<vpCameraParameters> undistorted = undistorted_by;
-  if (scaled) {
-    cv::resize(frame.gray, gray, size, 0.0, 0.0, cv::INTER_AREA);
-    for (DetectedLine& line : held) line.line = scale.Line(line.line);
-    if (undistorted) undistorted = scale.Camera(*undistorted);
-  }
-  cv::Mat image;
-  if (camera && frame.pose) {
-    image = AnnotatePose(gray, held, *frame.pose,
-                         scaled ? scale.Camera(camera->camera) : camera->camera, undistorted);
-  } else {
-    cv::cvtColor(gray, image, cv::COLOR_GRAY2BGR);
-  }
-  for (std::size_t i = 0; i < held.size(); ++i) {
-    const cv::Scalar& colour = kTrackColours[static_cast<std::size_t>(frame.ids[i]) % 8];
-    const auto runs = LineInFrame(held[i].line, image.cols, image.rows, undistorted);
-    for (const auto& run : runs) {
-      for (std::size_t k = 1; k < run.size(); ++k) {
-        cv::line(image, run[k - 1], run[k], colour, 1, cv::LINE_AA);
-      }
-    }
-    if (runs.empty() || runs.front().empty()) continue;
-    const cv::Point2d at = runs.front()[runs.front().size() * 2 / 3];
-    cv::putText(image, "#" + std::to_string(frame.ids[i]),
-                cv::Point(cvRound(at.x) + 3, cvRound(at.y) + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                colour, 1, cv::LINE_AA);
-  }
-  // White on a black outline: readable on a bright frame as on a dark one.
-  const cv::Point caption(4, image.rows - 6);
-  const std::string text = "frame " + std::to_string(frame.index);
-  cv::putText(image, text, caption, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3,
-              cv::LINE_AA);
-  cv::putText(image, text, caption, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
-              cv::LINE_AA);
-  return image;
-}
-
-// The thumbnail's size: kThumbnailWidth wide at most.
-cv::Size ThumbnailSize(const cv::Size& image) {
-  const double scale = std::min(1.0, static_cast<double>(kThumbnailWidth) / image.width);
-  return cv::Size(std::max(1, cvRound(scale * image.width)),
-                  std::max(1, cvRound(scale * image.height)));
-}
-
-std::vector<unsigned char> ThumbnailJpeg(const cv::Mat& annotated) {
-  cv::Mat small = annotated;
-  const cv::Size size = ThumbnailSize(annotated.size());
-  if (size != annotated.size()) cv::resize(annotated, small, size, 0.0, 0.0, cv::INTER_AREA);
-  std::vector<unsigned char> jpeg;
-  if (!cv::imencode(".jpg", small, jpeg, {cv::IMWRITE_JPEG_QUALITY, 85})) {
-    throw std::runtime_error("cannot encode a thumbnail");
-  }
-  return jpeg;
-}
-
-// The annotated video, written under a temporary name ending in .avi (the writer picks the
-// container from it) and renamed at Commit(). The images come at Size(frame size).
-class AnnotatedVideo {
- public:
-  AnnotatedVideo(fs::path target, double scale, std::string codec)
-      : scale_(scale),
-        codec_(std::move(codec)),
-        target_(std::move(target)),
-        temp_(target_.parent_path() /
-              (target_.stem().string() + ".tmp-" + std::to_string(::getpid()) + ".avi")) {}
-  ~AnnotatedVideo() {
-    writer_.release();
-    if (!committed_) RemoveQuietly(temp_);
-  }
-  AnnotatedVideo(const AnnotatedVideo&) = delete;
-  AnnotatedVideo& operator=(const AnnotatedVideo&) = delete;
-
-  cv::Size Size(const cv::Size& frame) const { return VideoSize(frame, scale_); }
-
-  void Write(const cv::Mat& image) {
-    if (!writer_.isOpened()) {
-      // XVID: libavcodec's MPEG-4 part 2 encoder (OpenCV's FFmpeg backend), ~3x faster than
-      // MJPG on noisy frames and ~5x smaller; MJPG: OpenCV's own encoder, every frame a
-      // key frame (docs/EVALUATE.md, figures).
-      const bool xvid = codec_ == "xvid";
-      const bool opened = xvid ? writer_.open(temp_.string(), cv::CAP_FFMPEG,
-                                              cv::VideoWriter::fourcc('X', 'V', 'I', 'D'),
-                                              kVideoFps, image.size(), true)
-                               : writer_.open(temp_.string(), cv::CAP_OPENCV_MJPEG,
-                                              cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
-                                              kVideoFps, image.size(), true);
-      if (!opened) {
-        throw std::runtime_error("cannot write the video " + temp_.string() +
-                                 (xvid ? " with XVID (OpenCV's FFmpeg backend); try "
-                                         "--video-codec mjpg"
-                                       : ""));
-      }
-      if (!xvid) writer_.set(cv::VIDEOWRITER_PROP_QUALITY, kVideoQuality);
-      size_ = image.size();
-    }
-    if (image.size() == size_) {
-      writer_.write(image);
-    } else {  // a sequence whose images change size: the video keeps the first one's
-      cv::Mat resized;
-      cv::resize(image, resized, size_, 0.0, 0.0, cv::INTER_AREA);
-      writer_.write(resized);
-    }
-  }
-  void Commit() {
-    if (!writer_.isOpened()) return;  // no frame
-    writer_.release();
-    fs::rename(temp_, target_);
-    committed_ = true;
-  }
-
- private:
-  double scale_;
-  std::string codec_;
-  fs::path target_, temp_;
-  cv::VideoWriter writer_;
-  cv::Size size_;
-  bool committed_ = false;
-};
-
-struct WriterResult {
-  std::vector<Thumbnail> thumbnails;
-  double busy_us = 0.0;
-  double annotate_us = 0.0;   ///< scaling, colour conversion and drawing
-  double encode_us = 0.0;     ///< VideoWriter::write (the encoder's colour conversion included)
-  double thumbnail_us = 0.0;  ///< the thumbnails' scaling and JPEG encoding
-  int annotated = 0;          ///< frames annotated
-  std::string error;
-};
-
-void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::size_t thumbnails,
-                 const std::optional<CameraFile>& camera,
-                 const std::optional<vpCameraParameters>& undistorted_by, WriterResult* result) {
-  WorstFrames worst(thumbnails);
-  try {
-    while (std::optional<TrackedFrame> frame = queue->Pop()) {
-      const Clock::time_point start = Clock::now();
-      const bool wanted = worst.Wants(frame->index, frame->badness);
-      if (video != nullptr || wanted) {
-        // Drawn at the video's size, or at the thumbnail's without a video.
-        const cv::Size size =
-            video != nullptr ? video->Size(frame->gray.size()) : ThumbnailSize(frame->gray.size());
-        const cv::Mat annotated = Annotate(*frame, camera, undistorted_by, size);
-        ++result->annotated;
-        const Clock::time_point drawn = Clock::now();
-        result->annotate_us += Us(drawn - start);
-        if (video != nullptr) video->Write(annotated);
-        const Clock::time_point encoded = Clock::now();
-        result->encode_us += Us(encoded - drawn);
-        if (wanted) {
-          worst.Add({frame->index, frame->why, ThumbnailJpeg(annotated)}, frame->badness);
-          result->thumbnail_us += Us(Clock::now() - encoded);
-        }
-      }
-      result->busy_us += Us(Clock::now() - start);
-    }
-  } catch (const std::exception& error) {
-    result->error = error.what();
-    queue->Close();
-  }
-  result->thumbnails = worst.Sorted();
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1017,7 +423,7 @@ struct Tally {
 class InputEvaluation {
  public:
   InputEvaluation(const RunContext& run, const PlannedInput& input, fs::path dir)
-      : run_(run), input_(input), dir_(std::move(dir)), truth_(run.options, input) {
+      : run_(run), input_(input), dir_(std::move(dir)), truth_(run.options.truth_path, input.spec) {
     camera_ = CameraFor(run, input, &camera_path_);
     series_.capacity = static_cast<std::size_t>(run.options.plot_frames);
   }
@@ -1028,7 +434,7 @@ class InputEvaluation {
 
   // Evaluates and writes every file; `on_frame` after each frame.
   Json Run(ImageSource* source, const std::function<void()>& on_frame, Json* timing) {
-    const Clock::time_point start = Clock::now();
+    const StageClock::time_point start = StageClock::now();
     fs::create_directories(dir_);
     TrackerOptions tracker_options;
     tracker_options.detector = run_.setup.detector;
@@ -1102,7 +508,7 @@ class InputEvaluation {
 
     Json summary = Summary(source, decode_stats);
     if (run_.options.compare) summary["compare"] = Compare();
-    const double wall_us = Us(Clock::now() - start);
+    const double wall_us = Microseconds(StageClock::now() - start);
     *timing =
         Json{{"input", input_.spec},
              {"frames", tally_.frames},
@@ -1295,9 +701,9 @@ class InputEvaluation {
     // A view of the frame for ViSP, no copy (the decoder's clone is continuous).
     const vpImage<unsigned char> image(frame.gray.data, static_cast<unsigned int>(h),
                                        static_cast<unsigned int>(w), false);
-    const Clock::time_point t0 = Clock::now();
+    const StageClock::time_point t0 = StageClock::now();
     tracker->track(image);
-    const Clock::time_point t1 = Clock::now();
+    const StageClock::time_point t1 = StageClock::now();
 
     TrackedFrame out;
     out.index = frame.index;
@@ -1321,14 +727,14 @@ class InputEvaluation {
     }
     Json pose_json;
     std::optional<PoseJump> jump;
-    const Clock::time_point t2 = Clock::now();
+    const StageClock::time_point t2 = StageClock::now();
     if (camera_) {
       pose_options.image_width = w;
       pose_options.image_height = h;
       pose_json = PoseOfFrame(image, frame.index, pose_options, &out, &jump);
     }
-    const Clock::time_point t3 = Clock::now();
-    const double track_us = Us(t1 - t0), pose_us = Us(t3 - t2);
+    const StageClock::time_point t3 = StageClock::now();
+    const double track_us = Microseconds(t1 - t0), pose_us = Microseconds(t3 - t2);
     track_times->push_back(track_us);
     if (camera_) pose_times->push_back(pose_us);
 
@@ -1451,7 +857,8 @@ class InputEvaluation {
                    {"frames", t.truth_frames},
                    {"truth_lines", t.truth_lines},
                    {"found_lines", t.found_lines},
-                   {"match_bounds", {{"angle_deg", kMatchAngleDeg}, {"offset_px", kMatchOffsetPx}}},
+                   {"match_bounds",
+                    {{"angle_deg", kTruthMatchAngleDeg}, {"offset_px", kTruthMatchOffsetPx}}},
                    {"angle_deg", Stats(t.angle_deg)},
                    {"offset_px", Stats(t.offset_px)},
                    {"pose_frames", t.pose_truth_frames},
