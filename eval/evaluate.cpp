@@ -1,3 +1,7 @@
+// One object per input, InputEvaluation, runs the tracking stage and owns what the input's
+// steps share (its tracker, truth, tallies, plot series and output files); the pipeline's other
+// stages and the judging of frames are in their own files (frame_decoder.h, annotated_output.h,
+// input_truth.h, frame_judgement.h, plot_series.h).
 #include "eval/evaluate.h"
 
 #include <visp3/core/vpImage.h>
@@ -28,8 +32,10 @@
 #include "eval/annotated_output.h"
 #include "eval/compare.h"
 #include "eval/frame_decoder.h"
+#include "eval/frame_judgement.h"
 #include "eval/input_truth.h"
 #include "eval/pipeline.h"
+#include "eval/plot_series.h"
 #include "eval/report.h"
 #include "eval/truth_file.h"
 #include "io/annotate.h"
@@ -50,13 +56,7 @@ namespace fs = std::filesystem;
 constexpr double kRadToDeg = 180.0 / kPi;
 constexpr std::size_t kQueueFrames = 8;         // decoded frames waiting for the tracker
 constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
-constexpr std::size_t kPlottedTracks = 10;      // the tracks seen longest get a series
-// A pose is flagged as a jump when, against the last trusted pose of at most kJumpFrames
-// frames before, the same four tracks are identified as other target lines, or the rotation
-// exceeds kJumpRotationDeg (docs/EVALUATE.md, frames.jsonl).
-constexpr int kJumpFrames = 10;
-constexpr double kJumpRotationDeg = 90.0;
-constexpr std::size_t kListedJumps = 100;  // jump frames named in the summary
+constexpr std::size_t kListedJumps = 100;       // jump frames named in the summary
 
 // The options are named as the user gives them, on evaluate's command line.
 template <typename T>
@@ -75,41 +75,6 @@ Json Stats(const SampleStats& values) {
               {"median", values.Quantile(0.5)},
               {"p95", values.Quantile(0.95)},
               {"max", values.max()}};
-}
-
-// ---------------------------------------------------------------------------------------
-// Inputs.
-
-bool HoldsImages(const fs::path& dir) {
-  std::error_code error;
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
-    if (entry.is_regular_file() && HasImageExtension(entry.path().string())) return true;
-  }
-  return false;
-}
-
-// A file-system-safe name for the input's output directory.
-std::string BaseName(const std::string& spec) {
-  fs::path path = fs::path(spec).lexically_normal();
-  if (path.filename().empty()) path = path.parent_path();
-  std::string name;
-  if (spec.find('%') != std::string::npos && !fs::exists(spec)) {
-    name = path.parent_path().filename().string();  // frames/img%04d.png -> frames
-    if (name.empty() || name == "." || name == "..") name = path.stem().string();
-  } else if (fs::is_directory(path)) {
-    name = fs::absolute(path).lexically_normal().filename().string();
-    if (name.empty())
-      name = fs::absolute(path).lexically_normal().parent_path().filename().string();
-  } else {
-    name = path.stem().string();
-  }
-  for (char& c : name) {
-    const bool safe =
-        std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
-    if (!safe) c = '_';
-  }
-  if (name.empty() || name[0] == '.') name = "input" + name;
-  return name;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -142,132 +107,6 @@ std::optional<CameraFile> CameraFor(const RunContext& run, const PlannedInput& i
   return LoadCameraFile(candidate.string());
 }
 
-// Per-frame values for the plots (report.h), nulls where a value does not exist. Fewer than
-// 2 x `capacity` frames are kept: at that, every other one is dropped and from then on only
-// every second frame recorded (then every fourth...), so a long input's plots cost bounded
-// memory; frames.jsonl keeps every frame.
-// A frame's status; its number is what the report's status plot draws.
-enum class FrameStatus : int {
-  kUnreadable = -1,
-  kLost = 0,      ///< no line held
-  kPartial = 1,   ///< some lines held, fewer than the target's
-  kDetected = 2,  ///< the target's lines held, no pose
-  kPose = 3,      ///< a pose
-};
-
-std::string ToString(FrameStatus status) {
-  switch (status) {
-    case FrameStatus::kUnreadable:
-      return "unreadable";
-    case FrameStatus::kLost:
-      return "lost";
-    case FrameStatus::kPartial:
-      return "partial";
-    case FrameStatus::kDetected:
-      return "detected";
-    case FrameStatus::kPose:
-      return "pose";
-  }
-  return "unreadable";
-}
-
-struct Series {
-  struct Track {
-    int id = 0;
-    double rho_px = 0, theta_deg = 0;
-  };
-  struct TruthLine {
-    int line = 0;
-    std::optional<double> offset_px, angle_deg;
-  };
-  struct Row {
-    int frame = 0;
-    FrameStatus status = FrameStatus::kUnreadable;
-    std::optional<double> held, pose_ok, pose_t_mm, pose_r_deg;
-    double decode_us = 0;
-    std::optional<double> track_us, pose_us;
-    std::vector<Track> tracks;
-    std::vector<TruthLine> truth;
-  };
-
-  std::vector<Row> rows;
-  std::map<int, int> seen;      // frames each track was held, every frame counted
-  std::size_t capacity = 2048;  ///< EvaluateOptions::plot_frames
-  std::size_t offered = 0, stride = 1;
-
-  void Add(Row row) {
-    for (const Track& track : row.tracks) ++seen[track.id];
-    if (offered++ % stride != 0) return;
-    rows.push_back(std::move(row));
-    if (rows.size() < 2 * capacity) return;
-    for (std::size_t i = 1; 2 * i < rows.size(); ++i) rows[i] = std::move(rows[2 * i]);
-    rows.resize((rows.size() + 1) / 2);
-    stride *= 2;
-  }
-
-  static Json Optional(const std::optional<double>& value) { return value ? Json(*value) : Json(); }
-  template <typename Get>
-  Json Column(Get get) const {
-    Json column = Json::array();
-    for (const Row& row : rows) column.push_back(get(row));
-    return column;
-  }
-  // {"key": [value or null per row]} for `keys`, each row's value from `find(row, key)`.
-  template <typename Find>
-  Json Keyed(const std::vector<int>& keys, Find find) const {
-    Json out = Json::object();
-    for (int key : keys)
-      out[std::to_string(key)] = Column([&](const Row& r) { return find(r, key); });
-    return out;
-  }
-  Json ToJson() const {
-    std::vector<std::pair<int, int>> by_seen(seen.begin(), seen.end());  // (id, frames)
-    std::stable_sort(by_seen.begin(), by_seen.end(),
-                     [](const auto& a, const auto& b) { return a.second > b.second; });
-    std::vector<int> tracks;
-    for (std::size_t i = 0; i < by_seen.size() && i < kPlottedTracks; ++i) {
-      tracks.push_back(by_seen[i].first);
-    }
-    std::sort(tracks.begin(), tracks.end());
-    std::set<int> truth_lines;
-    for (const Row& row : rows) {
-      for (const TruthLine& line : row.truth) truth_lines.insert(line.line);
-    }
-    const std::vector<int> lines(truth_lines.begin(), truth_lines.end());
-    const auto track_value = [](double Track::*member) {
-      return [member](const Row& row, int id) {
-        for (const Track& track : row.tracks) {
-          if (track.id == id) return Json(track.*member);
-        }
-        return Json();
-      };
-    };
-    const auto truth_value = [](std::optional<double> TruthLine::*member) {
-      return [member](const Row& row, int line) {
-        for (const TruthLine& truth : row.truth) {
-          if (truth.line == line) return Optional(truth.*member);
-        }
-        return Json();
-      };
-    };
-    return Json{{"frame", Column([](const Row& r) { return Json(r.frame); })},
-                {"status", Column([](const Row& r) { return Json(static_cast<int>(r.status)); })},
-                {"held", Column([](const Row& r) { return Optional(r.held); })},
-                {"pose_ok", Column([](const Row& r) { return Optional(r.pose_ok); })},
-                {"rho", Keyed(tracks, track_value(&Track::rho_px))},
-                {"theta_deg", Keyed(tracks, track_value(&Track::theta_deg))},
-                {"offset_px", Keyed(lines, truth_value(&TruthLine::offset_px))},
-                {"angle_deg", Keyed(lines, truth_value(&TruthLine::angle_deg))},
-                {"pose_t_mm", Column([](const Row& r) { return Optional(r.pose_t_mm); })},
-                {"pose_r_deg", Column([](const Row& r) { return Optional(r.pose_r_deg); })}};
-  }
-  Json TimingJson() const {
-    return Json{{"decode_us", Column([](const Row& r) { return Json(r.decode_us); })},
-                {"track_us", Column([](const Row& r) { return Optional(r.track_us); })},
-                {"pose_us", Column([](const Row& r) { return Optional(r.pose_us); })}};
-  }
-};
-
 Json TrackJson(const TrackedLine& track) {
   return Json{{"id", track.id},
               {"status", ToString(track.status)},
@@ -276,98 +115,6 @@ Json TrackJson(const TrackedLine& track) {
               {"support", track.line.support},
               {"frames_seen", track.frames_seen},
               {"frames_lost", track.frames_lost}};
-}
-
-// The track ids identified as target lines 1-4 (-1: not identified).
-std::array<int, 4> IdentifiedTracks(const PoseResult& pose, const std::vector<int>& ids) {
-  std::array<int, 4> tracks{{-1, -1, -1, -1}};
-  for (std::size_t k = 0; k < 4; ++k) {
-    const int index = pose.line_index[k];
-    if (index >= 0 && index < static_cast<int>(ids.size())) tracks[k] = ids[index];
-  }
-  return tracks;
-}
-
-// An ok pose and the tracks it identified: the reference against which jumps are found.
-struct TrustedPose {
-  int frame = 0;
-  vpHomogeneousMatrix cMo;
-  std::array<int, 4> tracks{};
-};
-
-// A pose that jumped from the last trusted one (kJumpFrames, kJumpRotationDeg).
-struct PoseJump {
-  int from_frame = 0;
-  double rotation_deg = 0.0, translation_mm = 0.0;
-  bool relabelled = false;  ///< the same four tracks, identified as other target lines
-};
-
-// What a frame's thumbnail is chosen by.
-struct FrameJudgement {
-  FrameStatus status = FrameStatus::kLost;
-  std::size_t held = 0;              ///< lines held
-  const PoseResult* pose = nullptr;  ///< none without a camera
-  std::optional<PoseJump> jump;
-  int missed = 0;                                       ///< truth lines not found
-  double worst_offset_px = 0.0;                         ///< of the truth lines found
-  std::optional<std::pair<double, double>> pose_error;  ///< mm, deg
-  bool truth_known = false;
-};
-
-// How bad a frame is, for the thumbnails (lost > partial > pose jump > no pose > truth
-// errors), and why, in words.
-void Judge(const FrameJudgement& frame, double* badness, std::string* why_text) {
-  std::ostringstream why;
-  *badness = 0.0;
-  if (frame.status == FrameStatus::kLost || frame.status == FrameStatus::kPartial) {
-    const bool lost = frame.status == FrameStatus::kLost;
-    *badness += lost ? 1000.0 : 500.0;
-    why << (lost ? "no line held" : std::to_string(frame.held) + " lines held") << "; ";
-  }
-  const bool pose_ok = frame.pose != nullptr && frame.pose->status == PoseStatus::kOk;
-  if (frame.pose != nullptr && !pose_ok) {
-    *badness += 100.0;
-    why << "pose " << ToString(frame.pose->status) << "; ";
-  }
-  if (frame.jump) {
-    *badness += 200.0;
-    why << "pose jumped " << std::round(frame.jump->rotation_deg * 10.0) / 10.0
-        << " deg from frame " << frame.jump->from_frame
-        << (frame.jump->relabelled ? " (lines relabelled)" : "") << "; ";
-  }
-  if (frame.missed > 0) {
-    *badness += 50.0 * frame.missed;
-    why << frame.missed << " truth line(s) missed; ";
-  }
-  if (frame.worst_offset_px > 0.0) {
-    *badness += frame.worst_offset_px;
-    why << "line offset " << std::round(frame.worst_offset_px * 100.0) / 100.0 << " px; ";
-  }
-  if (frame.pose_error) {
-    *badness += frame.pose_error->first / 10.0 + frame.pose_error->second;
-    why << "pose error " << std::round(frame.pose_error->first * 10.0) / 10.0 << " mm, "
-        << std::round(frame.pose_error->second * 100.0) / 100.0 << " deg; ";
-  } else if (pose_ok && !frame.truth_known) {
-    *badness += frame.pose->residual_px;
-    why << "residual " << std::round(frame.pose->residual_px * 100.0) / 100.0 << " px; ";
-  }
-  *why_text = why.str();
-  if (why_text->size() >= 2) why_text->resize(why_text->size() - 2);
-}
-
-std::optional<PoseJump> JumpFrom(const std::optional<TrustedPose>& trusted, int frame,
-                                 const vpHomogeneousMatrix& cMo, const std::array<int, 4>& tracks) {
-  if (!trusted || frame - trusted->frame > kJumpFrames) return std::nullopt;
-  std::array<int, 4> now = tracks, before = trusted->tracks;
-  std::sort(now.begin(), now.end());
-  std::sort(before.begin(), before.end());
-  const bool same_tracks = now == before && now[0] >= 0;
-  PoseJump jump;
-  jump.from_frame = trusted->frame;
-  std::tie(jump.translation_mm, jump.rotation_deg) = PoseError(cMo, trusted->cMo);
-  jump.relabelled = same_tracks && tracks != trusted->tracks;
-  if (!jump.relabelled && !(jump.rotation_deg > kJumpRotationDeg)) return std::nullopt;
-  return jump;
 }
 
 Json PoseFrameJson(const PoseResult& pose, const std::vector<int>& ids,
@@ -554,7 +301,7 @@ class InputEvaluation {
                   false);
     WriteJsonLine(timing, Json{{"frame", frame.index}, {"decode_us", frame.decode_us}}, false);
     decode_us_.push_back(frame.decode_us);
-    Series::Row row;
+    PlotSeries::Row row;
     row.frame = frame.index;
     row.decode_us = frame.decode_us;
     series_.Add(std::move(row));
@@ -608,7 +355,7 @@ class InputEvaluation {
     std::optional<std::pair<double, double>> pose_error;  ///< mm, deg
   };
   TruthComparison CompareWithTruth(const FrameTruth& truth, const TrackedFrame& out, bool pose_ok,
-                                   std::vector<Series::TruthLine>* plotted) {
+                                   std::vector<PlotSeries::TruthLine>* plotted) {
     TruthComparison result;
     if (!truth.known) return result;
     ++tally_.truth_frames;
@@ -628,7 +375,7 @@ class InputEvaluation {
                            {"track", e.track},
                            {"angle_deg", found ? Json(e.angle_deg) : Json()},
                            {"offset_px", found ? Json(e.offset_px) : Json()}});
-      Series::TruthLine line;
+      PlotSeries::TruthLine line;
       line.line = e.line;
       if (found) line.offset_px = e.offset_px, line.angle_deg = e.angle_deg;
       plotted->push_back(line);
@@ -748,7 +495,7 @@ class InputEvaluation {
     CountFrame(detected, pose_ok, out.pose);
 
     const FrameTruth truth = truth_.Get(frame.source, frame.index, w, h);
-    Series::Row row;
+    PlotSeries::Row row;
     const TruthComparison compared = CompareWithTruth(truth, out, pose_ok, &row.truth);
     const Json& truth_json = compared.json;
     const double worst_offset = compared.worst_offset_px;
@@ -927,7 +674,7 @@ class InputEvaluation {
   Tally tally_;
   std::optional<TrustedPose> trusted_;               ///< the last trusted pose (JumpFrom)
   std::optional<TargetPoseTracker> target_tracker_;  ///< the pose of a '#' target
-  Series series_;
+  PlotSeries series_;
   SampleStats decode_us_;
 };
 
@@ -964,22 +711,6 @@ Json ReadJsonOrNull(const fs::path& path) {
   }
 }
 
-// Why a plan has no input: the directories given and what they hold.
-std::string NoInputsMessage(const std::vector<std::string>& inputs, const InputPlan& plan) {
-  std::string names;
-  for (const std::string& input : inputs) names += (names.empty() ? "'" : ", '") + input + "'";
-  std::string message = "no inputs found in " + names +
-                        " (expected videos, image sequences, or directories of these)";
-  constexpr std::size_t kListed = 5;
-  for (std::size_t k = 0; k < plan.skipped.size() && k < kListed; ++k) {
-    message += "; " + plan.skipped[k];
-  }
-  if (plan.skipped.size() > kListed) {
-    message += "; and " + std::to_string(plan.skipped.size() - kListed) + " more";
-  }
-  return message;
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -1007,65 +738,6 @@ void EvaluateOptions::Check() const {
   if (fs::exists(out_dir) && !fs::is_directory(out_dir)) {
     throw std::invalid_argument("output '" + out_dir + "' is not a directory");
   }
-}
-
-std::pair<int, int> ParseShard(const std::string& text) {
-  const auto slash = text.find('/');
-  int index = -1, count = 0;
-  try {
-    if (slash != std::string::npos) {
-      std::size_t used_index = 0, used_count = 0;
-      index = std::stoi(text.substr(0, slash), &used_index);
-      count = std::stoi(text.substr(slash + 1), &used_count);
-      if (used_index != slash || used_count != text.size() - slash - 1) index = -1;
-    }
-  } catch (const std::exception&) {
-    index = -1;
-  }
-  if (index < 0 || count < 1 || index >= count) {
-    throw std::invalid_argument("--shard '" + text +
-                                "': expected I/N with 0 <= I < N, e.g. 0/4 (I is 0-based)");
-  }
-  return {index, count};
-}
-
-InputPlan PlanInputs(const std::vector<std::string>& inputs) {
-  InputPlan plan;
-  std::vector<std::string> specs;
-  for (const std::string& input : inputs) {
-    std::error_code error;
-    if (!fs::is_directory(input, error) || HoldsImages(input)) {
-      specs.push_back(input);
-      continue;
-    }
-    std::vector<fs::path> entries;
-    for (const fs::directory_entry& entry : fs::directory_iterator(input, error)) {
-      entries.push_back(entry.path());
-    }
-    std::sort(entries.begin(), entries.end());
-    const std::size_t before = specs.size();
-    for (const fs::path& entry : entries) {
-      if (fs::is_regular_file(entry) && HasVideoExtension(entry.string())) {
-        specs.push_back(entry.string());
-      } else if (fs::is_directory(entry) && HoldsImages(entry)) {
-        specs.push_back(entry.string());
-      } else if (!(fs::is_regular_file(entry) && IsCompanionFile(entry.string()))) {
-        plan.skipped.push_back(entry.string() + ": not a video or a directory of images");
-      }
-    }
-    if (specs.size() == before) {
-      plan.skipped.push_back(input + ": holds no video and no directory of images");
-    }
-  }
-  std::set<std::string> used;
-  for (const std::string& spec : specs) {
-    const std::string base = BaseName(spec);
-    std::string name = base;
-    for (int k = 2; used.count(name) != 0; ++k) name = base + "-" + std::to_string(k);
-    used.insert(name);
-    plan.inputs.push_back({spec, name});
-  }
-  return plan;
 }
 
 EvaluateResult Evaluate(const EvaluateOptions& options,

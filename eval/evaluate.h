@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/input_plan.h"
 #include "eval/oal_methods.h"
 #include "io/json_io.h"
 
@@ -90,26 +91,6 @@ struct EvaluateOptions {
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
 };
-
-/// "I/N" -> (I, N); throws std::invalid_argument unless 0 <= I < N.
-std::pair<int, int> ParseShard(const std::string& text);
-
-/// One input after the expansion of directories.
-struct PlannedInput {
-  std::string spec;  ///< what OpenImageSource opens
-  std::string name;  ///< its output directory's name, unique in the plan
-};
-
-struct InputPlan {
-  std::vector<PlannedInput> inputs;  ///< every input, before sharding
-  /// Entries of input directories that are no input (companion files left out), and input
-  /// directories holding no input.
-  std::vector<std::string> skipped;
-};
-
-/// Expands `inputs` (file comment) and names them. Inputs that do not exist stay in the
-/// plan (they fail when evaluated, without stopping the others).
-InputPlan PlanInputs(const std::vector<std::string>& inputs);
 
 /// What happened to one input of the shard.
 struct InputOutcome {
