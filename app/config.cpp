@@ -1,3 +1,6 @@
+// The YAML reader of every configuration section: one table of fields per section, read by one
+// machinery (Value, Field, ReadFields, CheckAt) that gives every message its file, line and key;
+// kept in one file so that a new key is one line beside its kin and the machinery stays private.
 #include "app/config.h"
 
 #include <visp3/core/vpMath.h>

@@ -1,3 +1,5 @@
+// One class, the Controller-A simulator: its pseudo-terminal loop, the ACL commands it answers,
+// its motion model and the faults tests inject, all on the same private state.
 #include "robots/scorbot_controller_sim.h"
 
 #include <fcntl.h>

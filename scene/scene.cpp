@@ -1,3 +1,6 @@
+// The renderer in one translation unit: the ground truth, the per-sample drawing and the scene
+// dressing (annotations, clutter, shadow, paper) share the plane geometry, and the per-pixel
+// calls inline across them.
 #include "scene/scene.h"
 
 #include <visp3/core/vpPixelMeterConversion.h>

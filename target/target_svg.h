@@ -1,0 +1,80 @@
+// A printable, true-scale SVG of a planar line target on one page (`oalservo target`).
+//
+// The target: any LineTarget; `oalservo target` takes a built-in by name, a config's
+// `target:`, or the sheet target made for the page (SheetTargetName: four-line-a4 for a4,
+// four-line-a3 for a3, four-line-letter for letter; config/four-line-*.yaml).
+//
+// The page: exactly the sheet (A4, A3, US letter), portrait unless `landscape`, 1 SVG unit =
+// 1 mm (width/height in mm, viewBox in mm); or `full`, the board at its full size with 10 mm
+// around it (the 2 m board, for a plotter or a print shop). The board is centred on the page,
+// upright (object x to the right, y down, as the camera sees it) when it fits so, else turned
+// by 90 degrees clockwise (object x down the page, y to the left), which the SVG's <desc> and
+// the drawing's note say. A board that fits the page in neither orientation is refused
+// (TargetDoesNotFit, saying what to print instead); nothing is tiled or scaled.
+//
+// What is printed: the stripes, black filled polygons exactly as the target has them (the
+// centre line widened by width / 2 on both sides, flat ends), clipped to the board; the board's
+// outline is not printed (the sheet is the board, and an outline would be one more line for
+// the camera). Everything else is small and thin (text 3 mm, strokes at most 0.3 mm, grey),
+// because a camera looks at the sheet and a thick mark would be a line: the line numbers
+// 1..N beside both ends of each stripe, the target's name and size with "print at 100 %, do
+// not scale", and a 100 mm scale bar with a tick every 10 mm. Each of those is at least
+// kClearanceMm from every stripe and from the page's edge (a printer's margin is 3-6 mm),
+// never between the stripes' crossings (the middle cell of the '#', from which the tracker
+// finds the target), and laid out in the paper between the stripes by a search: a corner
+// cell of the '#' first, else the cell with the most room, upright first, then turned by 90
+// degrees, then (the scale bar on a small sheet) at a slant. A text's extent is estimated as
+// kTextWidthEm per character by kTextHeightEm, around a centre kTextBaselineEm above its
+// baseline (see the constants); its `x`, `y` are the middle of its baseline (text-anchor
+// middle).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "target/line_target.h"
+
+namespace oal {
+
+/// Distance kept from every stripe and from the page's edge by everything but the stripes, mm.
+inline constexpr double kClearanceMm = 5.0;
+/// The estimated extent of a text of N characters at font size S (sans-serif): N *
+/// kTextWidthEm * S wide, kTextHeightEm * S tall, centred kTextBaselineEm * S above the
+/// baseline. Generous for DejaVu Sans and Helvetica (capitals, digits, '%', descenders).
+inline constexpr double kTextWidthEm = 0.7;
+inline constexpr double kTextHeightEm = 1.05;
+inline constexpr double kTextBaselineEm = 0.275;
+
+/// A board that fits the page in neither orientation; the message says what does not fit and
+/// what to do instead.
+class TargetDoesNotFit : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A drawing of a target and the page it was laid out on.
+struct TargetDrawing {
+  std::string svg;              ///< the whole SVG document
+  double page_width_mm = 0.0;   ///< the SVG's width
+  double page_height_mm = 0.0;  ///< the SVG's height
+  std::string page;             ///< "A4 portrait", "A3 landscape", ..., or "full size"
+  bool turned = false;          ///< drawn turned by 90 degrees (clockwise) to fit the page
+  std::string note;             ///< when turned: what that means for printing; else empty
+  std::string warning;          ///< a stripe within kClearanceMm of the page's edge; else empty
+};
+
+/// Lays `target` out on `page` ("a4", "a3", "letter" or "full"), portrait unless
+/// `landscape` (not with "full"). Throws std::invalid_argument for another page name, for
+/// landscape with "full" or for a target that fails Check(), TargetDoesNotFit for a board the
+/// page does not hold, std::runtime_error when the legend finds no room.
+TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page,
+                            bool landscape = false);
+
+/// Throws std::invalid_argument unless `page` is a4, a3, letter or full.
+void CheckPageName(const std::string& page);
+
+/// The sheet target made for `page`: four-line-a4 for a4, four-line-a3 for a3,
+/// four-line-letter for letter; for full, the first built-in (four-line-a3).
+std::string SheetTargetName(const std::string& page);
+
+}  // namespace oal
