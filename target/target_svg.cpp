@@ -18,7 +18,6 @@
 namespace oal {
 namespace {
 
-
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 constexpr double kFullMarginMm = 10.0;  // --page full: blank paper around the board
 constexpr double kGapMm = 1.5;          // between two printed items other than stripes
