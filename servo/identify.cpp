@@ -106,6 +106,28 @@ class Identifier {
   SubsetResult Evaluate(const std::array<int, 4>& idx) const;
 
  private:
+  // The four lines in two groups of crossing lines, G and H (indices into lines_).
+  struct Groups {
+    std::array<int, 2> g{}, h{};
+  };
+  // The corners q[i][j] = G_i ∩ H_j, pixels, and the sign of the quadrilateral's turns.
+  struct Quad {
+    Vec2 q[2][2]{};
+    double orientation = 0.0;
+  };
+  // One assignment of target lines 1-4 to the image lines and its cost.
+  struct Assignment {
+    double cost = 0.0;
+    double previous_angle_deg = 180.0;  // from the previous pose's rotation (180 without one)
+    std::array<int, 4> line_index{};
+    std::array<Point2d, 4> corners{};
+  };
+
+  bool SplitIntoGroups(const std::array<int, 4>& idx, Groups* groups, std::string* message) const;
+  bool FindCorners(const Groups& groups, Quad* quad, std::string* message) const;
+  int Assign(const Groups& groups, const Quad& quad, std::array<Assignment, 4>* kept) const;
+  SubsetResult Choose(const std::array<Assignment, 4>& kept, int n_kept) const;
+
   double GroupAngle(int a, int b, int c, int d) const {
     const LineParams* l[4] = {&lines_[a].line, &lines_[b].line, &lines_[c].line, &lines_[d].line};
     return std::min(std::min(AngleBetween(*l[0], *l[2]), AngleBetween(*l[0], *l[3])),
@@ -195,9 +217,9 @@ double Identifier::Cost(const Mat3& h, const std::array<int, 4>& image_line_of_t
   return cost;
 }
 
-SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
-  SubsetResult result;
-  // 1. The split into two groups with the largest angle between groups.
+// Step 1: the split of the four lines into two groups with the largest angle between groups.
+bool Identifier::SplitIntoGroups(const std::array<int, 4>& idx, Groups* groups,
+                                 std::string* message) const {
   static constexpr int kSplits[3][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}};
   int best_split = 0;
   double best_angle = -1.0;
@@ -209,29 +231,32 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
       best_split = s;
     }
   }
-  const int group_g[2] = {idx[kSplits[best_split][0]], idx[kSplits[best_split][1]]};
-  const int group_h[2] = {idx[kSplits[best_split][2]], idx[kSplits[best_split][3]]};
+  groups->g = {idx[kSplits[best_split][0]], idx[kSplits[best_split][1]]};
+  groups->h = {idx[kSplits[best_split][2]], idx[kSplits[best_split][3]]};
   if (best_angle * kDegPerRad < options_.min_group_angle_deg) {
-    std::ostringstream message;
-    message << "the lines do not form two groups of crossing lines: lines of different groups "
-               "meet at "
-            << best_angle * kDegPerRad
-            << " deg < min_group_angle_deg = " << options_.min_group_angle_deg;
-    result.message = message.str();
-    return result;
+    std::ostringstream text;
+    text << "the lines do not form two groups of crossing lines: lines of different groups "
+            "meet at "
+         << best_angle * kDegPerRad
+         << " deg < min_group_angle_deg = " << options_.min_group_angle_deg;
+    *message = text.str();
+    return false;
   }
+  return true;
+}
 
-  // 2. Corners q[i][j] = G_i ∩ H_j, near the image, a convex quadrilateral.
-  Vec2 q[2][2];
+// Step 2: the corners q[i][j] = G_i ∩ H_j, near the image, a convex quadrilateral; its
+// orientation (the sign of its turns).
+bool Identifier::FindCorners(const Groups& groups, Quad* quad, std::string* message) const {
   const vpCameraParameters& camera = options_.camera;
   for (int i = 0; i < 2; ++i) {
     for (int j = 0; j < 2; ++j) {
       Point2d p;
-      if (!Intersect(lines_[group_g[i]].line, lines_[group_h[j]].line, &p, 1e-6)) {
-        result.message = "two lines of different groups are parallel";
-        return result;
+      if (!Intersect(lines_[groups.g[i]].line, lines_[groups.h[j]].line, &p, 1e-6)) {
+        *message = "two lines of different groups are parallel";
+        return false;
       }
-      q[i][j] = {p.u, p.v};
+      quad->q[i][j] = {p.u, p.v};
       double x = 0.0, y = 0.0;
       pose_internal::PixelToMetre(camera, options_.lines_undistorted, p, &x, &y);
       const double radius = std::hypot(x, y);
@@ -241,46 +266,47 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
             {0.0, -p.u, p.u - (options_.image_width - 1), -p.v, p.v - (options_.image_height - 1)});
       }
       if (!(radius <= options_.max_intersection_radius) || outside > options_.max_outside_px) {
-        std::ostringstream message;
-        message << "the intersection of lines " << group_g[i] << " and " << group_h[j]
-                << " lies too far away: (" << p.u << ", " << p.v << ") px, " << outside
-                << " px outside the image (max_outside_px = " << options_.max_outside_px
-                << "), radius " << radius
-                << " (max_intersection_radius = " << options_.max_intersection_radius << ")";
-        result.message = message.str();
-        return result;
+        std::ostringstream text;
+        text << "the intersection of lines " << groups.g[i] << " and " << groups.h[j]
+             << " lies too far away: (" << p.u << ", " << p.v << ") px, " << outside
+             << " px outside the image (max_outside_px = " << options_.max_outside_px
+             << "), radius " << radius
+             << " (max_intersection_radius = " << options_.max_intersection_radius << ")";
+        *message = text.str();
+        return false;
       }
     }
   }
-  const Vec2 quad[4] = {q[0][0], q[1][0], q[1][1], q[0][1]};
-  double orientation = 0.0;
+  const Vec2 corners[4] = {quad->q[0][0], quad->q[1][0], quad->q[1][1], quad->q[0][1]};
   for (int c = 0; c < 4; ++c) {
-    const Vec2 e1 = Minus(quad[(c + 1) % 4], quad[c]);
-    const Vec2 e2 = Minus(quad[(c + 2) % 4], quad[(c + 1) % 4]);
+    const Vec2 e1 = Minus(corners[(c + 1) % 4], corners[c]);
+    const Vec2 e2 = Minus(corners[(c + 2) % 4], corners[(c + 1) % 4]);
     const double turn = Cross(e1, e2);
     const double side = std::hypot(e1.x, e1.y);
     if (side < options_.min_side_px || turn == 0.0 ||
-        (c > 0 && (turn > 0.0) != (orientation > 0.0))) {
-      std::ostringstream message;
-      message << "the four intersections do not form a convex quadrilateral with sides of at "
-                 "least min_side_px = "
-              << options_.min_side_px << " px";
-      result.message = message.str();
-      return result;
+        (c > 0 && (turn > 0.0) != (quad->orientation > 0.0))) {
+      std::ostringstream text;
+      text << "the four intersections do not form a convex quadrilateral with sides of at "
+              "least min_side_px = "
+           << options_.min_side_px << " px";
+      *message = text.str();
+      return false;
     }
-    if (c == 0) orientation = turn;
+    if (c == 0) quad->orientation = turn;
   }
+  return true;
+}
 
-  // 3. The four orientation-preserving assignments.
-  const Mat3 h0 = SquareToQuad(quad[0], quad[1], quad[2], quad[3]);
+// Step 3: the orientation-preserving assignments of the target's lines to the groups (four
+// of the eight; a reflection would put the camera behind the board), each with its cost.
+int Identifier::Assign(const Groups& groups, const Quad& quad,
+                       std::array<Assignment, 4>* kept) const {
+  const Mat3 h0 = SquareToQuad(quad.q[0][0], quad.q[1][0], quad.q[1][1], quad.q[0][1]);
   static constexpr int kPairs[2][2] = {{0, 2}, {1, 3}};  // target lines 1, 3 and 2, 4
-  struct Assignment {
-    double cost;
-    double previous_angle_deg;  // from the previous pose's rotation (180 without one)
-    std::array<int, 4> line_index;
-    std::array<Point2d, 4> corners;
+  // Board corner of target lines a and b (adjacent indices mod 4).
+  const auto corner_of = [](int a, int b) {
+    return ((a + 1) % 4 == b) ? a : b;  // corner[k] = lines[k] ∩ lines[k+1]
   };
-  std::array<Assignment, 4> kept{};
   int n_kept = 0;
   for (int swap = 0; swap < 2; ++swap) {
     for (int flip_g = 0; flip_g < 2; ++flip_g) {
@@ -290,29 +316,26 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
           target_g[i] = kPairs[swap][i ^ flip_g];
           target_h[i] = kPairs[1 - swap][i ^ flip_h];
         }
-        // Board corner of target lines a and b (adjacent indices mod 4).
-        auto corner_of = [](int a, int b) {
-          return ((a + 1) % 4 == b) ? a : b;  // corner[k] = lines[k] ∩ lines[k+1]
-        };
         const Vec2& o00 = target_.corner[corner_of(target_g[0], target_h[0])];
         const Vec2& o10 = target_.corner[corner_of(target_g[1], target_h[0])];
         const Vec2& o01 = target_.corner[corner_of(target_g[0], target_h[1])];
         const Vec2 e1 = Minus(o10, o00), e2 = Minus(o01, o00);
         const double det = Cross(e1, e2);
-        if (det * orientation <= 0.0) continue;  // a reflection: camera behind the board
+        if (det * quad.orientation <= 0.0) continue;  // a reflection: camera behind the board
         // Board -> square: (s, t) = M^-1 (X - o00), M = [e1 e2].
         const Mat3 board_to_square = {e2.y / det,  -e2.x / det, (e2.x * o00.y - e2.y * o00.x) / det,
                                       -e1.y / det, e1.x / det,  (e1.y * o00.x - e1.x * o00.y) / det,
                                       0.0,         0.0,         1.0};
         const Mat3 h = Multiply(h0, board_to_square);
-        Assignment& a = kept[n_kept++];
+        Assignment& a = (*kept)[n_kept++];
         for (int i = 0; i < 2; ++i) {
-          a.line_index[target_g[i]] = group_g[i];
-          a.line_index[target_h[i]] = group_h[i];
+          a.line_index[target_g[i]] = groups.g[i];
+          a.line_index[target_h[i]] = groups.h[i];
         }
         for (int i = 0; i < 2; ++i)
           for (int j = 0; j < 2; ++j)
-            a.corners[corner_of(target_g[i], target_h[j])] = Point2d{q[i][j].x, q[i][j].y};
+            a.corners[corner_of(target_g[i], target_h[j])] =
+                Point2d{quad.q[i][j].x, quad.q[i][j].y};
         a.cost = Cost(h, a.line_index);
         a.previous_angle_deg = previous_cRo_ != nullptr && options_.previous_max_deg > 0.0
                                    ? PreviousAngleDeg(h)
@@ -320,7 +343,12 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
       }
     }
   }
-  // 4. A clear winner.
+  return n_kept;
+}
+
+// Step 4: a clear winner among the assignments, or the one that agrees with the previous pose.
+SubsetResult Identifier::Choose(const std::array<Assignment, 4>& kept, int n_kept) const {
+  SubsetResult result;
   int best = -1, second = -1;
   for (int k = 0; k < n_kept; ++k) {
     if (best < 0 || kept[k].cost < kept[best].cost) {
@@ -374,6 +402,17 @@ SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
   }
   result.status = PoseStatus::kOk;
   return result;
+}
+
+SubsetResult Identifier::Evaluate(const std::array<int, 4>& idx) const {
+  SubsetResult result;
+  Groups groups;
+  if (!SplitIntoGroups(idx, &groups, &result.message)) return result;
+  Quad quad;
+  if (!FindCorners(groups, &quad, &result.message)) return result;
+  std::array<Assignment, 4> kept{};
+  const int n_kept = Assign(groups, quad, &kept);
+  return Choose(kept, n_kept);
 }
 
 }  // namespace

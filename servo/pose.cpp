@@ -260,6 +260,120 @@ PoseResult Fail(PoseResult result, const std::string& message) {
   return result;
 }
 
+// In a loop the previous pose is a good seed: its refinement alone is kept when it fits well
+// (previous_accept_px), and the linear methods are skipped. Whether it was kept.
+bool KeepPreviousPose(const vpHomogeneousMatrix& previous_cMo, const Corners& corners,
+                      const HashTarget& hash, const PoseOptions& options, PoseResult* result,
+                      vpHomogeneousMatrix* cMo, double* residual_px) {
+  vpHomogeneousMatrix seeded = previous_cMo;
+  corners.Set(&seeded, result, nullptr);
+  if (!RefineOnCorners(hash, result->corners_m, &seeded)) return false;
+  const double seeded_px = ResidualPx(seeded, hash, result->corners_m, options.camera);
+  if (!(seeded_px < options.previous_accept_px)) return false;
+  *cMo = seeded;
+  *residual_px = seeded_px;
+  result->method = PoseMethod::kPrevious;
+  result->from_previous = true;
+  return true;
+}
+
+// Steps 3-4: Lagrange, and Dementhon unless Lagrange's residual is already below
+// dementhon_above_px (where the refinement would end in the same minimum anyway); the lower
+// residual is refined by virtual visual servoing, and so is the previous pose when there is one
+// (kept when its residual is within previous_tolerance_px). Why no pose was found, if none.
+std::optional<std::string> LinearPoseRefined(const vpHomogeneousMatrix* previous_cMo,
+                                             const Corners& corners, const HashTarget& hash,
+                                             const PoseOptions& options, vpPose* pose,
+                                             PoseResult* result, vpHomogeneousMatrix* cMo,
+                                             double* residual_px) {
+  const vpCameraParameters& camera = options.camera;
+  corners.Set(nullptr, result, pose);
+  vpHomogeneousMatrix by_dementhon, by_lagrange;
+  const bool lagrange_ok = Compute(pose, vpPose::LAGRANGE, &by_lagrange);
+  const double lagrange_px =
+      lagrange_ok ? ResidualPx(by_lagrange, hash, result->corners_m, camera) : HUGE_VAL;
+  const bool run_dementhon = !(lagrange_px < options.dementhon_above_px);
+  const bool dementhon_ok = run_dementhon && Compute(pose, vpPose::DEMENTHON, &by_dementhon);
+  const double dementhon_px =
+      dementhon_ok ? ResidualPx(by_dementhon, hash, result->corners_m, camera) : HUGE_VAL;
+  if (!std::isfinite(dementhon_px) && !std::isfinite(lagrange_px)) {
+    return "vpPose found no pose in front of the camera (Dementhon and Lagrange failed)";
+  }
+  result->method = dementhon_px <= lagrange_px ? PoseMethod::kDementhon : PoseMethod::kLagrange;
+  *cMo = result->method == PoseMethod::kDementhon ? by_dementhon : by_lagrange;
+  // The stripe-centre shifts are a small fraction of a pixel and change little with the
+  // pose: seen from the linear pose, one refinement after them suffices.
+  const vpHomogeneousMatrix linear = *cMo;
+  corners.Set(&linear, result, pose);
+  if (Refine(hash, result->corners_m, pose, cMo)) {
+    *residual_px = ResidualPx(*cMo, hash, result->corners_m, camera);
+  }
+  if (previous_cMo != nullptr) {
+    vpHomogeneousMatrix seeded = *previous_cMo;
+    if (Refine(hash, result->corners_m, pose, &seeded)) {
+      const double seeded_px = ResidualPx(seeded, hash, result->corners_m, camera);
+      if (std::isfinite(seeded_px) && seeded_px <= *residual_px + options.previous_tolerance_px) {
+        *cMo = seeded;
+        *residual_px = seeded_px;
+        result->from_previous = true;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+// Step 2: the roll of line 1, from its corner with line 2 (corner 0) to its corner with line 4
+// (corner 3), in (undistorted) pixels, after the stripe-centre correction.
+double Line1RollDeg(const PoseResult& result, const vpCameraParameters& camera) {
+  const double du = camera.get_px() * (result.corners_m[3][0] - result.corners_m[0][0]);
+  const double dv = camera.get_py() * (result.corners_m[3][1] - result.corners_m[0][1]);
+  return Wrap360(std::atan2(-du, dv) * kDegPerRad);
+}
+
+// Why the pose cannot be right, if it cannot: a corner behind the camera, the board seen from
+// behind, or a residual above max_residual_px.
+std::optional<std::string> Implausible(const vpHomogeneousMatrix& cMo, double residual_px,
+                                       const HashTarget& hash, const PoseOptions& options) {
+  for (int k = 0; k < 4; ++k) {
+    const double zc = cMo[2][0] * hash.corner[k].x + cMo[2][1] * hash.corner[k].y + cMo[2][3];
+    if (!(zc >= options.min_depth_m)) {
+      std::ostringstream message;
+      message << "pose behind the camera: corner " << k + 1 << " at depth " << zc
+              << " m (min_depth_m = " << options.min_depth_m << ")";
+      return message.str();
+    }
+  }
+  // The camera's object z, the third row of oMc = cMo^-1's translation -cRo^T cto.
+  const double camera_z = -(cMo[0][2] * cMo[0][3] + cMo[1][2] * cMo[1][3] + cMo[2][2] * cMo[2][3]);
+  if (!(camera_z < 0.0)) return "pose sees the back of the board (camera at object z >= 0)";
+  if (residual_px > options.max_residual_px) {
+    std::ostringstream message;
+    message << "reprojection residual " << residual_px
+            << " px > max_residual_px = " << options.max_residual_px;
+    return message.str();
+  }
+  return std::nullopt;
+}
+
+// Roll, yaw and pitch of cMo, and Eq. 5: the board normal (object z in the camera frame)
+// against lines 1 and 2.
+void SetAngles(const vpHomogeneousMatrix& cMo, const HashTarget& hash, PoseResult* result) {
+  const vpRotationMatrix cRo = cMo.getRotationMatrix();
+  const vpRzyxVector rzyx(cRo);
+  result->roll_deg = Wrap360(rzyx[0] * kDegPerRad);
+  result->yaw_deg = Wrap180(rzyx[1] * kDegPerRad);
+  result->pitch_deg = Wrap180(rzyx[2] * kDegPerRad);
+  const double n[3] = {cRo[0][2], cRo[1][2], cRo[2][2]};
+  for (int k = 0; k < 2; ++k) {
+    const double dx = cRo[0][0] * hash.direction[k].x + cRo[0][1] * hash.direction[k].y;
+    const double dy = cRo[1][0] * hash.direction[k].x + cRo[1][1] * hash.direction[k].y;
+    const double norm = std::hypot(dx, dy);
+    // m = z × d, the in-image direction across the line.
+    const double across = norm > 0.0 ? (n[0] * -dy + n[1] * dx) / norm : 0.0;
+    result->plane_angle_deg[k] = std::atan2(-across, n[2]) * kDegPerRad;
+  }
+}
+
 }  // namespace
 
 PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget& target,
@@ -275,77 +389,26 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
       pose_internal::Identify(lines, hash, options, have_previous ? &previous_cRo : nullptr);
   if (result.status != PoseStatus::kOk) return result;
 
-  const vpCameraParameters& camera = options.camera;
-  const std::array<Point2d, 4> measured_px = result.corners_px;
   std::array<bool, 4> is_stripe{};
   for (int k = 0; k < 4; ++k) is_stripe[k] = lines[result.line_index[k]].width_px > 0.0;
+  // Corners::Set rewrites result.corners_px from the measured ones: a copy, not a reference.
+  const std::array<Point2d, 4> measured_px = result.corners_px;
   const Corners corners{measured_px, is_stripe, hash, options};
   vpPose pose;
   pose.setVvsIterMax(options.vvs_max_iterations);
   vpHomogeneousMatrix cMo;
   double residual_px = HUGE_VAL;
-
-  // In a loop the previous pose is a good seed: its refinement alone is kept when it fits
-  // well (previous_accept_px), and the linear methods are skipped.
-  if (have_previous && options.previous_accept_px > 0.0) {
-    vpHomogeneousMatrix seeded = *previous_cMo;
-    corners.Set(&seeded, &result, nullptr);
-    if (RefineOnCorners(hash, result.corners_m, &seeded)) {
-      const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
-      if (seeded_px < options.previous_accept_px) {
-        cMo = seeded;
-        residual_px = seeded_px;
-        result.method = PoseMethod::kPrevious;
-        result.from_previous = true;
-      }
+  const bool kept_previous =
+      have_previous && options.previous_accept_px > 0.0 &&
+      KeepPreviousPose(*previous_cMo, corners, hash, options, &result, &cMo, &residual_px);
+  if (!kept_previous) {
+    if (const std::optional<std::string> failure =
+            LinearPoseRefined(have_previous ? &*previous_cMo : nullptr, corners, hash, options,
+                              &pose, &result, &cMo, &residual_px)) {
+      return Fail(std::move(result), *failure);
     }
   }
-
-  if (result.method != PoseMethod::kPrevious) {
-    // Steps 3-4: Lagrange, and Dementhon unless Lagrange's residual is already below
-    // dementhon_above_px (where the refinement would end in the same minimum anyway); the
-    // lower residual is refined by virtual visual servoing.
-    corners.Set(nullptr, &result, &pose);
-    vpHomogeneousMatrix by_dementhon, by_lagrange;
-    const bool lagrange_ok = Compute(&pose, vpPose::LAGRANGE, &by_lagrange);
-    const double lagrange_px =
-        lagrange_ok ? ResidualPx(by_lagrange, hash, result.corners_m, camera) : HUGE_VAL;
-    const bool run_dementhon = !(lagrange_px < options.dementhon_above_px);
-    const bool dementhon_ok = run_dementhon && Compute(&pose, vpPose::DEMENTHON, &by_dementhon);
-    const double dementhon_px =
-        dementhon_ok ? ResidualPx(by_dementhon, hash, result.corners_m, camera) : HUGE_VAL;
-    if (!std::isfinite(dementhon_px) && !std::isfinite(lagrange_px)) {
-      return Fail(std::move(result),
-                  "vpPose found no pose in front of the camera (Dementhon and Lagrange failed)");
-    }
-    result.method = dementhon_px <= lagrange_px ? PoseMethod::kDementhon : PoseMethod::kLagrange;
-    cMo = result.method == PoseMethod::kDementhon ? by_dementhon : by_lagrange;
-    // The stripe-centre shifts are a small fraction of a pixel and change little with the
-    // pose: seen from the linear pose, one refinement after them suffices.
-    const vpHomogeneousMatrix linear = cMo;
-    corners.Set(&linear, &result, &pose);
-    if (Refine(hash, result.corners_m, &pose, &cMo)) {
-      residual_px = ResidualPx(cMo, hash, result.corners_m, camera);
-    }
-    if (have_previous) {
-      vpHomogeneousMatrix seeded = *previous_cMo;
-      if (Refine(hash, result.corners_m, &pose, &seeded)) {
-        const double seeded_px = ResidualPx(seeded, hash, result.corners_m, camera);
-        if (std::isfinite(seeded_px) && seeded_px <= residual_px + options.previous_tolerance_px) {
-          cMo = seeded;
-          residual_px = seeded_px;
-          result.from_previous = true;
-        }
-      }
-    }
-  }
-  // Step 2: the roll of line 1, from its corner with line 2 (corner 0) to its corner with
-  // line 4 (corner 3), in (undistorted) pixels, after the stripe-centre correction.
-  {
-    const double du = camera.get_px() * (result.corners_m[3][0] - result.corners_m[0][0]);
-    const double dv = camera.get_py() * (result.corners_m[3][1] - result.corners_m[0][1]);
-    result.line1_roll_deg = Wrap360(std::atan2(-du, dv) * kDegPerRad);
-  }
+  result.line1_roll_deg = Line1RollDeg(result, options.camera);
   vpMatrix covariance;
   if (options.compute_covariance && std::isfinite(residual_px)) {
     // The previous-pose path refined without vpPose: give it the same corners.
@@ -359,47 +422,12 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
     return Fail(std::move(result), "vpPose's virtual visual servoing did not converge");
   }
   result.residual_px = residual_px;
-
-  // Checks: in front of the camera, facing the board's front, small residual.
-  for (int k = 0; k < 4; ++k) {
-    const double zc = cMo[2][0] * hash.corner[k].x + cMo[2][1] * hash.corner[k].y + cMo[2][3];
-    if (!(zc >= options.min_depth_m)) {
-      std::ostringstream message;
-      message << "pose behind the camera: corner " << k + 1 << " at depth " << zc
-              << " m (min_depth_m = " << options.min_depth_m << ")";
-      return Fail(std::move(result), message.str());
-    }
-  }
-  // The camera's object z, the third row of oMc = cMo^-1's translation -cRo^T cto.
-  const double camera_z = -(cMo[0][2] * cMo[0][3] + cMo[1][2] * cMo[1][3] + cMo[2][2] * cMo[2][3]);
-  if (!(camera_z < 0.0)) {
-    return Fail(std::move(result), "pose sees the back of the board (camera at object z >= 0)");
-  }
-  if (residual_px > options.max_residual_px) {
-    std::ostringstream message;
-    message << "reprojection residual " << residual_px
-            << " px > max_residual_px = " << options.max_residual_px;
-    return Fail(std::move(result), message.str());
+  if (const std::optional<std::string> why = Implausible(cMo, residual_px, hash, options)) {
+    return Fail(std::move(result), *why);
   }
   result.cMo = cMo;
   result.covariance = covariance;
-
-  const vpRotationMatrix cRo = cMo.getRotationMatrix();
-  const vpRzyxVector rzyx(cRo);
-  result.roll_deg = Wrap360(rzyx[0] * kDegPerRad);
-  result.yaw_deg = Wrap180(rzyx[1] * kDegPerRad);
-  result.pitch_deg = Wrap180(rzyx[2] * kDegPerRad);
-
-  // Eq. 5: the board normal (object z in the camera frame) against lines 1 and 2.
-  const double n[3] = {cRo[0][2], cRo[1][2], cRo[2][2]};
-  for (int k = 0; k < 2; ++k) {
-    const double dx = cRo[0][0] * hash.direction[k].x + cRo[0][1] * hash.direction[k].y;
-    const double dy = cRo[1][0] * hash.direction[k].x + cRo[1][1] * hash.direction[k].y;
-    const double norm = std::hypot(dx, dy);
-    // m = z × d, the in-image direction across the line.
-    const double across = norm > 0.0 ? (n[0] * -dy + n[1] * dx) / norm : 0.0;
-    result.plane_angle_deg[k] = std::atan2(-across, n[2]) * kDegPerRad;
-  }
+  SetAngles(cMo, hash, &result);
   result.status = PoseStatus::kOk;
   result.message.clear();
   return result;
