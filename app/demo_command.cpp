@@ -18,6 +18,7 @@
 #include "app/render_command.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
+#include "eval/line_scoring.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/image_source.h"
@@ -48,56 +49,40 @@ RenderOptions CheapCamera() {
   return options;
 }
 
-struct Candidate {
-  DemoMatch match;
-  bool taken = false;
-};
-
-DemoMatch Compare(const TruthLine& truth, int detected_index, const DetectedLine& detected,
-                  const PointUndistorter& undistorter) {
-  // Distance to a line is linear along a segment, so its maximum over the chord is at an end.
-  const Point2d a = undistorter.Undistort(truth.end_a);
-  const Point2d b = undistorter.Undistort(truth.end_b);
-  DemoMatch match;
-  match.truth_index = truth.index;
-  match.detected_index = detected_index;
-  match.angle_error_deg = AngleBetween(detected.line, truth.ideal) * kRadToDeg;
-  match.max_offset_px = std::max(std::abs(detected.line.SignedDistance(a.u, a.v)),
-                                 std::abs(detected.line.SignedDistance(b.u, b.v)));
-  return match;
-}
-
-// Greedy one-to-one matching, closest pairs first.
-std::vector<DemoMatch> MatchLines(const std::vector<TruthLine>& truth,
+// The visible true lines matched one to one with the detected ones (eval/line_scoring.h's
+// MatchLines), in undistorted pixels: a detected line more than kMaxMatchAngleDeg from a true
+// one is not its match; the offset is bounded only by the image. Missed lines get a row too.
+std::vector<DemoMatch> MatchTruth(const std::vector<TruthLine>& truth,
                                   const std::vector<DetectedLine>& detected,
                                   const vpCameraParameters& camera) {
   const PointUndistorter undistorter(camera);
-  std::vector<DemoMatch> pairs;
+  std::vector<ReferenceLine> references;
+  std::vector<int> reference_truth;  // the truth index of each reference
   for (const TruthLine& line : truth) {
     if (!line.visible) continue;
-    for (std::size_t d = 0; d < detected.size(); ++d) {
-      const DemoMatch pair = Compare(line, static_cast<int>(d), detected[d], undistorter);
-      if (pair.angle_error_deg <= kMaxMatchAngleDeg) pairs.push_back(pair);
-    }
+    references.push_back(
+        {line.ideal, undistorter.Undistort(line.end_a), undistorter.Undistort(line.end_b)});
+    reference_truth.push_back(line.index);
   }
-  std::sort(pairs.begin(), pairs.end(), [](const DemoMatch& x, const DemoMatch& y) {
-    return x.max_offset_px < y.max_offset_px;
-  });
+  std::vector<LineParams> lines;
+  for (const DetectedLine& line : detected) lines.push_back(line.line);
+  constexpr double kAnyOffsetPx = 1e9;
   std::vector<DemoMatch> matches;
-  std::vector<bool> truth_done(truth.size(), false), detected_done(detected.size(), false);
-  for (const DemoMatch& pair : pairs) {
-    const auto t = static_cast<std::size_t>(pair.truth_index);
-    const auto d = static_cast<std::size_t>(pair.detected_index);
-    if (truth_done[t] || detected_done[d]) continue;
-    truth_done[t] = detected_done[d] = true;
-    matches.push_back(pair);
+  std::vector<bool> found(references.size(), false);
+  for (const LineMatch& pair : MatchLines(references, lines, kMaxMatchAngleDeg, kAnyOffsetPx)) {
+    DemoMatch match;
+    match.truth_index = reference_truth[pair.reference];
+    match.detected_index = static_cast<int>(pair.line);
+    match.angle_error_deg = pair.angle_deg;
+    match.max_offset_px = pair.offset_px;
+    matches.push_back(match);
+    found[pair.reference] = true;
   }
-  for (const TruthLine& line : truth) {
-    if (line.visible && !truth_done[static_cast<std::size_t>(line.index)]) {
-      DemoMatch missed;
-      missed.truth_index = line.index;
-      matches.push_back(missed);
-    }
+  for (std::size_t r = 0; r < references.size(); ++r) {
+    if (found[r]) continue;
+    DemoMatch missed;
+    missed.truth_index = reference_truth[r];
+    matches.push_back(missed);
   }
   std::sort(matches.begin(), matches.end(),
             [](const DemoMatch& x, const DemoMatch& y) { return x.truth_index < y.truth_index; });
@@ -271,7 +256,7 @@ DemoReport RunDemoScene(const DemoCommandOptions& options, std::ostream& out) {
   DemoReport report;
   report.detected = static_cast<int>(lines.size());
   report.time_us = detection.time_us;
-  report.matches = MatchLines(frame.truth, lines, render.camera);
+  report.matches = MatchTruth(frame.truth, lines, render.camera);
   if (detection.target) report.pose_status = ToString(detection.target->status);
 
   const fs::path dir(options.out_dir);
