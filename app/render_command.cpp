@@ -18,6 +18,7 @@
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/json_io.h"
+#include "io/truth_file.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
 
@@ -199,20 +200,6 @@ std::uint64_t NoiseSeed(std::uint64_t seed, int index) {
   return seed ^ (0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(index + 1));
 }
 
-Json TruthJson(const std::string& target, std::uint64_t seed, const RenderedFrame& frame, int index,
-               std::uint64_t noise_seed, const vpCameraParameters& camera, int width, int height) {
-  Json lines = Json::array();
-  for (const TruthLine& line : frame.truth) lines.push_back(TruthLineJson(line));
-  return Json{{"frame", index},
-              {"image", FrameName(index, ".png")},
-              {"target", target},
-              {"seed", seed},
-              {"noise_seed", noise_seed},
-              {"camera", CameraJson(camera, width, height)},
-              {"cMo", PoseJson(frame.cMo)},
-              {"lines", std::move(lines)}};
-}
-
 Json OccluderJson(const Occluder& occluder) {
   const bool disc = occluder.shape == Occluder::Shape::kDisc;
   Json json{{"shape", disc ? "disc" : "rectangle"},
@@ -282,8 +269,8 @@ void RenderSequenceDataset(const RenderCommandOptions& options, const AppConfig&
   for (int i = 0; i < options.count; ++i) {
     const SequenceFrame& step = sequence.frames[static_cast<std::size_t>(i)];
     const RenderedFrame frame = renderer.Render(step.cMo, step.noise_seed, step.effects);
-    Json truth = TruthJson(target.name, options.seed, frame, i, step.noise_seed, render.camera,
-                           render.width, render.height);
+    Json truth = FrameTruthJson(frame, i, FrameName(i, ".png"), target.name, options.seed,
+                                step.noise_seed, render.camera, render.width, render.height);
     for (std::size_t l = 0; l < frame.truth.size(); ++l) {
       truth["lines"][l]["occluded_fraction"] = frame.truth[l].occluded_fraction;
     }
@@ -322,8 +309,8 @@ void RenderRandomDataset(const RenderCommandOptions& options, const AppConfig& c
     const std::uint64_t noise_seed = NoiseSeed(options.seed, i);
     const RenderedFrame frame = renderer.Render(cMo, noise_seed);
     WriteFrame(dir, i, frame,
-               TruthJson(target.name, options.seed, frame, i, noise_seed, camera, options.width,
-                         options.height));
+               FrameTruthJson(frame, i, FrameName(i, ".png"), target.name, options.seed, noise_seed,
+                              camera, options.width, options.height));
   }
 }
 

@@ -26,11 +26,11 @@
 #include "detector/lens.h"
 #include "detector/tracker.h"
 #include "eval/opencv_methods.h"
-#include "eval/truth_file.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
+#include "io/truth_file.h"
 #include "scene/scene.h"
 #include "servo/target_tracker.h"
 

@@ -37,12 +37,12 @@
 #include "eval/pipeline.h"
 #include "eval/plot_series.h"
 #include "eval/report.h"
-#include "eval/truth_file.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
 #include "io/quiet_stderr.h"
+#include "io/truth_file.h"
 #include "loop/lens_estimate.h"
 #include "scene/bench_scene.h"  // IsSheet
 #include "servo/pose.h"

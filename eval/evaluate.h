@@ -54,7 +54,7 @@ struct EvaluateOptions {
   /// ViSP camera XML for every input; "": camera.xml next to each input if there is one,
   /// else the input gets no pose (tracking only, said in its summary).
   std::string camera_path;
-  /// Truth for the single input: a .csv (eval/truth_file.h) or a directory of frame JSON
+  /// Truth for the single input: a .csv (io/truth_file.h) or a directory of frame JSON
   /// files; "": per input, the renderer's JSON next to each image, or <video>.truth.csv next
   /// to a video. Given with several inputs it is an error.
   std::string truth_path;

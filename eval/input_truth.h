@@ -15,8 +15,8 @@
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "eval/line_scoring.h"
-#include "eval/truth_file.h"
 #include "io/image_source.h"
+#include "io/truth_file.h"
 
 namespace oal {
 

@@ -1,6 +1,6 @@
-// Lines scored against their truth, the one place every evaluation matches lines: a target
-// line's truth in a frame, the geometry a score is made of (image pixels, detector/line.h's
-// convention) and the one-to-one matching of found lines with truth lines.
+// Lines scored against their truth, the one place every evaluation matches lines: the geometry
+// a score is made of (image pixels, detector/line.h's convention) and the one-to-one matching
+// of found lines with truth lines (io/truth_file.h reads the truth).
 #pragma once
 
 #include <cstddef>
@@ -8,17 +8,9 @@
 #include <vector>
 
 #include "detector/line.h"
+#include "io/truth_file.h"  // TargetLineTruth
 
 namespace oal {
-
-/// One target line in one frame: what scoring and a user re-initialising a tracker see.
-struct TargetLineTruth {
-  int id = 0;             ///< the line's identity across frames (target index, CSV `line`)
-  LineParams image_line;  ///< image (distorted) coordinates: distorted_fit or the CSV line
-  LineParams ideal_line;  ///< undistorted pixels (JSON `ideal`); = image_line for CSV
-  Point2d end_a, end_b;   ///< ends of the visible chord, image pixels
-  double width_px = 0.0;  ///< stripe width, pixels (0: an edge or unknown)
-};
 
 /// The point of `line` nearest to `p`.
 Point2d Foot(const LineParams& line, const Point2d& p);

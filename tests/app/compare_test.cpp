@@ -14,8 +14,8 @@
 
 #include "app/evaluation_config.h"
 #include "app/render_command.h"
-#include "eval/truth_file.h"
 #include "io/camera_file.h"
+#include "io/truth_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
 

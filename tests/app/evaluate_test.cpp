@@ -31,9 +31,9 @@
 #include "app/evaluation_config.h"
 #include "app/render_command.h"
 #include "eval/report.h"
-#include "eval/truth_file.h"
 #include "io/camera_file.h"
 #include "io/quiet_stderr.h"
+#include "io/truth_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
 

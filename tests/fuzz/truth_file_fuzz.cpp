@@ -4,7 +4,7 @@
 #include <exception>
 #include <string>
 
-#include "eval/truth_file.h"
+#include "io/truth_file.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,5 +1,5 @@
-// Ground truth for `oalservo evaluate`: target lines and the camera pose per frame, from the
-// renderer's frame_NNNN.json (oalservo render) or from one CSV file.
+// Ground truth files: target lines and the camera pose per frame, in the renderer's
+// frame_NNNN.json (`oalservo render` writes it, FrameTruthJson) or in one CSV file.
 //
 // Truth CSV (docs/EVALUATE.md): one row per line and frame, and at most one pose row per
 // frame, in any order:
@@ -21,16 +21,29 @@
 // A header row starting with "frame", blank lines and lines starting with '#' are skipped.
 #pragma once
 
+#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "eval/line_scoring.h"
+#include "detector/line.h"
+#include "io/json_io.h"
+#include "scene/scene.h"  // RenderedFrame
 
 namespace oal {
+
+/// One target line in one frame: what scoring and a user re-initialising a tracker see.
+struct TargetLineTruth {
+  int id = 0;             ///< the line's identity across frames (target index, CSV `line`)
+  LineParams image_line;  ///< image (distorted) coordinates: distorted_fit or the CSV line
+  LineParams ideal_line;  ///< undistorted pixels (JSON `ideal`); = image_line for CSV
+  Point2d end_a, end_b;   ///< ends of the visible chord, image pixels
+  double width_px = 0.0;  ///< stripe width, pixels (0: an edge or unknown)
+};
 
 /// The frame number a truth CSV row names for the frame read from `source` at 0-based
 /// `position` in its input: the last run of digits in the file name (image.0001.pgm -> 1,
@@ -60,5 +73,12 @@ TruthCsv LoadTruthCsvWithPoses(const std::string& path);
 /// The pose cMo of a frame_NNNN.json truth file (oalservo render); nothing if it has none.
 /// Throws std::runtime_error naming the file if it is missing or malformed.
 std::optional<vpHomogeneousMatrix> LoadTruthPoseJson(const std::string& path);
+
+/// The renderer's truth of one frame, the frame_NNNN.json that LoadTruthJson and
+/// LoadTruthPoseJson read: {frame, image, target, seed, noise_seed, camera, cMo, lines}.
+/// `image`: the frame's file name; `seed`: the data set's; `noise_seed`: the frame's.
+Json FrameTruthJson(const RenderedFrame& frame, int index, const std::string& image,
+                    const std::string& target, std::uint64_t seed, std::uint64_t noise_seed,
+                    const vpCameraParameters& camera, int width, int height);
 
 }  // namespace oal

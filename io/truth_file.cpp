@@ -1,4 +1,4 @@
-#include "eval/truth_file.h"
+#include "io/truth_file.h"
 
 #include <cctype>
 #include <cmath>
@@ -167,6 +167,21 @@ std::vector<TargetLineTruth> LoadTruthJson(const std::string& path) {
     Fail(path, 0, std::string("malformed truth: ") + error.what());
   }
   return lines;
+}
+
+Json FrameTruthJson(const RenderedFrame& frame, int index, const std::string& image,
+                    const std::string& target, std::uint64_t seed, std::uint64_t noise_seed,
+                    const vpCameraParameters& camera, int width, int height) {
+  Json lines = Json::array();
+  for (const TruthLine& line : frame.truth) lines.push_back(TruthLineJson(line));
+  return Json{{"frame", index},
+              {"image", image},
+              {"target", target},
+              {"seed", seed},
+              {"noise_seed", noise_seed},
+              {"camera", CameraJson(camera, width, height)},
+              {"cMo", PoseJson(frame.cMo)},
+              {"lines", std::move(lines)}};
 }
 
 }  // namespace oal

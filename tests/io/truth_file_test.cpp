@@ -1,4 +1,4 @@
-#include "eval/truth_file.h"
+#include "io/truth_file.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
