@@ -16,6 +16,7 @@
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
 #include "app/render_command.h"
+#include "base/pose_distance.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "eval/line_scoring.h"
@@ -221,11 +222,10 @@ void PrintPose(const TargetFrame& result, const vpHomogeneousMatrix& cMo_true, s
     return;
   }
   const vpHomogeneousMatrix& cMo = result.pose.cMo;
-  const double error_m =
-      (cMo.getTranslationVector() - cMo_true.getTranslationVector()).frobeniusNorm();
+  const PoseDistance error = Distance(cMo_true, cMo);
+  const double error_m = error.translation_m;
   const double distance_m = cMo_true.getTranslationVector().frobeniusNorm();
-  const double error_deg =
-      vpMath::deg(vpThetaUVector((cMo * cMo_true.inverse()).getRotationMatrix()).getTheta());
+  const double error_deg = vpMath::deg(error.rotation_rad);
   char row[200];
   std::snprintf(row, sizeof(row),
                 "Pose (borders from the %s, %d borders): %.2f mm (%.3f %% of the distance) and "

@@ -1,9 +1,8 @@
 #include "eval/input_truth.h"
 
-#include <visp3/core/vpThetaUVector.h>
-#include <visp3/core/vpTranslationVector.h>
-
 #include <cmath>
+
+#include "base/pose_distance.h"
 
 namespace oal {
 namespace {
@@ -42,10 +41,8 @@ std::vector<LineError> MatchTruth(const std::vector<TargetLineTruth>& truth,
 
 std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
                                     const vpHomogeneousMatrix& truth) {
-  const vpTranslationVector dt = cMo.getTranslationVector() - truth.getTranslationVector();
-  const vpThetaUVector tu(truth.getRotationMatrix().t() * cMo.getRotationMatrix());
-  return {1000.0 * std::sqrt(dt.sumSquare()),
-          kRadToDeg * std::sqrt(tu[0] * tu[0] + tu[1] * tu[1] + tu[2] * tu[2])};
+  const PoseDistance d = Distance(truth, cMo);
+  return {1000.0 * d.translation_m, kRadToDeg * d.rotation_rad};
 }
 
 }  // namespace oal

@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "base/pose_distance.h"
 #include "detector/lens.h"
 #include "loop/lens_estimate.h"
 
@@ -159,12 +160,10 @@ PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
     } else {
       ++report.source_counts[ToString(result.source)];
       const vpHomogeneousMatrix& cMo = result.pose.cMo;
-      const vpTranslationVector error_t =
-          cMo.getTranslationVector() - cMo_true.getTranslationVector();
+      const PoseDistance error = Distance(cMo_true, cMo);
       const double t_pct =
-          100.0 * error_t.frobeniusNorm() / cMo_true.getTranslationVector().frobeniusNorm();
-      const double r_deg =
-          vpMath::deg(vpThetaUVector((cMo * cMo_true.inverse()).getRotationMatrix()).getTheta());
+          100.0 * error.translation_m / cMo_true.getTranslationVector().frobeniusNorm();
+      const double r_deg = vpMath::deg(error.rotation_rad);
       report.translation_error_pct.push_back(t_pct);
       report.rotation_error_deg.push_back(r_deg);
       double roll_error = std::fabs(RollDeg(cMo) - RollDeg(cMo_true));

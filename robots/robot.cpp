@@ -49,12 +49,4 @@ RobotPose Robot::PoseAlongMove(RobotFrame /*frame*/, const vpHomogeneousMatrix& 
   return p;
 }
 
-PoseDistance Distance(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
-  const vpHomogeneousMatrix aMb = a.inverse() * b;
-  PoseDistance d;
-  d.translation_m = aMb.getTranslationVector().frobeniusNorm();
-  d.rotation_rad = vpThetaUVector(aMb.getRotationMatrix()).getTheta();
-  return d;
-}
-
 }  // namespace oal

@@ -47,6 +47,8 @@
 #include <string>
 #include <utility>
 
+#include "base/pose_distance.h"  // Distance, used with every robot
+
 namespace oal {
 
 /// Outcome of a robot call. kOk is the only success.
@@ -162,13 +164,5 @@ class Robot {
   /// without one (the default).
   virtual std::string LinkSummary(int /*moves*/) const { return ""; }
 };
-
-/// Distance between two poses: translation in metres and rotation angle in radians of
-/// a^-1 * b.
-struct PoseDistance {
-  double translation_m = 0;
-  double rotation_rad = 0;
-};
-PoseDistance Distance(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b);
 
 }  // namespace oal

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/pose_distance.h"
 #include "detector/lens.h"  // DistortedPixel
 #include "detector/options.h"
 
@@ -38,14 +39,6 @@ bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
   if (!(u >= 1.0 && v >= 1.0 && u < image.width - 1.0 && v < image.height - 1.0)) return false;
   *grey = image.at(static_cast<int>(u), static_cast<int>(v));
   return true;
-}
-
-// Translation (metres) and rotation (degrees) between two poses.
-void PoseDifference(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double* metres,
-                    double* degrees) {
-  const vpHomogeneousMatrix d = a * b.inverse();
-  *metres = (a.getTranslationVector() - b.getTranslationVector()).frobeniusNorm();
-  *degrees = vpThetaUVector(d.getRotationMatrix()).getTheta() * kDegPerRad;
 }
 
 }  // namespace
@@ -406,7 +399,9 @@ void TargetPoseTracker::Accept(bool predicted) {
   const bool checked =
       !predicted && consecutive && (options_.max_jump_m > 0.0 || options_.max_jump_deg > 0.0);
   auto within = [&](const vpHomogeneousMatrix& other, double* metres, double* degrees) {
-    PoseDifference(cMo, other, metres, degrees);
+    const PoseDistance d = Distance(cMo, other);
+    *metres = d.translation_m;
+    *degrees = d.rotation_rad * kDegPerRad;
     return (options_.max_jump_m <= 0.0 || *metres <= options_.max_jump_m) &&
            (options_.max_jump_deg <= 0.0 || *degrees <= options_.max_jump_deg);
   };
