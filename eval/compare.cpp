@@ -409,6 +409,158 @@ std::vector<std::unique_ptr<LineMethod>> ComparedMethods(
 
 }  // namespace
 
+namespace {
+
+// The renderer's truth JSON of a frame: beside the image, or in --truth's directory.
+std::string TruthJsonPath(const GivenTruth& given, const Frame& frame) {
+  const fs::path image(frame.source);
+  return (given.json_dir.empty() ? fs::path(image).replace_extension(".json")
+                                 : fs::path(given.json_dir) / (image.stem().string() + ".json"))
+      .string();
+}
+
+// Each frame's truth lines: from the CSV rows of its frame number (clipped to the image), or
+// from the renderer's JSON (`source` "csv", "json"); none without truth ("none").
+std::vector<TargetLineTruth> TruthOf(const GivenTruth& given, const std::string& source,
+                                     const Frame& frame, int index) {
+  if (source == "json") return LoadTruthJson(TruthJsonPath(given, frame));
+  std::vector<TargetLineTruth> lines;
+  if (source == "csv") {
+    const auto it = given.csv.find(FrameNumber(frame.source, index));
+    if (it != given.csv.end()) {
+      for (TargetLineTruth target : it->second) {
+        if (ClipChord(&target, frame.gray.cols, frame.gray.rows)) lines.push_back(target);
+      }
+    }
+  }
+  return lines;
+}
+
+// What the target lines are (stripes or edges) and how far apart a stripe's edges may be
+// paired, from the options, else the detector's polarity and the first frame's truth widths.
+void ResolveTargetKind(const CompareOptions& options, const std::vector<TargetLineTruth>& truth,
+                       CompareReport* report) {
+  report->target_kind = options.target_kind;
+  if (report->target_kind == TargetKind::kAuto) {
+    report->target_kind = options.setup.detector.polarity == Polarity::kEdges
+                              ? TargetKind::kEdges
+                              : TargetKind::kStripes;
+  }
+  report->max_stripe_width_px = options.max_stripe_width_px;
+  if (report->max_stripe_width_px == 0.0) {
+    double widest = 0.0;
+    for (const TargetLineTruth& target : truth) widest = std::max(widest, target.width_px);
+    report->max_stripe_width_px = widest > 0.0 ? 1.5 * widest + 2.0 : 30.0;
+  }
+}
+
+// The methods run on the frames one after the other, each timed around its own call and
+// scored; without truth, our detector's first lines are the trackers' targets.
+class MethodRunner {
+ public:
+  MethodRunner(const CompareOptions& options, std::vector<std::unique_ptr<LineMethod>> methods,
+               const std::optional<CameraFile>& camera, bool has_truth, CompareReport* report)
+      : options_(options),
+        methods_(std::move(methods)),
+        camera_(camera),
+        has_truth_(has_truth),
+        report_(report),
+        scorer_{options.max_angle_deg, options.max_offset_px, std::nullopt},
+        failures_(methods_.size()) {
+    if (camera_) scorer_.undistorter.emplace(camera_->camera);
+    for (const auto& method : methods_) {
+      MethodResult result;
+      result.name = method->Name();
+      result.reference = !has_truth_                      ? "none"
+                         : report_->truth_source == "csv" ? "csv"
+                         : method->Undistorted()          ? "ideal"
+                                                          : "distorted_fit";
+      report_->methods.push_back(std::move(result));
+    }
+  }
+
+  // Frame `index` with its truth: every method's lines, time and score.
+  void Run(const Frame& frame, int index, const std::vector<TargetLineTruth>& truth) {
+    CopyInto(frame.gray, &image_);
+    std::vector<TargetLineTruth> targets = truth;
+    for (std::size_t m = 0; m < methods_.size(); ++m) {
+      LineMethod& method = *methods_[m];
+      if (index == 0 && m > 0) method.Start(image_, targets, has_truth_);
+      const double time_us = Timed(m, frame, index);
+      if (m == 0 && !has_truth_) targets = OurLinesAsTargets(frame);
+      Score(time_us, truth, targets, method, &report_->methods[m]);
+    }
+    for (std::size_t m = 1; m < methods_.size(); ++m) {
+      methods_[m]->AfterFrame(image_, targets, has_truth_);
+    }
+  }
+
+  // Failures, re-initialisations and methods that could not run, into the report.
+  void Finish() {
+    for (std::size_t m = 0; m < methods_.size(); ++m) {
+      report_->methods[m].failures = methods_[m]->failures();
+      report_->methods[m].reinitialisations = methods_[m]->reinitialisations();
+      if (failures_[m].frames > 0) {
+        report_->warnings.push_back(failures_[m].Warning(report_->methods[m].name));
+      }
+    }
+  }
+
+  const std::vector<std::unique_ptr<LineMethod>>& methods() const { return methods_; }
+
+ private:
+  // Method m's call on the frame, in microseconds; its lines in lines_.
+  double Timed(std::size_t m, const Frame& frame, int index) {
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      methods_[m]->Process(image_, &lines_);
+    } catch (const cv::Exception& error) {  // e.g. an image too small for the method
+      lines_.clear();
+      failures_[m].Add(index, frame, error);
+    }
+    const auto stop = std::chrono::steady_clock::now();
+    return std::chrono::duration<double, std::micro>(stop - start).count();
+  }
+
+  std::vector<TargetLineTruth> OurLinesAsTargets(const Frame& frame) const {
+    const OalMethod& ours = static_cast<const OalMethod&>(*methods_.front());
+    const std::size_t count = options_.lines > 0 ? static_cast<std::size_t>(options_.lines) : 4;
+    return TargetsFromDetections(ours.last(), count, ours.Undistorted(), camera_, frame.gray.cols,
+                                 frame.gray.rows);
+  }
+
+  void Score(double time_us, const std::vector<TargetLineTruth>& truth,
+             const std::vector<TargetLineTruth>& targets, const LineMethod& method,
+             MethodResult* result) {
+    const std::size_t k =
+        options_.lines > 0 ? static_cast<std::size_t>(options_.lines) : truth.size() + 2;
+    if (lines_.size() > k) lines_.resize(k);
+    result->time_us.push_back(time_us);
+    const std::size_t per = has_truth_ ? truth.size() : targets.size();
+    result->time_us_per_line.push_back(time_us /
+                                       static_cast<double>(std::max<std::size_t>(1, per)));
+    if (has_truth_) {
+      scorer_.Score(lines_, truth, method.Undistorted(), result);
+    } else {
+      result->spurious_lines += static_cast<int>(lines_.size());  // lines, unscored
+    }
+    result->lines.push_back(lines_);
+    ++result->frames;
+  }
+
+  const CompareOptions& options_;
+  std::vector<std::unique_ptr<LineMethod>> methods_;
+  const std::optional<CameraFile>& camera_;
+  const bool has_truth_;
+  CompareReport* report_;
+  Scorer scorer_;
+  std::vector<MethodFailure> failures_;
+  vpImage<unsigned char> image_;
+  std::vector<LineParams> lines_;
+};
+
+}  // namespace
+
 CompareReport RunComparison(const CompareOptions& options,
                             std::vector<std::unique_ptr<LineMethod>> extra_methods) {
   options.Check();
@@ -417,10 +569,7 @@ CompareReport RunComparison(const CompareOptions& options,
   options.setup.detector.Check();
   std::optional<CameraFile> camera;
   if (!options.camera_path.empty()) camera = LoadCameraFile(options.camera_path);
-
   const GivenTruth given = OpenGivenTruth(options, camera.has_value(), &report.truth_source);
-  const std::map<int, std::vector<TargetLineTruth>>& csv = given.csv;
-  const std::string& json_dir = given.json_dir;
 
   // Unexpected files skipped in a directory, and files after a pattern's gap, are warned
   // about (the truth JSON and camera.xml are expected there: no warning).
@@ -435,132 +584,44 @@ CompareReport RunComparison(const CompareOptions& options,
       report.warnings.push_back(*warning);
     }
   }
-
-  auto json_path = [&](const Frame& f) {
-    const fs::path image(f.source);
-    return json_dir.empty() ? fs::path(image).replace_extension(".json")
-                            : fs::path(json_dir) / (image.stem().string() + ".json");
-  };
   if (report.truth_source.empty()) {
-    report.truth_source = fs::is_regular_file(json_path(frame)) ? "json" : "none";
+    const std::string json = TruthJsonPath(given, frame);
+    report.truth_source = fs::is_regular_file(json) ? "json" : "none";
     if (report.truth_source == "none") {
-      report.warnings.push_back("no truth (" + json_path(frame).string() +
-                                " does not exist): only timing is measured");
+      report.warnings.push_back("no truth (" + json + " does not exist): only timing is measured");
     }
   }
   const bool has_truth = report.truth_source != "none";
-  auto truth_of = [&](const Frame& f, int index) {
-    if (report.truth_source == "json") return LoadTruthJson(json_path(f).string());
-    std::vector<TargetLineTruth> lines;
-    if (report.truth_source == "csv") {
-      const auto it = csv.find(FrameNumber(f.source, index));
-      if (it != csv.end()) {
-        for (TargetLineTruth target : it->second) {
-          if (ClipChord(&target, f.gray.cols, f.gray.rows)) lines.push_back(target);
-        }
-      }
-    }
-    return lines;
-  };
-
-  std::vector<TargetLineTruth> truth = truth_of(frame, 0);
-  report.target_kind = options.target_kind;
-  if (report.target_kind == TargetKind::kAuto) {
-    report.target_kind = options.setup.detector.polarity == Polarity::kEdges ? TargetKind::kEdges
-                                                                             : TargetKind::kStripes;
-  }
+  std::vector<TargetLineTruth> truth = TruthOf(given, report.truth_source, frame, 0);
+  ResolveTargetKind(options, truth, &report);
   const bool stripes = report.target_kind == TargetKind::kStripes;
-  report.max_stripe_width_px = options.max_stripe_width_px;
-  if (report.max_stripe_width_px == 0.0) {
-    double widest = 0.0;
-    for (const TargetLineTruth& target : truth) widest = std::max(widest, target.width_px);
-    report.max_stripe_width_px = widest > 0.0 ? 1.5 * widest + 2.0 : 30.0;
-  }
+  MethodRunner runner(options,
+                      ComparedMethods(options, camera, stripes, &report, std::move(extra_methods)),
+                      camera, has_truth, &report);
 
-  std::vector<std::unique_ptr<LineMethod>> methods =
-      ComparedMethods(options, camera, stripes, &report, std::move(extra_methods));
-  const OalMethod* ours = static_cast<const OalMethod*>(methods.front().get());
-  for (const auto& method : methods) {
-    MethodResult result;
-    result.name = method->Name();
-    result.reference = !has_truth                     ? "none"
-                       : report.truth_source == "csv" ? "csv"
-                       : method->Undistorted()        ? "ideal"
-                                                      : "distorted_fit";
-    report.methods.push_back(std::move(result));
-  }
-
-  Scorer scorer{options.max_angle_deg, options.max_offset_px, std::nullopt};
-  if (camera) scorer.undistorter.emplace(camera->camera);
-  const std::size_t untruthed_targets =
-      options.lines > 0 ? static_cast<std::size_t>(options.lines) : 4;
   std::vector<std::vector<TargetLineTruth>> truth_per_frame;
   std::vector<int> csv_frames_seen, csv_frames_without_truth;  // frame numbers (CSV truth)
-  std::vector<MethodFailure> method_failures(methods.size());
-  vpImage<unsigned char> image;
-  std::vector<LineParams> lines;
   int index = 0;
   do {
-    if (index > 0) truth = truth_of(frame, index);
+    if (index > 0) truth = TruthOf(given, report.truth_source, frame, index);
     if (report.truth_source == "csv") {
       const int number = FrameNumber(frame.source, index);
       csv_frames_seen.push_back(number);
-      if (csv.count(number) == 0) csv_frames_without_truth.push_back(number);
+      if (given.csv.count(number) == 0) csv_frames_without_truth.push_back(number);
     }
-    CopyInto(frame.gray, &image);
-    std::vector<TargetLineTruth> targets = truth;
-    for (std::size_t m = 0; m < methods.size(); ++m) {
-      LineMethod& method = *methods[m];
-      MethodResult& result = report.methods[m];
-      if (index == 0 && m > 0) method.Start(image, targets, has_truth);
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        method.Process(image, &lines);
-      } catch (const cv::Exception& error) {  // e.g. an image too small for the method
-        lines.clear();
-        method_failures[m].Add(index, frame, error);
-      }
-      const auto stop = std::chrono::steady_clock::now();
-      const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
-      if (m == 0 && !has_truth) {
-        targets = TargetsFromDetections(ours->last(), untruthed_targets, ours->Undistorted(),
-                                        camera, frame.gray.cols, frame.gray.rows);
-      }
-      const std::size_t k =
-          options.lines > 0 ? static_cast<std::size_t>(options.lines) : truth.size() + 2;
-      if (lines.size() > k) lines.resize(k);
-      result.time_us.push_back(time_us);
-      const std::size_t per = has_truth ? truth.size() : targets.size();
-      result.time_us_per_line.push_back(time_us /
-                                        static_cast<double>(std::max<std::size_t>(1, per)));
-      if (has_truth) {
-        scorer.Score(lines, truth, method.Undistorted(), &result);
-      } else {
-        result.spurious_lines += static_cast<int>(lines.size());  // lines, unscored
-      }
-      result.lines.push_back(lines);
-      ++result.frames;
-    }
-    for (std::size_t m = 1; m < methods.size(); ++m) {
-      methods[m]->AfterFrame(image, targets, has_truth);
-    }
+    runner.Run(frame, index, truth);
     truth_per_frame.push_back(has_truth ? truth : std::vector<TargetLineTruth>());
     ++index;
   } while ((options.max_frames == 0 || index < options.max_frames) && source->Next(&frame));
   report.frames = index;
-  for (std::size_t m = 0; m < methods.size(); ++m) {
-    report.methods[m].failures = methods[m]->failures();
-    report.methods[m].reinitialisations = methods[m]->reinitialisations();
-    if (method_failures[m].frames > 0) {
-      report.warnings.push_back(method_failures[m].Warning(report.methods[m].name));
-    }
-  }
+  runner.Finish();
   if (report.truth_source == "csv") {
-    CheckCsvCoverage(options, csv, csv_frames_seen, csv_frames_without_truth, &report.warnings);
+    CheckCsvCoverage(options, given.csv, csv_frames_seen, csv_frames_without_truth,
+                     &report.warnings);
   }
   if (options.out_dir.empty()) return report;
 
-  WriteComparisonFiles(options, methods, truth_per_frame, camera, &report);
+  WriteComparisonFiles(options, runner.methods(), truth_per_frame, camera, &report);
   return report;
 }
 
