@@ -1,98 +1,39 @@
 #include "app/servo_accuracy.h"
 
-#include <visp3/core/vpMath.h>
-
 #include <sstream>
-#include <stdexcept>
 
-#include "base/check.h"
-#include "scene/scene.h"
+#include "app/servo_run.h"
 
 namespace oal {
 
-int ServoAccuracyLaw::converged() const {
-  int count = 0;
-  for (const ServoAccuracyRun& run : runs) count += run.status == ServoRunStatus::kConverged;
-  return count;
-}
-
-void ServoAccuracyOptions::Check() const {
-  // Named as the command line gives them: these options come from nowhere else.
-  RequireOption(starts >= 1 && starts <= 1000000, "--starts", starts, "1 <= --starts <= 1000000");
-  RequireOption(min_distance_m > 0.0, "--min-distance", min_distance_m, "--min-distance > 0");
-  RequireOption(max_distance_m >= min_distance_m, "--max-distance", max_distance_m,
-                "--max-distance >= --min-distance");
-  RequireOption(max_off_deg >= 0.0 && max_off_deg <= 80.0, "--max-off-deg", max_off_deg,
-                "0 <= --max-off-deg <= 80");
-  RequireOption(max_iterations >= 0, "--max-iterations", max_iterations, "--max-iterations >= 0");
-  if (modes.empty()) throw std::invalid_argument("--laws: no law to run");
+ServoStartScene StartSceneOf(const ServoAppConfig& config) {
+  ServoStartScene scene;
+  scene.target = config.target;
+  scene.wMo = config.target_wMo;
+  scene.camera = config.camera.Camera();
+  scene.width = config.camera.width;
+  scene.height = config.camera.height;
+  return scene;
 }
 
 std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoAppConfig& config,
                                                    const ServoAccuracyOptions& options) {
-  options.Check();
-  RenderOptions render;
-  render.width = config.camera.width;
-  render.height = config.camera.height;
-  render.camera = config.camera.Camera();
-  const SceneRenderer renderer(config.target, render);
-  PoseSampling sampling;
-  sampling.min_distance_m = options.min_distance_m;
-  sampling.max_distance_m = options.max_distance_m;
-  sampling.max_tilt_deg = options.max_off_deg;
-  sampling.max_offset_m = 0.05;
-  sampling.any_roll = false;  // roll within ±max_off_deg of the goal's
-  sampling.min_visible_length_px = 0.15 * config.camera.width;
-  // A sheet is found by its middle cell: every start sees its four crossings.
-  const bool sheet = config.target.board_width_m <= 1.0 && config.target.board_height_m <= 1.0;
-  sampling.crossings_in_view = sheet;
-  std::uint64_t state = options.seed;
-  std::vector<vpHomogeneousMatrix> starts;
-  for (int i = 0; i < options.starts; ++i) {
-    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
-    starts.push_back(config.target_wMo * cMo.inverse());  // wMc = wMo · oMc
-  }
-  return starts;
+  return SampleServoStarts(StartSceneOf(config), options);
 }
 
 ServoAccuracyReport EvaluateServoAccuracy(const ServoAppConfig& config,
                                           const ServoAccuracyOptions& options,
                                           const std::function<void(int, int)>& progress) {
-  const std::vector<vpHomogeneousMatrix> starts = SampleServoStarts(config, options);
-  ServoAccuracyReport report;
-  report.options = options;
-  const int total = static_cast<int>(starts.size() * options.modes.size());
-  int done = 0;
-  for (const ServoMode mode : options.modes) {
-    ServoAccuracyLaw law;
-    law.mode = mode;
-    for (std::size_t i = 0; i < starts.size(); ++i) {
-      ServoAppConfig run_config = config;
-      run_config.servo.law.mode = mode;
-      if (options.max_iterations > 0) run_config.servo.max_iterations = options.max_iterations;
-      run_config.robot.start_wMc = starts[i];
-      std::ostringstream log;  // the per-iteration rows are not kept
-      const ServoRunReport result = RunServo(run_config, log);
-      ServoAccuracyRun run;
-      run.start = static_cast<int>(i);
-      run.start_wMc = starts[i];
-      run.status = result.status;
-      run.message = result.message;
-      run.moves = result.moves;
-      if (!result.iterations.empty()) {
-        const ServoIteration& first = result.iterations.front();
-        const ServoIteration& last = result.iterations.back();
-        run.start_distance_m = first.true_translation_error_mm * 1e-3;
-        run.start_off_deg = first.true_rotation_error_deg;
-        run.final_translation_error_mm = last.true_translation_error_mm;
-        run.final_rotation_error_deg = last.true_rotation_error_deg;
-      }
-      law.runs.push_back(run);
-      if (progress) progress(++done, total);
-    }
-    report.laws.push_back(std::move(law));
-  }
-  return report;
+  const ServoRunFrom run = [&config](const vpHomogeneousMatrix& start_wMc, ServoMode mode,
+                                     int max_iterations) {
+    ServoAppConfig run_config = config;
+    run_config.servo.law.mode = mode;
+    if (max_iterations > 0) run_config.servo.max_iterations = max_iterations;
+    run_config.robot.start_wMc = start_wMc;
+    std::ostringstream log;  // the per-iteration rows are not kept
+    return RunServo(run_config, log);
+  };
+  return EvaluateServoAccuracy(StartSceneOf(config), options, run, progress);
 }
 
 }  // namespace oal
