@@ -1,21 +1,13 @@
 
 #include "eval/compare.h"
 
-#include <visp3/me/vpMe.h>
-#include <visp3/me/vpMeLine.h>
-
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iomanip>
-#include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/ximgproc/fast_line_detector.hpp>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,15 +16,12 @@
 #include "base/statistics.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
-#include "detector/tracker.h"
 #include "eval/opencv_methods.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
 #include "io/truth_file.h"
-#include "scene/scene.h"
-#include "servo/target_tracker.h"
 
 namespace oal {
 namespace {

@@ -18,10 +18,8 @@
 #include <mutex>
 #include <optional>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 #include <thread>
-#include <tuple>
 
 #include "base/check.h"
 #include "base/format.h"

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "base/check.h"
+#include "scene/bench_scene.h"  // IsSheet
 #include "scene/scene.h"
 
 namespace oal {
@@ -43,8 +44,7 @@ std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoStartScene& scene,
   sampling.any_roll = false;  // roll within ±max_off_deg of the goal's
   sampling.min_visible_length_px = 0.15 * scene.width;
   // A sheet is found by its middle cell: every start sees its four crossings.
-  const bool sheet = scene.target.board_width_m <= 1.0 && scene.target.board_height_m <= 1.0;
-  sampling.crossings_in_view = sheet;
+  sampling.crossings_in_view = IsSheet(scene.target);
   std::uint64_t state = options.seed;
   std::vector<vpHomogeneousMatrix> starts;
   for (int i = 0; i < options.starts; ++i) {
