@@ -109,13 +109,14 @@ TargetPoseTracker MakeTracker(const TargetInputs& inputs) {
 // The tracker's own step times and the frames it posed, over a benchmark's iterations.
 struct StepTally {
   int ok = 0;
-  double find_us = 0, detect_us = 0, pose_us = 0;
+  double find_us = 0, detect_us = 0, pose_us = 0, candidates = 0;
 
   void Add(const TargetFrame& frame) {
     ok += frame.status == TargetStatus::kOk;
     find_us += frame.find_us;
     detect_us += frame.detect_us;
     pose_us += frame.pose_us;
+    candidates += frame.candidates;
   }
   void Report(benchmark::State& state) const {
     const double n = static_cast<double>(state.iterations());
@@ -123,6 +124,7 @@ struct StepTally {
     state.counters["find_us"] = find_us / n;
     state.counters["detect_us"] = detect_us / n;
     state.counters["pose_us"] = pose_us / n;
+    state.counters["candidates"] = candidates / n;  // the sheet finder's, tried
   }
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include "detector/options.h"
@@ -145,6 +146,41 @@ bool RefineSide(const GrayImageView& image, const Side& side, double light, doub
   if (close.size() < 4) return false;
   *line = FitLine(close);
   return true;
+}
+
+// Bit i of words (64 cells a word) set when cells[i] >= threshold, i < n; the bits past n are 0.
+void LightMask(const std::uint8_t* cells, int n, int threshold, std::uint64_t* words) {
+  const int word_count = (n + 63) / 64;
+  std::fill(words, words + word_count, 0u);
+  int i = 0;
+#if OAL_HAVE_SSE2
+  // cells >= threshold  <=>  max(cells, threshold) == cells, 16 cells a step.
+  const __m128i level = _mm_set1_epi8(static_cast<char>(threshold));
+  for (; i + 16 <= n; i += 16) {
+    const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(cells + i));
+    const auto bits = static_cast<std::uint64_t>(
+        static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(c, level), c))));
+    words[i >> 6] |= bits << (i & 63);  // i is a multiple of 16: the 16 bits stay in one word
+  }
+#endif
+  for (; i < n; ++i) {
+    words[i >> 6] |= static_cast<std::uint64_t>(cells[i] >= threshold) << (i & 63);
+  }
+}
+
+// The first i >= from whose bit is `set` (set: 1, else 0); words.size() * 64 when there is none.
+int NextBit(const std::vector<std::uint64_t>& words, int from, bool set) {
+  const int count = static_cast<int>(words.size());
+  int w = from >> 6;
+  if (w >= count) return count * 64;
+  std::uint64_t word =
+      (set ? words[static_cast<std::size_t>(w)] : ~words[static_cast<std::size_t>(w)]) &
+      (~std::uint64_t{0} << (from & 63));
+  while (word == 0) {
+    if (++w >= count) return count * 64;
+    word = set ? words[static_cast<std::size_t>(w)] : ~words[static_cast<std::size_t>(w)];
+  }
+  return w * 64 + __builtin_ctzll(word);
 }
 
 }  // namespace
@@ -358,24 +394,26 @@ bool SheetFinder::ClosedInCells(const Point2d& from, const Point2d& outward, int
 
 void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
   // Runs of light cells row by row, each joined to the runs of the row above that it touches
-  // (4-connectivity: overlapping columns).
+  // (4-connectivity: overlapping columns). A row's light cells are found as a bit mask and its
+  // runs by counting zeros: on a textured bench, a branch per cell mispredicts at every run.
   runs_.clear();
+  const int words = (grid_width_ + 63) / 64;
+  light_bits_.resize(static_cast<std::size_t>(words));
   std::size_t above_begin = 0, above_end = 0;
   for (int gy = 0; gy < grid_height_; ++gy) {
-    const std::uint8_t* row = cells_.data() + static_cast<std::size_t>(gy) * grid_width_;
+    LightMask(cells_.data() + static_cast<std::size_t>(gy) * grid_width_, grid_width_, threshold,
+              light_bits_.data());
     const std::size_t row_begin = runs_.size();
-    for (int gx = 0; gx < grid_width_;) {
-      if (row[gx] < threshold) {
-        ++gx;
-        continue;
-      }
+    std::size_t above = above_begin;  // the first run above that may touch this row's next run
+    for (int gx = NextBit(light_bits_, 0, true); gx < grid_width_;
+         gx = NextBit(light_bits_, gx, true)) {
       const int first = gx;
-      while (gx < grid_width_ && row[gx] >= threshold) ++gx;
+      gx = std::min(NextBit(light_bits_, gx, false), grid_width_);
+      const int last = gx - 1;
       const int index = static_cast<int>(runs_.size());
-      runs_.push_back(CellRun{gy, first, gx - 1, index});
-      for (std::size_t a = above_begin; a < above_end; ++a) {
-        const CellRun& up = runs_[a];
-        if (up.last < first || up.first > gx - 1) continue;
+      runs_.push_back(CellRun{gy, first, last, index});
+      while (above < above_end && runs_[above].last < first) ++above;
+      for (std::size_t a = above; a < above_end && runs_[a].first <= last; ++a) {
         const int ra = Root(static_cast<int>(a)), rb = Root(index);
         if (ra != rb) runs_[static_cast<std::size_t>(std::max(ra, rb))].parent = std::min(ra, rb);
       }

@@ -114,7 +114,8 @@ class SheetFinder {
   SheetFinderOptions options_;
   int grid_width_ = 0, grid_height_ = 0;
   std::vector<std::uint8_t> cells_;
-  std::vector<std::uint32_t> row_sums_;  ///< per grid row, prefix sums of the cell means
+  std::vector<std::uint32_t> row_sums_;    ///< per grid row, prefix sums of the cell means
+  std::vector<std::uint64_t> light_bits_;  ///< one grid row's light cells at a threshold
   std::vector<CellRun> runs_;
   std::vector<CellRun> component_;
   std::vector<int> order_, starts_;
