@@ -88,6 +88,9 @@ void TargetTrackerOptions::Check() const {
   RequireOption(tracked_borders >= 2 && tracked_borders <= 64,
                 "TargetTrackerOptions::tracked_borders", tracked_borders,
                 "2 <= tracked_borders <= 64");
+  RequireOption(quick_max_identification_cost >= 0.0 && quick_max_identification_cost <= 1e9,
+                "TargetTrackerOptions::quick_max_identification_cost",
+                quick_max_identification_cost, "0 <= quick_max_identification_cost <= 1e9");
   RequireOption(max_candidates >= 1 && max_candidates <= 16, "TargetTrackerOptions::max_candidates",
                 max_candidates, "1 <= max_candidates <= 16");
   RequireOption(min_line_support >= 0 && min_line_support <= 1000,
@@ -338,6 +341,23 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   return true;
 }
 
+bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
+                                         const vpHomography& plane_to_image) {
+  const std::vector<LineSeed> seeds = SeedsFrom(plane_to_image);
+  for (const int count : {options_.tracked_borders, options_.borders}) {
+    TargetBorders(layout_, plane_to_image, camera_, count, &borders_);
+    if (borders_.empty()) return false;
+    if (count == options_.tracked_borders) ++frame_.candidates;
+    // Each candidate on its own: a prior that failed above says nothing about it.
+    const bool accepted = Attempt(image, borders_, seeds, std::nullopt, ScanSource::kMiddleCell);
+    if (count >= options_.borders) return accepted;
+    if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
+      return true;
+    }
+  }
+  return false;
+}
+
 const TargetFrame& TargetPoseTracker::Track(
     const GrayImageView& image, const std::optional<vpHomogeneousMatrix>& predicted_cMo) {
   frame_ = TargetFrame{};
@@ -366,15 +386,7 @@ const TargetFrame& TargetPoseTracker::Track(
         frame_.find_us += Microseconds(refine_start);
         const std::optional<vpHomography> plane_to_image =
             PlaneToImageFromCell(layout_, cell, camera_);
-        if (!plane_to_image) continue;
-        TargetBorders(layout_, *plane_to_image, camera_, options_.borders, &borders_);
-        if (borders_.empty()) continue;
-        ++frame_.candidates;
-        // Each candidate on its own: a prior that failed above says nothing about it.
-        if ((found = Attempt(image, borders_, SeedsFrom(*plane_to_image), std::nullopt,
-                             ScanSource::kMiddleCell))) {
-          break;
-        }
+        if (plane_to_image && (found = AttemptCandidate(image, *plane_to_image))) break;
       }
     }
     if (!found && options_.image_fallback) {

@@ -8,7 +8,9 @@
 //      pose is estimated from the prior.
 //   2. Without one, or when that fails: the target's middle cell is looked for
 //      (detector/sheet_finder.h); for each candidate closed in on three sides or more, best
-//      first (at most max_candidates), the borders its homography gives are scanned.
+//      first (at most max_candidates), the borders its homography gives are scanned: as few
+//      as a tracked frame's first (its lines are seeded as a prior's are), all `borders` when
+//      those give no pose or lines whose widths barely identify them.
 //   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
 //      with the paper's concentric image borders.
 // A pose is accepted only when the image shows the target where it says: along each stripe's
@@ -73,11 +75,19 @@ ScanMode ScanModeFromString(const std::string& text);
 struct TargetTrackerOptions {
   ScanMode scan = ScanMode::kTarget;
   /// Borders on the target plane (target_layout.h) when the target is looked for (no prior,
-  /// or the prior failed). Range [2, 64].
+  /// or the prior failed) and a candidate's first scan on tracked_borders gave no pose.
+  /// Range [2, 64].
   int borders = 16;
   /// ... and when it is tracked from a prior pose, whose seeded lines need fewer votes to
-  /// stand out. Range [2, 64].
+  /// stand out; also a sheet finder's candidate's first scan (its lines are seeded too).
+  /// Range [2, 64].
   int tracked_borders = 8;
+  /// A candidate's first scan (on tracked_borders) is kept only when its lines identify with
+  /// less than this cost (PoseResult::identification_cost, a chi-square over the widths and
+  /// the geometry): widths measured on few borders that disagree with the target are
+  /// measured again on `borders`. 0: every candidate is scanned on `borders` alone (a
+  /// first frame's pose a third more accurate, its detection twice as long). Range [0, 1e9].
+  double quick_max_identification_cost = 9.0;
   SheetFinderOptions finder;
   /// Middle-cell candidates scanned per frame at most. Range [1, 16].
   int max_candidates = 3;
@@ -162,6 +172,10 @@ class TargetPoseTracker {
   bool Attempt(const GrayImageView& image, const ScanBorders& borders,
                const std::vector<LineSeed>& seeds, const std::optional<vpHomogeneousMatrix>& prior,
                ScanSource source);
+  /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
+  /// (tracked_borders), then `borders` when those give no pose or one identified at more
+  /// than quick_max_identification_cost; true when a pose is accepted.
+  bool AttemptCandidate(const GrayImageView& image, const vpHomography& plane_to_image);
   /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
   std::vector<LineSeed> SeedsFrom(const vpHomography& plane_to_image) const;
   /// The model check and the jump check on an estimated pose: the frame's status.
