@@ -7,7 +7,7 @@
 // clean light quadrilateral whatever lies around the sheet (a light bench, a bright photo
 // beside it, a shadow), and from it the target's geometry predicts where the rest of the
 // target lies. The finder works on a grid of cells (cell_px x cell_px pixel means, about 5000
-// for 640 x 480, from every eighth row):
+// for 640 x 480, from every fourth row):
 //   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
 //      Otsu's over the light class again (a light bench, a bright photo), while the classes
 //      differ by at least min_contrast;
