@@ -1,100 +1,17 @@
-// The fault campaign of the servo loop, `oalservo servo-accuracy --faults N`: N runs of the
-// configuration's servo job (as `oalservo servo` runs it, outputs written), each with one fault
-// injected at a random moment (fixed seed), each judged from outside the loop:
-//   - the run ends with the robot stopped and the reason printed; where the fault takes the
-//     link itself (the port closed, a silent controller, a drive that stops answering), the
-//     stop cannot be confirmed and the run must say "STOP COULD NOT BE SENT";
-//   - no motion command reaches the robot after the stop command that followed the fault;
-//   - the time from the fault to that stop command;
-//   - the output folder holds whole files only: the CSV with every row, images that decode,
-//     no temporary file;
-//   - a run the fault did not stop (line noise the driver could ignore, an occlusion the
-//     detector saw past) ends at the goal as a fault-free run does (the simulation's truth).
-// Where the commands are watched: for the Scorbot (robot.type scorbot), on the wire: the
-// Controller-A simulator, run here rather than by the loop, logs every line it receives with
-// its arrival time (a "MOVE" is a motion command, Ctrl-A the stop); for the simulated camera
-// robot, a wrapper of its driver logs every call.
-// The moment: uniform over the first 85 % of a fault-free run (timed first); an impact waits
-// for the arm to move, a frame fault spoils the first frame taken after it. A run that let go of
-// the robot (its final stop) before its fault's moment is run again with the moment halved,
-// up to 4 times; then it is "not reached" and not judged.
+// `oalservo servo-accuracy --faults N`: the fault campaign (eval/fault_campaign.h) on the
+// configuration's servo job, as `oalservo servo` runs it (outputs written, no window): a
+// simulated camera, and the simulated robot or the Scorbot through its Controller-A simulator.
 #pragma once
 
-#include <cstdint>
 #include <functional>
-#include <limits>
-#include <string>
-#include <vector>
 
 #include "app/config.h"
-#include "app/servo_run.h"
+#include "eval/fault_campaign.h"
 
 namespace oal {
 
-enum class FaultKind {
-  kImpact,            ///< Scorbot: the arm hits something (IMPACT PROTECTION, control off)
-  kControllerSilent,  ///< Scorbot: the controller hangs (nothing executed, nothing answered)
-  kReplyCut,          ///< Scorbot: a reply cut short, its prompt lost
-  kLineNoise,         ///< Scorbot: random bytes amid the controller's output
-  kPortClosed,        ///< Scorbot: the serial link goes away (cable, adapter)
-  kXoffHeld,          ///< Scorbot: XOFF from the controller and no XON after it
-  kDriveFault,        ///< simulated robot: every motion and read call fails from now on
-  kDriveTimeout,      ///< simulated robot: every call, the stop too, times out from now on
-  kUnreadableFrame,   ///< the camera gives no frame
-  kOcclusion,         ///< a hand (a dark blob) over the middle of the view
-  kPoseJump,          ///< the frame rolled by 6-25 deg: the image disagrees with the motion
-};
-
-/// "impact", "controller-silent", "reply-cut", "line-noise", "port-closed", "xoff-held",
-/// "drive-fault", "drive-timeout", "unreadable-frame", "occlusion", "pose-jump".
-std::string ToString(FaultKind kind);
-
-/// The faults of `robot_type` (the Scorbot: the link's and the frames'; else the drive's and the
-/// frames'), in the order runs take them in turn.
-std::vector<FaultKind> FaultKindsFor(RobotType robot_type);
-
-struct FaultCampaignOptions {
-  int runs = 1000;         ///< [1, 1000000]
-  std::uint64_t seed = 1;  ///< of the moments and the faults' details
-  /// The Scorbot simulator's simulated seconds per second, [0.01, 1000] (the link keeps the
-  /// configuration's pace).
-  double time_scale = 20.0;
-  /// The runs' output folders, run_NNNN/; a run that passes is removed, a failed one kept
-  /// with its console log (servo.log).
-  std::string work_dir = "out/fault-campaign";
-  /// Runs at once, [1, 64]: a run mostly waits on the link's pace, so more than the cores.
-  int jobs = 4;
-
-  /// Throws std::invalid_argument naming the option, its value and the violated constraint.
-  void Check() const;
-};
-
-struct FaultRun {
-  int index = 0;
-  FaultKind kind = FaultKind::kImpact;
-  bool reached = false;  ///< the fault happened before the run ended
-  double fault_at_s = std::numeric_limits<double>::quiet_NaN();  ///< after the run began
-  ServoRunStatus status = ServoRunStatus::kError;
-  std::string message;
-  bool robot_stopped = false;     ///< the run says so, and nothing moves after it
-  bool stop_unconfirmed = false;  ///< the run says "STOP COULD NOT BE SENT"
-  /// From the fault to the first stop command the robot received after it; NaN: none.
-  double fault_to_stop_ms = std::numeric_limits<double>::quiet_NaN();
-  int moves_after_stop = 0;   ///< motion commands the robot received after that stop
-  bool outputs_whole = true;  ///< no temporary file, images decode, one CSV row an iteration
-  double final_true_translation_mm = std::numeric_limits<double>::quiet_NaN();
-  double final_true_rotation_deg = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::string> problems;  ///< the rules above it broke; empty: it passed
-};
-
-struct FaultCampaignReport {
-  FaultCampaignOptions options;
-  RobotType robot_type = RobotType::kSimulated;
-  double fault_free_s = 0;  ///< the fault-free run's duration
-  double fault_free_translation_mm = 0, fault_free_rotation_deg = 0;  ///< its true final error
-  std::vector<FaultRun> runs;
-  int failed() const;
-};
+/// The faults injected into the robot a configuration names.
+FaultedRobot FaultedRobotOf(RobotType type);
 
 /// Runs the campaign on `config` (robot.type scorbot with port "simulator", or simulated; a
 /// simulated camera). Throws std::invalid_argument for a configuration it cannot run (a real
@@ -102,12 +19,5 @@ struct FaultCampaignReport {
 FaultCampaignReport RunFaultCampaign(
     const ServoAppConfig& config, const FaultCampaignOptions& options,
     const std::function<void(int done, int total)>& progress = nullptr);
-
-/// The campaign per fault as a Markdown table (runs, reached, stopped with the reason printed,
-/// stop not confirmed and said so, converged on the goal, motion after the stop, fault to
-/// stop command median / max, outputs whole, failed), then each failed run and its problems.
-std::string FaultCampaignTable(const FaultCampaignReport& report);
-/// The campaign as JSON: the options, the fault-free run, every run.
-std::string FaultCampaignJson(const FaultCampaignReport& report);
 
 }  // namespace oal

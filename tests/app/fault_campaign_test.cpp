@@ -26,7 +26,8 @@ using ::testing::HasSubstr;
 FaultCampaignReport RunSmallCampaign(const ServoAppConfig& config, int per_kind,
                                      const test::TestDir& dir) {
   FaultCampaignOptions options;
-  options.runs = per_kind * static_cast<int>(FaultKindsFor(config.robot.type).size());
+  options.runs =
+      per_kind * static_cast<int>(FaultKindsFor(FaultedRobotOf(config.robot.type)).size());
   options.work_dir = dir / "faults";
   options.jobs = 3;
   const FaultCampaignReport report = RunFaultCampaign(config, options);
@@ -49,7 +50,7 @@ FaultCampaignReport RunSmallCampaign(const ServoAppConfig& config, int per_kind,
       EXPECT_TRUE(std::isfinite(run.fault_to_stop_ms)) << ToString(run.kind);
     }
   }
-  for (const FaultKind kind : FaultKindsFor(config.robot.type)) {
+  for (const FaultKind kind : FaultKindsFor(FaultedRobotOf(config.robot.type))) {
     EXPECT_GE(reached[kind], 1) << ToString(kind) << " never reached";
   }
   // Runs that passed leave nothing behind.
