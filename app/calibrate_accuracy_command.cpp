@@ -5,10 +5,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/calibrate_accuracy.h"
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
 #include "base/format.h"
+#include "eval/calibrate_accuracy.h"
 
 namespace oal {
 namespace {

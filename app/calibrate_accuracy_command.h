@@ -3,7 +3,7 @@
 namespace oal {
 
 /// `oalservo calibrate-accuracy`: calibration from the printed line target on rendered views of
-/// known cameras (app/calibrate_accuracy.h), printed as a table and optionally written as JSON.
+/// known cameras (eval/calibrate_accuracy.h), printed as a table and optionally written as JSON.
 int RunCalibrateAccuracy(int argc, char** argv);
 
 }  // namespace oal

@@ -12,10 +12,10 @@
 
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
-#include "app/sheet_views.h"
 #include "base/format.h"
 #include "calibration/calibrate.h"
 #include "calibration/chessboard.h"
+#include "calibration/sheet_view_finder.h"
 #include "calibration/view_selector.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"

@@ -9,8 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "app/evaluation_config.h"
 #include "calibration/calibrate.h"
+#include "eval/rendered_frames.h"
+#include "scene/bench_scene.h"
+#include "servo/target_tracker.h"
+#include "target/line_target.h"
 
 namespace oal {
 

@@ -1,11 +1,11 @@
-#include "app/calibrate_accuracy.h"
+#include "eval/calibrate_accuracy.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "app/sheet_views.h"
 #include "base/check.h"
+#include "calibration/sheet_view_finder.h"
 #include "detector/lens.h"
 
 namespace oal {

@@ -1,4 +1,4 @@
-#include "app/sheet_views.h"
+#include "calibration/sheet_view_finder.h"
 
 #include <array>
 
