@@ -32,6 +32,19 @@ PlumbLineResult StripeCollector::Estimate(const vpCameraParameters& pinhole, int
 
 ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameters& pinhole,
                              const NextFrame& next, int frames, int max_read) {
+  // Every view on all its borders: the plumb line wants every point along the stripes (on 8
+  // borders instead of 16, the lens told was off by 3 % instead of 1-2 %).
+  struct FullScans {
+    TargetPoseTracker& tracker;
+    const bool quick = tracker.quick_scan();
+    explicit FullScans(TargetPoseTracker& t) : tracker(t) { tracker.set_quick_scan(false); }
+    ~FullScans() {
+      tracker.set_quick_scan(quick);
+      tracker.Reset();
+    }
+    FullScans(const FullScans&) = delete;
+    FullScans& operator=(const FullScans&) = delete;
+  } full_scans(tracker);
   StripeCollector stripes;
   GrayImageView view;
   int read = 0;
@@ -41,7 +54,6 @@ ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameter
     tracker.Track(view);
     stripes.Add(tracker);
   }
-  tracker.Reset();
   ToldLens told;
   told.frames = stripes.frames();
   if (stripes.frames() < frames) {

@@ -49,7 +49,8 @@ struct ToldLens {
 
 /// Tracks frames from `next`, each on its own, with `tracker` (a pinhole camera's), until
 /// `frames` show the target or `max_read` have been read, and tells the lens from their stripes
-/// through `pinhole`. The tracker is reset after. What `next` throws goes through.
+/// through `pinhole`. Every view is scanned on all its borders (TargetPoseTracker::
+/// set_quick_scan); the tracker is reset after. What `next` throws goes through.
 ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameters& pinhole,
                              const NextFrame& next, int frames = kLensFrames,
                              int max_read = kMaxLensFramesRead);

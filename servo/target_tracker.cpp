@@ -344,10 +344,14 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
 bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
                                          const vpHomography& plane_to_image) {
   const std::vector<LineSeed> seeds = SeedsFrom(plane_to_image);
-  for (const int count : {options_.tracked_borders, options_.borders}) {
+  const bool quick = quick_scan_ && options_.tracked_borders < options_.borders;
+  const std::array<int, 2> scans{quick ? options_.tracked_borders : options_.borders,
+                                 options_.borders};
+  for (std::size_t scan = 0; scan < scans.size(); ++scan) {
+    const int count = scans[scan];
     TargetBorders(layout_, plane_to_image, camera_, count, &borders_);
     if (borders_.empty()) return false;
-    if (count == options_.tracked_borders) ++frame_.candidates;
+    if (scan == 0) ++frame_.candidates;
     // Each candidate on its own: a prior that failed above says nothing about it.
     const bool accepted = Attempt(image, borders_, seeds, std::nullopt, ScanSource::kMiddleCell);
     if (count >= options_.borders) return accepted;

@@ -165,6 +165,11 @@ class TargetPoseTracker {
   const TargetTrackerOptions& options() const { return options_; }
   /// The last accepted pose, if the last frames had one.
   const std::optional<vpHomogeneousMatrix>& last_cMo() const { return last_cMo_; }
+  /// Whether a sheet candidate may be scanned first on tracked_borders (the default); off,
+  /// every candidate is scanned on `borders` at once: more feature points along each stripe,
+  /// for those who use them (the lens told from the stripes).
+  void set_quick_scan(bool allowed) { quick_scan_ = allowed; }
+  bool quick_scan() const { return quick_scan_; }
 
  private:
   /// Detects in `borders` (the whole image when empty) and estimates the pose from `prior`;
@@ -186,6 +191,7 @@ class TargetPoseTracker {
   TargetLayout layout_;
   PoseOptions pose_options_;
   TargetTrackerOptions options_;
+  bool quick_scan_ = true;
   OalDetector detector_;
   SheetFinder finder_;
   std::vector<DetectedLine> lines_;

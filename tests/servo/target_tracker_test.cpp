@@ -93,6 +93,28 @@ TEST(TargetPoseTracker, FindsA3AndA4SheetsAtEveryRollWithoutAPrior) {
   }
 }
 
+// A candidate is scanned first on as few borders as a tracked frame; with the quick scan off
+// (as the lens is told), on all of them at once, and the pose is right either way.
+TEST(TargetPoseTracker, ACandidateIsScannedOnFewBordersFirstUnlessTheQuickScanIsOff) {
+  const SceneRenderer renderer(FourLineA3Target(), BenchRender(7));
+  TargetPoseTracker tracker = TrackerFor(renderer);
+  const vpHomogeneousMatrix cMo(0.02, -0.01, 0.55, vpMath::rad(12), vpMath::rad(-9), 0.7);
+  const RenderedFrame rendered = renderer.Render(cMo, 31);
+  ASSERT_TRUE(tracker.quick_scan());
+  const TargetFrame quick = tracker.Track(ViewOf(rendered.image));
+  ExpectRightPose(quick, cMo, "quick scan");
+  EXPECT_EQ(quick.source, ScanSource::kMiddleCell);
+  EXPECT_LE(quick.borders, tracker.options().tracked_borders);
+  EXPECT_LT(quick.pose.identification_cost, tracker.options().quick_max_identification_cost);
+
+  tracker.Reset();
+  tracker.set_quick_scan(false);
+  const TargetFrame full = tracker.Track(ViewOf(rendered.image));
+  ExpectRightPose(full, cMo, "full scan");
+  EXPECT_GT(full.borders, tracker.options().tracked_borders);
+  EXPECT_EQ(full.candidates, quick.candidates);
+}
+
 // A camera sliding over the sheet: every frame after the first is tracked from the last pose.
 TEST(TargetPoseTracker, FollowsAMovingSheetFromItsLastPose) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(5));
