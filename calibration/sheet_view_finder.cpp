@@ -25,6 +25,8 @@ SheetViewFinder::SheetViewFinder(const LineTarget& target, int width, int height
     guess.initPersProjWithoutDistortion(focal_per_width * width, focal_per_width * width,
                                         0.5 * (width - 1), 0.5 * (height - 1));
     trackers_.emplace_back(target, guess, detector, pose, tracking);
+    // Every view on all its borders: the calibration wants every point along the stripes.
+    trackers_.back().set_quick_scan(false);
   }
 }
 
