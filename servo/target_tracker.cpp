@@ -344,7 +344,9 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
 bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
                                          const vpHomography& plane_to_image) {
   const std::vector<LineSeed> seeds = SeedsFrom(plane_to_image);
-  const bool quick = quick_scan_ && options_.tracked_borders < options_.borders;
+  // quick_max_identification_cost 0 could never keep a quick scan: none is made.
+  const bool quick = quick_scan_ && options_.quick_max_identification_cost > 0.0 &&
+                     options_.tracked_borders < options_.borders;
   const std::array<int, 2> scans{quick ? options_.tracked_borders : options_.borders,
                                  options_.borders};
   for (std::size_t scan = 0; scan < scans.size(); ++scan) {

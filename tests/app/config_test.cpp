@@ -145,6 +145,10 @@ TEST(Config, OutOfRangeValueNamesFileLineAndField) {
   // A constraint between two fields: the line of the field Check() names, if the file set it.
   EXPECT_THAT(ErrorOf("detector:\n  min_width_px: 10\n  max_width_px: 5\n"),
               HasSubstr("cfg.yaml:3: 'detector.max_width_px' is invalid"));
+  EXPECT_THAT(ErrorOf("tracking:\n  tracked_borders: 8\n  quick_max_identification_cost: -1\n"),
+              HasSubstr("cfg.yaml:3: 'tracking.quick_max_identification_cost' is invalid"));
+  EXPECT_THAT(ErrorOf("tracking:\n  quick_max_identification_cost: cheap\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.quick_max_identification_cost' must be a number"));
   const std::string above_default_max = std::to_string(DetectorOptions().max_width_px + 1.0);
   EXPECT_THAT(ErrorOf("detector:\n  min_width_px: " + above_default_max + "\n"),
               HasSubstr("cfg.yaml: section 'detector' is invalid: detector.max_width_px = "));

@@ -113,6 +113,19 @@ TEST(TargetPoseTracker, ACandidateIsScannedOnFewBordersFirstUnlessTheQuickScanIs
   ExpectRightPose(full, cMo, "full scan");
   EXPECT_GT(full.borders, tracker.options().tracked_borders);
   EXPECT_EQ(full.candidates, quick.candidates);
+
+  // A cost bound of 0 could keep no quick scan: the configuration's way to turn it off.
+  TargetTrackerOptions no_quick;
+  no_quick.quick_max_identification_cost = 0.0;
+  PoseOptions pose;
+  pose.camera = renderer.options().camera;
+  pose.image_width = renderer.options().width;
+  pose.image_height = renderer.options().height;
+  TargetPoseTracker configured(renderer.target(), renderer.options().camera, DetectorOptions(),
+                               pose, no_quick);
+  const TargetFrame by_options = configured.Track(ViewOf(rendered.image));
+  ExpectRightPose(by_options, cMo, "quick scan off by the options");
+  EXPECT_EQ(by_options.borders, full.borders);
 }
 
 // A camera sliding over the sheet: every frame after the first is tracked from the last pose.
