@@ -42,6 +42,7 @@ FaultCampaignReport RunFaultCampaign(const ServoAppConfig& config,
   FaultCampaignSetup setup;
   setup.robot = FaultedRobotOf(config.robot.type);
   if (setup.robot == FaultedRobot::kScorbot) setup.controller = ControllerSimOptions(config);
+  setup.outcome_prefix = "oalservo servo: ";  // RunServoWithOutputs' outcome line
   setup.run = [&config](const FaultRunRequest& request, std::ostream& log) {
     ServoAppConfig run = config;
     run.output.directory = request.output_dir;

@@ -397,7 +397,7 @@ void FinalTrueError(const ServoRunReport& report, double* mm, double* deg) {
 }
 
 FaultRun Judge(const Outcome& outcome, const FaultPlan& plan, const fs::path& dir,
-               const FaultCampaignReport& campaign) {
+               const FaultCampaignReport& campaign, const std::string& outcome_prefix) {
   FaultRun run;
   run.kind = plan.kind;
   const ServoRunReport& report = outcome.report;
@@ -425,7 +425,7 @@ FaultRun Judge(const Outcome& outcome, const FaultPlan& plan, const fs::path& di
                       (outcome.commands.empty() || last_is_stop);
 
   std::vector<std::string>& problems = run.problems;
-  const std::string printed = ToString(report.status) + ": ";
+  const std::string printed = outcome_prefix + ToString(report.status) + ": ";
   if (report.message.empty() || outcome.log.find(printed) == std::string::npos) {
     problems.push_back("the outcome and its reason were not printed");
   }
@@ -564,7 +564,7 @@ FaultCampaignReport RunFaultCampaign(const FaultCampaignSetup& setup,
       if (outcome.fault_at || attempt == kAttempts) break;
       plan.delay_s /= 2;
     }
-    FaultRun run = Judge(outcome, plan, dir, campaign);
+    FaultRun run = Judge(outcome, plan, dir, campaign, setup.outcome_prefix);
     run.index = i;
     if (run.problems.empty()) {
       fs::remove_all(dir);

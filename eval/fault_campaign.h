@@ -96,9 +96,11 @@ struct FaultCampaignSetup {
   /// input).
   ScorbotSimOptions controller;
   /// Runs the servo job once as `request` asks, writing its outputs and its console lines to
-  /// `log` (the outcome and its reason among them, as "STATUS: MESSAGE"). Called from
-  /// FaultCampaignOptions::jobs threads at once.
+  /// `log` (the outcome and its reason among them, as `outcome_prefix` + "STATUS: MESSAGE").
+  /// Called from FaultCampaignOptions::jobs threads at once.
   std::function<ServoRunReport(const FaultRunRequest& request, std::ostream& log)> run;
+  /// What the job's console line with the outcome begins with (e.g. "oalservo servo: ").
+  std::string outcome_prefix;
 };
 
 struct FaultRun {
