@@ -4,11 +4,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
-#include <sstream>
 #include <stdexcept>
 #include <string>
-#include <system_error>
-#include <utility>
 #include <vector>
 
 #include "app/command_line.h"
@@ -16,9 +13,7 @@
 #include "app/evaluation_config.h"  // AddSeedOption
 #include "base/check.h"
 #include "io/atomic_file.h"
-#include "io/camera_file.h"
-#include "io/json_io.h"
-#include "io/truth_file.h"
+#include "io/rendered_dataset.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
 
@@ -28,12 +23,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kCameraName = "oal-render";
-
-std::string FrameName(int index, const char* extension) {
-  std::string number = std::to_string(index);
-  if (number.size() < 4) number.insert(0, 4 - number.size(), '0');
-  return "frame_" + number + extension;
-}
 
 // The render of the options: the config's scene (if any), then the command line's camera,
 // noise, blur and light; --background replaces the scene's surface.
@@ -64,167 +53,6 @@ PoseSampling ToPoseSampling(const RenderCommandOptions& options) {
   sampling.crossings_in_view = options.crossings_margin_px >= 0.0;
   sampling.crossings_margin_px = std::max(0.0, options.crossings_margin_px);
   return sampling;
-}
-
-// A renderer file in a data set's folder: frame_NNNN.png, frame_NNNN.json, camera.xml or
-// sequence.json (what RenderDataset writes and --overwrite replaces).
-bool IsRendererFile(const fs::directory_entry& entry) {
-  if (!entry.is_regular_file()) return false;
-  const std::string name = entry.path().filename().string();
-  if (name == "camera.xml" || name == "sequence.json" || name == "target.yaml") return true;
-  const std::string stem = entry.path().stem().string();
-  const std::string extension = entry.path().extension().string();
-  return (extension == ".png" || extension == ".json") && stem.size() > 6 &&
-         stem.compare(0, 6, "frame_") == 0 &&
-         stem.find_first_not_of("0123456789", 6) == std::string::npos;
-}
-
-std::vector<fs::path> RendererFilesIn(const fs::path& dir) {
-  std::vector<fs::path> files;
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
-    if (IsRendererFile(entry)) files.push_back(entry.path());
-  }
-  return files;
-}
-
-// "20 frames, camera.xml" for the renderer files `files`; empty for none.
-std::string DescribeRendererFiles(const std::vector<fs::path>& files) {
-  int frames = 0;
-  std::string others;
-  for (const fs::path& file : files) {
-    const std::string name = file.filename().string();
-    if (file.extension() == ".png") {
-      ++frames;
-    } else if (file.extension() != ".json" || name == "sequence.json") {
-      others += ", " + name;
-    }
-  }
-  if (frames == 0 && others.empty() && !files.empty()) return "frame_NNNN.json files";
-  if (frames == 0) return others.empty() ? "" : others.substr(2);
-  return std::to_string(frames) + (frames == 1 ? " frame" : " frames") + others;
-}
-
-// The data set's folder, written all or nothing: the frames go to a temporary sibling folder
-// `<DIR>.tmp-<pid>`, which Commit() moves into place (one rename when DIR does not exist;
-// else the renderer files already in DIR are removed and the new ones moved in, other files
-// kept). Without Commit() (an error), the temporary folder and any parent folders created
-// for it are removed: nothing is left behind.
-class StagedDataset {
- public:
-  // Throws std::invalid_argument when DIR is not a folder, or holds renderer files and
-  // `overwrite` is false; std::runtime_error when the temporary folder cannot be made.
-  StagedDataset(const std::string& out_dir, bool overwrite) : name_(out_dir) {
-    target_ = fs::absolute(out_dir).lexically_normal();
-    if (!target_.has_filename()) target_ = target_.parent_path();  // "data/", "."
-    if (fs::exists(target_) && !fs::is_directory(target_)) {
-      throw std::invalid_argument("--out '" + name_ + "' exists and is not a folder");
-    }
-    if (fs::is_directory(target_) && !overwrite) {
-      const std::string held = DescribeRendererFiles(RendererFilesIn(target_));
-      if (!held.empty()) {
-        throw std::invalid_argument("--out '" + name_ + "' already holds a rendered data set (" +
-                                    held +
-                                    "); pass --overwrite to replace it (other files in the "
-                                    "folder are kept), or choose another folder");
-      }
-    }
-    const fs::path parent = target_.parent_path();
-    for (fs::path p = parent; !p.empty() && !fs::exists(p); p = p.parent_path()) created_ = p;
-    std::error_code error;
-    fs::create_directories(parent, error);
-    temp_ = TempPathFor(target_);
-    if (!error) fs::remove_all(temp_, error);  // a stale one of an earlier process of this pid
-    if (!error) fs::create_directory(temp_, error);
-    if (error) {
-      RemoveCreatedParents();
-      throw std::runtime_error("cannot create the folder '" + temp_.string() + "' for --out '" +
-                               name_ + "': " + error.message());
-    }
-  }
-
-  ~StagedDataset() {
-    if (committed_) return;
-    std::error_code ignored;
-    fs::remove_all(temp_, ignored);
-    RemoveCreatedParents();
-  }
-
-  StagedDataset(const StagedDataset&) = delete;
-  StagedDataset& operator=(const StagedDataset&) = delete;
-
-  /// Where the files are written until Commit().
-  const fs::path& dir() const { return temp_; }
-
-  void Commit() {
-    if (!fs::exists(target_)) {
-      fs::rename(temp_, target_);
-    } else {
-      for (const fs::path& old : RendererFilesIn(target_)) fs::remove(old);
-      // Frames first, then camera.xml, then sequence.json (its presence means complete).
-      std::vector<fs::path> files;
-      for (const fs::directory_entry& entry : fs::directory_iterator(temp_)) {
-        files.push_back(entry.path());
-      }
-      auto rank = [](const fs::path& file) {
-        const std::string name = file.filename().string();
-        return std::make_pair(name == "sequence.json" ? 2 : name == "camera.xml" ? 1 : 0, name);
-      };
-      std::sort(files.begin(), files.end(),
-                [&](const fs::path& a, const fs::path& b) { return rank(a) < rank(b); });
-      for (const fs::path& file : files) fs::rename(file, target_ / file.filename());
-      fs::remove(temp_);
-    }
-    committed_ = true;
-  }
-
- private:
-  // Removes the parent folders the constructor created, if they are (still) empty.
-  void RemoveCreatedParents() noexcept {
-    if (created_.empty()) return;
-    std::error_code error;
-    for (fs::path p = target_.parent_path(); !error; p = p.parent_path()) {
-      fs::remove(p, error);
-      if (p == created_) break;
-    }
-  }
-
-  std::string name_;  // --out as given, for messages
-  fs::path target_;   // absolute, no trailing separator
-  fs::path temp_;     // <target>.tmp-<pid>
-  fs::path created_;  // the outermost parent folder the constructor created; empty: none
-  bool committed_ = false;
-};
-
-// Noise seed of frame `index`: distinct per frame, a pure function of the data set's seed.
-std::uint64_t NoiseSeed(std::uint64_t seed, int index) {
-  return seed ^ (0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(index + 1));
-}
-
-Json OccluderJson(const Occluder& occluder) {
-  const bool disc = occluder.shape == Occluder::Shape::kDisc;
-  Json json{{"shape", disc ? "disc" : "rectangle"},
-            {"centre", Json::array({occluder.centre_u_px, occluder.centre_v_px})}};
-  if (disc) {
-    json["radius_px"] = occluder.half_width_px;
-  } else {
-    json["size_px"] = Json::array({2.0 * occluder.half_width_px, 2.0 * occluder.half_height_px});
-  }
-  json["grey"] = occluder.grey;
-  return json;
-}
-
-Json EffectsJson(const FrameEffects& effects) {
-  Json occluders = Json::array();
-  for (const Occluder& occluder : effects.occluders) occluders.push_back(OccluderJson(occluder));
-  return Json{{"gain", effects.gain}, {"offset", effects.offset}, {"occluders", occluders}};
-}
-
-// Writes frame_NNNN.png and frame_NNNN.json, each atomically.
-void WriteFrame(const fs::path& dir, int index, const RenderedFrame& frame, const Json& truth) {
-  const cv::Mat image(static_cast<int>(frame.image.getHeight()),
-                      static_cast<int>(frame.image.getWidth()), CV_8UC1, frame.image.bitmap);
-  WritePng(dir / FrameName(index, ".png"), image);
-  WriteFileAtomically(dir / FrameName(index, ".json"), truth.dump(2) + "\n");
 }
 
 // The target and scene to render: the config's `target:` and `scene:` sections if a config
@@ -258,60 +86,20 @@ RenderOptions SequenceRenderOptions(const RenderCommandOptions& options, const S
 // Renders the sequence's frames, camera.xml and sequence.json into `dir`.
 void RenderSequenceDataset(const RenderCommandOptions& options, const AppConfig& config,
                            const fs::path& dir) {
-  const LineTarget& target = config.target;
-  const Sequence sequence =
-      MakeSequence(SequenceKindFromString(options.sequence), options.count, options.seed, target);
+  const Sequence sequence = MakeSequence(SequenceKindFromString(options.sequence), options.count,
+                                         options.seed, config.target);
   const SceneRenderer renderer(sequence.target,
                                SequenceRenderOptions(options, sequence, config.scene));
-  const RenderOptions& render = renderer.options();
-  SaveCameraFile((dir / "camera.xml").string(), render.camera, kCameraName,
-                 static_cast<unsigned int>(render.width), static_cast<unsigned int>(render.height));
-  for (int i = 0; i < options.count; ++i) {
-    const SequenceFrame& step = sequence.frames[static_cast<std::size_t>(i)];
-    const RenderedFrame frame = renderer.Render(step.cMo, step.noise_seed, step.effects);
-    Json truth = FrameTruthJson(frame, i, FrameName(i, ".png"), target.name, options.seed,
-                                step.noise_seed, render.camera, render.width, render.height);
-    for (std::size_t l = 0; l < frame.truth.size(); ++l) {
-      truth["lines"][l]["occluded_fraction"] = frame.truth[l].occluded_fraction;
-    }
-    truth["sequence"] = options.sequence;
-    truth["effects"] = EffectsJson(step.effects);
-    WriteFrame(dir, i, frame, truth);
-  }
-  const Json summary{
-      {"kind", options.sequence},
-      {"seed", options.seed},
-      {"count", options.count},
-      {"target", target.name},
-      {"description", sequence.description},
-      {"camera", CameraJson(render.camera, render.width, render.height)},
-      {"noise_sigma", render.noise_sigma},
-      {"blur_sigma_px", render.blur_sigma_px},
-      {"illumination_gradient", render.illumination_gradient},
-      {"gradient_angle_rad", render.gradient_angle_rad},
-      {"frames", FrameName(0, ".png") + " ... " + FrameName(options.count - 1, ".png")}};
-  WriteFileAtomically(dir / "sequence.json", summary.dump(2) + "\n");
+  WriteSequenceDataset(sequence, options.sequence, renderer,
+                       DatasetLabels{config.target.name, options.seed, kCameraName}, dir);
 }
 
 // Renders independent random poses, their truth and camera.xml into `dir`.
 void RenderRandomDataset(const RenderCommandOptions& options, const AppConfig& config,
                          const fs::path& dir) {
-  const LineTarget& target = config.target;
-  const SceneRenderer renderer(target, ToRenderOptions(options, config.scene));
-  const PoseSampling sampling = ToPoseSampling(options);
-  const vpCameraParameters& camera = renderer.options().camera;
-  SaveCameraFile((dir / "camera.xml").string(), camera, kCameraName,
-                 static_cast<unsigned int>(options.width),
-                 static_cast<unsigned int>(options.height));
-  std::uint64_t state = options.seed;
-  for (int i = 0; i < options.count; ++i) {
-    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
-    const std::uint64_t noise_seed = NoiseSeed(options.seed, i);
-    const RenderedFrame frame = renderer.Render(cMo, noise_seed);
-    WriteFrame(dir, i, frame,
-               FrameTruthJson(frame, i, FrameName(i, ".png"), target.name, options.seed, noise_seed,
-                              camera, options.width, options.height));
-  }
+  const SceneRenderer renderer(config.target, ToRenderOptions(options, config.scene));
+  WriteRandomDataset(renderer, ToPoseSampling(options), options.count,
+                     DatasetLabels{config.target.name, options.seed, kCameraName}, dir);
 }
 
 }  // namespace
@@ -365,7 +153,7 @@ vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu)
 int RenderDataset(const RenderCommandOptions& options) {
   options.Check();
   const AppConfig config = ConfigOf(options);
-  StagedDataset staged(options.out_dir, options.overwrite);
+  StagedDataset staged(options.out_dir, options.overwrite, {"--out", "--overwrite"});
   if (options.sequence.empty()) {
     RenderRandomDataset(options, config, staged.dir());
   } else {

@@ -1,24 +1,10 @@
-// `oalservo render`: a synthetic data set with ground truth, laid out so that
-// `oalservo detect DIR --camera DIR/camera.xml` runs on it:
-//
-//   DIR/frame_0000.png    8-bit grey frame
-//   DIR/frame_0000.json   ground truth: pose cMo, camera, one entry per target line
-//   DIR/camera.xml        ViSP camera file, camera "oal-render", perspectiveProjWithDistortion
-//   DIR/target.yaml       the target rendered, as a config's `target:` section (`oalservo pose
-//                         DIR` and `evaluate DIR` read it when no --config is given)
-//
-// With a sequence (`--sequence KIND`, scene/sequence.h) the frames are a reproducible camera
-// motion with per-frame effects instead of independent random poses, and two more things are
-// written: each frame's JSON gains "sequence", "effects" (gain, offset, occluders) and a
-// per-line "occluded_fraction", and DIR/sequence.json (kind, seed, count, target, description,
-// render settings) is written last, so its presence means the sequence is complete.
-//
-// All or nothing: the files are written into a temporary folder next to DIR (DIR.tmp-<pid>)
-// and moved into DIR only when every frame is written; an error leaves nothing behind (no
-// temporary folder, no parent folder created for it) and a data set already in DIR untouched.
-// A DIR that already holds renderer files (frame_NNNN.png/json, camera.xml, sequence.json) is
-// refused unless `overwrite`: then those files are replaced by the new data set and any other
-// file in DIR is kept (so stale frames of a longer earlier run never sit beside a new camera).
+// `oalservo render`: a synthetic data set with ground truth, laid out as io/rendered_dataset.h
+// describes, so that `oalservo detect DIR --camera DIR/camera.xml` runs on it; DIR/target.yaml
+// is the target rendered, as a config's `target:` section (`pose DIR` and `evaluate DIR` read
+// it). With `--sequence KIND` (scene/sequence.h) the frames are a reproducible camera motion
+// with per-frame effects instead of independent random poses. All or nothing; a DIR that
+// already holds a data set is refused unless `overwrite`, which replaces the data set's files
+// and keeps any other file in DIR.
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>
