@@ -1,4 +1,6 @@
-
+// The comparison's run and what it writes (figures, Markdown, JSON) share the per-frame
+// records and the truth handling; the methods (line_method.h) and the scoring
+// (line_scoring.h) live in their own files.
 #include "eval/compare.h"
 
 #include <algorithm>

@@ -1,3 +1,6 @@
+// One run of the loop in one file: its steps (grab, pose, checks, command, log row) are small
+// functions around one ServoRun, and every stop path must reach the same StopGuard; split,
+// they would each need the run's state handed across files.
 #include "loop/servo_loop.h"
 
 #include <visp3/core/vpMath.h>
