@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "base/check.h"
+
 namespace oal {
 namespace {
 
@@ -85,6 +87,20 @@ vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, dou
   camera.initPersProjWithDistortion(px, py, u0, v0, 0.0, kdu);
   camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
   return camera;
+}
+
+void CheckPerspectiveCamera(const vpCameraParameters& camera, const std::string& field) {
+  const auto model = camera.get_projModel();
+  RequireOption(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
+                    model == vpCameraParameters::perspectiveProjWithDistortion,
+                field + ".projModel", static_cast<int>(model),
+                "perspective projection with or without (kdu) distortion");
+  RequireOption(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), field + ".px",
+                camera.get_px(), "px > 0");
+  RequireOption(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), field + ".py",
+                camera.get_py(), "py > 0");
+  RequireOption(std::isfinite(camera.get_u0()), field + ".u0", camera.get_u0(), "u0 is finite");
+  RequireOption(std::isfinite(camera.get_v0()), field + ".v0", camera.get_v0(), "v0 is finite");
 }
 
 }  // namespace oal

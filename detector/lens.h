@@ -10,6 +10,8 @@
 
 #include <visp3/core/vpCameraParameters.h>
 
+#include <string>
+
 #include "detector/line.h"
 
 namespace oal {
@@ -46,5 +48,10 @@ double FitKud(const vpCameraParameters& camera, int width, int height);
 /// width x height image (FitKud), as a calibration gives both (kud = 0 when kdu = 0).
 vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
                                  int height);
+
+/// Throws std::invalid_argument naming `field` (e.g. "PoseOptions::camera") unless `camera`
+/// is a perspective projection, with or without ViSP's distortion, of finite px, py > 0 and
+/// finite u0, v0.
+void CheckPerspectiveCamera(const vpCameraParameters& camera, const std::string& field);
 
 }  // namespace oal

@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "detector/lens.h"
 #include "detector/options.h"
 #include "scene/geometry.h"
 
@@ -1235,19 +1236,7 @@ std::shared_ptr<const SceneDressing> BuildDressing(const LineTarget& target,
 void RenderOptions::Check() const {
   RequireOption(InRange(width, 16, 8192), "RenderOptions::width", width, "16 <= width <= 8192");
   RequireOption(InRange(height, 16, 8192), "RenderOptions::height", height, "16 <= height <= 8192");
-  const auto model = camera.get_projModel();
-  RequireOption(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
-                    model == vpCameraParameters::perspectiveProjWithDistortion,
-                "RenderOptions::camera.projModel", static_cast<int>(model),
-                "perspective projection with or without (kdu) distortion");
-  RequireOption(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), "RenderOptions::camera.px",
-                camera.get_px(), "px > 0");
-  RequireOption(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), "RenderOptions::camera.py",
-                camera.get_py(), "py > 0");
-  RequireOption(std::isfinite(camera.get_u0()), "RenderOptions::camera.u0", camera.get_u0(),
-                "u0 is finite");
-  RequireOption(std::isfinite(camera.get_v0()), "RenderOptions::camera.v0", camera.get_v0(),
-                "v0 is finite");
+  CheckPerspectiveCamera(camera, "RenderOptions::camera");
   // The pixel -> ray map must not fold over inside the image: 1 + 3 kdu r^2 > 0 at the
   // farthest corner (the radial derivative of r (1 + kdu r^2)).
   const double du = std::max(std::fabs(camera.get_u0()), std::fabs(width - 1 - camera.get_u0()));

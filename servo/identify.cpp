@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "detector/lens.h"
 #include "servo/pose.h"
 #include "servo/pose_internal.h"
 
@@ -537,17 +538,7 @@ std::string ToString(PoseMethod method) {
 }
 
 void PoseOptions::Check() const {
-  const auto model = camera.get_projModel();
-  RequireOption(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
-                    model == vpCameraParameters::perspectiveProjWithDistortion,
-                "PoseOptions::camera.projModel", static_cast<int>(model),
-                "perspective projection with or without (kdu) distortion");
-  RequireOption(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), "PoseOptions::camera.px",
-                camera.get_px(), "px > 0");
-  RequireOption(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), "PoseOptions::camera.py",
-                camera.get_py(), "py > 0");
-  RequireOption(std::isfinite(camera.get_u0()) && std::isfinite(camera.get_v0()),
-                "PoseOptions::camera.u0", camera.get_u0(), "u0 and v0 are finite");
+  CheckPerspectiveCamera(camera, "PoseOptions::camera");
   RequireOption(max_candidate_lines >= 4 && max_candidate_lines <= 12,
                 "PoseOptions::max_candidate_lines", max_candidate_lines,
                 "4 <= max_candidate_lines <= 12");
