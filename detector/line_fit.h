@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "detector/line.h"
@@ -51,19 +52,32 @@ LineParams RefitLine(const LineParams& line, const std::vector<FramePoint>& poin
 SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint>& points,
                             double tolerance_px);
 
-/// How far the feature points within `tolerance_px` of `line` bend away from it: the sagitta
-/// (pixels) of the parabola fitted to their distances from the line over the stretch they
-/// cover, signed (positive towards the line's normal). The parabola averages the points' noise
-/// out, where their RMS distance would add it in: a straight stripe seen through a lens the
-/// camera model misses shows as a bend. 0 with fewer than 6 points.
+/// The stretch of a line between the feet of two points on it, e.g. a printed stripe's ends.
+struct LineExtent {
+  Point2d a, b;
+};
+
+/// How far a line bends beyond what its points' scatter can tell, pixels, signed (positive
+/// towards the line's normal): the sagitta of the parabola fitted to the distances from `line`
+/// of its feature points over the stretch they cover, less one standard error of that sagitta
+/// (0 when the error is larger). The points are those within `tolerance_px` of the line whose
+/// run lay along one side of a border (a run around a corner gives the midpoint of its ends,
+/// off the centre line), and with an `extent` only those whose feet lie on it (a stripe's line
+/// runs on past its ink, over whatever lies there); up to three stray ones (a run cut short by
+/// a mark or an edge) are left out. The parabola averages the points' noise out, where their
+/// RMS distance would add it in, and its error grows where the points bunch at the two ends of
+/// the line: a straight stripe seen through a lens the camera model misses shows as a bend, a
+/// short or sparsely seen one as none. 0 with fewer than 6 points.
 double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
-                   double tolerance_px);
+                   double tolerance_px, const std::optional<LineExtent>& extent = std::nullopt);
 
 /// How straight four lines are, pixels: the second largest of their bends (|LineSagitta|). A
 /// lens the camera model misses bends every line that does not pass through the principal
 /// point, and a '#' has two on either side of it; one bent line alone is a stray point near it
 /// (a printed mark, the sheet's edge).
+/// `extents`: where each line is known to lie (a printed stripe's ends), or nothing.
 double StraightnessOfFour(const std::array<LineParams, 4>& lines,
-                          const std::vector<FramePoint>& points, double tolerance_px);
+                          const std::vector<FramePoint>& points, double tolerance_px,
+                          const std::array<std::optional<LineExtent>, 4>& extents = {});
 
 }  // namespace oal

@@ -254,8 +254,9 @@ void TargetPoseTracker::Reset() {
   frames_since_ok_ = 0;
 }
 
-std::vector<LineSeed> TargetPoseTracker::SeedsFrom(const vpHomography& plane_to_image) const {
-  std::vector<LineSeed> seeds;
+std::array<std::optional<LineExtent>, 4> TargetPoseTracker::StripeEnds(
+    const vpHomography& plane_to_image) const {
+  std::array<std::optional<LineExtent>, 4> extents;
   for (int k = 0; k < 4; ++k) {
     const StripeSpan& stripe = layout_.stripes[static_cast<std::size_t>(k)];
     Point2d ends[2];
@@ -274,8 +275,18 @@ std::vector<LineSeed> TargetPoseTracker::SeedsFrom(const vpHomography& plane_to_
                                        : DistortedPixel(camera_, x, y);
       ok = std::isfinite(ends[e].u) && std::isfinite(ends[e].v);
     }
-    if (ok && std::hypot(ends[1].u - ends[0].u, ends[1].v - ends[0].v) > 1.0) {
-      seeds.push_back(LineSeed{k, LineThrough(ends[0], ends[1])});
+    if (ok) extents[static_cast<std::size_t>(k)] = LineExtent{ends[0], ends[1]};
+  }
+  return extents;
+}
+
+std::vector<LineSeed> TargetPoseTracker::SeedsFrom(const vpHomography& plane_to_image) const {
+  std::vector<LineSeed> seeds;
+  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(plane_to_image);
+  for (int k = 0; k < 4; ++k) {
+    const std::optional<LineExtent>& end = ends[static_cast<std::size_t>(k)];
+    if (end && std::hypot(end->b.u - end->a.u, end->b.v - end->a.v) > 1.0) {
+      seeds.push_back(LineSeed{k, LineThrough(end->a, end->b)});
     }
   }
   return seeds;
@@ -307,8 +318,10 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   for (std::size_t k = 0; k < identified.size(); ++k) {
     identified[k] = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
   }
+  // Only the points on the printed stripes: beyond their ends the lines run over the bench.
   frame_.straightness_px = StraightnessOfFour(identified, detector_.feature_points(),
-                                              2.0 * detector_.options().support_tolerance_px);
+                                              2.0 * detector_.options().support_tolerance_px,
+                                              StripeEnds(PlaneToImage(frame_.pose.cMo)));
   for (int k = 0; k < 4; ++k) {
     const DetectedLine& line =
         lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];

@@ -182,6 +182,9 @@ class TargetPoseTracker {
   /// than quick_max_identification_cost; true when a pose is accepted.
   bool AttemptCandidate(const GrayImageView& image, const vpHomography& plane_to_image);
   /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
+  /// Each stripe's centre line from end to end in the detector's coordinates; nothing for a
+  /// stripe with an end behind the camera.
+  std::array<std::optional<LineExtent>, 4> StripeEnds(const vpHomography& plane_to_image) const;
   std::vector<LineSeed> SeedsFrom(const vpHomography& plane_to_image) const;
   /// The model check and the jump check on an estimated pose: the frame's status.
   void Accept(bool predicted);
@@ -206,8 +209,8 @@ class TargetPoseTracker {
 /// The lens check over several frames: whether their lines 1-4, after the camera model's
 /// correction, bend by more than a matching model leaves. A single frame can show a stray
 /// bend (a mark beside a stripe), so the median of at least `min_frames` frames decides:
-/// on the A3 bench scenes a matching camera file gives a median of about 0.05 px, one whose
-/// kdu is off by 0.1 about 0.4 px (docs/BENCHMARKS.md).
+/// on the A3 bench scenes a matching camera file gives a median of 0.00 px, one whose kdu is
+/// off by 0.1 about 0.4 px (docs/BENCHMARKS.md).
 struct LensCheck {
   int frames = 0;          ///< frames with a pose that were counted
   double median_px = 0.0;  ///< their median TargetFrame::straightness_px
