@@ -78,51 +78,56 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
 
 namespace {
 
-double Parabola(const std::array<double, 3>& fit, double x) {
-  return fit[0] + x * (fit[1] + x * fit[2]);
-}
+// The least-squares parabola d = a + b x + k x^2 through samples (x, d): its coefficients and
+// the inverse of its normal matrix (for the leverage of a sample and the error of k).
+struct Parabola {
+  std::array<double, 3> coefficients{};
+  std::array<std::array<double, 3>, 3> inverse{};
 
-// The normal equations of the least-squares parabola d = a + b x + k x^2 through samples
-// (x, d), as sums that a sample can be added to or taken out of.
-struct ParabolaSums {
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, d0 = 0, d1 = 0, d2 = 0;
-
-  void Add(const Point2d& sample, double weight) {
-    const double x = sample.u, d = sample.v, x2 = x * x;
-    s0 += weight, s1 += weight * x, s2 += weight * x2, s3 += weight * x2 * x;
-    s4 += weight * x2 * x2;
-    d0 += weight * d, d1 += weight * x * d, d2 += weight * x2 * d;
+  double At(double x) const {
+    return coefficients[0] + x * (coefficients[1] + x * coefficients[2]);
   }
-  // {a, b, k}, and the k diagonal entry of the inverse normal matrix; false when the samples
-  // do not determine the parabola.
-  bool Solve(std::array<double, 3>* fit, double* inverse_kk) const {
-    auto det3 = [](double a, double b, double c, double d, double e, double f, double g, double h,
-                   double i) {
-      return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
-    };
-    const double det = det3(s0, s1, s2, s1, s2, s3, s2, s3, s4);
-    if (!(std::fabs(det) > 1e-12)) return false;
-    *fit = {det3(d0, s1, s2, d1, s2, s3, d2, s3, s4) / det,
-            det3(s0, d0, s2, s1, d1, s3, s2, d2, s4) / det,
-            det3(s0, s1, d0, s1, s2, d1, s2, s3, d2) / det};
-    *inverse_kk = (s0 * s2 - s1 * s1) / det;
-    return true;
+  // How much of the fit at x is the sample at x itself (the hat matrix's diagonal).
+  double Leverage(double x) const {
+    const double v[3] = {1.0, x, x * x};
+    double h = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) h += v[i] * inverse[i][j] * v[j];
+    }
+    return h;
   }
 };
 
-// How far each kept sample lies from the parabola fitted to the other kept ones: a stray
-// sample cannot pull that fit towards itself, so it stands out even at a line's end.
-void DeletedResiduals(const std::vector<Point2d>& samples, const std::vector<char>& kept,
-                      const ParabolaSums& sums, std::vector<double>* residuals) {
-  residuals->assign(samples.size(), 0.0);
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (!kept[i]) continue;
-    ParabolaSums others = sums;
-    others.Add(samples[i], -1.0);
-    std::array<double, 3> fit{};
-    double unused = 0.0;
-    if (others.Solve(&fit, &unused)) (*residuals)[i] = samples[i].v - Parabola(fit, samples[i].u);
+struct SagittaSample {
+  double x = 0.0, d = 0.0;
+  bool kept = true;
+};
+
+// The parabola through the kept samples; false when they are fewer than 6 or do not
+// determine it.
+bool FitParabola(const std::vector<SagittaSample>& samples, Parabola* fit) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, d0 = 0, d1 = 0, d2 = 0;
+  for (const SagittaSample& sample : samples) {
+    if (!sample.kept) continue;
+    const double x = sample.x, d = sample.d, x2 = x * x;
+    s0 += 1.0, s1 += x, s2 += x2, s3 += x2 * x, s4 += x2 * x2;
+    d0 += d, d1 += x * d, d2 += x2 * d;
   }
+  if (s0 < 6.0) return false;
+  // The normal matrix [s0 s1 s2; s1 s2 s3; s2 s3 s4] is symmetric: its inverse is its
+  // cofactors over its determinant.
+  const double c00 = s2 * s4 - s3 * s3, c01 = s2 * s3 - s1 * s4, c02 = s1 * s3 - s2 * s2;
+  const double c11 = s0 * s4 - s2 * s2, c12 = s1 * s2 - s0 * s3, c22 = s0 * s2 - s1 * s1;
+  const double det = s0 * c00 + s1 * c01 + s2 * c02;
+  if (!(std::fabs(det) > 1e-12)) return false;
+  fit->inverse = {{{c00 / det, c01 / det, c02 / det},
+                   {c01 / det, c11 / det, c12 / det},
+                   {c02 / det, c12 / det, c22 / det}}};
+  for (int i = 0; i < 3; ++i) {
+    const auto& row = fit->inverse[static_cast<std::size_t>(i)];
+    fit->coefficients[static_cast<std::size_t>(i)] = row[0] * d0 + row[1] * d1 + row[2] * d2;
+  }
+  return true;
 }
 
 }  // namespace
@@ -136,63 +141,65 @@ double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points
     t_lo = std::min(ta, tb);
     t_hi = std::max(ta, tb);
   }
-  auto near = [&](const FramePoint& point) {
-    const double t = -point.p.u * s + point.p.v * c;
-    return t >= t_lo && t <= t_hi &&
-           std::fabs(point.p.u * c + point.p.v * s - line.rho_px) <= tolerance_px;
-  };
   // Only runs along one side of a border: one around a border's corner gives the midpoint of
   // its ends, off the stripe's centre line, a bend that is not the lens's.
-  auto counts = [&](const FramePoint& point) { return point.straight && near(point); };
-  // The points as (x, d): along the line, scaled to [-1, 1] over the stretch they cover, and
-  // their distance from it.
-  std::vector<Point2d> samples;
+  std::vector<SagittaSample> samples;
   double t_min = HUGE_VAL, t_max = -HUGE_VAL;
   for (const FramePoint& point : points) {
-    if (!counts(point)) continue;
+    if (!point.straight) continue;
     const double t = -point.p.u * s + point.p.v * c;
-    samples.push_back(Point2d{t, point.p.u * c + point.p.v * s - line.rho_px});
+    const double d = point.p.u * c + point.p.v * s - line.rho_px;
+    if (t < t_lo || t > t_hi || std::fabs(d) > tolerance_px) continue;
+    samples.push_back(SagittaSample{t, d, true});
     t_min = std::min(t_min, t);
     t_max = std::max(t_max, t);
   }
   if (samples.size() < 6 || !(t_max - t_min > 1.0)) return 0.0;
+  // Along the line, x in [-1, 1] over the stretch the points cover.
   const double middle = 0.5 * (t_min + t_max), half = 0.5 * (t_max - t_min);
-  for (Point2d& sample : samples) sample.u = (sample.u - middle) / half;
+  for (SagittaSample& sample : samples) sample.x = (sample.x - middle) / half;
+  Parabola fit;
+  if (!FitParabola(samples, &fit)) return 0.0;
   // A stray point (a run cut short by a mark or by the sheet's edge) bends a parabola through
-  // a dozen points by a pixel: up to three are left out, each the one farthest from the fit of
-  // the others when beyond four robust sigmas of all such distances (and a third of a pixel).
-  std::vector<char> kept(samples.size(), 1);
-  ParabolaSums sums;
-  for (const Point2d& sample : samples) sums.Add(sample, 1.0);
-  std::vector<double> residuals, magnitudes;
-  for (int round = 0; round < 3 && sums.s0 > 6.5; ++round) {
-    DeletedResiduals(samples, kept, sums, &residuals);
+  // a dozen points by a pixel. Up to three are left out, each the one farthest from the fit of
+  // the others (its residual over 1 - its leverage, so that it cannot pull that fit towards
+  // itself, even at a line's end) when beyond four robust sigmas of all such distances and a
+  // third of a pixel.
+  std::vector<double> magnitudes;
+  for (int round = 0; round < 3 && samples.size() - static_cast<std::size_t>(round) > 6; ++round) {
     magnitudes.clear();
-    std::size_t worst = 0;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      if (!kept[i]) continue;
-      magnitudes.push_back(std::fabs(residuals[i]));
-      if (std::fabs(residuals[i]) > std::fabs(residuals[worst]) || !kept[worst]) worst = i;
+    double worst_distance = 0.0;
+    SagittaSample* worst = nullptr;
+    for (SagittaSample& sample : samples) {
+      if (!sample.kept) continue;
+      const double free = 1.0 - fit.Leverage(sample.x);
+      const double distance = free > 1e-6 ? std::fabs(sample.d - fit.At(sample.x)) / free : 0.0;
+      magnitudes.push_back(distance);
+      if (distance > worst_distance) worst_distance = distance, worst = &sample;
     }
     auto median = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
     std::nth_element(magnitudes.begin(), median, magnitudes.end());
-    if (!(std::fabs(residuals[worst]) > std::max(4.0 * 1.4826 * *median, 1.0 / 3.0))) break;
-    kept[worst] = 0;
-    sums.Add(samples[worst], -1.0);
+    if (worst == nullptr || !(worst_distance > std::max(4.0 * 1.4826 * *median, 1.0 / 3.0))) break;
+    worst->kept = false;
+    Parabola refit;
+    if (!FitParabola(samples, &refit)) {
+      worst->kept = true;
+      break;
+    }
+    fit = refit;
   }
-  std::array<double, 3> fit{};  // d = fit[0] + fit[1] x + fit[2] x^2: fit[2] is the sagitta
-  double inverse_kk = 0.0;
-  if (!sums.Solve(&fit, &inverse_kk)) return 0.0;
-  double squares = 0.0;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const double r = samples[i].v - Parabola(fit, samples[i].u);
-    if (kept[i]) squares += r * r;
+  double squares = 0.0, kept = 0.0;
+  for (const SagittaSample& sample : samples) {
+    if (!sample.kept) continue;
+    const double r = sample.d - fit.At(sample.x);
+    squares += r * r;
+    kept += 1.0;
   }
-  const double k_error = std::sqrt(squares / (sums.s0 - 3.0) * inverse_kk);
+  const double k = fit.coefficients[2];
+  const double k_error = std::sqrt(squares / (kept - 3.0) * fit.inverse[2][2]);
   // The bend beyond what the points' own scatter allows: points bunched at the two ends of a
   // line (the borders of a scan near its ends) tell a curvature poorly.
-  const double beyond = std::max(0.0, std::fabs(fit[2]) - 1.0 * k_error);
-  return std::copysign(beyond, fit[2]);
+  return std::copysign(std::max(0.0, std::fabs(k) - k_error), k);
 }
 
 double StraightnessOfFour(const std::array<LineParams, 4>& lines,
