@@ -156,7 +156,9 @@ class TargetPoseTracker {
 
   /// The feature points within `tolerance_px` of lines 1-4 of the last frame, when it has a
   /// pose (else empty), in the detector's pixels (undistorted when it undistorts): the points
-  /// of four straight stripes, to tell a lens by (calibration/plumb_line.h).
+  /// of four straight stripes, to tell a lens by (calibration/plumb_line.h). Only runs along
+  /// one side of a border (one around a corner is off the centre line), between the stripe's
+  /// printed ends as the pose puts them (beyond, the line runs over the bench).
   std::array<std::vector<Point2d>, 4> StripePoints(double tolerance_px) const;
   /// The lines of the last scan that gave the frame's pose (or of the last scan), best first.
   const std::vector<DetectedLine>& lines() const { return lines_; }
