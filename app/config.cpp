@@ -454,6 +454,7 @@ const std::vector<Field<PoseOptions>>& PoseFields() {
       BoolField("correct_stripe_centres", &O::correct_stripe_centres),
       DoubleField("dementhon_above_px", &O::dementhon_above_px),
       DoubleField("previous_accept_px", &O::previous_accept_px),
+      DoubleField("homography_accept_px", &O::homography_accept_px),
       BoolField("compute_covariance", &O::compute_covariance),
       IntField("vvs_max_iterations", &O::vvs_max_iterations),
   };

@@ -6,7 +6,7 @@
 //    "pose_status":"ok","cMo":{"matrix":[[...],...],"t_m":[x,y,z],"thetau_rad":[tux,tuy,tuz]},
 //    "roll_deg":..,"pitch_deg":..,"yaw_deg":..,"line1_roll_deg":..,
 //    "plane_angles_deg":[a1,a2],"residual_px":..,"covariance":[[..6..],..6 rows..],
-//    "method":"lagrange","from_previous":false,
+//    "method":"homography","from_previous":false,
 //    "lines":[i1,i2,i3,i4],"coordinates":"image","corners_px":[[u,v],[u,v],[u,v],[u,v]],
 //    "scan":{"mode":"target","source":"middle-cell","borders":16,"candidates":1,
 //            "region":[[u,v],...]},

@@ -533,6 +533,8 @@ std::string ToString(PoseMethod method) {
       return "lagrange";
     case PoseMethod::kPrevious:
       return "previous";
+    case PoseMethod::kHomography:
+      return "homography";
   }
   return "unknown";
 }
@@ -578,6 +580,8 @@ void PoseOptions::Check() const {
                 dementhon_above_px, "0 <= dementhon_above_px <= 1000");
   RequireOption(InRange(previous_accept_px, 0.0, 1000.0), "PoseOptions::previous_accept_px",
                 previous_accept_px, "0 <= previous_accept_px <= 1000");
+  RequireOption(InRange(homography_accept_px, 0.0, 1000.0), "PoseOptions::homography_accept_px",
+                homography_accept_px, "0 <= homography_accept_px <= 1000");
   RequireOption(InRange(previous_max_deg, 0.0, 180.0), "PoseOptions::previous_max_deg",
                 previous_max_deg, "0 <= previous_max_deg <= 180");
   RequireOption(vvs_max_iterations >= 1 && vvs_max_iterations <= 1000,

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "servo/pose_internal.h"
+#include "servo/target_layout.h"
 
 namespace oal {
 namespace {
@@ -260,21 +261,58 @@ PoseResult Fail(PoseResult result, const std::string& message) {
   return result;
 }
 
-// In a loop the previous pose is a good seed: its refinement alone is kept when it fits well
-// (previous_accept_px), and the linear methods are skipped. Whether it was kept.
-bool KeepPreviousPose(const vpHomogeneousMatrix& previous_cMo, const Corners& corners,
-                      const HashTarget& hash, const PoseOptions& options, PoseResult* result,
-                      vpHomogeneousMatrix* cMo, double* residual_px) {
-  vpHomogeneousMatrix seeded = previous_cMo;
+// A pose seeded from elsewhere, refined on the corners (seen from the seed for the stripe-centre
+// shifts), is kept alone when it fits within `accept_px`, and the linear methods are skipped:
+// in a loop the previous pose, on a first frame the pose of the corners' homography. Whether
+// it was kept.
+bool KeepSeededPose(const vpHomogeneousMatrix& seed, PoseMethod method, double accept_px,
+                    const Corners& corners, const HashTarget& hash, const PoseOptions& options,
+                    PoseResult* result, vpHomogeneousMatrix* cMo, double* residual_px) {
+  vpHomogeneousMatrix seeded = seed;
   corners.Set(&seeded, result, nullptr);
   if (!RefineOnCorners(hash, result->corners_m, &seeded)) return false;
   const double seeded_px = ResidualPx(seeded, hash, result->corners_m, options.camera);
-  if (!(seeded_px < options.previous_accept_px)) return false;
+  if (!(seeded_px < accept_px)) return false;
   *cMo = seeded;
   *residual_px = seeded_px;
-  result->method = PoseMethod::kPrevious;
-  result->from_previous = true;
+  result->method = method;
+  result->from_previous = method == PoseMethod::kPrevious;
   return true;
+}
+
+// The plane pose whose homography H ~ [r1 r2 t] takes the target's four corners (board plane,
+// metres) onto the measured ones (normalised): four points fix it exactly, so it is as good a
+// start as vpPose's linear methods on the same four, at a fraction of their cost. Nullopt when
+// the corners are degenerate.
+std::optional<vpHomogeneousMatrix> HomographyPose(const HashTarget& hash,
+                                                  const std::array<vpColVector, 4>& corners_m) {
+  std::array<Point2d, 4> plane, image;
+  Point2d centre{0.0, 0.0};
+  for (int k = 0; k < 4; ++k) {
+    plane[k] = Point2d{hash.corner[k].x, hash.corner[k].y};
+    image[k] = Point2d{corners_m[k][0], corners_m[k][1]};
+    centre = Point2d{centre.u + 0.25 * plane[k].u, centre.v + 0.25 * plane[k].v};
+  }
+  const std::optional<vpHomography> found = FourPointHomography(plane, image, centre);
+  if (!found) return std::nullopt;
+  const vpHomography& h = *found;  // positive third coordinate inside: the plane in front
+  Eigen::Matrix3d columns;
+  for (int r = 0; r < 3; ++r) columns.row(r) << h[r][0], h[r][1], h[r][2];
+  const double scale = std::sqrt(columns.col(0).norm() * columns.col(1).norm());
+  if (!(scale > 0.0) || !std::isfinite(scale)) return std::nullopt;
+  columns /= scale;
+  Eigen::Matrix3d rotation;
+  rotation << columns.col(0), columns.col(1), columns.col(0).cross(columns.col(1));
+  // The nearest rotation (the homography of measured corners is not exactly a rigid one).
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(rotation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  rotation = svd.matrixU() * svd.matrixV().transpose();
+  if (rotation.determinant() < 0.0) return std::nullopt;
+  vpHomogeneousMatrix cMo;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) cMo[r][c] = rotation(r, c);
+    cMo[r][3] = columns(r, 2);
+  }
+  return cMo;
 }
 
 // Steps 3-4: Lagrange, and Dementhon unless Lagrange's residual is already below
@@ -398,10 +436,21 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
   pose.setVvsIterMax(options.vvs_max_iterations);
   vpHomogeneousMatrix cMo;
   double residual_px = HUGE_VAL;
-  const bool kept_previous =
-      have_previous && options.previous_accept_px > 0.0 &&
-      KeepPreviousPose(*previous_cMo, corners, hash, options, &result, &cMo, &residual_px);
-  if (!kept_previous) {
+  // The pose the refinement starts from when it is kept alone: the previous one, or the
+  // corners' homography's.
+  std::optional<vpHomogeneousMatrix> seed;
+  bool kept_seed = false;
+  if (have_previous && options.previous_accept_px > 0.0) {
+    seed = *previous_cMo;
+    kept_seed = KeepSeededPose(*seed, PoseMethod::kPrevious, options.previous_accept_px, corners,
+                               hash, options, &result, &cMo, &residual_px);
+  } else if (!have_previous && options.homography_accept_px > 0.0) {
+    corners.Set(nullptr, &result, nullptr);
+    seed = HomographyPose(hash, result.corners_m);
+    kept_seed = seed && KeepSeededPose(*seed, PoseMethod::kHomography, options.homography_accept_px,
+                                       corners, hash, options, &result, &cMo, &residual_px);
+  }
+  if (!kept_seed) {
     if (const std::optional<std::string> failure =
             LinearPoseRefined(have_previous ? &*previous_cMo : nullptr, corners, hash, options,
                               &pose, &result, &cMo, &residual_px)) {
@@ -411,8 +460,8 @@ PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget
   result.line1_roll_deg = Line1RollDeg(result, options.camera);
   vpMatrix covariance;
   if (options.compute_covariance && std::isfinite(residual_px)) {
-    // The previous-pose path refined without vpPose: give it the same corners.
-    if (result.method == PoseMethod::kPrevious) corners.Set(&*previous_cMo, &result, &pose);
+    // A kept seed was refined without vpPose: give it the same corners.
+    if (kept_seed) corners.Set(&*seed, &result, &pose);
     // From the converged pose the refinement stops after an iteration or two.
     pose.setCovarianceComputation(true);
     vpHomogeneousMatrix refined = cMo;

@@ -2,12 +2,14 @@
 //
 //   step 1  identify the detected lines as target lines 1-4          IdentifyTargetLines()
 //   step 2  roll from the orientation of line 1, over 0-360 deg      PoseResult::line1_roll_deg
-//   step 3  the four intersections -> vpPose (Dementhon, Lagrange,   EstimatePose()
-//           lower residual kept; corners corrected for the perspective
-//           shift of wide stripes' middles; refined by Gauss-Newton on
-//           the corners, virtual visual servoing's model and update on
-//           fixed-size matrices (vpPose's where that fails), also from
-//           the previous pose if given)
+//   step 3  the four intersections -> a pose: the previous one, or   EstimatePose()
+//           the corners' homography's, refined and kept alone when it
+//           fits; else vpPose (Dementhon, Lagrange, lower residual
+//           kept); corners corrected for the perspective shift of wide
+//           stripes' middles; refined by Gauss-Newton on the corners,
+//           virtual visual servoing's model and update on fixed-size
+//           matrices (vpPose's where that fails), also from the
+//           previous pose if given)
 //   step 4  the position; the paper's plane angles (Eq. 5) reported  PoseResult::plane_angle_deg
 //
 // Target. A LineTarget (target/line_target.h) whose lines 1 and 3 are parallel, lines 2 and 4 are
@@ -73,11 +75,12 @@ enum class PoseStatus {
 };
 
 /// Which pose was refined into the result: a linear method's (vpPose::DEMENTHON or LAGRANGE),
-/// or the previous pose alone (PoseOptions::previous_accept_px).
-enum class PoseMethod { kNone, kDementhon, kLagrange, kPrevious };
+/// the previous pose alone (PoseOptions::previous_accept_px), or, without one, the pose of the
+/// four corners' homography alone (PoseOptions::homography_accept_px).
+enum class PoseMethod { kNone, kDementhon, kLagrange, kPrevious, kHomography };
 
 /// The one place where these enums meet strings ("ok", "not-enough-lines",
-/// "not-identifiable", "degenerate"; "none", "dementhon", "lagrange", "previous").
+/// "not-identifiable", "degenerate"; "none", "dementhon", "lagrange", "previous", "homography").
 std::string ToString(PoseStatus status);
 std::string ToString(PoseMethod method);
 
@@ -141,6 +144,10 @@ struct PoseOptions {
   /// linear methods when its residual is below this, undistorted pixels (the usual case in a
   /// servo loop: ~3x faster). 0 always runs the linear methods too. Range [0, 1000].
   double previous_accept_px = 0.5;
+  /// Without a previous pose (a first frame): the pose of the four corners' homography,
+  /// refined, is kept without running vpPose's linear methods when its residual is below
+  /// this, undistorted pixels (~4x faster). 0 always runs the linear methods. Range [0, 1000].
+  double homography_accept_px = 0.5;
   /// Compute PoseResult::covariance (one more short refinement, ~8 us). Range: bool.
   bool compute_covariance = true;
   /// Iterations of vpPose's virtual visual servoing (the covariance's, and the refinement's

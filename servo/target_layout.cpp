@@ -25,40 +25,6 @@ double Cross(const Point2d& a, const Point2d& b) {
   return a.u * b.v - a.v * b.u;
 }
 
-// The homography taking four plane points exactly onto four image points, solved with
-// Eigen's LU on its eight unknowns, the ninth fixed by h(origin) having third coordinate 1
-// (`origin` lies inside the quadrilateral, so in front of the camera); nullopt when the
-// points are degenerate (three in a line). vpHomography::DLT's SVD, meant for many points,
-// cost more than the rest of a sheet candidate.
-std::optional<vpHomography> FourPointHomography(const std::array<Point2d, 4>& plane,
-                                                const std::array<Point2d, 4>& image,
-                                                const Point2d& origin) {
-  Eigen::Matrix<double, 8, 8> a;
-  Eigen::Matrix<double, 8, 1> b;
-  for (int k = 0; k < 4; ++k) {
-    const double X = plane[static_cast<std::size_t>(k)].u - origin.u;
-    const double Y = plane[static_cast<std::size_t>(k)].v - origin.v;
-    const double x = image[static_cast<std::size_t>(k)].u, y = image[static_cast<std::size_t>(k)].v;
-    a.row(2 * k) << X, Y, 1.0, 0.0, 0.0, 0.0, -x * X, -x * Y;
-    a.row(2 * k + 1) << 0.0, 0.0, 0.0, X, Y, 1.0, -y * X, -y * Y;
-    b(2 * k) = x;
-    b(2 * k + 1) = y;
-  }
-  const Eigen::FullPivLU<Eigen::Matrix<double, 8, 8>> lu(a);
-  if (!lu.isInvertible()) return std::nullopt;
-  const Eigen::Matrix<double, 8, 1> h = lu.solve(b);
-  if (!h.allFinite()) return std::nullopt;
-  // From the origin-centred plane coordinates back to the plane's: H · translate(-origin).
-  const double centred[3][3] = {{h(0), h(1), h(2)}, {h(3), h(4), h(5)}, {h(6), h(7), 1.0}};
-  vpHomography result;
-  for (int r = 0; r < 3; ++r) {
-    result[r][0] = centred[r][0];
-    result[r][1] = centred[r][1];
-    result[r][2] = centred[r][2] - centred[r][0] * origin.u - centred[r][1] * origin.v;
-  }
-  return result;
-}
-
 // Whether the four points turn the same way at every corner, enclosing more than a pixel.
 bool IsConvexQuadrilateral(const std::vector<Point2d>& q) {
   double first = 0.0;
@@ -119,6 +85,35 @@ Interval BetweenPair(const StripeSpan& s, const StripeSpan& t) {
 }
 
 }  // namespace
+
+std::optional<vpHomography> FourPointHomography(const std::array<Point2d, 4>& plane,
+                                                const std::array<Point2d, 4>& image,
+                                                const Point2d& origin) {
+  Eigen::Matrix<double, 8, 8> a;
+  Eigen::Matrix<double, 8, 1> b;
+  for (int k = 0; k < 4; ++k) {
+    const double X = plane[static_cast<std::size_t>(k)].u - origin.u;
+    const double Y = plane[static_cast<std::size_t>(k)].v - origin.v;
+    const double x = image[static_cast<std::size_t>(k)].u, y = image[static_cast<std::size_t>(k)].v;
+    a.row(2 * k) << X, Y, 1.0, 0.0, 0.0, 0.0, -x * X, -x * Y;
+    a.row(2 * k + 1) << 0.0, 0.0, 0.0, X, Y, 1.0, -y * X, -y * Y;
+    b(2 * k) = x;
+    b(2 * k + 1) = y;
+  }
+  const Eigen::FullPivLU<Eigen::Matrix<double, 8, 8>> lu(a);
+  if (!lu.isInvertible()) return std::nullopt;
+  const Eigen::Matrix<double, 8, 1> h = lu.solve(b);
+  if (!h.allFinite()) return std::nullopt;
+  // From the origin-centred plane coordinates back to the plane's: H · translate(-origin).
+  const double centred[3][3] = {{h(0), h(1), h(2)}, {h(3), h(4), h(5)}, {h(6), h(7), 1.0}};
+  vpHomography result;
+  for (int r = 0; r < 3; ++r) {
+    result[r][0] = centred[r][0];
+    result[r][1] = centred[r][1];
+    result[r][2] = centred[r][2] - centred[r][0] * origin.u - centred[r][1] * origin.v;
+  }
+  return result;
+}
 
 Point2d TargetLayout::ToPlane(double a, double b) const {
   return Point2d{origin.u + a * axis_a.u + b * axis_b.u, origin.v + a * axis_a.v + b * axis_b.v};

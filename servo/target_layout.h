@@ -74,6 +74,15 @@ struct TargetLayout {
 /// coordinates of a camera at cMo: H = [r1 r2 t].
 vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo);
 
+/// The homography taking four plane points exactly onto four image points, solved with
+/// Eigen's LU on its eight unknowns, the ninth fixed by h(origin) having third coordinate 1
+/// (`origin` lies inside the quadrilateral, so in front of the camera); nullopt when the
+/// points are degenerate (three in a line). vpHomography::DLT's SVD, meant for many points,
+/// costs more than the rest of a sheet candidate.
+std::optional<vpHomography> FourPointHomography(const std::array<Point2d, 4>& plane,
+                                                const std::array<Point2d, 4>& image,
+                                                const Point2d& origin);
+
 /// `count` borders (>= 2) from the outer to the inner rectangle, mapped through
 /// `plane_to_image` (to normalised coordinates) and `camera`'s lens into image pixels. A
 /// rectangle with a corner behind the camera, too far out, or whose image is not convex is

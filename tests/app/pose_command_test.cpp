@@ -75,7 +75,7 @@ void ExpectPoseNearTruth(const json& frame, const std::string& truth_path) {
     }
   }
   EXPECT_TRUE(frame.at("method") == "dementhon" || frame.at("method") == "lagrange" ||
-              frame.at("method") == "previous");
+              frame.at("method") == "previous" || frame.at("method") == "homography");
   EXPECT_TRUE(frame.at("from_previous").is_boolean());
   EXPECT_EQ(frame.at("lines").size(), 4u);
   for (const json& index : frame.at("lines")) EXPECT_GE(index.get<int>(), 0);

@@ -208,6 +208,7 @@ TEST(PoseStatus, ToString) {
   EXPECT_EQ(ToString(PoseStatus::kDegenerate), "degenerate");
   EXPECT_EQ(ToString(PoseMethod::kDementhon), "dementhon");
   EXPECT_EQ(ToString(PoseMethod::kLagrange), "lagrange");
+  EXPECT_EQ(ToString(PoseMethod::kHomography), "homography");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -652,6 +653,33 @@ TEST(EstimatePose, ThePreviousPosePathEndsWhereVpPoseEnds) {
     EXPECT_LT(between.getTranslationVector().frobeniusNorm(), 2e-5) << "pose " << pose;
     EXPECT_LT(RotationErrorDeg(alone.cMo, tracked.cMo), 0.01) << "pose " << pose;
     EXPECT_NEAR(tracked.residual_px, alone.residual_px, 0.01);
+  }
+}
+
+// A first pose starts from the four corners' homography and keeps its refinement alone: it
+// must end where vpPose's linear methods and refinement end (homography_accept_px 0).
+TEST(EstimatePose, TheHomographyPathEndsWhereTheLinearMethodsEnd) {
+  const RenderOptions render = SmallRender(false);
+  const SceneRenderer renderer(FourLineTarget(), render);
+  PoseOptions linear = OptionsFor(render);
+  linear.homography_accept_px = 0.0;
+  const PoseOptions options = OptionsFor(render);
+  std::mt19937 rng(17);
+  for (int pose = 0; pose < 8; ++pose) {
+    const vpHomogeneousMatrix cMo = PoseAt(0.4 + 0.06 * pose, 45.0 * pose, 35.0, 15.0 * pose);
+    const std::vector<DetectedLine> lines =
+        SyntheticLines(renderer.Truth(cMo), {0, 1, 2, 3}, render.camera, &rng);
+    const PoseResult by_linear = EstimatePose(lines, FourLineTarget(), linear);
+    ASSERT_EQ(by_linear.status, PoseStatus::kOk) << by_linear.message;
+    EXPECT_NE(by_linear.method, PoseMethod::kHomography);
+    const PoseResult first = EstimatePose(lines, FourLineTarget(), options);
+    ASSERT_EQ(first.status, PoseStatus::kOk) << first.message;
+    EXPECT_EQ(first.method, PoseMethod::kHomography) << "pose " << pose;
+    EXPECT_FALSE(first.from_previous);
+    const vpHomogeneousMatrix between = by_linear.cMo.inverse() * first.cMo;
+    EXPECT_LT(between.getTranslationVector().frobeniusNorm(), 2e-5) << "pose " << pose;
+    EXPECT_LT(RotationErrorDeg(by_linear.cMo, first.cMo), 0.01) << "pose " << pose;
+    EXPECT_EQ(first.covariance.getRows(), by_linear.covariance.getRows());
   }
 }
 
