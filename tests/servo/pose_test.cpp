@@ -15,6 +15,7 @@
 #include <iostream>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -628,59 +629,55 @@ TEST(EstimatePose, APreviousPoseKeepsLines1To4FromTurningOnABadWidth) {
 namespace oal {
 namespace {
 
-// The previous-pose path refines on the corners with its own fixed-size Gauss-Newton
-// (pose.cpp, RefineOnCorners): it must end where vpPose's virtual visual servoing ends, up to
-// the stripe-centre shifts, which it takes from the previous pose instead of the linear one
-// (micrometres; the pose's accuracy is a tenth of a millimetre).
-TEST(EstimatePose, ThePreviousPosePathEndsWhereVpPoseEnds) {
-  const RenderOptions render = SmallRender(false);
-  const SceneRenderer renderer(FourLineTarget(), render);
-  const PoseOptions options = OptionsFor(render);
-  std::mt19937 rng(13);
-  for (int pose = 0; pose < 8; ++pose) {
-    const vpHomogeneousMatrix cMo = PoseAt(0.45 + 0.05 * pose, 45.0 * pose, 25.0, 10.0 * pose);
-    const std::vector<DetectedLine> lines =
-        SyntheticLines(renderer.Truth(cMo), {0, 1, 2, 3}, render.camera, &rng);
-    const PoseResult alone = EstimatePose(lines, FourLineTarget(), options);
-    ASSERT_EQ(alone.status, PoseStatus::kOk) << alone.message;
-    // A previous pose 5 mm and 1 deg away, as in a loop.
-    const vpHomogeneousMatrix previous =
-        vpHomogeneousMatrix(0.005, 0.0, 0.0, 0.0, 0.017, 0.0) * cMo;
-    const PoseResult tracked = EstimatePose(lines, FourLineTarget(), options, previous);
-    ASSERT_EQ(tracked.status, PoseStatus::kOk) << tracked.message;
-    EXPECT_EQ(tracked.method, PoseMethod::kPrevious) << "pose " << pose;
-    const vpHomogeneousMatrix between = alone.cMo.inverse() * tracked.cMo;
-    EXPECT_LT(between.getTranslationVector().frobeniusNorm(), 2e-5) << "pose " << pose;
-    EXPECT_LT(RotationErrorDeg(alone.cMo, tracked.cMo), 0.01) << "pose " << pose;
-    EXPECT_NEAR(tracked.residual_px, alone.residual_px, 0.01);
-  }
+// Two poses of the same lines: within 20 micrometres and 0.01 deg of each other (the pose's
+// accuracy is a tenth of a millimetre), the residuals alike.
+void ExpectSamePose(const PoseResult& reference, const PoseResult& other, int pose) {
+  const vpHomogeneousMatrix between = reference.cMo.inverse() * other.cMo;
+  EXPECT_LT(between.getTranslationVector().frobeniusNorm(), 2e-5) << "pose " << pose;
+  EXPECT_LT(RotationErrorDeg(reference.cMo, other.cMo), 0.01) << "pose " << pose;
+  EXPECT_NEAR(other.residual_px, reference.residual_px, 0.01) << "pose " << pose;
 }
 
-// A first pose starts from the four corners' homography and keeps its refinement alone: it
-// must end where vpPose's linear methods and refinement end (homography_accept_px 0).
-TEST(EstimatePose, TheHomographyPathEndsWhereTheLinearMethodsEnd) {
+// The pose of eight views' lines by vpPose's linear methods and virtual visual servoing
+// (homography_accept_px 0), and by `options` given the previous pose `offset` away from the
+// true one (none: the first frame's path).
+void ComparePaths(const PoseOptions& options, const std::optional<vpHomogeneousMatrix>& offset,
+                  PoseMethod expected, unsigned seed) {
   const RenderOptions render = SmallRender(false);
   const SceneRenderer renderer(FourLineTarget(), render);
-  PoseOptions linear = OptionsFor(render);
+  PoseOptions linear = options;
   linear.homography_accept_px = 0.0;
-  const PoseOptions options = OptionsFor(render);
-  std::mt19937 rng(17);
+  std::mt19937 rng(seed);
   for (int pose = 0; pose < 8; ++pose) {
-    const vpHomogeneousMatrix cMo = PoseAt(0.4 + 0.06 * pose, 45.0 * pose, 35.0, 15.0 * pose);
+    const vpHomogeneousMatrix cMo = PoseAt(0.4 + 0.06 * pose, 45.0 * pose, 30.0, 12.0 * pose);
     const std::vector<DetectedLine> lines =
         SyntheticLines(renderer.Truth(cMo), {0, 1, 2, 3}, render.camera, &rng);
     const PoseResult by_linear = EstimatePose(lines, FourLineTarget(), linear);
     ASSERT_EQ(by_linear.status, PoseStatus::kOk) << by_linear.message;
     EXPECT_NE(by_linear.method, PoseMethod::kHomography);
-    const PoseResult first = EstimatePose(lines, FourLineTarget(), options);
-    ASSERT_EQ(first.status, PoseStatus::kOk) << first.message;
-    EXPECT_EQ(first.method, PoseMethod::kHomography) << "pose " << pose;
-    EXPECT_FALSE(first.from_previous);
-    const vpHomogeneousMatrix between = by_linear.cMo.inverse() * first.cMo;
-    EXPECT_LT(between.getTranslationVector().frobeniusNorm(), 2e-5) << "pose " << pose;
-    EXPECT_LT(RotationErrorDeg(by_linear.cMo, first.cMo), 0.01) << "pose " << pose;
-    EXPECT_EQ(first.covariance.getRows(), by_linear.covariance.getRows());
+    const std::optional<vpHomogeneousMatrix> previous =
+        offset ? std::optional<vpHomogeneousMatrix>(*offset * cMo) : std::nullopt;
+    const PoseResult result = EstimatePose(lines, FourLineTarget(), options, previous);
+    ASSERT_EQ(result.status, PoseStatus::kOk) << result.message;
+    EXPECT_EQ(result.method, expected) << "pose " << pose;
+    EXPECT_EQ(result.from_previous, expected == PoseMethod::kPrevious);
+    ExpectSamePose(by_linear, result, pose);
   }
+}
+
+// The previous-pose path refines on the corners with its own fixed-size Gauss-Newton
+// (pose.cpp, RefineOnCorners): it must end where vpPose's virtual visual servoing ends, up to
+// the stripe-centre shifts, which it takes from the previous pose instead of the linear one.
+TEST(EstimatePose, ThePreviousPosePathEndsWhereVpPoseEnds) {
+  // A previous pose 5 mm and 1 deg away, as in a loop.
+  ComparePaths(OptionsFor(SmallRender(false)),
+               vpHomogeneousMatrix(0.005, 0.0, 0.0, 0.0, 0.017, 0.0), PoseMethod::kPrevious, 13);
+}
+
+// A first pose starts from the four corners' homography and keeps its refinement alone: it
+// must end where vpPose's linear methods and refinement end.
+TEST(EstimatePose, TheHomographyPathEndsWhereTheLinearMethodsEnd) {
+  ComparePaths(OptionsFor(SmallRender(false)), std::nullopt, PoseMethod::kHomography, 17);
 }
 
 }  // namespace
