@@ -148,7 +148,9 @@ struct PoseOptions {
   /// refined, is kept without running vpPose's linear methods when its residual is below
   /// this, undistorted pixels (~4x faster). 0 always runs the linear methods. Range [0, 1000].
   double homography_accept_px = 0.5;
-  /// Compute PoseResult::covariance (one more short refinement, ~8 us). Range: bool.
+  /// Compute PoseResult::covariance (vpPose's virtual visual servoing once more, with ViSP's
+  /// dynamic matrices: ~170 us a frame on the CI machine, three times the rest of the pose;
+  /// the servo loop and the benchmarks run without it). Range: bool.
   bool compute_covariance = true;
   /// Iterations of vpPose's virtual visual servoing (the covariance's, and the refinement's
   /// where the fixed-size one fails). Range [1, 1000].
