@@ -134,26 +134,14 @@ bool FitParabola(const std::vector<SagittaSample>& samples, Parabola* fit) {
 
 double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
                    double tolerance_px, const std::optional<LineExtent>& extent) {
-  const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
-  double t_lo = -HUGE_VAL, t_hi = HUGE_VAL;
-  if (extent) {
-    const double ta = -extent->a.u * s + extent->a.v * c, tb = -extent->b.u * s + extent->b.v * c;
-    t_lo = std::min(ta, tb);
-    t_hi = std::max(ta, tb);
-  }
-  // Only runs along one side of a border: one around a border's corner gives the midpoint of
-  // its ends, off the stripe's centre line, a bend that is not the lens's.
   std::vector<SagittaSample> samples;
   double t_min = HUGE_VAL, t_max = -HUGE_VAL;
-  for (const FramePoint& point : points) {
-    if (!point.straight) continue;
-    const double t = -point.p.u * s + point.p.v * c;
-    const double d = point.p.u * c + point.p.v * s - line.rho_px;
-    if (t < t_lo || t > t_hi || std::fabs(d) > tolerance_px) continue;
-    samples.push_back(SagittaSample{t, d, true});
-    t_min = std::min(t_min, t);
-    t_max = std::max(t_max, t);
-  }
+  ForEachPointOnStretch(line, points, tolerance_px, extent,
+                        [&](const FramePoint&, double t, double d) {
+                          samples.push_back(SagittaSample{t, d, true});
+                          t_min = std::min(t_min, t);
+                          t_max = std::max(t_max, t);
+                        });
   if (samples.size() < 6 || !(t_max - t_min > 1.0)) return 0.0;
   // Along the line, x in [-1, 1] over the stretch the points cover.
   const double middle = 0.5 * (t_min + t_max), half = 0.5 * (t_max - t_min);

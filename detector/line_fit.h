@@ -2,6 +2,7 @@
 // by total least squares, and score it by how many of those points lie on it.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -57,17 +58,39 @@ struct LineExtent {
   Point2d a, b;
 };
 
+/// Calls visit(point, t, d) for each feature point of a straight stretch of `line`: within
+/// `tolerance_px` of it, its run along one side of a border (a run around a corner gives the
+/// midpoint of its ends, off the centre line), and, given an `extent`, its foot on it (a
+/// stripe's line runs on past its ink, over whatever lies there). t is the foot's coordinate
+/// along the line (direction (-sin, cos) of theta), d the point's signed distance from it.
+template <typename Visit>
+void ForEachPointOnStretch(const LineParams& line, const std::vector<FramePoint>& points,
+                           double tolerance_px, const std::optional<LineExtent>& extent,
+                           Visit visit) {
+  const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
+  double t_lo = -HUGE_VAL, t_hi = HUGE_VAL;
+  if (extent) {
+    const double ta = -extent->a.u * s + extent->a.v * c, tb = -extent->b.u * s + extent->b.v * c;
+    t_lo = std::min(ta, tb);
+    t_hi = std::max(ta, tb);
+  }
+  for (const FramePoint& point : points) {
+    if (!point.straight) continue;
+    const double t = -point.p.u * s + point.p.v * c;
+    const double d = point.p.u * c + point.p.v * s - line.rho_px;
+    if (t < t_lo || t > t_hi || std::fabs(d) > tolerance_px) continue;
+    visit(point, t, d);
+  }
+}
+
 /// How far a line bends beyond what its points' scatter can tell, pixels, signed (positive
 /// towards the line's normal): the sagitta of the parabola fitted to the distances from `line`
 /// of its feature points over the stretch they cover, less one standard error of that sagitta
-/// (0 when the error is larger). The points are those within `tolerance_px` of the line whose
-/// run lay along one side of a border (a run around a corner gives the midpoint of its ends,
-/// off the centre line), and with an `extent` only those whose feet lie on it (a stripe's line
-/// runs on past its ink, over whatever lies there); up to three stray ones (a run cut short by
-/// a mark or an edge) are left out. The parabola averages the points' noise out, where their
-/// RMS distance would add it in, and its error grows where the points bunch at the two ends of
-/// the line: a straight stripe seen through a lens the camera model misses shows as a bend, a
-/// short or sparsely seen one as none. 0 with fewer than 6 points.
+/// (0 when the error is larger). The points are ForEachPointOnStretch's; up to three stray
+/// ones (a run cut short by a mark or an edge) are left out. The parabola averages the points'
+/// noise out, where their RMS distance would add it in, and its error grows where the points bunch
+/// at the two ends of the line: a straight stripe seen through a lens the camera model misses shows
+/// as a bend, a short or sparsely seen one as none. 0 with fewer than 6 points.
 double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
                    double tolerance_px, const std::optional<LineExtent>& extent = std::nullopt);
 

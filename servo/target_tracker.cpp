@@ -114,21 +114,9 @@ std::array<std::vector<Point2d>, 4> TargetPoseTracker::StripePoints(double toler
   const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(PlaneToImage(frame_.pose.cMo));
   for (std::size_t k = 0; k < 4; ++k) {
     const LineParams& line = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
-    const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
-    double t_lo = -HUGE_VAL, t_hi = HUGE_VAL;
-    if (ends[k]) {
-      const double ta = -ends[k]->a.u * s + ends[k]->a.v * c,
-                   tb = -ends[k]->b.u * s + ends[k]->b.v * c;
-      t_lo = std::min(ta, tb);
-      t_hi = std::max(ta, tb);
-    }
-    for (const FramePoint& point : detector_.feature_points()) {
-      const double t = -point.p.u * s + point.p.v * c;
-      if (point.straight && t >= t_lo && t <= t_hi &&
-          std::fabs(point.p.u * c + point.p.v * s - line.rho_px) <= tolerance_px) {
-        stripes[k].push_back(point.p);
-      }
-    }
+    ForEachPointOnStretch(
+        line, detector_.feature_points(), tolerance_px, ends[k],
+        [&](const FramePoint& point, double, double) { stripes[k].push_back(point.p); });
   }
   return stripes;
 }

@@ -183,10 +183,10 @@ class TargetPoseTracker {
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.
   bool AttemptCandidate(const GrayImageView& image, const vpHomography& plane_to_image);
-  /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
-  /// Each stripe's centre line from end to end in the detector's coordinates; nothing for a
-  /// stripe with an end behind the camera.
+  /// Each stripe's centre line from end to end where `plane_to_image` puts it, in the
+  /// detector's coordinates; nothing for a stripe with an end behind the camera.
   std::array<std::optional<LineExtent>, 4> StripeEnds(const vpHomography& plane_to_image) const;
+  /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
   std::vector<LineSeed> SeedsFrom(const vpHomography& plane_to_image) const;
   /// The model check and the jump check on an estimated pose: the frame's status.
   void Accept(bool predicted);
