@@ -149,6 +149,10 @@ TEST(Config, OutOfRangeValueNamesFileLineAndField) {
               HasSubstr("cfg.yaml:3: 'tracking.quick_max_identification_cost' is invalid"));
   EXPECT_THAT(ErrorOf("tracking:\n  quick_max_identification_cost: cheap\n"),
               HasSubstr("cfg.yaml:2: 'tracking.quick_max_identification_cost' must be a number"));
+  EXPECT_THAT(ErrorOf("pose:\n  previous_accept_px: 0.5\n  homography_accept_px: -0.5\n"),
+              HasSubstr("cfg.yaml:3: 'pose.homography_accept_px' is invalid"));
+  EXPECT_THAT(ErrorOf("pose:\n  homography_accept_px: [0.5]\n"),
+              HasSubstr("cfg.yaml:2: 'pose.homography_accept_px' must be a number"));
   const std::string above_default_max = std::to_string(DetectorOptions().max_width_px + 1.0);
   EXPECT_THAT(ErrorOf("detector:\n  min_width_px: " + above_default_max + "\n"),
               HasSubstr("cfg.yaml: section 'detector' is invalid: detector.max_width_px = "));
