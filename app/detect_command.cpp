@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -47,16 +48,27 @@ std::optional<CameraFile> LoadCamera(const DetectCommandOptions& options) {
   return LoadCameraFile(options.camera_path, options.camera_name);
 }
 
-// StraightnessOfFour of the four strongest lines, as `pose` measures lines 1-4; empty with
-// fewer than four lines. Not a lens check by itself: detect knows no target, and among the
-// strongest lines of a cluttered scene some are not straight edges (a line of text, points of
-// two objects); pose, evaluate and servo check the lens on the target's lines 1-4.
-std::optional<double> Straightness(const std::vector<DetectedLine>& lines,
-                                   const OalDetector& detector) {
+// How much the four strongest lines bend after the camera's correction, as `pose` measures
+// lines 1-4 (RadialBend::bend_px); empty with fewer than four lines. Without a camera file the
+// principal point is taken at the image's centre and the focal length as its width (the bend
+// does not depend on the focal length). Not a lens check by itself: detect knows no target,
+// and among the strongest lines of a cluttered scene some are not straight edges (a line of
+// text, points of two objects); pose, evaluate and servo check the lens on the target's lines.
+std::optional<double> Straightness(const std::vector<DetectedLine>& lines, const DetectRun& run,
+                                   const Frame& frame) {
   if (lines.size() < 4) return std::nullopt;
-  return StraightnessOfFour({lines[0].line, lines[1].line, lines[2].line, lines[3].line},
-                            detector.feature_points(),
-                            2.0 * detector.options().support_tolerance_px);
+  Point2d principal_point{0.5 * (frame.gray.cols - 1), 0.5 * (frame.gray.rows - 1)};
+  double focal_px = frame.gray.cols;
+  if (run.camera) {
+    const vpCameraParameters& camera = run.camera->camera;
+    principal_point = Point2d{camera.get_u0(), camera.get_v0()};
+    focal_px = std::sqrt(camera.get_px() * camera.get_py());
+  }
+  return RadialBendOfFour({lines[0].line, lines[1].line, lines[2].line, lines[3].line},
+                          run.detector.feature_points(),
+                          2.0 * run.detector.options().support_tolerance_px, {}, principal_point,
+                          focal_px)
+      .bend_px;
 }
 
 Json FrameJson(int index, const Frame& frame, double time_us, bool undistorted,
@@ -95,7 +107,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
       const std::vector<DetectedLine>& lines = run->detector.Detect(frame.view());
       const auto stop = std::chrono::steady_clock::now();
       const double time_us = std::chrono::duration<double, std::micro>(stop - start).count();
-      const std::optional<double> straightness = Straightness(lines, run->detector);
+      const std::optional<double> straightness = Straightness(lines, *run, frame);
       if (straightness) summary->straightness_px.push_back(*straightness);
       WriteJsonLine(sink,
                     FrameJson(summary->frames, frame, time_us, undistorted, lines, straightness),

@@ -73,6 +73,16 @@ AppConfig LoadPoseConfig(const PoseCommandOptions& options, PoseSummary* summary
   return config;
 }
 
+// What lines 1-4 tell of the camera file's kdu: null without a pose or when they cannot tell
+// (all near the principal point, too few points).
+Json LensJson(const TargetFrame& result) {
+  if (result.status != TargetStatus::kOk || !std::isfinite(result.lens.kdu_error_sd)) return Json();
+  return Json{{"kdu_error", result.lens.kdu_error},
+              {"kdu_error_sd", result.lens.kdu_error_sd},
+              {"lines", result.lens.lines},
+              {"contradicts_camera", ContradictsLens(result.lens)}};
+}
+
 Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFrame& result,
                ScanMode mode) {
   const PoseResult& pose = result.pose;
@@ -121,7 +131,8 @@ Json FrameJson(int index, const Frame& frame, bool undistorted, const TargetFram
       {"scan", ScanJson(result, mode)},
       {"stripe_agreement",
        result.pose.status == PoseStatus::kOk ? Json(result.agreement.Worst()) : Json()},
-      {"straightness_px", if_ok(result.straightness_px)},
+      {"straightness_px", if_ok(result.lens.bend_px)},
+      {"lens", LensJson(result)},
       {"time_us",
        Json{{"find", result.find_us}, {"detect", result.detect_us}, {"pose", result.pose_us}}},
   };
@@ -249,7 +260,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
     }
     if (result.status == TargetStatus::kOk) {
       ++summary->ok;
-      summary->straightness_px.push_back(result.straightness_px);
+      summary->lens.push_back(result.lens);
     }
     ++summary->frames;
   }
@@ -287,7 +298,7 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
-  const LensCheck lens = CheckLens(summary.straightness_px);
+  const LensCheck lens = CheckLens(summary.lens);
   if (lens.mismatch) {
     summary.warnings.push_back(LensMismatchWarning(
         lens, "'" + summary.camera_path + "'",

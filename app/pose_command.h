@@ -10,7 +10,9 @@
 //    "lines":[i1,i2,i3,i4],"coordinates":"image","corners_px":[[u,v],[u,v],[u,v],[u,v]],
 //    "scan":{"mode":"target","source":"middle-cell","borders":16,"candidates":1,
 //            "region":[[u,v],...]},
-//    "stripe_agreement":..,"time_us":{"find":..,"detect":..,"pose":..}}
+//    "stripe_agreement":..,"straightness_px":..,
+//    "lens":{"kdu_error":..,"kdu_error_sd":..,"lines":4,"contradicts_camera":false},
+//    "time_us":{"find":..,"detect":..,"pose":..}}
 //
 // status is TargetStatus's ToString() ("ok", "not-found", "model-mismatch", "jump") and
 // message its reason ("" when ok); pose_status is the last estimate's PoseStatus ("ok",
@@ -23,7 +25,12 @@
 // (ScanJson, io/json_io.h: mode "target" or "image"; source "prior", "middle-cell", "image"
 // or "none"; region the outermost border scanned, empty for the whole image);
 // stripe_agreement is the model check's worst fraction over lines 1-4 (null when no pose was
-// estimated).
+// estimated). straightness_px and lens are the lens check (TargetFrame::lens): how far lines
+// 1-4 still bend after the camera file's correction, and the camera's kdu less the lens's that
+// the bend shows, with its standard deviation, the lines that told it and whether the frame
+// contradicts the camera file (ContradictsLens); null unless ok, lens also when the lines
+// cannot tell (all near the principal point). Over the run, most frames contradicting the
+// file gives a warning.
 //
 // The pose needs the camera's intrinsics: --camera FILE, or, without it, the camera.xml that
 // `oalservo render` writes next to the frames (the directory of the first input), which is
@@ -39,6 +46,7 @@
 #include <vector>
 
 #include "app/frame_command.h"
+#include "detector/line_fit.h"
 
 namespace oal {
 
@@ -76,8 +84,8 @@ struct PoseSummary {
   std::vector<std::string> notes;
   /// kdu told from the stripes (--estimate-distortion), when it was.
   std::optional<double> estimated_kdu;
-  /// TargetFrame::straightness_px of the frames with a pose, in order.
-  std::vector<double> straightness_px;
+  /// TargetFrame::lens of the frames with a pose, in order.
+  std::vector<RadialBend> lens;
 };
 
 /// Estimates the pose in every frame of every input. Output goes to options.out_path

@@ -78,6 +78,10 @@ SupportStats MeasureSupport(const LineParams& line, const std::vector<FramePoint
 
 namespace {
 
+// How far a feature point's position may be off the stripe's centre line in a way that does
+// not average out over the neighbouring points, pixels.
+constexpr double kPointBiasPx = 0.05;
+
 // The least-squares parabola d = a + b x + k x^2 through samples (x, d): its coefficients and
 // the inverse of its normal matrix (for the leverage of a sample and the error of k).
 struct Parabola {
@@ -132,8 +136,9 @@ bool FitParabola(const std::vector<SagittaSample>& samples, Parabola* fit) {
 
 }  // namespace
 
-double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
-                   double tolerance_px, const std::optional<LineExtent>& extent) {
+LineBend FitLineBend(const LineParams& line, const std::vector<FramePoint>& points,
+                     double tolerance_px, const std::optional<LineExtent>& extent) {
+  LineBend bend;
   std::vector<SagittaSample> samples;
   double t_min = HUGE_VAL, t_max = -HUGE_VAL;
   ForEachPointOnStretch(line, points, tolerance_px, extent,
@@ -142,12 +147,13 @@ double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points
                           t_min = std::min(t_min, t);
                           t_max = std::max(t_max, t);
                         });
-  if (samples.size() < 6 || !(t_max - t_min > 1.0)) return 0.0;
+  if (samples.size() < 6 || !(t_max - t_min > 1.0)) return bend;
   // Along the line, x in [-1, 1] over the stretch the points cover.
-  const double middle = 0.5 * (t_min + t_max), half = 0.5 * (t_max - t_min);
-  for (SagittaSample& sample : samples) sample.x = (sample.x - middle) / half;
+  bend.middle = 0.5 * (t_min + t_max);
+  bend.half = 0.5 * (t_max - t_min);
+  for (SagittaSample& sample : samples) sample.x = (sample.x - bend.middle) / bend.half;
   Parabola fit;
-  if (!FitParabola(samples, &fit)) return 0.0;
+  if (!FitParabola(samples, &fit)) return bend;
   // A stray point (a run cut short by a mark or by the sheet's edge) bends a parabola through
   // a dozen points by a pixel. Up to three are left out, each the one farthest from the fit of
   // the others (its residual over 1 - its leverage, so that it cannot pull that fit towards
@@ -183,22 +189,84 @@ double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points
     squares += r * r;
     kept += 1.0;
   }
-  const double k = fit.coefficients[2];
-  const double k_error = std::sqrt(squares / (kept - 3.0) * fit.inverse[2][2]);
-  // The bend beyond what the points' own scatter allows: points bunched at the two ends of a
-  // line (the borders of a scan near its ends) tell a curvature poorly.
-  return std::copysign(std::max(0.0, std::fabs(k) - k_error), k);
+  bend.k_px = fit.coefficients[2];
+  // The points' scatter about the parabola, and a bias that does not scatter: a run's midpoint
+  // lies a few hundredths of a pixel off the centre line where blur, a crossing stripe or the
+  // printed end weighs on both its ends alike, the same on neighbouring borders. Where the
+  // points bunch at the line's two ends, such a bias alone can fake a bend.
+  const double scatter = squares / (kept - 3.0) + kPointBiasPx * kPointBiasPx;
+  bend.k_error_px = std::sqrt(scatter * fit.inverse[2][2]);
+  bend.points = static_cast<int>(kept);
+  return bend;
 }
 
-double StraightnessOfFour(const std::array<LineParams, 4>& lines,
-                          const std::vector<FramePoint>& points, double tolerance_px,
-                          const std::array<std::optional<LineExtent>, 4>& extents) {
-  std::array<double, 4> bends{};
-  for (std::size_t k = 0; k < bends.size(); ++k) {
-    bends[k] = std::fabs(LineSagitta(lines[k], points, tolerance_px, extents[k]));
+namespace {
+
+// One line's measurement of a radial lens error e: its bend k = e g, with g = rho h^2 / f^2.
+struct RadialSample {
+  double g = 0.0, k = 0.0, k_error = 0.0;
+  bool used = true;
+};
+
+// The weighted least-squares e of the used samples and its standard deviation.
+void CombineRadial(const std::vector<RadialSample>& samples, RadialBend* out) {
+  double sgg = 0.0, sgk = 0.0;
+  out->lines = 0;
+  for (const RadialSample& sample : samples) {
+    if (!sample.used) continue;
+    const double w = 1.0 / (sample.k_error * sample.k_error);
+    sgg += w * sample.g * sample.g;
+    sgk += w * sample.g * sample.k;
+    ++out->lines;
   }
-  std::sort(bends.begin(), bends.end());
-  return bends[2];
+  // A standard deviation of one in kdu (lines through the principal point, or too short to
+  // bend) says nothing about a lens.
+  if (!(sgg >= 1.0)) {
+    *out = RadialBend{};
+    return;
+  }
+  out->kdu_error = sgk / sgg;
+  out->kdu_error_sd = 1.0 / std::sqrt(sgg);
+}
+
+}  // namespace
+
+RadialBend RadialBendOfFour(const std::array<LineParams, 4>& lines,
+                            const std::vector<FramePoint>& points, double tolerance_px,
+                            const std::array<std::optional<LineExtent>, 4>& extents,
+                            const Point2d& principal_point, double focal_px) {
+  std::vector<RadialSample> samples;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const LineBend bend = FitLineBend(lines[i], points, tolerance_px, extents[i]);
+    if (!bend.Tells()) continue;
+    const double c = std::cos(lines[i].theta_rad), s = std::sin(lines[i].theta_rad);
+    // The line's signed distance from the principal point, along its normal.
+    const double rho = lines[i].rho_px - (principal_point.u * c + principal_point.v * s);
+    const double g = rho * bend.half * bend.half / (focal_px * focal_px);
+    samples.push_back(RadialSample{g, bend.k_px, bend.k_error_px});
+  }
+  RadialBend result;
+  CombineRadial(samples, &result);
+  if (result.lines >= 3) {
+    // A line whose bend the others do not share by more than three of its errors is a mark
+    // beside a stripe or a run cut short, not a lens: the most discordant one is left out.
+    RadialSample* worst = nullptr;
+    double worst_z = 3.0;
+    for (RadialSample& sample : samples) {
+      const double z = std::fabs(sample.k - result.kdu_error * sample.g) / sample.k_error;
+      if (z > worst_z) worst_z = z, worst = &sample;
+    }
+    if (worst != nullptr) {
+      worst->used = false;
+      CombineRadial(samples, &result);
+    }
+  }
+  if (result.lines == 0) return result;
+  const double beyond_doubt = std::max(0.0, std::fabs(result.kdu_error) - result.kdu_error_sd);
+  for (const RadialSample& sample : samples) {
+    if (sample.used) result.bend_px = std::max(result.bend_px, beyond_doubt * std::fabs(sample.g));
+  }
+  return result;
 }
 
 }  // namespace oal

@@ -83,24 +83,43 @@ void ForEachPointOnStretch(const LineParams& line, const std::vector<FramePoint>
   }
 }
 
-/// How far a line bends beyond what its points' scatter can tell, pixels, signed (positive
-/// towards the line's normal): the sagitta of the parabola fitted to the distances from `line`
-/// of its feature points over the stretch they cover, less one standard error of that sagitta
-/// (0 when the error is larger). The points are ForEachPointOnStretch's; up to three stray
-/// ones (a run cut short by a mark or an edge) are left out. The parabola averages the points'
-/// noise out, where their RMS distance would add it in, and its error grows where the points bunch
-/// at the two ends of the line: a straight stripe seen through a lens the camera model misses shows
-/// as a bend, a short or sparsely seen one as none. 0 with fewer than 6 points.
-double LineSagitta(const LineParams& line, const std::vector<FramePoint>& points,
-                   double tolerance_px, const std::optional<LineExtent>& extent = std::nullopt);
+/// A line's bend: the parabola d = a + b x + k x^2 fitted to the distances d from `line` of its
+/// feature points (ForEachPointOnStretch's, up to three stray ones left out: a run cut short by
+/// a mark or an edge), x in [-1, 1] over the stretch t in [middle - half, middle + half] that
+/// they cover. The parabola averages the points' noise out, where their RMS distance would add
+/// it in, and its error grows where the points bunch at the two ends of the line.
+struct LineBend {
+  double k_px = 0.0;  ///< the bend, signed (positive towards the line's normal)
+  /// Its standard error from the points' scatter about the parabola; infinite when they
+  /// cannot tell a bend (fewer than 6, or a stretch under a pixel).
+  double k_error_px = HUGE_VAL;
+  double middle = 0.0, half = 0.0;  ///< the stretch, along the line's direction (-sin, cos)
+  int points = 0;                   ///< kept
 
-/// How straight four lines are, pixels: the second largest of their bends (|LineSagitta|). A
-/// lens the camera model misses bends every line that does not pass through the principal
-/// point, and a '#' has two on either side of it; one bent line alone is a stray point near it
-/// (a printed mark, the sheet's edge).
-/// `extents`: where each line is known to lie (a printed stripe's ends), or nothing.
-double StraightnessOfFour(const std::array<LineParams, 4>& lines,
-                          const std::vector<FramePoint>& points, double tolerance_px,
-                          const std::array<std::optional<LineExtent>, 4>& extents = {});
+  bool Tells() const { return std::isfinite(k_error_px); }
+};
+LineBend FitLineBend(const LineParams& line, const std::vector<FramePoint>& points,
+                     double tolerance_px, const std::optional<LineExtent>& extent = std::nullopt);
+
+/// The radial lens error that four straight lines show, and the bend it puts on them. A camera
+/// model whose kdu (ViSP's distorted-to-ideal term, x_u = x_d (1 + kdu r^2)) is off by e leaves
+/// each corrected point moved by about e r^2 from the principal point: a line at distance rho
+/// from it, seen over a stretch of half-length h, bends by k = e rho h^2 / f^2 pixels (f the
+/// focal length, pixels), all lines the same way (outwards for e > 0). Each line's k, over its
+/// error, is one measurement of e; weighted together they tell e where a line near the
+/// principal point, or a short one, tells nothing, and a bend the other lines do not share (a
+/// mark beside one stripe) is not a lens.
+struct RadialBend {
+  double kdu_error = 0.0;          ///< e: the camera's kdu less the lens's
+  double kdu_error_sd = HUGE_VAL;  ///< its standard deviation (infinite: the lines cannot tell)
+  /// The largest bend, pixels, that |e| less one standard deviation puts on one of the lines
+  /// (0 when e is within one standard deviation of none): what the stripes show of the lens.
+  double bend_px = 0.0;
+  int lines = 0;  ///< lines that told e (a line disagreeing with the others is left out)
+};
+RadialBend RadialBendOfFour(const std::array<LineParams, 4>& lines,
+                            const std::vector<FramePoint>& points, double tolerance_px,
+                            const std::array<std::optional<LineExtent>, 4>& extents,
+                            const Point2d& principal_point, double focal_px);
 
 }  // namespace oal

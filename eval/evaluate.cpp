@@ -161,7 +161,7 @@ struct Tally {
   std::set<int> track_ids;
   int pose_jumps = 0;
   std::vector<int> jump_frames;
-  std::vector<double> straightness_px;  ///< of the target tracker's frames with a pose
+  std::vector<RadialBend> lens;  ///< of the target tracker's frames with a pose
 };
 
 // The evaluation of one input: decoder, tracker and writer (file comment of evaluate.h).
@@ -311,7 +311,7 @@ class InputEvaluation {
   PoseResult TargetPose(const vpImage<unsigned char>& image,
                         const std::vector<DetectedLine>& held) {
     const TargetFrame& found = target_tracker_->Track(ViewOf(image));
-    straightness_px_ = found.straightness_px;
+    lens_ = found.lens;
     PoseResult pose = found.pose;
     if (found.status != TargetStatus::kOk) {
       if (pose.status == PoseStatus::kOk) pose.status = PoseStatus::kDegenerate;
@@ -413,12 +413,9 @@ class InputEvaluation {
         trusted_ = TrustedPose{index, out->pose->cMo, identified};
       }
     }
-    const std::optional<double> straightness =
-        target_tracker_ ? std::optional<double>(straightness_px_) : std::nullopt;
-    if (straightness && out->pose->status == PoseStatus::kOk) {
-      tally_.straightness_px.push_back(*straightness);
-    }
-    return PoseFrameJson(*out->pose, out->ids, *jump, straightness);
+    if (!target_tracker_) return PoseFrameJson(*out->pose, out->ids, *jump, std::nullopt);
+    if (out->pose->status == PoseStatus::kOk) tally_.lens.push_back(lens_);
+    return PoseFrameJson(*out->pose, out->ids, *jump, lens_.bend_px);
   }
 
   // A readable frame in the tally: detected, posed, and the episodes of loss.
@@ -579,7 +576,7 @@ class InputEvaluation {
     }
     if (!decode.stop_reason.empty()) warnings.push_back(decode.stop_reason);
     if (t.readable > 0 && t.detected < 0.1 * t.readable) warnings.push_back(LowDetectionHint(t));
-    const LensCheck lens = CheckLens(t.straightness_px);
+    const LensCheck lens = CheckLens(t.lens);
     if (lens.mismatch) {
       warnings.push_back(LensMismatchWarning(lens, "'" + camera_path_ + "'",
                                              "Calibrate the camera (oalservo calibrate)"));
@@ -591,6 +588,8 @@ class InputEvaluation {
       pose = Json{{"frames_ok", t.pose_ok},
                   {"availability", t.pose_ok / readable},
                   {"straightness_px_median", lens.frames > 0 ? Json(lens.median_px) : Json()},
+                  {"lens_kdu_error_median", lens.frames > 0 ? Json(lens.median_kdu_error) : Json()},
+                  {"lens_frames_contradicting", lens.contradicting},
                   {"by_status", std::move(by_status)},
                   {"jumps", t.pose_jumps},
                   {"jump_frames", t.jump_frames}};
@@ -668,7 +667,7 @@ class InputEvaluation {
   std::optional<vpCameraParameters> undistorted_by_;
   std::optional<PointUndistorter> undistorter_;
   std::vector<std::string> warnings_;
-  double straightness_px_ = 0.0;  // the target tracker's last frame
+  RadialBend lens_;  // the target tracker's last frame
   Tally tally_;
   std::optional<TrustedPose> trusted_;               ///< the last trusted pose (JumpFrom)
   std::optional<TargetPoseTracker> target_tracker_;  ///< the pose of a '#' target

@@ -71,11 +71,15 @@ ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameter
 
 std::string LensMismatchWarning(const LensCheck& lens, const std::string& corrected_by,
                                 const std::string& remedy) {
-  return "lines 1-4 still bend by " + Fixed(lens.median_px, 2) + " px (median of " +
-         std::to_string(lens.frames) +
-         " frames; a camera file that matches the lens leaves under 0.1 px) after " + corrected_by +
-         " corrects them: it does not describe this lens (its distortion, or the resolution it "
-         "was made for), and every pose is biased. " +
+  const double lens_minus_camera = -lens.median_kdu_error;
+  return "lines 1-4 still bend after " + corrected_by +
+         " corrects them, as if the lens's kdu were the camera's " +
+         (lens_minus_camera >= 0.0 ? "+" : "") + Fixed(lens_minus_camera, 2) + " (" +
+         std::to_string(lens.contradicting) + " of " + std::to_string(lens.frames) +
+         " frames; median bend " + Fixed(lens.median_px, 2) +
+         " px; a camera file that matches the lens leaves the kdu within 0.01): it does not "
+         "describe this lens (its distortion, or the resolution it was made for), and every "
+         "pose is biased. " +
          remedy;
 }
 

@@ -55,8 +55,8 @@ ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameter
                              const NextFrame& next, int frames = kLensFrames,
                              int max_read = kMaxLensFramesRead);
 
-/// The lens check's warning: "lines 1-4 still bend by ... after `corrected_by` corrects them:
-/// ... this lens ... `remedy`".
+/// The lens check's warning: "lines 1-4 still bend after `corrected_by` corrects them, as if
+/// the lens's kdu were the camera's +0.10 ... `remedy`".
 std::string LensMismatchWarning(const LensCheck& lens, const std::string& corrected_by,
                                 const std::string& remedy);
 

@@ -630,10 +630,9 @@ class ServoRun {
   // the lens biases every pose, which the loop cannot see otherwise.
   void CheckLensOnce(const TargetFrame& tracked) {
     constexpr std::size_t kLensCheckFrames = 5;
-    if (tracked.status != TargetStatus::kOk || straightness_.size() >= kLensCheckFrames) return;
-    straightness_.push_back(tracked.straightness_px);
-    const LensCheck lens =
-        CheckLens(straightness_, kLensMismatchPx, static_cast<int>(kLensCheckFrames));
+    if (tracked.status != TargetStatus::kOk || lens_frames_.size() >= kLensCheckFrames) return;
+    lens_frames_.push_back(tracked.lens);
+    const LensCheck lens = CheckLens(lens_frames_, static_cast<int>(kLensCheckFrames));
     if (lens.mismatch) {
       log_ << "oalservo servo: warning: "
            << LensMismatchWarning(lens, "the camera model",
@@ -713,7 +712,7 @@ class ServoRun {
   bool confirmed_ = false;          ///< the first pose confirmed by a second frame
   std::optional<vpHomogeneousMatrix> previous_cMo_;
   vpHomogeneousMatrix previous_wMc_;
-  std::vector<double> straightness_;
+  std::vector<RadialBend> lens_frames_;
   cv::Mat gray_;
 };
 

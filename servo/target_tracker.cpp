@@ -121,14 +121,29 @@ std::array<std::vector<Point2d>, 4> TargetPoseTracker::StripePoints(double toler
   return stripes;
 }
 
-LensCheck CheckLens(std::vector<double> straightness_px, double threshold_px, int min_frames) {
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+}  // namespace
+
+LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames) {
   LensCheck check;
-  check.frames = static_cast<int>(straightness_px.size());
-  if (straightness_px.empty()) return check;
-  const auto middle = straightness_px.begin() + straightness_px.size() / 2;
-  std::nth_element(straightness_px.begin(), middle, straightness_px.end());
-  check.median_px = *middle;
-  check.mismatch = check.frames >= min_frames && check.median_px > threshold_px;
+  check.frames = static_cast<int>(frames.size());
+  std::vector<double> bends, errors;
+  for (const RadialBend& frame : frames) {
+    bends.push_back(frame.bend_px);
+    if (std::isfinite(frame.kdu_error_sd)) errors.push_back(frame.kdu_error);
+    check.contradicting += ContradictsLens(frame);
+  }
+  check.median_px = Median(bends);
+  check.median_kdu_error = Median(errors);
+  check.mismatch = check.frames >= min_frames && 2 * check.contradicting > check.frames;
   return check;
 }
 
@@ -306,7 +321,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   frame_.pose = EstimatePose(lines_, target_, pose_options_, prior);
   frame_.pose_us += Microseconds(start);
   frame_.agreement = StripeAgreement{};
-  frame_.straightness_px = 0.0;
+  frame_.lens = RadialBend{};
   if (frame_.pose.status != PoseStatus::kOk) {
     frame_.status = TargetStatus::kNotFound;
     frame_.message = frame_.pose.message;
@@ -317,9 +332,10 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     identified[k] = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
   }
   // Only the points on the printed stripes: beyond their ends the lines run over the bench.
-  frame_.straightness_px = StraightnessOfFour(identified, detector_.feature_points(),
-                                              2.0 * detector_.options().support_tolerance_px,
-                                              StripeEnds(PlaneToImage(frame_.pose.cMo)));
+  frame_.lens = RadialBendOfFour(
+      identified, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px,
+      StripeEnds(PlaneToImage(frame_.pose.cMo)), Point2d{camera_.get_u0(), camera_.get_v0()},
+      std::sqrt(camera_.get_px() * camera_.get_py()));
   for (int k = 0; k < 4; ++k) {
     const DetectedLine& line =
         lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];

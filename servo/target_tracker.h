@@ -31,11 +31,13 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/line_fit.h"
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
 #include "servo/pose.h"
@@ -131,11 +133,12 @@ struct TargetFrame {
   int borders = 0;
   int candidates = 0;  ///< middle-cell candidates scanned
   StripeAgreement agreement;
-  /// How straight lines 1-4 came out after the lens model's correction: the second largest
-  /// bend (sagitta, pixels) of their feature points over the stretch seen (0 without a pose).
-  /// Stripes bent by a lens the camera file does not describe (a distortion-free model on a
-  /// wide lens, the wrong resolution) raise it.
-  double straightness_px = 0.0;
+  /// How straight lines 1-4 came out after the lens model's correction (nothing without a
+  /// pose): the kdu error they show and the bend it puts on them (bend_px, the frame's
+  /// straightness), over their feature points between the stripes' printed ends. Stripes bent
+  /// by a lens the camera file does not describe (a distortion-free model on a wide lens, the
+  /// wrong resolution) raise it.
+  RadialBend lens;
   double find_us = 0.0, detect_us = 0.0, pose_us = 0.0;  ///< time spent in each step
 };
 
@@ -208,20 +211,28 @@ class TargetPoseTracker {
   int frames_since_ok_ = 0;  ///< 1: the last frame's pose was accepted; 0: none ever was
 };
 
+/// The lens kdu error a frame's lines 1-4 must show, beyond one standard deviation, to say
+/// that the camera model misses the lens: a third of what a wrong or missing calibration
+/// leaves (0.1 and more), where a matching model's frames stay under 0.01 (docs/BENCHMARKS.md).
+inline constexpr double kLensMismatchKdu = 0.03;
+
+/// Whether one frame's lines say the camera model misses the lens.
+inline bool ContradictsLens(const RadialBend& lens) {
+  return std::fabs(lens.kdu_error) - lens.kdu_error_sd >= kLensMismatchKdu;
+}
+
 /// The lens check over several frames: whether their lines 1-4, after the camera model's
-/// correction, bend by more than a matching model leaves. A single frame can show a stray
-/// bend (a mark beside a stripe), so the median of at least `min_frames` frames decides:
-/// on the A3 bench scenes a matching camera file gives a median of 0.00 px, one whose kdu is
-/// off by 0.1 about 0.4 px (docs/BENCHMARKS.md).
+/// correction, bend as a lens the model misses would. A single frame can mislead (a mark
+/// beside a stripe, a far sheet near the principal point that bends too little to tell), so
+/// most of at least `min_frames` frames must say so.
 struct LensCheck {
-  int frames = 0;          ///< frames with a pose that were counted
-  double median_px = 0.0;  ///< their median TargetFrame::straightness_px
-  bool mismatch = false;   ///< median above the threshold, over at least min_frames frames
+  int frames = 0;                 ///< frames with a pose that were counted
+  int contradicting = 0;          ///< of them, those whose lines contradict the model
+  double median_px = 0.0;         ///< the median of their straightness_px (RadialBend::bend_px)
+  double median_kdu_error = 0.0;  ///< the median kdu error of the frames whose lines tell one
+  bool mismatch = false;          ///< over half contradict, of at least min_frames frames
 };
-/// The bend above which a median says the camera model misses the lens, pixels.
-inline constexpr double kLensMismatchPx = 0.2;
-LensCheck CheckLens(std::vector<double> straightness_px, double threshold_px = kLensMismatchPx,
-                    int min_frames = 3);
+LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames = 3);
 
 /// The model check alone: how well `image` shows the target of `layout` at cMo. Each stripe
 /// is sampled at 16 points spread over the part of it in view (away from the crossings),

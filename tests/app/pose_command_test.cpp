@@ -158,6 +158,7 @@ TEST(Pose, ACameraFileThatMissesTheLensIsToldOnce) {
   ASSERT_EQ(summary.ok, 6);
   for (const json& frame : ParseJsonLines(out.str())) {
     EXPECT_LT(frame.at("straightness_px").get<double>(), 0.2);
+    EXPECT_FALSE(frame.at("lens").at("contradicts_camera").get<bool>()) << frame.dump();
   }
   auto lens_warnings = [](const PoseSummary& run) {
     int count = 0;
@@ -177,6 +178,10 @@ TEST(Pose, ACameraFileThatMissesTheLensIsToldOnce) {
   out.str("");
   summary = EstimatePoses(options, out);
   EXPECT_EQ(lens_warnings(summary), 1);
+  // The lens's kdu (0.25) less the pinhole's (0), as the stripes tell it, frame by frame.
+  for (const json& frame : ParseJsonLines(out.str())) {
+    EXPECT_NEAR(-frame.at("lens").at("kdu_error").get<double>(), 0.25, 0.06) << frame.dump();
+  }
 }
 
 // Frames without the four lines (two lines, a blank image) are rows with their status; the

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace oal {
@@ -25,23 +28,31 @@ std::vector<FramePoint> BentPoints(double sagitta) {
   return points;
 }
 
-TEST(LineSagitta, MeasuresABendAndNoneOnAStraightLine) {
+// FitLineBend's bend beyond one standard error (0 within it), signed.
+double Sagitta(const LineParams& line, const std::vector<FramePoint>& points,
+               const std::optional<LineExtent>& extent = std::nullopt) {
+  const LineBend bend = FitLineBend(line, points, 3.0, extent);
+  if (!bend.Tells()) return 0.0;
+  return std::copysign(std::max(0.0, std::fabs(bend.k_px) - bend.k_error_px), bend.k_px);
+}
+
+TEST(FitLineBend, MeasuresABendAndNoneOnAStraightLine) {
   // The parabola's k is negative when the middle lies towards +v (d = a + k x^2, a = sagitta).
-  EXPECT_NEAR(LineSagitta(kLine, BentPoints(0.8), 3.0), -0.8, 0.1);
-  EXPECT_NEAR(LineSagitta(kLine, BentPoints(0.0), 3.0), 0.0, 0.05);
+  EXPECT_NEAR(Sagitta(kLine, BentPoints(0.8)), -0.8, 0.1);
+  EXPECT_NEAR(Sagitta(kLine, BentPoints(0.0)), 0.0, 0.05);
 }
 
 // One run cut short by a mark lies a pixel off: it does not make the line bent.
-TEST(LineSagitta, LeavesAStrayPointOut) {
+TEST(FitLineBend, LeavesAStrayPointOut) {
   std::vector<FramePoint> points = BentPoints(0.0);
   points[5].p.v += 1.2;
-  EXPECT_NEAR(LineSagitta(kLine, points, 3.0), 0.0, 0.05);
+  EXPECT_NEAR(Sagitta(kLine, points), 0.0, 0.05);
   points[16].p.v -= 0.9;  // a second one
-  EXPECT_NEAR(LineSagitta(kLine, points, 3.0), 0.0, 0.05);
+  EXPECT_NEAR(Sagitta(kLine, points), 0.0, 0.05);
 }
 
 // A run around a border's corner gives the midpoint of its ends, off the centre line.
-TEST(LineSagitta, IgnoresRunsAroundACorner) {
+TEST(FitLineBend, IgnoresRunsAroundACorner) {
   std::vector<FramePoint> points = BentPoints(0.0);
   for (int i = 0; i < 6; ++i) {
     FramePoint corner;
@@ -49,24 +60,24 @@ TEST(LineSagitta, IgnoresRunsAroundACorner) {
     corner.straight = false;
     points.push_back(corner);
   }
-  EXPECT_NEAR(LineSagitta(kLine, points, 3.0), 0.0, 0.05);
+  EXPECT_NEAR(Sagitta(kLine, points), 0.0, 0.05);
 }
 
 // Beyond a stripe's printed ends its line runs over the bench: points there do not count.
-TEST(LineSagitta, KeepsToTheLinesExtent) {
+TEST(FitLineBend, KeepsToTheLinesExtent) {
   std::vector<FramePoint> points = BentPoints(0.0);
   for (int i = 0; i < 8; ++i) {
     FramePoint beyond;
     beyond.p = Point2d{400.0 + 10.0 * i, 100.0 + 0.15 * i * i / 8.0};
     points.push_back(beyond);
   }
-  EXPECT_GT(std::fabs(LineSagitta(kLine, points, 3.0)), 0.2);
+  EXPECT_GT(std::fabs(Sagitta(kLine, points)), 0.2);
   const LineExtent stripe{Point2d{0.0, 100.0}, Point2d{380.0, 100.0}};
-  EXPECT_NEAR(LineSagitta(kLine, points, 3.0, stripe), 0.0, 0.05);
+  EXPECT_NEAR(Sagitta(kLine, points, stripe), 0.0, 0.05);
 }
 
 // Points bunched at the two ends tell little of a curvature: a wobble there is not a bend.
-TEST(LineSagitta, SaysNothingOfPointsBunchedAtTheEnds) {
+TEST(FitLineBend, SaysNothingOfPointsBunchedAtTheEnds) {
   std::vector<FramePoint> points;
   for (int i = 0; i < 5; ++i) {
     FramePoint left, right;
@@ -75,23 +86,76 @@ TEST(LineSagitta, SaysNothingOfPointsBunchedAtTheEnds) {
     points.push_back(left);
     points.push_back(right);
   }
-  EXPECT_LT(std::fabs(LineSagitta(kLine, points, 3.0)), 0.1);
+  EXPECT_LT(std::fabs(Sagitta(kLine, points)), 0.1);
 }
 
-TEST(StraightnessOfFour, IsTheSecondLargestBend) {
-  const std::vector<FramePoint> bent = BentPoints(0.6);
-  std::vector<FramePoint> points = bent;
-  // Three more lines: v = 300 straight, v = 500 bent by 0.3, v = 700 straight.
-  for (double offset : {200.0, 400.0, 600.0}) {
-    const std::vector<FramePoint> line = BentPoints(offset == 400.0 ? 0.3 : 0.0);
-    for (FramePoint point : line) {
-      point.p.v += offset;
+// A '#' of four straight lines seen through a camera model whose kdu is off by `kdu_error`
+// (principal point (320, 240), focal 600 px): each point moved by kdu_error r^2 from the
+// principal point, plus a small fixed wobble; `mark_px` bends the first line alone, as a mark
+// beside it would.
+constexpr double kFocal = 600.0;
+const Point2d kCentre{320.0, 240.0};
+const std::array<LineParams, 4> kHash{LineParams{150.0, 0.5 * kPi}, LineParams{340.0, 0.5 * kPi},
+                                      LineParams{220.0, 0.0}, LineParams{430.0, 0.0}};
+
+std::vector<FramePoint> HashPoints(double kdu_error, double mark_px = 0.0) {
+  std::vector<FramePoint> points;
+  for (std::size_t k = 0; k < kHash.size(); ++k) {
+    const double c = std::cos(kHash[k].theta_rad), s = std::sin(kHash[k].theta_rad);
+    // Along the line from the foot of the perpendicular from the principal point.
+    const double rho = kHash[k].rho_px - (kCentre.u * c + kCentre.v * s);
+    for (int i = 0; i < 24; ++i) {
+      const double x = -1.0 + 2.0 * i / 23.0, t = 180.0 * x;
+      const double offset = rho + (k == 0 ? mark_px * (1.0 - x * x) : 0.0);
+      const double du = offset * c - t * s, dv = offset * s + t * c + 0.04 * std::sin(2.7 * i + k);
+      const double factor = 1.0 + kdu_error * (du * du + dv * dv) / (kFocal * kFocal);
+      FramePoint point;
+      point.p = Point2d{kCentre.u + du * factor, kCentre.v + dv * factor};
       points.push_back(point);
     }
   }
-  const std::array<LineParams, 4> lines{kLine, LineParams{300.0, 0.5 * kPi},
-                                        LineParams{500.0, 0.5 * kPi}, LineParams{700.0, 0.5 * kPi}};
-  EXPECT_NEAR(StraightnessOfFour(lines, points, 3.0), 0.3, 0.08);
+  return points;
+}
+
+TEST(RadialBendOfFour, TellsTheCameraModelsKduError) {
+  for (double error : {-0.1, 0.05, 0.1}) {
+    const RadialBend bend = RadialBendOfFour(kHash, HashPoints(error), 3.0, {}, kCentre, kFocal);
+    EXPECT_EQ(bend.lines, 4);
+    EXPECT_NEAR(bend.kdu_error, error, 0.01) << error;
+    EXPECT_LT(bend.kdu_error_sd, 0.01);
+    EXPECT_GT(bend.bend_px, 0.1) << error;
+  }
+}
+
+TEST(RadialBendOfFour, SeesNoneOnStraightLines) {
+  const RadialBend bend = RadialBendOfFour(kHash, HashPoints(0.0), 3.0, {}, kCentre, kFocal);
+  EXPECT_NEAR(bend.kdu_error, 0.0, 0.01);
+  EXPECT_LT(bend.bend_px, 0.02);
+}
+
+// A bend the other three lines do not share is a mark beside a stripe, not a lens.
+TEST(RadialBendOfFour, LeavesOutALineBentAlone) {
+  const RadialBend bend = RadialBendOfFour(kHash, HashPoints(0.0, 0.8), 3.0, {}, kCentre, kFocal);
+  EXPECT_EQ(bend.lines, 3);
+  EXPECT_NEAR(bend.kdu_error, 0.0, 0.01);
+  EXPECT_LT(bend.bend_px, 0.02);
+}
+
+// Lines through the principal point do not bend under a radial lens: they tell nothing.
+TEST(RadialBendOfFour, CannotTellFromLinesThroughThePrincipalPoint) {
+  const std::array<LineParams, 4> through{LineParams{240.0, 0.5 * kPi}, LineParams{320.0, 0.0},
+                                          LineParams{240.0, 0.5 * kPi}, LineParams{320.0, 0.0}};
+  std::vector<FramePoint> points;
+  for (int i = 0; i < 24; ++i) {
+    FramePoint horizontal, vertical;
+    horizontal.p = Point2d{140.0 + 15.0 * i, 240.0 + 0.04 * std::sin(2.7 * i)};
+    vertical.p = Point2d{320.0 + 0.04 * std::cos(1.9 * i), 60.0 + 15.0 * i};
+    points.push_back(horizontal);
+    points.push_back(vertical);
+  }
+  const RadialBend bend = RadialBendOfFour(through, points, 3.0, {}, kCentre, kFocal);
+  EXPECT_FALSE(std::isfinite(bend.kdu_error_sd));
+  EXPECT_EQ(bend.bend_px, 0.0);
 }
 
 }  // namespace

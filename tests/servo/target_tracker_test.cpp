@@ -147,8 +147,8 @@ TEST(TargetPoseTracker, FollowsAMovingSheetFromItsLastPose) {
 }
 
 // The straightness of lines 1-4 after the lens correction tells a camera file that matches
-// the lens (kdu 0.15) from ones whose distortion is off by 0.1 or missing, over every run of
-// five frames; a single frame may show a stray bend, never the median of five.
+// the lens (kdu 0.15) from ones whose distortion is off by 0.1 or missing: on each frame (no
+// right one contradicts its file, at most one wrong one fails to) and over every run of five.
 TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(13));
   const PoseSampling sampling = SheetSampling(renderer.target());
@@ -165,24 +165,39 @@ TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
     pose.image_width = 640;
     pose.image_height = 480;
     TargetPoseTracker tracker(renderer.target(), camera, DetectorOptions(), pose);
-    std::vector<double> values;
+    std::vector<RadialBend> values;
     for (const vpImage<unsigned char>& frame : frames) {
       tracker.Reset();
       const TargetFrame& result = tracker.Track(ViewOf(frame));
-      if (result.status == TargetStatus::kOk) values.push_back(result.straightness_px);
+      if (result.status == TargetStatus::kOk) values.push_back(result.lens);
     }
     ASSERT_GE(values.size(), 35u) << "kdu " << kdu;
-    if (right) {  // no single frame of the right file bends: no stray point, no run-end effect
-      for (const double value : values) EXPECT_LT(value, kLensMismatchPx);
+    int contradicting = 0;
+    for (const RadialBend& value : values) {
+      if (right) {  // no single frame of the right file bends: no stray point, no run-end effect
+        EXPECT_FALSE(ContradictsLens(value)) << value.kdu_error << " +- " << value.kdu_error_sd;
+        EXPECT_LT(value.bend_px, 0.1);
+      }
+      contradicting += ContradictsLens(value);
+    }
+    if (!right) {
+      EXPECT_GE(contradicting, static_cast<int>(values.size()) - 1) << "kdu " << kdu;
     }
     for (std::size_t first = 0; first + 5 <= values.size(); first += 5) {
       const LensCheck check =
-          CheckLens(std::vector<double>(values.begin() + first, values.begin() + first + 5));
+          CheckLens(std::vector<RadialBend>(values.begin() + first, values.begin() + first + 5));
       EXPECT_EQ(check.mismatch, !right)
           << "kdu " << kdu << ", frames from " << first << ": median " << check.median_px << " px";
+      // The camera's kdu less the lens's, as the lines tell it.
+      EXPECT_NEAR(check.median_kdu_error, kdu - 0.15, 0.03) << "kdu " << kdu;
     }
   }
-  EXPECT_FALSE(CheckLens({0.9, 0.8}).mismatch) << "two frames are too few to judge";
+  RadialBend bent;
+  bent.kdu_error = 0.1;
+  bent.kdu_error_sd = 0.01;
+  EXPECT_FALSE(CheckLens({bent, bent}).mismatch) << "two frames are too few to judge";
+  EXPECT_TRUE(CheckLens({bent, bent, RadialBend{}}).mismatch);
+  EXPECT_FALSE(CheckLens({bent, RadialBend{}, RadialBend{}}).mismatch) << "one frame of three";
   EXPECT_EQ(CheckLens({}).frames, 0);
 }
 
