@@ -99,6 +99,29 @@ KduStep StepKdu(const std::vector<Line>& lines, double kdu) {
   return {jj > 0 ? kdu - ej / jj : kdu, jj, ee, used};
 }
 
+// The information on kdu left once each line's offset and direction have taken their share:
+// the part of each point's d e / d kdu that a line's shift and turn (1, along) cannot mimic.
+double KduInformation(const std::vector<Line>& lines, double kdu) {
+  double information = 0.0;
+  for (const Line& line : lines) {
+    double n = 0, st = 0, stt = 0, sj = 0, stj = 0, sjj = 0;
+    for (std::size_t i = 0; i < line.points.size(); ++i) {
+      if (!line.inlier[i]) continue;
+      const Ideal u = Undistort(line.points[i], kdu);
+      const double t = -line.ny * u.x + line.nx * u.y;  // along the line
+      const double j = (line.nx * u.x + line.ny * u.y) * u.slope;
+      n += 1, st += t, stt += t * t, sj += j, stj += t * j, sjj += j * j;
+    }
+    if (n < 3) continue;
+    // Residual sum of squares of j regressed on (1, t).
+    const double det = n * stt - st * st;
+    if (!(det > 0)) continue;
+    const double a = (stt * sj - st * stj) / det, b = (n * stj - st * sj) / det;
+    information += std::max(0.0, sjj - a * sj - b * stj);
+  }
+  return information;
+}
+
 double RmsPx(const std::vector<Line>& lines, double kdu, double scale_px) {
   double sum = 0;
   int n = 0;
@@ -162,10 +185,14 @@ PlumbLineResult EstimateRadialDistortion(const std::vector<std::vector<Point2d>>
       if (iteration > 0 && std::fabs(step.kdu - before) < 1e-12) break;
     }
   }
-  // How far kdu is pinned: the residuals' spread through the step's information.
-  const double sigma2 = step.used > 1 ? step.rss / (step.used - 1) : 0.0;
-  result.kdu_sd = step.information > 0 ? std::sqrt(sigma2 / step.information) : HUGE_VAL;
-  if (!(step.information > 0) || !(result.kdu_sd < 0.05)) {
+  // How far kdu is pinned: the residuals' spread (kdu and each line's two parameters fitted)
+  // through what the lines leave of its information. The step's own information, with the
+  // lines held, made kdu look ten times surer than ten frames' scatter showed it to be.
+  const int dof = step.used - 1 - 2 * static_cast<int>(lines.size());
+  const double sigma2 = dof > 0 ? step.rss / dof : 0.0;
+  const double information = KduInformation(lines, step.kdu);
+  result.kdu_sd = information > 0 ? std::sqrt(sigma2 / information) : HUGE_VAL;
+  if (!(information > 0) || !(result.kdu_sd < 0.05)) {
     throw std::runtime_error(
         "the lines pass too near the image's centre to show the lens (kdu +- " +
         Number(result.kdu_sd, 3) + "): view the target off-centre, its stripes reaching the edges");
