@@ -161,7 +161,9 @@ class TargetPoseTracker {
   /// pose (else empty), in the detector's pixels (undistorted when it undistorts): the points
   /// of four straight stripes, to tell a lens by (calibration/plumb_line.h). Only runs along
   /// one side of a border (one around a corner is off the centre line), between the stripe's
-  /// printed ends as the pose puts them (beyond, the line runs over the bench).
+  /// printed ends as the pose puts them (beyond, the line runs over the bench), each moved
+  /// along its run onto the image of the stripe's centre line as the pose projects it (under
+  /// perspective a run's middle is not on it).
   std::array<std::vector<Point2d>, 4> StripePoints(double tolerance_px) const;
   /// The lines of the last scan that gave the frame's pose (or of the last scan), best first.
   const std::vector<DetectedLine>& lines() const { return lines_; }
