@@ -54,7 +54,7 @@ std::string Table(const PoseAccuracyReport& r) {
       << Quantile(r.roll_error_deg, 1.0) << " |\n"
       << "| frames with roll off by > 45 deg | " << r.roll_flips << " |\n";
   if (r.options.estimate_distortion) {
-    out << "| kdu told from the stripes of 10 frames | "
+    out << "| kdu told from the stripes of " << r.options.estimate_frames << " frames | "
         << (r.estimate_failed.empty()
                 ? Fixed(r.estimated_kdu, 4) + " +- " + Fixed(r.estimated_kdu_sd, 4) + " (truth " +
                       Fixed(r.options.kdu, 4) + ")"
@@ -163,8 +163,12 @@ int RunPoseAccuracy(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
   cli.add_flag("--estimate-distortion", options.estimate_distortion,
-               "do not tell the tracker the lens: estimate kdu from the target's stripes in 10 "
+               "do not tell the tracker the lens: estimate kdu from the target's stripes in "
                "frames of other poses, then use it");
+  cli.add_option("--estimate-frames", options.estimate_frames,
+                 "frames with the target that --estimate-distortion tells the lens from")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   cli.footer(
       "Examples:\n"
       "  oalservo pose-accuracy --frames 1000 --seed 1 --out out/pose-a3.json\n"

@@ -185,9 +185,6 @@ class FrameFeed {
   std::size_t replayed_input_ = static_cast<std::size_t>(-1);
 };
 
-// Frames read ahead at most while looking for the frames with a pose that tell the lens.
-constexpr int kMaxLensFramesRead = 100;
-
 // Reads frames ahead until `frames` of them show the target, estimates kdu from their stripes
 // and, when it succeeds, gives the tracker the camera with it. Says what it did in `summary`.
 void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* run,

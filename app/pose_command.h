@@ -47,6 +47,7 @@
 
 #include "app/frame_command.h"
 #include "detector/line_fit.h"
+#include "loop/lens_estimate.h"  // kLensFrames
 
 namespace oal {
 
@@ -66,7 +67,7 @@ struct PoseCommandOptions : FrameCommandOptions {
   /// first `estimate_frames` frames with a pose (read ahead and then processed as all others,
   /// calibration/plumb_line.h) and used for every frame.
   bool estimate_distortion = false;
-  int estimate_frames = 10;  ///< Range [1, 100].
+  int estimate_frames = kLensFrames;  ///< Range [1, 100].
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;

@@ -77,6 +77,9 @@ void PoseAccuracyOptions::Check() const {
   check.camera = MakeRenderOptions(*this).camera;
   check.Check();
   IdentifyTargetLines({}, target, check);  // throws unless the target is a '#'
+  RequireOption(estimate_frames >= 1 && estimate_frames <= 100,
+                "PoseAccuracyOptions::estimate_frames", estimate_frames,
+                "1 <= estimate_frames <= 100");
 }
 
 namespace {
@@ -96,14 +99,18 @@ vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
   std::uint64_t state = options.seed + kLensSeedOffset;
   int frame = 0;
   RenderedFrame rendered;
-  const ToldLens told = TellLensFromStripes(tracker, pinhole, [&](GrayImageView* view) {
-    const SceneRenderer& renderer = scenes.For(frame);
-    rendered = renderer.Render(SamplePose(renderer, options.sampling, &state),
-                               state + static_cast<std::uint64_t>(frame), scenes.EffectsFor(frame));
-    ++frame;
-    *view = ViewOf(rendered.image);
-    return true;
-  });
+  const ToldLens told = TellLensFromStripes(
+      tracker, pinhole,
+      [&](GrayImageView* view) {
+        const SceneRenderer& renderer = scenes.For(frame);
+        rendered =
+            renderer.Render(SamplePose(renderer, options.sampling, &state),
+                            state + static_cast<std::uint64_t>(frame), scenes.EffectsFor(frame));
+        ++frame;
+        *view = ViewOf(rendered.image);
+        return true;
+      },
+      options.estimate_frames);
   report->estimated_kdu = std::numeric_limits<double>::quiet_NaN();
   if (!told.lens) {
     report->estimate_failed = told.why;

@@ -12,7 +12,8 @@
 
 #include "detector/options.h"
 #include "eval/rendered_frames.h"
-#include "scene/bench_scene.h"  // SheetSampling
+#include "loop/lens_estimate.h"  // kLensFrames
+#include "scene/bench_scene.h"   // SheetSampling
 #include "scene/scene.h"
 #include "servo/pose.h"
 #include "servo/target_tracker.h"
@@ -35,9 +36,10 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
   double line_angle_deg = 1.0;
   double line_offset_px = 2.0;
   /// The tracker is not told the lens: kdu is estimated from the target's stripes in the first
-  /// 10 frames (of poses drawn apart from the evaluated ones) a pinhole tracker finds it in,
-  /// then used for every frame (loop/lens_estimate.h).
+  /// `estimate_frames` frames (of poses drawn apart from the evaluated ones) a pinhole tracker
+  /// finds it in, then used for every frame (loop/lens_estimate.h).
   bool estimate_distortion = false;
+  int estimate_frames = kLensFrames;  ///< Range [1, 100].
 
   /// The paper's board (its first evaluation): 0.3-1.0 m, tilt up to 40 deg, any roll, every
   /// line crossing 150 px of the image.

@@ -11,6 +11,7 @@
 
 #include "app/config.h"
 #include "app/servo_command.h"
+#include "loop/lens_estimate.h"  // kLensFrames
 #include "robots/robot.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
@@ -71,7 +72,10 @@ TEST(HandEyeCommand, TellsTheLensFirstWhenTheConfigAsksIt) {
   const OalservoRun run =
       RunOalservo(dir, "hand-eye --config '" + config + "' --out '" + (dir / "he.yaml") + "'");
   ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
-  EXPECT_NE(run.out.find("lens told from the stripes of 10 frames"), std::string::npos) << run.out;
+  EXPECT_NE(
+      run.out.find("lens told from the stripes of " + std::to_string(kLensFrames) + " frames"),
+      std::string::npos)
+      << run.out;
   const AppConfig read = LoadConfig(dir / "he.yaml", LoadConfig(config, DefaultServoConfig()));
   const PoseDistance error = Distance(kBracket, read.camera.eMc);
   EXPECT_LT(error.translation_m, 1e-3);

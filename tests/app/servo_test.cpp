@@ -24,6 +24,7 @@
 #include "app/servo_command.h"
 #include "app/servo_default_config.h"
 #include "app/servo_run.h"
+#include "loop/lens_estimate.h"  // kLensFrames
 #include "robots/simulated_camera.h"
 #include "scene/scene.h"
 #include "servo_test_util.h"
@@ -259,7 +260,8 @@ TEST(ServoLoop, ALensToldFromTheStripesConvergesAsTheLensGiven) {
                                             "lens.yaml", DefaultServoConfig());
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
-  EXPECT_THAT(log.str(), HasSubstr("lens told from the stripes of 10 frames: kdu 0.15"));
+  EXPECT_THAT(log.str(), HasSubstr("lens told from the stripes of " + std::to_string(kLensFrames) +
+                                   " frames: kdu 0.15"));
   EXPECT_THAT(log.str(), ::testing::Not(HasSubstr("Calibrate the camera")));
   ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
   EXPECT_LE(report.iterations.back().true_translation_error_mm, 1.0);
