@@ -497,7 +497,9 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
     const std::uint8_t* row = cells_.data() + static_cast<std::size_t>(gy) * grid_width_;
     for (int gx = 0; gx < grid_width_; ++gx) sums[gx + 1] = sums[gx] + row[gx];
   }
-  // Light against dark, then the light class split again (a light bench, a bright photo).
+  // Light against dark, then the light class split again (a light bench, a bright photo),
+  // until a cell closed in on all four sides (a '#'s middle cell) is found: the splits are
+  // for a sheet the first threshold merged with the bench, and cost a labelling each.
   int lo = 0;
   for (int level = 0; level < 3; ++level) {
     double contrast = 0.0;
@@ -505,6 +507,10 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
     if (threshold > 255 || contrast < options_.min_contrast) break;
     AddComponents(image, threshold);
     lo = threshold;
+    if (std::any_of(candidates_.begin(), candidates_.end(),
+                    [](const LightQuad& quad) { return quad.ClosedSideCount() == 4; })) {
+      break;
+    }
   }
   std::stable_sort(candidates_.begin(), candidates_.end(),
                    [](const LightQuad& a, const LightQuad& b) { return a.score > b.score; });

@@ -10,7 +10,8 @@
 // for 640 x 480, from every fourth row):
 //   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
 //      Otsu's over the light class again (a light bench, a bright photo), while the classes
-//      differ by at least min_contrast;
+//      differ by at least min_contrast and no quadrilateral closed in on all four sides has
+//      been found at the thresholds before;
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
