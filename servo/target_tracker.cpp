@@ -110,6 +110,17 @@ void TargetTrackerOptions::Check() const {
 
 namespace {
 
+// A target-plane point through a plane-to-image homography: normalised image coordinates, and
+// the third homogeneous coordinate before the division (positive in front of the camera).
+struct PlaneImage {
+  double x = 0.0, y = 0.0, w = 0.0;
+};
+PlaneImage ThroughHomography(const vpHomography& h, const Point2d& plane) {
+  const double w = h[2][0] * plane.u + h[2][1] * plane.v + h[2][2];
+  return {(h[0][0] * plane.u + h[0][1] * plane.v + h[0][2]) / w,
+          (h[1][0] * plane.u + h[1][1] * plane.v + h[1][2]) / w, w};
+}
+
 // A stripe's two edges and centre line in the image of a view, as lines n . p = c in the
 // detector's pixels, and where a run across the stripe has its middle on them.
 struct StripeOutline {
@@ -121,11 +132,9 @@ struct StripeOutline {
                           const vpCameraParameters& camera) {
     const StripeSpan& span = layout.stripes[static_cast<std::size_t>(k)];
     const auto to_pixel = [&](const Point2d& plane) {
-      const vpHomography& h = plane_to_image;
-      const double w = h[2][0] * plane.u + h[2][1] * plane.v + h[2][2];
-      const double x = (h[0][0] * plane.u + h[0][1] * plane.v + h[0][2]) / w;
-      const double y = (h[1][0] * plane.u + h[1][1] * plane.v + h[1][2]) / w;
-      return Point2d{camera.get_u0() + camera.get_px() * x, camera.get_v0() + camera.get_py() * y};
+      const PlaneImage image = ThroughHomography(plane_to_image, plane);
+      return Point2d{camera.get_u0() + camera.get_px() * image.x,
+                     camera.get_v0() + camera.get_py() * image.y};
     };
     StripeOutline view;
     const double across[3] = {-span.half, 0.0, span.half};
@@ -334,16 +343,13 @@ std::array<std::optional<LineExtent>, 4> TargetPoseTracker::StripeEnds(
     bool ok = true;
     for (int e = 0; e < 2 && ok; ++e) {
       const Point2d plane = layout_.OnStripe(k, e == 0 ? stripe.along.lo : stripe.along.hi, 0.0);
-      const vpHomography& h = plane_to_image;
-      const double w = h[2][0] * plane.u + h[2][1] * plane.v + h[2][2];
-      ok = w > 1e-9;
+      const PlaneImage image = ThroughHomography(plane_to_image, plane);
+      ok = image.w > 1e-9;
       if (!ok) break;
-      const double x = (h[0][0] * plane.u + h[0][1] * plane.v + h[0][2]) / w;
-      const double y = (h[1][0] * plane.u + h[1][1] * plane.v + h[1][2]) / w;
       // The detector's coordinates: undistorted pixels when it undistorts.
-      ends[e] = detector_.Undistorts() ? Point2d{camera_.get_u0() + camera_.get_px() * x,
-                                                 camera_.get_v0() + camera_.get_py() * y}
-                                       : DistortedPixel(camera_, x, y);
+      ends[e] = detector_.Undistorts() ? Point2d{camera_.get_u0() + camera_.get_px() * image.x,
+                                                 camera_.get_v0() + camera_.get_py() * image.y}
+                                       : DistortedPixel(camera_, image.x, image.y);
       ok = std::isfinite(ends[e].u) && std::isfinite(ends[e].v);
     }
     if (ok) extents[static_cast<std::size_t>(k)] = LineExtent{ends[0], ends[1]};
