@@ -103,6 +103,18 @@ TEST(AccuracyCommands, ConfigSectionsTheyDoNotReadAreRejected) {
   EXPECT_THAT(both.err, HasSubstr("--target four-line-a4 and the target: section of"));
 }
 
+// --estimate-frames out of range or not a number: the option named, exit 2, nothing evaluated.
+TEST(AccuracyCommands, ABadEstimateFramesIsRefused) {
+  test::TestDir dir;
+  for (const std::string value : {"0", "101", "abc"}) {
+    const test::OalservoRun run =
+        test::RunOalservo(dir, "pose-accuracy --estimate-distortion --estimate-frames " + value);
+    EXPECT_EQ(run.exit_code, 2) << value;
+    EXPECT_THAT(run.err, HasSubstr("--estimate-frames: Value " + value + " not in range 1 to 100"));
+    EXPECT_TRUE(run.out.empty()) << run.out;
+  }
+}
+
 // --out is checked before the evaluation: an error, and no table printed (it used to come
 // after the whole evaluation, with the table already on stdout).
 TEST(AccuracyCommands, OutputIsCheckedBeforeTheWork) {
