@@ -209,32 +209,29 @@ bool PlaneProjector::Project(const Point2d& plane, Point2d* pixel) const {
 
 double PlaneProjector::DistortedOverIdeal(double rho2) const {
   // ViSP's kdu model: rho = r (1 + kdu r^2) for the distorted radius r of the ideal radius
-  // rho, solved by Newton. Beyond the turning point (kdu < 0) no r exists.
-  if (!(rho2 > 0.0)) return 1.0;
+  // rho. In the ratio s = r / rho it reads e s^3 + s = 1 with e = kdu rho^2, solved by Newton
+  // (no square root, no division by rho). Beyond the turning point (kdu < 0) no s exists.
   if (kdu_ < 0.0 && rho2 > max_rho2_) return std::numeric_limits<double>::quiet_NaN();
-  const double rho = std::sqrt(rho2);
   const double e = kdu_ * rho2;
-  auto newton_step = [&](double r) {
-    return (kdu_ * r * r * r + r - rho) / (3.0 * kdu_ * r * r + 1.0);
-  };
+  auto newton_step = [e](double s) { return (e * s * s * s + s - 1.0) / (3.0 * e * s * s + 1.0); };
   if (std::fabs(e) < 0.1) {
-    // The inverse's series r = rho (1 - e + 3 e^2 - 12 e^3 + 55 e^4 - ...) is within 1 % of r
-    // here; each Newton step squares the relative error times under 3 |e|, so two leave
-    // under 1e-10 of it (1e-7 px): a fixed count, no test in the loop.
-    double r = rho * (1.0 + e * (-1.0 + e * (3.0 + e * (-12.0 + 55.0 * e))));
-    r -= newton_step(r);
-    r -= newton_step(r);
-    return r / rho;
+    // The series s = 1 - e + 3 e^2 - 12 e^3 + 55 e^4 - ... is within 1 % of s here; each
+    // Newton step squares the relative error times under 3 |e|, so two leave under 1e-10 of
+    // it (1e-7 px): a fixed count, no test in the loop.
+    double s = 1.0 + e * (-1.0 + e * (3.0 + e * (-12.0 + 55.0 * e)));
+    s -= newton_step(s);
+    s -= newton_step(s);
+    return s;
   }
-  double r = rho / (1.0 + e);
-  // Newton converges quadratically here: the error left after a step is about
-  // 3 |kdu| r step² (f'' / 2 f'), so a step under 1e-7 leaves one far under 1e-12.
+  double s = 1.0 / (1.0 + e);
+  // Newton converges quadratically: the error left after a step is about 3 |e| step², so a
+  // step under 1e-8 leaves one far under 1e-12.
   for (int i = 0; i < 50; ++i) {
-    const double step = newton_step(r);
-    r -= step;
-    if (std::fabs(step) <= 1e-7 * (1.0 + r)) break;
+    const double step = newton_step(s);
+    s -= step;
+    if (std::fabs(step) <= 1e-8) break;
   }
-  return r / rho;
+  return s;
 }
 
 ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
