@@ -220,7 +220,14 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
   for (int gy = 0; gy < grid_height_; ++gy) {
     std::fill(sums.begin(), sums.end(), 0u);
     for (int r = first_row; r < c; r += 4) {
-      const std::uint8_t* row = image.data + static_cast<std::ptrdiff_t>(gy * c + r) * image.stride;
+      const int y = gy * c + r;
+      const std::uint8_t* row = image.data + static_cast<std::ptrdiff_t>(y) * image.stride;
+      // The row two used rows below, asked for now: a frame just out of memory costs more
+      // to wait for than to sum, and the rows used are too far apart for the hardware to guess.
+      if (y + 8 < image.height) {
+        const std::uint8_t* ahead = row + 8 * static_cast<std::ptrdiff_t>(image.stride);
+        for (int x = 0; x < image.width; x += 64) __builtin_prefetch(ahead + x);
+      }
       int gx = 0;
 #if OAL_HAVE_SSE2
       if (c == 8) {  // one psadbw sums two cells' eight pixels
