@@ -433,7 +433,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
 }
 
 bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
-                                         const vpHomography& plane_to_image) {
+                                         const vpHomography& plane_to_image, ScanSource source) {
   const std::vector<LineSeed> seeds = SeedsFrom(plane_to_image);
   // quick_max_identification_cost 0 could never keep a quick scan: none is made.
   const bool quick = quick_scan_ && options_.quick_max_identification_cost > 0.0 &&
@@ -444,9 +444,9 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
     const int count = scans[scan];
     TargetBorders(layout_, plane_to_image, camera_, count, &borders_);
     if (borders_.empty()) return false;
-    if (scan == 0) ++frame_.candidates;
+    if (scan == 0 && source == ScanSource::kMiddleCell) ++frame_.candidates;
     // Each candidate on its own: a prior that failed above says nothing about it.
-    const bool accepted = Attempt(image, borders_, seeds, std::nullopt, ScanSource::kMiddleCell);
+    const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source);
     if (count >= options_.borders) return accepted;
     if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
       return true;
@@ -483,11 +483,15 @@ const TargetFrame& TargetPoseTracker::Track(
         frame_.find_us += Microseconds(refine_start);
         const std::optional<vpHomography> plane_to_image =
             PlaneToImageFromCell(layout_, cell, camera_);
-        if (plane_to_image && (found = AttemptCandidate(image, *plane_to_image))) break;
+        if (plane_to_image &&
+            (found = AttemptCandidate(image, *plane_to_image, ScanSource::kMiddleCell))) {
+          break;
+        }
       }
     }
     if (!found && options_.image_fallback) {
-      found = Attempt(image, ScanBorders{}, {}, std::nullopt, ScanSource::kImage);
+      found = Attempt(image, ScanBorders{}, {}, std::nullopt, ScanSource::kImage) &&
+              ConfirmOnTarget(image);
     }
   }
   if (!found) {
@@ -497,6 +501,38 @@ const TargetFrame& TargetPoseTracker::Track(
   }
   Accept(predicted_cMo.has_value());
   return frame_;
+}
+
+bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
+  const TargetFrame whole_image = frame_;
+  const std::vector<DetectedLine> whole_image_lines = lines_;
+  auto keep_whole_image = [&] {
+    frame_ = whole_image;
+    lines_ = whole_image_lines;
+    return true;
+  };
+  // The target's plane gave nothing (a board seen from near fills the view, its borders' lines
+  // too short): the whole image's pose stands as the paper's scan gives it.
+  if (!AttemptCandidate(image, PlaneToImage(whole_image.pose.cMo), ScanSource::kImage)) {
+    return keep_whole_image();
+  }
+  const PoseDistance apart = Distance(whole_image.pose.cMo, frame_.pose.cMo);
+  const double degrees = apart.rotation_rad * kDegPerRad;
+  if ((options_.max_jump_m > 0.0 && apart.translation_m > options_.max_jump_m) ||
+      (options_.max_jump_deg > 0.0 && degrees > options_.max_jump_deg)) {
+    std::ostringstream message;
+    message << "the whole image's pose and the one on the target's plane seen from it are "
+            << 1000.0 * apart.translation_m << " mm and " << degrees
+            << " deg apart (max_jump_m = " << options_.max_jump_m
+            << ", max_jump_deg = " << options_.max_jump_deg << ")";
+    frame_.status = TargetStatus::kModelMismatch;
+    frame_.message = message.str();
+    return false;
+  }
+  // Both passed the checks: the one whose four corners a rigid target fits better. (Kept, the
+  // whole image's lines come with the feature points of the scan on the target's plane, the
+  // detector's last: the same stripes' points, close to the lines either way.)
+  return frame_.pose.residual_px <= whole_image.pose.residual_px || keep_whole_image();
 }
 
 void TargetPoseTracker::Accept(bool predicted) {

@@ -12,7 +12,13 @@
 //      as a tracked frame's first (its lines are seeded as a prior's are), all `borders` when
 //      those give no pose or lines whose widths barely identify them.
 //   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
-//      with the paper's concentric image borders.
+//      with the paper's concentric image borders. A line of the bench can stand in for a
+//      stripe's edge there and tilt the pose by degrees yet pass the checks below, so the
+//      borders on the target's plane seen from that pose are scanned as a candidate's (step
+//      2): when both poses pass, they must lie within max_jump_m / max_jump_deg of each other
+//      (else the frame is kModelMismatch), and the one whose corners fit the target better
+//      (the lower residual) is the frame's; when only the whole image's does (a board seen from
+//      near, whose lines traverse the view), it stands.
 // A pose is accepted only when the image shows the target where it says: along each stripe's
 // projected centre line, between the crossings and the printed ends, the pixels must be darker
 // than the paper on both sides (min_stripe_agreement of the samples inside the image);
@@ -187,7 +193,11 @@ class TargetPoseTracker {
   /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.
-  bool AttemptCandidate(const GrayImageView& image, const vpHomography& plane_to_image);
+  bool AttemptCandidate(const GrayImageView& image, const vpHomography& plane_to_image,
+                        ScanSource source);
+  /// The whole image's accepted pose scanned again on the target's plane (step 3): false when
+  /// the two poses disagree; the frame keeps the better fitting one.
+  bool ConfirmOnTarget(const GrayImageView& image);
   /// Each stripe's centre line from end to end where `plane_to_image` puts it, in the
   /// detector's coordinates; nothing for a stripe with an end behind the camera.
   std::array<std::optional<LineExtent>, 4> StripeEnds(const vpHomography& plane_to_image) const;

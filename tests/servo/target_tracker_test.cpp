@@ -129,6 +129,42 @@ TEST(TargetPoseTracker, ACandidateIsScannedOnFewBordersFirstUnlessTheQuickScanIs
   EXPECT_EQ(by_options.borders, full.borders);
 }
 
+// Without a middle cell (a sheet finder that can find none), the whole image's scan places the
+// sheet, and the borders on the target's plane seen from its pose are scanned again: their
+// pose is taken when it fits the target's corners better. Every accepted pose is right.
+TEST(TargetPoseTracker, AWholeImagePoseIsScannedAgainOnTheTargetsPlane) {
+  const SceneRenderer renderer(FourLineA3Target(), BenchRender(4));
+  TargetTrackerOptions blind;
+  blind.finder.min_area_fraction = 1.0;  // no light region covers the whole image
+  PoseOptions pose;
+  pose.camera = renderer.options().camera;
+  pose.image_width = renderer.options().width;
+  pose.image_height = renderer.options().height;
+  TargetPoseTracker tracker(renderer.target(), renderer.options().camera, DetectorOptions(), pose,
+                            blind);
+  PoseSampling sampling = SheetSampling(renderer.target());
+  sampling.max_distance_m = 0.45;  // near: the sheet's stripes cross the image's borders
+  std::uint64_t state = 5;
+  int accepted = 0, rescanned = 0;
+  for (int frame = 0; frame < 12; ++frame) {
+    const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
+    tracker.Reset();
+    const TargetFrame& result = tracker.Track(ViewOf(renderer.Render(cMo, 70 + frame).image));
+    const std::string what = "frame " + std::to_string(frame);
+    EXPECT_EQ(result.candidates, 0) << what;
+    if (result.status != TargetStatus::kOk) continue;
+    ++accepted;
+    EXPECT_EQ(result.source, ScanSource::kImage) << what;
+    if (result.borders > 0) {
+      ++rescanned;
+      EXPECT_FALSE(result.region.empty()) << what;
+    }
+    ExpectRightPose(result, cMo, what);
+  }
+  EXPECT_GT(accepted, 0) << "the whole image's scan never placed the sheet";
+  EXPECT_GT(rescanned, 0) << "no pose came from the target's plane seen from the whole image's";
+}
+
 // A camera sliding over the sheet: every frame after the first is tracked from the last pose.
 TEST(TargetPoseTracker, FollowsAMovingSheetFromItsLastPose) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(5));
