@@ -2,9 +2,12 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <iomanip>
+#include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "app/command_line.h"
@@ -13,6 +16,10 @@
 #include "base/format.h"
 #include "base/statistics.h"
 #include "eval/pose_accuracy.h"
+#include "io/atomic_file.h"
+#include "io/json_io.h"
+#include "io/rendered_dataset.h"
+#include "io/truth_file.h"
 #include "servo/pose.h"
 
 namespace oal {
@@ -125,6 +132,27 @@ void ApplyTargetDefaults(const CLI::App& cli, bool scene_given, PoseAccuracyOpti
   ApplySheetDefaults(cli, options->target, scene_given, options, &options->sampling);
 }
 
+// A missed frame as `oalservo render` writes one (frame_NNNN.png and its truth), with what the
+// tracker made of it under "pose_accuracy", so that `oalservo pose DIR` replays it.
+void WriteMissedFrame(const std::filesystem::path& dir, const PoseAccuracyOptions& options,
+                      const PoseAccuracyMiss& miss) {
+  const RenderOptions& render = miss.render;
+  Json truth = FrameTruthJson(miss.rendered, miss.frame, DatasetFrameName(miss.frame, ".png"),
+                              options.target.name, options.seed, miss.noise_seed, render.camera,
+                              render.width, render.height);
+  truth["effects"] = EffectsJson(miss.effects);
+  Json found{{"status", ToString(miss.result.status)},
+             {"message", miss.result.message},
+             {"source", ToString(miss.result.source)},
+             {"wrong", miss.wrong}};
+  if (miss.wrong) {
+    found["translation_error_pct"] = miss.translation_error_pct;
+    found["rotation_error_deg"] = miss.rotation_error_deg;
+  }
+  truth["pose_accuracy"] = std::move(found);
+  WriteDatasetFrame(dir, miss.frame, miss.rendered, truth);
+}
+
 }  // namespace
 
 int RunPoseAccuracy(int argc, char** argv) {
@@ -162,6 +190,17 @@ int RunPoseAccuracy(int argc, char** argv) {
                  "sections; another section is an error")
       ->check(CLI::ExistingFile);
   cli.add_option("--out", out_path, "write the report as JSON to this file");
+  std::string missed_dir;
+  bool overwrite = false;
+  cli.add_option("--save-missed", missed_dir,
+                 "write each frame without a pose or with a wrong one into this folder as "
+                 "`oalservo render` writes frames (frame_NNNN.png, its truth and what the tracker "
+                 "said in frame_NNNN.json, camera.xml, target.yaml), to replay with `oalservo "
+                 "pose DIR`; a folder that already holds a data set is refused unless "
+                 "--overwrite");
+  cli.add_flag("--overwrite", overwrite,
+               "replace the data set already in --save-missed (its frame_NNNN.png/json, "
+               "camera.xml and target.yaml; other files are kept)");
   cli.add_flag("--estimate-distortion", options.estimate_distortion,
                "do not tell the tracker the lens: estimate kdu from the target's stripes in "
                "frames of other poses, then use it");
@@ -174,7 +213,9 @@ int RunPoseAccuracy(int argc, char** argv) {
       "  oalservo pose-accuracy --frames 1000 --seed 1 --out out/pose-a3.json\n"
       "  oalservo pose-accuracy --target four-line-a4 --frames 1000 --seed 2\n"
       "  oalservo pose-accuracy --target four-line-board --frames 1000 --seed 1\n"
-      "  oalservo pose-accuracy --config config/scene-dark-table.yaml --frames 1000 --seed 3");
+      "  oalservo pose-accuracy --config config/scene-dark-table.yaml --frames 1000 --seed 3\n"
+      "  oalservo pose-accuracy --frames 1000 --seed 4 --save-missed out/missed\n"
+      "  oalservo pose out/missed   # the missed frames again, one JSON line each");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
 
   // Everything that can fail before the evaluation's minutes of work.
@@ -196,8 +237,30 @@ int RunPoseAccuracy(int argc, char** argv) {
                                                 {"PoseSampling::max_tilt_deg", "--max-tilt-deg"},
                                                 {"PoseSampling::max_offset_m", "--max-offset"}});
   CheckReportFile(out_path);
-  const PoseAccuracyReport report = EvaluatePoseAccuracy(options, TerminalFrameProgress());
+  std::optional<StagedDataset> missed;
+  if (!missed_dir.empty())
+    missed.emplace(missed_dir, overwrite, StagedDataset::Names{"--save-missed", "--overwrite"});
+  std::optional<RenderOptions> render;  // of the first missed frame: the camera file's
+  int missed_frames = 0;
+  const PoseAccuracyReport report =
+      EvaluatePoseAccuracy(options, TerminalFrameProgress(), [&](const PoseAccuracyMiss& miss) {
+        if (!missed) return;
+        WriteMissedFrame(missed->dir(), options, miss);
+        if (!render) render = miss.render;
+        ++missed_frames;
+      });
+  if (missed) {
+    // Every frame has the same camera; without a missed frame, the first scene's.
+    if (render) SaveDatasetCamera(missed->dir(), *render, "oal-pose-accuracy");
+    WriteFileAtomically(missed->dir() / "target.yaml", TargetYaml(options.target));
+    missed->Commit();
+  }
   PrintAccuracyReport(Table(report), ToJson(report, config_path), out_path);
+  if (missed) {
+    std::cerr << "oalservo pose-accuracy: " << missed_frames
+              << " frame(s) without a pose or with a wrong one written to " << missed_dir
+              << (missed_frames > 0 ? " (replay: oalservo pose " + missed_dir + ")" : "") << "\n";
+  }
   return kExitOk;
 }
 

@@ -123,8 +123,9 @@ vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
 
 }  // namespace
 
-PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
-                                        const std::function<void(int, int)>& progress) {
+PoseAccuracyReport EvaluatePoseAccuracy(
+    const PoseAccuracyOptions& options, const std::function<void(int, int)>& progress,
+    const std::function<void(const PoseAccuracyMiss&)>& on_miss) {
   options.Check();
   const EvaluationScenes scenes(options.target, options);
   PoseAccuracyReport report;
@@ -146,8 +147,9 @@ PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
   for (int frame = 0; frame < options.frames; ++frame) {
     const SceneRenderer& renderer = scenes.For(frame);
     const vpHomogeneousMatrix cMo_true = SamplePose(renderer, options.sampling, &state);
-    const RenderedFrame rendered =
-        renderer.Render(cMo_true, options.seed * 7919ULL + frame, scenes.EffectsFor(frame));
+    const std::uint64_t noise_seed = options.seed * 7919ULL + frame;
+    const FrameEffects effects = scenes.EffectsFor(frame);
+    const RenderedFrame rendered = renderer.Render(cMo_true, noise_seed, effects);
 
     tracker.Reset();  // each frame on its own
     const auto start = std::chrono::steady_clock::now();
@@ -161,9 +163,15 @@ PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
     ++report.status_counts[ToString(result.status)];
     report.lines_found +=
         AllLinesFound(tracker.lines(), rendered, undistorter, undistorted, options);
+    auto missed = [&](bool wrong, double t_pct, double r_deg) {
+      if (!on_miss) return;
+      on_miss(PoseAccuracyMiss{frame, rendered, renderer.options(), noise_seed, effects, result,
+                               wrong, t_pct, r_deg});
+    };
     if (result.status != TargetStatus::kOk) {
       ++report.pose_status_counts[ToString(result.pose.status)];
       report.failed_frames.push_back(frame);
+      missed(false, 0.0, 0.0);
     } else {
       ++report.source_counts[ToString(result.source)];
       const vpHomogeneousMatrix& cMo = result.pose.cMo;
@@ -180,6 +188,7 @@ PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
       report.roll_flips += roll_error > 45.0;
       if (t_pct > options.wrong_translation_pct || r_deg > options.wrong_rotation_deg) {
         report.wrong_frames.push_back(frame);
+        missed(true, t_pct, r_deg);
       }
     }
     if (progress) progress(frame + 1, options.frames);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
@@ -71,7 +72,21 @@ struct PoseAccuracyReport {
   int posed() const;
 };
 
-PoseAccuracyReport EvaluatePoseAccuracy(const PoseAccuracyOptions& options,
-                                        const std::function<void(int, int)>& progress = {});
+/// A frame counted against the tracker, as it was rendered: without a pose, or with a wrong one.
+struct PoseAccuracyMiss {
+  int frame = 0;
+  const RenderedFrame& rendered;
+  const RenderOptions& render;  ///< the scene it was rendered with (camera, size, surface)
+  std::uint64_t noise_seed = 0;
+  FrameEffects effects;
+  const TargetFrame& result;  ///< what the tracker made of it
+  bool wrong = false;         ///< a pose was given and is wrong; else none was
+  double translation_error_pct = 0.0, rotation_error_deg = 0.0;  ///< of a wrong pose
+};
+
+/// `on_miss` sees each frame without a pose or with a wrong one, to keep it for a replay.
+PoseAccuracyReport EvaluatePoseAccuracy(
+    const PoseAccuracyOptions& options, const std::function<void(int, int)>& progress = {},
+    const std::function<void(const PoseAccuracyMiss&)>& on_miss = {});
 
 }  // namespace oal

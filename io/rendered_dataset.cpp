@@ -58,12 +58,12 @@ Json OccluderJson(const Occluder& occluder) {
   return json;
 }
 
+}  // namespace
+
 void SaveDatasetCamera(const fs::path& dir, const RenderOptions& render, const std::string& name) {
   SaveCameraFile((dir / "camera.xml").string(), render.camera, name,
                  static_cast<unsigned int>(render.width), static_cast<unsigned int>(render.height));
 }
-
-}  // namespace
 
 std::string DatasetFrameName(int index, const char* extension) {
   std::string number = std::to_string(index);

@@ -68,6 +68,10 @@ class StagedDataset {
 /// The frame's gain, offset and occluders as JSON ("effects" of a sequence's frame).
 Json EffectsJson(const FrameEffects& effects);
 
+/// Writes `dir`/camera.xml: `render`'s camera and image size, the camera named `name`.
+void SaveDatasetCamera(const std::filesystem::path& dir, const RenderOptions& render,
+                       const std::string& name);
+
 /// Writes frame_NNNN.png and frame_NNNN.json into `dir`, each atomically.
 void WriteDatasetFrame(const std::filesystem::path& dir, int index, const RenderedFrame& frame,
                        const Json& truth);

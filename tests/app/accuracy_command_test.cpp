@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -47,6 +48,49 @@ TEST(PoseAccuracy, ConfigPoseSectionIsApplied) {
   EXPECT_EQ(report.at("posed"), 0);
   EXPECT_EQ(report.at("options").at("max_residual_px"), 1e-4);
   EXPECT_EQ(report.at("options").at("config"), dir / "strict.yaml");
+}
+
+// --save-missed keeps each frame without a pose (here all three, under a residual bound no pose
+// meets) as `render` writes frames, with what the tracker said; `pose` replays the folder; a
+// folder holding a data set is refused before the work unless --overwrite.
+TEST(PoseAccuracy, MissedFramesAreSavedForAReplay) {
+  test::TestDir dir;
+  test::WriteText(dir / "strict.yaml", "pose:\n  max_residual_px: 0.0001\n");
+  const std::string evaluate = "pose-accuracy" + kFewFrames + " --config '" + dir / "strict.yaml" +
+                               "' --save-missed '" + dir / "missed" + "'";
+  const test::OalservoRun run =
+      test::RunOalservo(dir, evaluate + " --out '" + dir / "report.json" + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_THAT(run.err, HasSubstr("3 frame(s) without a pose or with a wrong one written to"));
+  const json report = json::parse(test::ReadText(dir / "report.json"));
+  EXPECT_EQ(report.at("frames_without_pose"), json({0, 1, 2}));
+  EXPECT_TRUE(fs::exists(dir / "missed/camera.xml"));
+  EXPECT_TRUE(fs::exists(dir / "missed/target.yaml"));
+  for (const char* frame : {"frame_0000", "frame_0001", "frame_0002"}) {
+    EXPECT_TRUE(fs::exists(dir / ("missed/" + std::string(frame) + ".png"))) << frame;
+    const json truth =
+        json::parse(test::ReadText(dir / ("missed/" + std::string(frame) + ".json")));
+    EXPECT_EQ(truth.at("pose_accuracy").at("status"), "not-found") << frame;
+    EXPECT_FALSE(truth.at("pose_accuracy").at("message").get<std::string>().empty()) << frame;
+    EXPECT_EQ(truth.at("pose_accuracy").at("wrong"), false);
+    EXPECT_EQ(truth.at("lines").size(), 4u) << frame;
+  }
+
+  // The default pose options find the target in each of them again.
+  const test::OalservoRun replay = test::RunOalservo(dir, "pose '" + dir / "missed" + "'");
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  EXPECT_EQ(std::count(replay.out.begin(), replay.out.end(), '\n'), 3) << replay.out;
+  EXPECT_THAT(replay.out, HasSubstr("\"status\":\"ok\""));
+
+  const std::string before = test::ReadText(dir / "missed/frame_0001.json");
+  const test::OalservoRun again = test::RunOalservo(dir, evaluate);
+  EXPECT_EQ(again.exit_code, 1);  // as `render --out` on a data set
+  EXPECT_THAT(again.err, HasSubstr("--save-missed"));
+  EXPECT_THAT(again.err, HasSubstr("--overwrite"));
+  EXPECT_TRUE(again.out.empty()) << again.out;
+  EXPECT_EQ(test::ReadText(dir / "missed/frame_0001.json"), before);
+  const test::OalservoRun replaced = test::RunOalservo(dir, evaluate + " --overwrite");
+  EXPECT_EQ(replaced.exit_code, 0) << replaced.err;
 }
 
 // The report: status_counts keyed by status name, and the roll median the table shows.
