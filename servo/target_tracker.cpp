@@ -507,7 +507,10 @@ bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
   const TargetFrame whole_image = frame_;
   const std::vector<DetectedLine> whole_image_lines = lines_;
   auto keep_whole_image = [&] {
+    const double detect_us = frame_.detect_us, pose_us = frame_.pose_us;  // both scans'
     frame_ = whole_image;
+    frame_.detect_us = detect_us;
+    frame_.pose_us = pose_us;
     lines_ = whole_image_lines;
     return true;
   };
@@ -529,9 +532,9 @@ bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
     frame_.message = message.str();
     return false;
   }
-  // Both passed the checks: the one whose four corners a rigid target fits better. (Kept, the
-  // whole image's lines come with the feature points of the scan on the target's plane, the
-  // detector's last: the same stripes' points, close to the lines either way.)
+  // Both passed the checks: the one whose four corners a rigid target fits better. (The whole
+  // image's lines, when kept, go with the feature points of the plane's scan, the detector's
+  // last: the same stripes' points, close to those lines.)
   return frame_.pose.residual_px <= whole_image.pose.residual_px || keep_whole_image();
 }
 
