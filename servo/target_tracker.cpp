@@ -519,13 +519,11 @@ bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
   if (!AttemptCandidate(image, PlaneToImage(whole_image.pose.cMo), ScanSource::kImage)) {
     return keep_whole_image();
   }
-  const PoseDistance apart = Distance(whole_image.pose.cMo, frame_.pose.cMo);
-  const double degrees = apart.rotation_rad * kDegPerRad;
-  if ((options_.max_jump_m > 0.0 && apart.translation_m > options_.max_jump_m) ||
-      (options_.max_jump_deg > 0.0 && degrees > options_.max_jump_deg)) {
+  double metres = 0.0, degrees = 0.0;
+  if (!WithinJump(whole_image.pose.cMo, frame_.pose.cMo, &metres, &degrees)) {
     std::ostringstream message;
     message << "the whole image's pose and the one on the target's plane seen from it are "
-            << 1000.0 * apart.translation_m << " mm and " << degrees
+            << 1000.0 * metres << " mm and " << degrees
             << " deg apart (max_jump_m = " << options_.max_jump_m
             << ", max_jump_deg = " << options_.max_jump_deg << ")";
     frame_.status = TargetStatus::kModelMismatch;
@@ -538,6 +536,15 @@ bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
   return frame_.pose.residual_px <= whole_image.pose.residual_px || keep_whole_image();
 }
 
+bool TargetPoseTracker::WithinJump(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b,
+                                   double* metres, double* degrees) const {
+  const PoseDistance d = Distance(a, b);
+  *metres = d.translation_m;
+  *degrees = d.rotation_rad * kDegPerRad;
+  return (options_.max_jump_m <= 0.0 || *metres <= options_.max_jump_m) &&
+         (options_.max_jump_deg <= 0.0 || *degrees <= options_.max_jump_deg);
+}
+
 void TargetPoseTracker::Accept(bool predicted) {
   const vpHomogeneousMatrix& cMo = frame_.pose.cMo;
   // Only a pose found on the borders of the last one is held to it: one found afresh, after
@@ -546,17 +553,10 @@ void TargetPoseTracker::Accept(bool predicted) {
       frames_since_ok_ == 1 && last_cMo_.has_value() && frame_.source == ScanSource::kPrior;
   const bool checked =
       !predicted && consecutive && (options_.max_jump_m > 0.0 || options_.max_jump_deg > 0.0);
-  auto within = [&](const vpHomogeneousMatrix& other, double* metres, double* degrees) {
-    const PoseDistance d = Distance(cMo, other);
-    *metres = d.translation_m;
-    *degrees = d.rotation_rad * kDegPerRad;
-    return (options_.max_jump_m <= 0.0 || *metres <= options_.max_jump_m) &&
-           (options_.max_jump_deg <= 0.0 || *degrees <= options_.max_jump_deg);
-  };
   double metres = 0.0, degrees = 0.0;
-  if (checked && !within(*last_cMo_, &metres, &degrees)) {
+  if (checked && !WithinJump(cMo, *last_cMo_, &metres, &degrees)) {
     double held_m = 0.0, held_deg = 0.0;
-    if (!(held_cMo_ && within(*held_cMo_, &held_m, &held_deg))) {
+    if (!(held_cMo_ && WithinJump(cMo, *held_cMo_, &held_m, &held_deg))) {
       held_cMo_ = cMo;
       std::ostringstream message;
       message << "the pose moved " << metres << " m and " << degrees

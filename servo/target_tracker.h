@@ -203,6 +203,10 @@ class TargetPoseTracker {
   std::array<std::optional<LineExtent>, 4> StripeEnds(const vpHomography& plane_to_image) const;
   /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
   std::vector<LineSeed> SeedsFrom(const vpHomography& plane_to_image) const;
+  /// Whether poses `a` and `b` lie within max_jump_m and max_jump_deg of each other (a bound
+  /// of 0 is no bound), and how far apart they are.
+  bool WithinJump(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double* metres,
+                  double* degrees) const;
   /// The model check and the jump check on an estimated pose: the frame's status.
   void Accept(bool predicted);
 
