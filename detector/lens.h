@@ -35,6 +35,11 @@ class PointUndistorter {
 /// ViSP's kdu of `camera`; 0 for a camera without distortion.
 double Kdu(const vpCameraParameters& camera);
 
+/// The distorted over the ideal normalised radius of a point whose ideal radius squared is
+/// `rho2`, under ViSP's kdu model (ideal rho = r (1 + kdu r^2) of distorted r), to rounding;
+/// NaN where kdu < 0 reaches no such radius.
+double DistortedOverIdeal(double kdu, double rho2);
+
 /// Distorted pixel of an ideal normalised point (x, y) under the kdu model (numerical
 /// inverse of vpPixelMeterConversion); exact to 1e-9 px. With kdu < 0 the model cannot reach
 /// points beyond a radius; they come back as NaN.

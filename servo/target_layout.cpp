@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
+#include "detector/lens.h"  // Kdu, DistortedOverIdeal
 #include "servo/pose_internal.h"
 
 namespace oal {
@@ -184,11 +184,7 @@ PlaneProjector::PlaneProjector(const vpHomography& plane_to_image, const vpCamer
       py_(camera.get_py()),
       u0_(camera.get_u0()),
       v0_(camera.get_v0()),
-      kdu_(camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
-               ? camera.get_kdu()
-               : 0.0),
-      // rho = r (1 + kdu r^2) turns at r^2 = -1 / (3 kdu), where rho^2 = -4 / (27 kdu).
-      max_rho2_(kdu_ < 0.0 ? -4.0 / (27.0 * kdu_) : HUGE_VAL) {
+      kdu_(Kdu(camera)) {
   for (unsigned int r = 0; r < 3; ++r) {
     for (unsigned int c = 0; c < 3; ++c) h_[r][c] = plane_to_image[r][c];
   }
@@ -200,38 +196,11 @@ bool PlaneProjector::Project(const Point2d& plane, Point2d* pixel) const {
   const double inverse_w = 1.0 / w;
   const double x = (h_[0][0] * plane.u + h_[0][1] * plane.v + h_[0][2]) * inverse_w;
   const double y = (h_[1][0] * plane.u + h_[1][1] * plane.v + h_[1][2]) * inverse_w;
-  const double scale = kdu_ != 0.0 ? DistortedOverIdeal(x * x + y * y) : 1.0;
+  const double scale = kdu_ != 0.0 ? DistortedOverIdeal(kdu_, x * x + y * y) : 1.0;
   pixel->u = u0_ + px_ * x * scale;
   pixel->v = v0_ + py_ * y * scale;
   return std::isfinite(pixel->u) && std::isfinite(pixel->v) && std::fabs(pixel->u) < kFarPx &&
          std::fabs(pixel->v) < kFarPx;
-}
-
-double PlaneProjector::DistortedOverIdeal(double rho2) const {
-  // ViSP's kdu model: rho = r (1 + kdu r^2) for the distorted radius r of the ideal radius
-  // rho. In the ratio s = r / rho it reads e s^3 + s = 1 with e = kdu rho^2, solved by Newton
-  // (no square root, no division by rho). Beyond the turning point (kdu < 0) no s exists.
-  if (kdu_ < 0.0 && rho2 > max_rho2_) return std::numeric_limits<double>::quiet_NaN();
-  const double e = kdu_ * rho2;
-  auto newton_step = [e](double s) { return (e * s * s * s + s - 1.0) / (3.0 * e * s * s + 1.0); };
-  if (std::fabs(e) < 0.1) {
-    // The series s = 1 - e + 3 e^2 - 12 e^3 + 55 e^4 - ... is within 1 % of s here; each
-    // Newton step squares the relative error times under 3 |e|, so two leave under 1e-10 of
-    // it (1e-7 px): a fixed count, no test in the loop.
-    double s = 1.0 + e * (-1.0 + e * (3.0 + e * (-12.0 + 55.0 * e)));
-    s -= newton_step(s);
-    s -= newton_step(s);
-    return s;
-  }
-  double s = 1.0 / (1.0 + e);
-  // Newton converges quadratically: the error left after a step is about 3 |e| step², so a
-  // step under 1e-8 leaves one far under 1e-12.
-  for (int i = 0; i < 50; ++i) {
-    const double step = newton_step(s);
-    s -= step;
-    if (std::fabs(step) <= 1e-8) break;
-  }
-  return s;
 }
 
 ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,

@@ -115,13 +115,8 @@ class PlaneProjector {
   bool Project(const Point2d& plane, Point2d* pixel) const;
 
  private:
-  /// The distorted over the ideal normalised radius for the ideal radius squared; NaN where
-  /// the lens reaches no such radius.
-  double DistortedOverIdeal(double rho2) const;
-
   double h_[3][3];
   double px_, py_, u0_, v0_, kdu_;
-  double max_rho2_;  ///< the largest ideal radius squared the lens reaches (kdu < 0)
 };
 
 }  // namespace oal
