@@ -241,22 +241,21 @@ int RunPoseAccuracy(int argc, char** argv) {
   if (!missed_dir.empty())
     missed.emplace(missed_dir, overwrite, StagedDataset::Names{"--save-missed", "--overwrite"});
   std::optional<RenderOptions> render;  // of the first missed frame: the camera file's
-  int missed_frames = 0;
   const PoseAccuracyReport report =
       EvaluatePoseAccuracy(options, TerminalFrameProgress(), [&](const PoseAccuracyMiss& miss) {
         if (!missed) return;
         WriteMissedFrame(missed->dir(), options, miss);
         if (!render) render = miss.render;
-        ++missed_frames;
       });
   if (missed) {
-    // Every frame has the same camera; without a missed frame, the first scene's.
+    // Every frame has the same camera (none is written when no frame was missed).
     if (render) SaveDatasetCamera(missed->dir(), *render, "oal-pose-accuracy");
     WriteFileAtomically(missed->dir() / "target.yaml", TargetYaml(options.target));
     missed->Commit();
   }
   PrintAccuracyReport(Table(report), ToJson(report, config_path), out_path);
   if (missed) {
+    const std::size_t missed_frames = report.failed_frames.size() + report.wrong_frames.size();
     std::cerr << "oalservo pose-accuracy: " << missed_frames
               << " frame(s) without a pose or with a wrong one written to " << missed_dir
               << (missed_frames > 0 ? " (replay: oalservo pose " + missed_dir + ")" : "") << "\n";
