@@ -939,6 +939,102 @@ void ReadTrackingSection(const YAML::Node& section, const std::string& file, App
 // ------------------------------------------------------------------------------------------
 // `scene:`: SceneOptions.
 
+// A range [lo, hi] of a drawn value.
+DrawRange ReadRange(const Value& value) {
+  const YAML::Node& node = value.node;
+  if (!node.IsSequence() || node.size() != 2) {
+    value.Fail("'" + value.key + "' must be a range [lo, hi] of two numbers, got '" +
+               (node.IsSequence() ? "a sequence of " + std::to_string(node.size()) : value.Text()) +
+               "'");
+  }
+  return DrawRange{Value{node[0], value.file, value.key + "[0]"}.FiniteDouble(),
+                   Value{node[1], value.file, value.key + "[1]"}.FiniteDouble()};
+}
+
+template <typename Options>
+Field<Options> RangeField(const char* key, DrawRange Options::*member) {
+  return {key,
+          [member](const Value& value, Options* options) { options->*member = ReadRange(value); }};
+}
+
+// One subsection of the lived-in conditions, checked as LivedInOptions checks it, its message
+// naming the key as the subsection writes it ("LivedInOptions::glare.fraction" -> "fraction").
+struct LivedInCheck {
+  const LivedInOptions& options;
+  std::string subsection;  // "glare"
+  void Check() const {
+    try {
+      options.Check();
+    } catch (const std::invalid_argument& error) {
+      std::string message = error.what();
+      const std::string named = "LivedInOptions::" + subsection + ".";
+      if (message.rfind(named, 0) == 0) {
+        message = "LivedInOptions::" + message.substr(named.size());
+      }
+      throw std::invalid_argument(message);
+    }
+  }
+};
+
+// `scene.<subsection>: {...}`: one condition of a lived-in scene, read into `part` of
+// scene->lived_in through `fields` and checked at the line of the key it names.
+template <typename Part>
+Field<SceneOptions> LivedInField(const char* subsection, Part LivedInOptions::*part,
+                                 std::vector<Field<Part>> (*fields)()) {
+  return {subsection, [subsection, part, fields](const Value& value, SceneOptions* scene) {
+            if (!value.node.IsMap()) value.Fail("'" + value.key + "' must be a map of keys");
+            Lines lines;
+            ReadFields(value.node, value.file, value.key, fields(), "", &(scene->lived_in.*part),
+                       &lines);
+            CheckAt(LivedInCheck{scene->lived_in, subsection}, value.file, value.key, lines,
+                    value.node.Mark().line + 1);
+          }};
+}
+
+std::vector<Field<LivedInOptions::Occluders>> OccluderFields() {
+  using O = LivedInOptions::Occluders;
+  return {
+      DoubleField("fraction", &O::fraction),
+      {"kinds",
+       [](const Value& value, O* options) {
+         if (!value.node.IsSequence() || value.node.size() == 0) {
+           value.Fail("'" + value.key +
+                      "' must be a sequence of kinds (hand, pen, cable, tool), got '" +
+                      value.Text() + "'");
+         }
+         options->kinds.clear();
+         for (std::size_t i = 0; i < value.node.size(); ++i) {
+           options->kinds.push_back(
+               Value{value.node[i], value.file, value.key + "[" + std::to_string(i) + "]"}.Choice(
+                   &OccluderKindFromString, "hand, pen, cable, tool"));
+         }
+       }},
+      RangeField("grey", &O::grey),
+      DoubleField("texture_grey", &O::texture_grey),
+      DoubleField("shadow_darkness", &O::shadow_darkness)};
+}
+
+std::vector<Field<LivedInOptions::Glare>> GlareFields() {
+  using O = LivedInOptions::Glare;
+  return {DoubleField("fraction", &O::fraction), RangeField("sigma_m", &O::sigma_m),
+          RangeField("peak_grey", &O::peak_grey)};
+}
+
+std::vector<Field<LivedInOptions::Exposure>> ExposureFields() {
+  using O = LivedInOptions::Exposure;
+  return {DoubleField("fraction", &O::fraction), RangeField("gain", &O::gain)};
+}
+
+std::vector<Field<LivedInOptions::MotionBlur>> MotionBlurFields() {
+  using O = LivedInOptions::MotionBlur;
+  return {DoubleField("fraction", &O::fraction), RangeField("length_px", &O::length_px)};
+}
+
+std::vector<Field<LivedInOptions::Jpeg>> JpegFields() {
+  using O = LivedInOptions::Jpeg;
+  return {DoubleField("fraction", &O::fraction), RangeField("quality", &O::quality)};
+}
+
 const std::vector<Field<SceneOptions>>& SceneFields() {
   using O = SceneOptions;
   static const std::vector<Field<O>> fields = {
@@ -968,6 +1064,11 @@ const std::vector<Field<SceneOptions>>& SceneFields() {
       IntField("clutter_objects", &O::clutter_objects),
       DoubleField("clutter_reach_m", &O::clutter_reach_m),
       IntField("seed", &O::seed),
+      LivedInField("occluders", &LivedInOptions::occluders, &OccluderFields),
+      LivedInField("glare", &LivedInOptions::glare, &GlareFields),
+      LivedInField("exposure", &LivedInOptions::exposure, &ExposureFields),
+      LivedInField("motion_blur", &LivedInOptions::motion_blur, &MotionBlurFields),
+      LivedInField("jpeg", &LivedInOptions::jpeg, &JpegFields),
   };
   return fields;
 }

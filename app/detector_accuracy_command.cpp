@@ -74,6 +74,8 @@ int RunDetectAccuracy(int argc, char** argv) {
                                            "pose-accuracy)")
                             ->capture_default_str();
   AddRenderedFrameOptions(cli, &options, "lens distortion (ViSP kdu; 0.33 = cheap wide lens)");
+  std::string camera_path;
+  AddRenderedCameraOptions(cli, &options, &camera_path);
   cli.add_option("--gradient", options.illumination_gradient, "illumination fall-off, 0..0.9")
       ->capture_default_str();
   cli.add_option("--min-visible-px", options.sampling.min_visible_length_px,
@@ -101,6 +103,7 @@ int RunDetectAccuracy(int argc, char** argv) {
       "  oalservo detect-accuracy --target four-line-a3 --frames 1000 --seed 1\n"
       "      an A3 sheet on the bench photographs of Debian's visp-images-data");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  ApplyRenderedCameraOptions(cli, camera_path, &options);
 
   // Everything that can fail before the evaluation's minutes of work.
   AppConfig config;

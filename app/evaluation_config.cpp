@@ -14,6 +14,7 @@
 #include "app/frame_command.h"  // CompanionFile
 #include "base/check.h"
 #include "io/atomic_file.h"
+#include "io/camera_file.h"
 #include "io/image_source.h"
 #include "io/json_io.h"
 
@@ -52,6 +53,52 @@ void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
                  "image of the surface the target lies on; several are used in turn from frame "
                  "to frame (default: the config's scene.background, else a uniform grey, except "
                  "for the sheet targets: photographs of Debian's visp-images-data)");
+}
+
+void AddRenderedCameraOptions(CLI::App& cli, RenderedFrameOptions* options,
+                              std::string* camera_path) {
+  cli.add_option("--width", options->width, "image width, pixels, [16, 8192]")
+      ->capture_default_str();
+  cli.add_option("--height", options->height, "image height, pixels, [16, 8192]")
+      ->capture_default_str();
+  cli.add_option("--focal", options->focal_px,
+                 "focal length, pixels (default: 600 at 640 px wide, in proportion to --width: "
+                 "56 deg across; a 70 deg webcam is 914 at 1280, 1371 at 1920)");
+  cli.add_option("--camera", *camera_path,
+                 "render through this ViSP camera file's camera (px, py, u0, v0, kdu) at its "
+                 "image size, instead of --focal and --kdu")
+      ->check(CLI::ExistingFile);
+}
+
+void ApplyRenderedCameraOptions(const CLI::App& cli, const std::string& camera_path,
+                                RenderedFrameOptions* options) {
+  const auto given = [&cli](const char* name) {
+    const CLI::Option* option = cli.get_option_no_throw(name);
+    return option != nullptr && option->count() > 0;
+  };
+  if (camera_path.empty()) {
+    if (given("--width") && !given("--focal")) options->focal_px = 600.0 * options->width / 640.0;
+    return;
+  }
+  for (const char* name : {"--focal", "--kdu"}) {
+    if (given(name)) {
+      throw std::runtime_error(std::string(name) + " cannot be given with --camera " + camera_path +
+                               ": the camera file gives it");
+    }
+  }
+  const CameraFile file = LoadCameraFile(camera_path);
+  options->camera = file.camera;
+  if (file.width > 0 && file.height > 0) {
+    if ((given("--width") && static_cast<unsigned>(options->width) != file.width) ||
+        (given("--height") && static_cast<unsigned>(options->height) != file.height)) {
+      throw std::runtime_error("--width/--height " + std::to_string(options->width) + "x" +
+                               std::to_string(options->height) + " disagree with --camera " +
+                               camera_path + ", calibrated at " + std::to_string(file.width) + "x" +
+                               std::to_string(file.height));
+    }
+    options->width = static_cast<int>(file.width);
+    options->height = static_cast<int>(file.height);
+  }
 }
 
 AppConfig LoadAccuracyConfig(const std::string& path, const std::string& command,

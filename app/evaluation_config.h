@@ -31,6 +31,18 @@ CLI::Option* AddSeedOption(CLI::App& cli, std::uint64_t* seed, const std::string
 void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
                              const std::string& kdu_help);
 
+/// Adds the rendered camera's options: --width, --height, --focal, and --camera FILE (a ViSP
+/// camera file, whose camera and image size replace them and --kdu).
+void AddRenderedCameraOptions(CLI::App& cli, RenderedFrameOptions* options,
+                              std::string* camera_path);
+
+/// After parsing: the camera file `camera_path` (when given) read into options->camera and its
+/// image size into width and height (when it has one); with --width and no --focal, the
+/// focal length that keeps the reference camera's field of view (600 px at 640 px wide).
+/// Throws std::runtime_error naming --camera, or naming the options that cannot go with it.
+void ApplyRenderedCameraOptions(const CLI::App& cli, const std::string& camera_path,
+                                RenderedFrameOptions* options);
+
 /// Whether the YAML file at `path` (read before, without error) has a top-level `section`.
 bool ConfigHasSection(const std::string& path, const std::string& section);
 

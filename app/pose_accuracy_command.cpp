@@ -169,6 +169,8 @@ int RunPoseAccuracy(int argc, char** argv) {
   PoseAccuracyOptions options;
   std::string target_name = options.target.name, config_path, out_path;
   AddRenderedFrameOptions(cli, &options, "lens distortion (ViSP kdu)");
+  std::string camera_path;
+  AddRenderedCameraOptions(cli, &options, &camera_path);
   cli.add_option("--gradient", options.illumination_gradient,
                  "illumination fall-off across the image, [0, 0.9]")
       ->capture_default_str();
@@ -217,6 +219,7 @@ int RunPoseAccuracy(int argc, char** argv) {
       "  oalservo pose-accuracy --frames 1000 --seed 4 --save-missed out/missed\n"
       "  oalservo pose out/missed   # the missed frames again, one JSON line each");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  ApplyRenderedCameraOptions(cli, camera_path, &options);
 
   // Everything that can fail before the evaluation's minutes of work.
   AppConfig config;

@@ -13,6 +13,7 @@
 #include "app/evaluation_config.h"  // AddSeedOption
 #include "base/check.h"
 #include "io/atomic_file.h"
+#include "io/camera_file.h"
 #include "io/rendered_dataset.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
@@ -37,6 +38,14 @@ RenderOptions ToRenderOptions(const RenderCommandOptions& options, const SceneOp
   render.width = options.width;
   render.height = options.height;
   render.camera = RenderCamera(options.width, options.height, options.fx_px, options.kdu);
+  if (!options.camera_path.empty()) {
+    const CameraFile file = LoadCameraFile(options.camera_path);
+    render.camera = file.camera;
+    if (file.width > 0 && file.height > 0) {
+      render.width = static_cast<int>(file.width);
+      render.height = static_cast<int>(file.height);
+    }
+  }
   render.noise_sigma = options.noise_sigma;
   render.blur_sigma_px = options.blur_sigma_px;
   if (options.gradient > 0.0) render.illumination_gradient = options.gradient;
@@ -99,7 +108,8 @@ void RenderRandomDataset(const RenderCommandOptions& options, const AppConfig& c
                          const fs::path& dir) {
   const SceneRenderer renderer(config.target, ToRenderOptions(options, config.scene));
   WriteRandomDataset(renderer, ToPoseSampling(options), options.count,
-                     DatasetLabels{config.target.name, options.seed, kCameraName}, dir);
+                     DatasetLabels{config.target.name, options.seed, kCameraName}, dir,
+                     config.scene.lived_in);
 }
 
 }  // namespace
@@ -207,6 +217,10 @@ int RunRender(int argc, char** argv) {
           ->capture_default_str(),
       cli.add_option("--kdu", options.kdu, "lens distortion (ViSP kdu; 0.33 is a cheap wide lens)")
           ->capture_default_str(),
+      cli.add_option("--camera", options.camera_path,
+                     "render through this ViSP camera file's camera (px, py, u0, v0, kdu) at its "
+                     "image size, instead of --fx, --kdu (and --width, --height when it has one)")
+          ->check(CLI::ExistingFile),
       cli.add_option("--noise", options.noise_sigma, "Gaussian noise sigma, grey levels")
           ->capture_default_str(),
       cli.add_option("--blur", options.blur_sigma_px, "Gaussian blur sigma, pixels")
@@ -233,6 +247,8 @@ int RunRender(int argc, char** argv) {
                      "every target line visible over at least this length, pixels")
           ->capture_default_str()};
   for (CLI::Option* option : random_pose_options) sequence->excludes(option);
+  // The camera file gives the focal length and the lens.
+  cli.get_option("--camera")->excludes(cli.get_option("--fx"))->excludes(cli.get_option("--kdu"));
   cli.footer(
       "All or nothing: the frames are rendered into a temporary folder next to --out "
       "(DIR.tmp-PID) and moved into --out only when all are written; on an error nothing is "

@@ -31,10 +31,13 @@ struct RenderCommandOptions {
   std::string out_dir;     ///< created if missing; required
   /// Replace the renderer files already in out_dir; false: such a folder is an error.
   bool overwrite = false;
-  int width = 640;             ///< pixels, [16, 8192]
-  int height = 480;            ///< pixels, [16, 8192]
-  double fx_px = 600.0;        ///< focal length, pixels (fy = fx), > 0
-  double kdu = 0.0;            ///< ViSP distortion, distorted -> undistorted; 0: none
+  int width = 640;       ///< pixels, [16, 8192]
+  int height = 480;      ///< pixels, [16, 8192]
+  double fx_px = 600.0;  ///< focal length, pixels (fy = fx), > 0
+  double kdu = 0.0;      ///< ViSP distortion, distorted -> undistorted; 0: none
+  /// A ViSP camera file to render through instead (its px, py, u0, v0, kdu and, when it has
+  /// one, its image size); fx_px and kdu are then unused. Empty: none.
+  std::string camera_path;
   double noise_sigma = 0.0;    ///< Gaussian noise, grey levels, [0, 100]
   double blur_sigma_px = 0.0;  ///< Gaussian blur, pixels, [0, 20]
   double gradient = 0.0;       ///< illumination fall-off across the image, [0, 0.9]

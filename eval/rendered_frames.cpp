@@ -40,6 +40,9 @@ void RenderedFrameOptions::Check() const {
                 focal_px, "focal_px > 0");
   RequireOption(noise_max <= 100.0, "--noise-max", noise_max, "--noise-max <= 100");
   RequireOption(blur_max_px <= 20.0, "--blur-max", blur_max_px, "--blur-max <= 20");
+  RequireOption(width <= 8192 && height <= 8192, "RenderedFrameOptions::width, height",
+                std::to_string(width) + "x" + std::to_string(height), "both <= 8192");
+  scene.lived_in.Check();
 }
 
 RenderOptions MakeRenderOptions(const RenderedFrameOptions& options) {
@@ -61,7 +64,7 @@ RenderOptions MakeRenderOptions(const RenderedFrameOptions& options) {
 }
 
 EvaluationScenes::EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options)
-    : options_(options) {
+    : options_(options), target_(target) {
   std::vector<std::string> paths = options.backgrounds;
   if (paths.empty() && !options.scene.background.empty()) paths = {options.scene.background};
   const RenderOptions base = MakeRenderOptions(options);
@@ -99,6 +102,7 @@ FrameEffects EvaluationScenes::EffectsFor(int frame) const {
   };
   effects.noise_sigma = draw(options_.noise_sigma, options_.noise_max, 1);
   effects.blur_sigma_px = draw(options_.blur_sigma_px, options_.blur_max_px, 2);
+  DrawLivedIn(options_.scene.lived_in, target_, options_.seed, frame, &effects);
   return effects;
 }
 
@@ -127,18 +131,37 @@ std::vector<std::string> DefaultBenchPhotos() {
 }
 
 nlohmann::json RenderedFrameJson(const RenderedFrameOptions& options) {
-  return {{"frames", options.frames},
-          {"seed", options.seed},
-          {"width", options.width},
-          {"height", options.height},
-          {"focal_px", options.focal_px},
-          {"kdu", options.kdu},
-          {"noise_sigma", options.noise_sigma},
-          {"blur_sigma_px", options.blur_sigma_px},
-          {"noise_max", options.noise_max},
-          {"blur_max_px", options.blur_max_px},
-          {"illumination_gradient", options.illumination_gradient},
-          {"backgrounds", options.backgrounds}};
+  nlohmann::json json{{"frames", options.frames},
+                      {"seed", options.seed},
+                      {"width", options.width},
+                      {"height", options.height},
+                      {"focal_px", options.focal_px},
+                      {"kdu", options.kdu},
+                      {"noise_sigma", options.noise_sigma},
+                      {"blur_sigma_px", options.blur_sigma_px},
+                      {"noise_max", options.noise_max},
+                      {"blur_max_px", options.blur_max_px},
+                      {"illumination_gradient", options.illumination_gradient},
+                      {"backgrounds", options.backgrounds}};
+  if (options.camera) {
+    const vpCameraParameters& c = *options.camera;
+    json["camera"] = {
+        {"px", c.get_px()},
+        {"py", c.get_py()},
+        {"u0", c.get_u0()},
+        {"v0", c.get_v0()},
+        {"kdu", c.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion ? c.get_kdu()
+                                                                                       : 0.0}};
+  }
+  if (options.scene.lived_in.Any()) {
+    const LivedInOptions& l = options.scene.lived_in;
+    json["lived_in"] = {{"occluders", l.occluders.fraction},
+                        {"glare", l.glare.fraction},
+                        {"exposure", l.exposure.fraction},
+                        {"motion_blur", l.motion_blur.fraction},
+                        {"jpeg", l.jpeg.fraction}};
+  }
+  return json;
 }
 
 // scene/bench_scene.h's DressAsBench() as a config (the benchmarks and tests render it so).

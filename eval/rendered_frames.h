@@ -62,13 +62,15 @@ class EvaluationScenes {
   EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options);
   /// The renderer of frame `frame` (backgrounds in turn).
   const SceneRenderer& For(int frame) const;
-  /// Frame `frame`'s noise and blur (FrameEffects), drawn from `seed` and the frame.
+  /// Frame `frame`'s noise and blur, and the scene's lived-in conditions (FrameEffects),
+  /// drawn from `seed` and the frame.
   FrameEffects EffectsFor(int frame) const;
   /// "Klimt.pgm" etc., or "uniform grey", for frame `frame`.
   std::string BackgroundName(int frame) const;
 
  private:
   RenderedFrameOptions options_;
+  LineTarget target_;
   std::vector<SceneRenderer> renderers_;
   std::vector<std::string> names_;
 };

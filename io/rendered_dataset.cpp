@@ -152,7 +152,44 @@ void StagedDataset::RemoveCreatedParents() noexcept {
 Json EffectsJson(const FrameEffects& effects) {
   Json occluders = Json::array();
   for (const Occluder& occluder : effects.occluders) occluders.push_back(OccluderJson(occluder));
-  return Json{{"gain", effects.gain}, {"offset", effects.offset}, {"occluders", occluders}};
+  Json json{{"gain", effects.gain}, {"offset", effects.offset}, {"occluders", occluders}};
+  if (!effects.plane_occluders.empty()) {
+    Json on_plane = Json::array();
+    for (const PlaneOccluder& o : effects.plane_occluders) {
+      Json capsules = Json::array(), ellipses = Json::array();
+      for (const PlaneOccluder::Capsule& c : o.capsules) {
+        capsules.push_back(
+            {{"from_m", {c.x1_m, c.y1_m}}, {"to_m", {c.x2_m, c.y2_m}}, {"radius_m", c.radius_m}});
+      }
+      for (const PlaneOccluder::Ellipse& e : o.ellipses) {
+        ellipses.push_back({{"centre_m", {e.x_m, e.y_m}},
+                            {"semi_axes_m", {e.semi_a_m, e.semi_b_m}},
+                            {"angle_rad", e.angle_rad}});
+      }
+      on_plane.push_back({{"capsules", capsules},
+                          {"ellipses", ellipses},
+                          {"grey", o.grey},
+                          {"texture_grey", o.texture_grey},
+                          {"shadow_darkness", o.shadow_darkness}});
+    }
+    json["plane_occluders"] = on_plane;
+  }
+  if (!effects.glares.empty()) {
+    Json glares = Json::array();
+    for (const Glare& g : effects.glares) {
+      glares.push_back(
+          {{"centre_m", {g.x_m, g.y_m}}, {"sigma_m", g.sigma_m}, {"peak_grey", g.peak_grey}});
+    }
+    json["glares"] = glares;
+  }
+  if (effects.motion_blur_px > 0.0) {
+    json["motion_blur_px"] = effects.motion_blur_px;
+    json["motion_blur_angle_rad"] = effects.motion_blur_angle_rad;
+  }
+  if (effects.jpeg_quality > 0) json["jpeg_quality"] = effects.jpeg_quality;
+  if (effects.noise_sigma >= 0.0) json["noise_sigma"] = effects.noise_sigma;
+  if (effects.blur_sigma_px >= 0.0) json["blur_sigma_px"] = effects.blur_sigma_px;
+  return json;
 }
 
 void WriteDatasetFrame(const fs::path& dir, int index, const RenderedFrame& frame,
@@ -164,18 +201,26 @@ void WriteDatasetFrame(const fs::path& dir, int index, const RenderedFrame& fram
 }
 
 void WriteRandomDataset(const SceneRenderer& renderer, const PoseSampling& sampling, int count,
-                        const DatasetLabels& labels, const fs::path& dir) {
+                        const DatasetLabels& labels, const fs::path& dir,
+                        const LivedInOptions& events) {
   const RenderOptions& render = renderer.options();
   SaveDatasetCamera(dir, render, labels.camera);
   std::uint64_t state = labels.seed;
   for (int i = 0; i < count; ++i) {
     const vpHomogeneousMatrix cMo = SamplePose(renderer, sampling, &state);
     const std::uint64_t noise_seed = NoiseSeed(labels.seed, i);
-    const RenderedFrame frame = renderer.Render(cMo, noise_seed);
-    WriteDatasetFrame(
-        dir, i, frame,
-        FrameTruthJson(frame, i, DatasetFrameName(i, ".png"), labels.target, labels.seed,
-                       noise_seed, render.camera, render.width, render.height));
+    FrameEffects effects;
+    DrawLivedIn(events, renderer.target(), labels.seed, i, &effects);
+    const RenderedFrame frame = renderer.Render(cMo, noise_seed, effects);
+    Json truth = FrameTruthJson(frame, i, DatasetFrameName(i, ".png"), labels.target, labels.seed,
+                                noise_seed, render.camera, render.width, render.height);
+    if (events.Any()) {
+      for (std::size_t l = 0; l < frame.truth.size(); ++l) {
+        truth["lines"][l]["occluded_fraction"] = frame.truth[l].occluded_fraction;
+      }
+      truth["effects"] = EffectsJson(effects);
+    }
+    WriteDatasetFrame(dir, i, frame, truth);
   }
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "io/json_io.h"
+#include "scene/lived_in.h"
 #include "scene/scene.h"
 #include "scene/sequence.h"
 
@@ -65,7 +66,8 @@ class StagedDataset {
   bool committed_ = false;
 };
 
-/// The frame's gain, offset and occluders as JSON ("effects" of a sequence's frame).
+/// The frame's effects as JSON ("effects" of a sequence's frame): gain, offset, occluders, and
+/// those of a lived-in scene when it has them (plane occluders, glares, motion blur, JPEG).
 Json EffectsJson(const FrameEffects& effects);
 
 /// Writes `dir`/camera.xml: `render`'s camera and image size, the camera named `name`.
@@ -85,10 +87,12 @@ struct DatasetLabels {
 };
 
 /// `count` frames of `renderer`'s scene from poses drawn by SamplePose(`sampling`) from
-/// `labels.seed`, their truth and camera.xml, written into `dir`. Throws what SamplePose and
-/// the writes throw.
+/// `labels.seed`, each with the lived-in conditions `events` draws for it (its truth then
+/// records them and each line's occluded fraction), their truth and camera.xml, written into
+/// `dir`. Throws what SamplePose and the writes throw.
 void WriteRandomDataset(const SceneRenderer& renderer, const PoseSampling& sampling, int count,
-                        const DatasetLabels& labels, const std::filesystem::path& dir);
+                        const DatasetLabels& labels, const std::filesystem::path& dir,
+                        const LivedInOptions& events = LivedInOptions());
 
 /// The frames of `sequence` through `renderer`, their truth (with the sequence's name, each
 /// frame's effects and each line's occluded fraction), camera.xml and sequence.json (last),

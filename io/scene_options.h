@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "scene/lived_in.h"
 #include "scene/scene.h"
 
 namespace oal {
@@ -42,6 +43,9 @@ struct SceneOptions {
   int clutter_objects = 0;                    ///< [0, 50]
   double clutter_reach_m = 0.3;               ///< (0, 10]
   int seed = 1;                               ///< the clutter's layout, >= 0
+  /// What happens from frame to frame in a lived-in scene (scene.occluders, glare, exposure,
+  /// motion_blur, jpeg): drawn per frame by whoever renders the frames (scene/lived_in.h).
+  LivedInOptions lived_in;
 
   /// Copies the effects into `render` and reads the background image. Throws
   /// std::runtime_error "FILE:LINE: scene.background ..." when it cannot be read, and

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
@@ -142,7 +143,7 @@ double ApparentWidth(const TargetLine& line, const vpHomogeneousMatrix& cMo,
 }
 
 TruthLine LineTruth(const TargetLine& line, int index, const vpHomogeneousMatrix& cMo,
-                    const RenderOptions& options, const std::vector<Occluder>& occluders) {
+                    const RenderOptions& options, const FrameEffects& effects) {
   TruthLine truth;
   truth.index = index;
   const Vec3 c1 = ToCamera(cMo, line.x1_m, line.y1_m);
@@ -153,10 +154,15 @@ TruthLine LineTruth(const TargetLine& line, int index, const vpHomogeneousMatrix
   if (!VisibleRange(view, &t_a, &t_b)) return truth;
 
   std::vector<Point2d> points;
+  std::vector<double> along;  // each point's parameter on the centre line
   points.reserve(kFitSamples);
   for (int i = 0; i < kFitSamples; ++i) {
     Point2d p;
-    if (view.Inside(t_a + (t_b - t_a) * i / (kFitSamples - 1.0), &p)) points.push_back(p);
+    const double t = t_a + (t_b - t_a) * i / (kFitSamples - 1.0);
+    if (view.Inside(t, &p)) {
+      points.push_back(p);
+      along.push_back(t);
+    }
   }
   if (points.size() < 2) return truth;
   truth.visible = true;
@@ -166,11 +172,19 @@ TruthLine LineTruth(const TargetLine& line, int index, const vpHomogeneousMatrix
   truth.visible_length_px =
       std::hypot(truth.end_b.u - truth.end_a.u, truth.end_b.v - truth.end_a.v);
   truth.width_px = ApparentWidth(line, cMo, options.camera, 0.5 * (t_a + t_b));
-  if (!occluders.empty()) {
-    const auto hidden = std::count_if(points.begin(), points.end(), [&](const Point2d& p) {
-      return std::any_of(occluders.begin(), occluders.end(),
-                         [&](const Occluder& o) { return o.Contains(p.u, p.v); });
-    });
+  const std::vector<Occluder>& occluders = effects.occluders;
+  const std::vector<PlaneOccluder>& on_plane = effects.plane_occluders;
+  if (!occluders.empty() || !on_plane.empty()) {
+    int hidden = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point2d& p = points[i];
+      const double X = line.x1_m + along[i] * (line.x2_m - line.x1_m);
+      const double Y = line.y1_m + along[i] * (line.y2_m - line.y1_m);
+      hidden += std::any_of(occluders.begin(), occluders.end(),
+                            [&](const Occluder& o) { return o.Contains(p.u, p.v); }) ||
+                std::any_of(on_plane.begin(), on_plane.end(),
+                            [&](const PlaneOccluder& o) { return o.Contains(X, Y); });
+    }
     truth.occluded_fraction = static_cast<double>(hidden) / static_cast<double>(points.size());
   }
   return truth;
@@ -833,9 +847,9 @@ class PlaneGrid {
   std::vector<std::vector<int>> cells_;
 };
 
-// Smooth value noise in [-1, 1] on kPaperCellM cells of the plane.
-double PaperNoise(double X, double Y, std::uint64_t seed) {
-  const double fx = X / kPaperCellM, fy = Y / kPaperCellM;
+// Smooth value noise in [-1, 1] on cells of cell_m of the plane.
+double ValueNoise(double X, double Y, double cell_m, std::uint64_t seed) {
+  const double fx = X / cell_m, fy = Y / cell_m;
   if (!(std::fabs(fx) < 1e9 && std::fabs(fy) < 1e9)) return 0.0;
   const double x0 = std::floor(fx), y0 = std::floor(fy);
   const double ax = fx - x0, ay = fy - y0;
@@ -847,6 +861,10 @@ double PaperNoise(double X, double Y, std::uint64_t seed) {
   const double top = (1.0 - ax) * lattice(x0, y0) + ax * lattice(x0 + 1.0, y0);
   const double bottom = (1.0 - ax) * lattice(x0, y0 + 1.0) + ax * lattice(x0 + 1.0, y0 + 1.0);
   return (1.0 - ay) * top + ay * bottom;
+}
+
+double PaperNoise(double X, double Y, std::uint64_t seed) {
+  return ValueNoise(X, Y, kPaperCellM, seed);
 }
 
 // Text in OpenCV's Hershey simplex font, lines from top to bottom, cap height cap_m, strokes
@@ -1228,6 +1246,141 @@ std::shared_ptr<const SceneDressing> BuildDressing(const LineTarget& target,
   return d;
 }
 
+// -------------------------------------------------------------------------------------------
+// A frame's events on the plane (glares, and occluders with their shadows) and in the image
+// (motion blur, JPEG).
+
+// Cells of an occluder's texture (metres).
+constexpr double kOccluderCellM = 0.005;
+
+// The frame's glares and plane occluders, each culled by a box on the plane.
+class PlaneEvents {
+ public:
+  explicit PlaneEvents(const FrameEffects& effects) {
+    for (const Glare& glare : effects.glares) {
+      const double reach = 4.0 * glare.sigma_m;
+      glares_.push_back({&glare, Box{glare.x_m - reach, glare.y_m - reach, glare.x_m + reach,
+                                     glare.y_m + reach}});
+    }
+    for (const PlaneOccluder& occluder : effects.plane_occluders) {
+      Box box = OutlineBox(occluder);
+      Box shadow = box;
+      const double dx = occluder.shadow_offset_m * std::cos(occluder.shadow_angle_rad);
+      const double dy = occluder.shadow_offset_m * std::sin(occluder.shadow_angle_rad);
+      const double soft = occluder.shadow_softness_m;
+      shadow = Box{box.min_x + dx - soft, box.min_y + dy - soft, box.max_x + dx + soft,
+                   box.max_y + dy + soft};
+      box = Box{box.min_x - kCullMarginM, box.min_y - kCullMarginM, box.max_x + kCullMarginM,
+                box.max_y + kCullMarginM};
+      occluders_.push_back({&occluder, box, shadow, dx, dy});
+    }
+  }
+
+  bool empty() const { return glares_.empty() && occluders_.empty(); }
+
+  // What the pixel whose centre sees the plane sample s shows, `under` being the scene there.
+  double Apply(double under, const PlaneSample& s) const {
+    double value = under;
+    for (const OccluderBoxes& o : occluders_) {
+      if (o.occluder->shadow_darkness <= 0.0 || !o.shadow.Contains(s.X, s.Y)) continue;
+      const double w = std::max(o.occluder->shadow_softness_m, Footprint(s));
+      const double d = o.occluder->SignedDistance(s.X - o.shadow_dx, s.Y - o.shadow_dy);
+      value *= 1.0 - o.occluder->shadow_darkness * std::clamp(0.5 - d / w, 0.0, 1.0);
+    }
+    for (const GlareBox& g : glares_) {
+      if (!g.box.Contains(s.X, s.Y)) continue;
+      const double dx = s.X - g.glare->x_m, dy = s.Y - g.glare->y_m;
+      value += g.glare->peak_grey *
+               std::exp(-(dx * dx + dy * dy) / (2.0 * g.glare->sigma_m * g.glare->sigma_m));
+    }
+    for (const OccluderBoxes& o : occluders_) {
+      if (!o.box.Contains(s.X, s.Y)) continue;
+      const PlaneOccluder& occluder = *o.occluder;
+      const double cover =
+          std::clamp(0.5 - occluder.SignedDistance(s.X, s.Y) / Footprint(s), 0.0, 1.0);
+      if (cover <= 0.0) continue;
+      double grey = occluder.grey;
+      if (occluder.texture_grey > 0.0) {
+        grey += occluder.texture_grey *
+                ValueNoise(s.X, s.Y, kOccluderCellM, Mix(occluder.texture_seed ^ 0x68616e64ull));
+      }
+      value += cover * (grey - value);
+    }
+    return value;
+  }
+
+ private:
+  struct GlareBox {
+    const Glare* glare;
+    Box box;
+  };
+  struct OccluderBoxes {
+    const PlaneOccluder* occluder;
+    Box box, shadow;
+    double shadow_dx, shadow_dy;
+  };
+
+  static Box OutlineBox(const PlaneOccluder& o) {
+    Box box{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+            std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+    const auto grow = [&box](double x, double y, double r) {
+      box.min_x = std::min(box.min_x, x - r);
+      box.min_y = std::min(box.min_y, y - r);
+      box.max_x = std::max(box.max_x, x + r);
+      box.max_y = std::max(box.max_y, y + r);
+    };
+    for (const PlaneOccluder::Capsule& c : o.capsules) {
+      grow(c.x1_m, c.y1_m, c.radius_m);
+      grow(c.x2_m, c.y2_m, c.radius_m);
+    }
+    for (const PlaneOccluder::Ellipse& e : o.ellipses) {
+      grow(e.x_m, e.y_m, std::max(e.semi_a_m, e.semi_b_m));
+    }
+    return box;
+  }
+
+  std::vector<GlareBox> glares_;
+  std::vector<OccluderBoxes> occluders_;
+};
+
+// The image integrated along a straight path of length_px in direction angle_rad: a kernel of
+// the segment's samples, each spread bilinearly over the four pixels around it.
+void ApplyMotionBlur(double length_px, double angle_rad, cv::Mat1f* image) {
+  if (length_px <= 0.0) return;
+  const int half = static_cast<int>(std::ceil(0.5 * length_px)) + 1;
+  cv::Mat1f kernel = cv::Mat1f::zeros(2 * half + 1, 2 * half + 1);
+  const int samples = std::max(2, static_cast<int>(std::ceil(8.0 * length_px)));
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  for (int i = 0; i < samples; ++i) {
+    const double t = length_px * ((i + 0.5) / samples - 0.5);
+    const double x = half + t * c, y = half + t * s;
+    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    const double ax = x - x0, ay = y - y0;
+    kernel(y0, x0) += static_cast<float>((1.0 - ax) * (1.0 - ay));
+    kernel(y0, x0 + 1) += static_cast<float>(ax * (1.0 - ay));
+    kernel(y0 + 1, x0) += static_cast<float>((1.0 - ax) * ay);
+    kernel(y0 + 1, x0 + 1) += static_cast<float>(ax * ay);
+  }
+  kernel /= static_cast<float>(cv::sum(kernel)[0]);
+  cv::filter2D(*image, *image, -1, kernel, cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT);
+}
+
+// The 8-bit frame compressed as a JPEG of `quality` and decoded again.
+void CompressAsJpeg(int quality, vpImage<unsigned char>* image) {
+  if (quality <= 0) return;
+  const cv::Mat view(static_cast<int>(image->getHeight()), static_cast<int>(image->getWidth()),
+                     CV_8U, image->bitmap);
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".jpg", view, bytes, {cv::IMWRITE_JPEG_QUALITY, quality})) {
+    throw std::runtime_error("the frame could not be compressed as a JPEG");
+  }
+  const cv::Mat decoded = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  if (decoded.size() != view.size() || decoded.type() != CV_8U) {
+    throw std::runtime_error("the frame's JPEG could not be decoded");
+  }
+  decoded.copyTo(view);
+}
+
 }  // namespace
 
 // -------------------------------------------------------------------------------------------
@@ -1313,6 +1466,68 @@ void Occluder::Check() const {
   RequireOption(InRange(grey, 0, 255), "Occluder::grey", grey, "0 <= grey <= 255");
 }
 
+double PlaneOccluder::SignedDistance(double X, double Y) const {
+  double distance = std::numeric_limits<double>::infinity();
+  for (const Capsule& c : capsules) {
+    const double dx = c.x2_m - c.x1_m, dy = c.y2_m - c.y1_m;
+    const double length2 = dx * dx + dy * dy;
+    const double t = length2 > 0.0
+                         ? std::clamp(((X - c.x1_m) * dx + (Y - c.y1_m) * dy) / length2, 0.0, 1.0)
+                         : 0.0;
+    distance =
+        std::min(distance, std::hypot(X - c.x1_m - t * dx, Y - c.y1_m - t * dy) - c.radius_m);
+  }
+  for (const Ellipse& e : ellipses) {
+    // f = (a'/A)^2 + (b'/B)^2 - 1 over its gradient's length: the distance to first order.
+    const double cs = std::cos(e.angle_rad), sn = std::sin(e.angle_rad);
+    const double a = cs * (X - e.x_m) + sn * (Y - e.y_m), b = -sn * (X - e.x_m) + cs * (Y - e.y_m);
+    const double ia = 1.0 / (e.semi_a_m * e.semi_a_m), ib = 1.0 / (e.semi_b_m * e.semi_b_m);
+    const double f = a * a * ia + b * b * ib - 1.0;
+    const double gradient = 2.0 * std::hypot(a * ia, b * ib);
+    distance =
+        std::min(distance, gradient > 0.0 ? f / gradient : -std::min(e.semi_a_m, e.semi_b_m));
+  }
+  return distance;
+}
+
+void PlaneOccluder::Check() const {
+  RequireOption(!capsules.empty() || !ellipses.empty(), "PlaneOccluder::capsules, ellipses", "none",
+                "at least one capsule or ellipse");
+  for (const Capsule& c : capsules) {
+    RequireOption(std::isfinite(c.x1_m) && std::isfinite(c.y1_m) && std::isfinite(c.x2_m) &&
+                      std::isfinite(c.y2_m),
+                  "PlaneOccluder::Capsule::x1_m, y1_m, x2_m, y2_m", "not finite", "finite");
+    RequireOption(c.radius_m > 0.0 && c.radius_m <= 1.0, "PlaneOccluder::Capsule::radius_m",
+                  c.radius_m, "0 < radius_m <= 1");
+  }
+  for (const Ellipse& e : ellipses) {
+    RequireOption(std::isfinite(e.x_m) && std::isfinite(e.y_m) && std::isfinite(e.angle_rad),
+                  "PlaneOccluder::Ellipse::x_m, y_m, angle_rad", "not finite", "finite");
+    RequireOption(e.semi_a_m > 0.0 && e.semi_a_m <= 1.0 && e.semi_b_m > 0.0 && e.semi_b_m <= 1.0,
+                  "PlaneOccluder::Ellipse::semi_a_m, semi_b_m",
+                  std::to_string(e.semi_a_m) + ", " + std::to_string(e.semi_b_m), "both in (0, 1]");
+  }
+  RequireOption(InRange(grey, 0, 255), "PlaneOccluder::grey", grey, "0 <= grey <= 255");
+  RequireOption(InRange(texture_grey, 0.0, 100.0), "PlaneOccluder::texture_grey", texture_grey,
+                "0 <= texture_grey <= 100");
+  RequireOption(InRange(shadow_darkness, 0.0, 0.95), "PlaneOccluder::shadow_darkness",
+                shadow_darkness, "0 <= shadow_darkness <= 0.95");
+  RequireOption(InRange(shadow_offset_m, 0.0, 1.0), "PlaneOccluder::shadow_offset_m",
+                shadow_offset_m, "0 <= shadow_offset_m <= 1");
+  RequireOption(std::isfinite(shadow_angle_rad), "PlaneOccluder::shadow_angle_rad",
+                shadow_angle_rad, "shadow_angle_rad is finite");
+  RequireOption(InRange(shadow_softness_m, 0.0, 1.0), "PlaneOccluder::shadow_softness_m",
+                shadow_softness_m, "0 <= shadow_softness_m <= 1");
+}
+
+void Glare::Check() const {
+  RequireOption(std::isfinite(x_m) && std::isfinite(y_m), "Glare::x_m, y_m", "not finite",
+                "finite");
+  RequireOption(sigma_m > 0.0 && sigma_m <= 1.0, "Glare::sigma_m", sigma_m, "0 < sigma_m <= 1");
+  RequireOption(InRange(peak_grey, 0.0, 2000.0), "Glare::peak_grey", peak_grey,
+                "0 <= peak_grey <= 2000");
+}
+
 void FrameEffects::Check() const {
   RequireOption(InRange(gain, 0.0, 10.0), "FrameEffects::gain", gain, "0 <= gain <= 10");
   RequireOption(InRange(offset, -255.0, 255.0), "FrameEffects::offset", offset,
@@ -1322,6 +1537,14 @@ void FrameEffects::Check() const {
                 "noise_sigma <= 100 (negative: the renderer's)");
   RequireOption(blur_sigma_px < 0.0 || blur_sigma_px <= 20.0, "FrameEffects::blur_sigma_px",
                 blur_sigma_px, "blur_sigma_px <= 20 (negative: the renderer's)");
+  for (const PlaneOccluder& occluder : plane_occluders) occluder.Check();
+  for (const Glare& glare : glares) glare.Check();
+  RequireOption(InRange(motion_blur_px, 0.0, 200.0), "FrameEffects::motion_blur_px", motion_blur_px,
+                "0 <= motion_blur_px <= 200");
+  RequireOption(std::isfinite(motion_blur_angle_rad), "FrameEffects::motion_blur_angle_rad",
+                motion_blur_angle_rad, "motion_blur_angle_rad is finite");
+  RequireOption(InRange(jpeg_quality, 0, 100), "FrameEffects::jpeg_quality", jpeg_quality,
+                "0 <= jpeg_quality <= 100");
 }
 
 void PoseSampling::Check() const {
@@ -1381,6 +1604,7 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_
                                    options_.background_grey);
   const double board = target_.board_grey, line = target_.line_grey;
   const SceneDressing* dressing = dressing_.get();
+  const PlaneEvents events(effects);
 
   cv::Mat1f radiance(options_.height, options_.width);
   for (int v = 0; v < options_.height; ++v) {
@@ -1400,14 +1624,15 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_
         if (c.board < 1.0) around = dressing->Surface(around, s, footprint_m);
         if (c.board > 0.0) paper = dressing->Paper(board, s, footprint_m);
       }
-      row[u] =
-          static_cast<float>(around * (1.0 - c.board) + paper * (c.board - c.dark) + line * c.dark);
+      const double seen = around * (1.0 - c.board) + paper * (c.board - c.dark) + line * c.dark;
+      row[u] = static_cast<float>(events.empty() ? seen : events.Apply(seen, s));
     }
   }
   PaintOccluders(effects.occluders, &radiance);
   ApplyIllumination(options_.illumination_gradient, options_.gradient_angle_rad, &radiance);
   ApplyLightFalloff(options_, &radiance);
   ApplyGainOffset(effects.gain, effects.offset, &radiance);
+  ApplyMotionBlur(effects.motion_blur_px, effects.motion_blur_angle_rad, &radiance);
   const double blur = effects.blur_sigma_px >= 0.0 ? effects.blur_sigma_px : options_.blur_sigma_px;
   if (blur > 0.0) {
     cv::GaussianBlur(radiance, radiance, cv::Size(), blur, blur, cv::BORDER_REFLECT);
@@ -1419,6 +1644,7 @@ RenderedFrame SceneRenderer::Render(const vpHomogeneousMatrix& cMo, std::uint64_
   frame.image.resize(static_cast<unsigned>(options_.height), static_cast<unsigned>(options_.width));
   cv::Mat out(options_.height, options_.width, CV_8U, frame.image.bitmap);
   radiance.convertTo(out, CV_8U);  // rounds and saturates to [0, 255]
+  CompressAsJpeg(effects.jpeg_quality, &frame.image);
   frame.cMo = cMo;
   frame.truth = Truth(cMo, effects);
   return frame;
@@ -1433,8 +1659,7 @@ std::vector<TruthLine> SceneRenderer::Truth(const vpHomogeneousMatrix& cMo,
   std::vector<TruthLine> truth;
   truth.reserve(target_.lines.size());
   for (std::size_t i = 0; i < target_.lines.size(); ++i) {
-    truth.push_back(
-        LineTruth(target_.lines[i], static_cast<int>(i), cMo, options_, effects.occluders));
+    truth.push_back(LineTruth(target_.lines[i], static_cast<int>(i), cMo, options_, effects));
   }
   return truth;
 }

@@ -136,6 +136,55 @@ struct Occluder {
   void Check() const;
 };
 
+/// Something lying on the target's plane or held just above it, in front of the board and the
+/// surface: a hand, a pen, a cable, a tool. Its outline is a union of capsules (a segment with
+/// a radius) and ellipses on the plane (object frame, metres); it is anti-aliased from its
+/// distance to the rim, textured, and may cast a soft shadow on what lies under it.
+struct PlaneOccluder {
+  struct Capsule {
+    double x1_m = 0.0, y1_m = 0.0, x2_m = 0.0, y2_m = 0.0;  ///< the segment, finite
+    double radius_m = 0.01;                                 ///< (0, 1]
+  };
+  struct Ellipse {
+    double x_m = 0.0, y_m = 0.0;              ///< centre, finite
+    double semi_a_m = 0.05, semi_b_m = 0.03;  ///< semi-axes along angle_rad and across, (0, 1]
+    double angle_rad = 0.0;                   ///< finite
+  };
+  std::vector<Capsule> capsules;
+  std::vector<Ellipse> ellipses;
+  int grey = 150;  ///< its mean grey level, [0, 255]
+  /// Its grey varies smoothly by up to +-texture_grey (value noise on 5 mm cells from
+  /// texture_seed: skin, fabric, a printed pen). [0, 100]
+  double texture_grey = 0.0;
+  std::uint64_t texture_seed = 0;
+  /// Held above the plane, it shades what lies under it: the outline moved by shadow_offset_m
+  /// along shadow_angle_rad (object frame), its edge ramping over shadow_softness_m, darkens by
+  /// the factor 1 - shadow_darkness. 0: none. [0, 0.95]
+  double shadow_darkness = 0.0;
+  double shadow_offset_m = 0.0;     ///< [0, 1]
+  double shadow_angle_rad = 0.0;    ///< finite
+  double shadow_softness_m = 0.01;  ///< [0, 1]
+
+  /// The signed distance from the plane point (X, Y) to the outline, metres: negative inside.
+  /// Exact for the capsules, first order near the rim for the ellipses.
+  double SignedDistance(double X, double Y) const;
+  bool Contains(double X, double Y) const { return SignedDistance(X, Y) <= 0.0; }
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
+/// A lamp's reflection on the paper: grey levels added around a point of the target's plane
+/// with a Gaussian fall-off, before the exposure, so that its core saturates the sensor over
+/// ink and paper alike.
+struct Glare {
+  double x_m = 0.0, y_m = 0.0;  ///< centre on the plane (object frame), finite
+  double sigma_m = 0.02;        ///< the Gaussian's standard deviation on the plane, (0, 1]
+  double peak_grey = 300.0;     ///< added at the centre, grey levels, [0, 2000]
+
+  /// Throws std::invalid_argument naming the field and the violated constraint.
+  void Check() const;
+};
+
 /// What changes from one frame of a sequence to the next besides the pose: a global
 /// illumination change and occluders. The default is a frame rendered as by Render(cMo, seed).
 struct FrameEffects {
@@ -147,6 +196,17 @@ struct FrameEffects {
   /// varies); negative: RenderOptions'. Ranges as RenderOptions'.
   double noise_sigma = -1.0;
   double blur_sigma_px = -1.0;
+  /// Things on or over the target's plane, drawn in order after the scene and its glares.
+  std::vector<PlaneOccluder> plane_occluders;
+  std::vector<Glare> glares;
+  /// The camera moved during the exposure: the image integrated along a straight path of
+  /// this length in pixels, in the direction motion_blur_angle_rad from the image's u axis
+  /// towards v (applied after the gain, before the blur and the noise). 0: none. [0, 200]
+  double motion_blur_px = 0.0;
+  double motion_blur_angle_rad = 0.0;  ///< finite
+  /// The frame as a webcam's MJPEG delivers it: compressed as a JPEG of this quality and
+  /// decoded, last. 0: not compressed. [0, 100]
+  int jpeg_quality = 0;
 
   /// Throws std::invalid_argument naming the field and the violated constraint.
   void Check() const;
@@ -162,8 +222,9 @@ struct TruthLine {
   Point2d end_a, end_b;      ///< ends of its visible part in the distorted image
   double visible_length_px = 0.0;  ///< |end_b - end_a|, pixels
   double width_px = 0.0;  ///< apparent width in the middle of the visible part, ideal pixels
-  /// Fraction of the visible part of the centre line hidden by occluders, [0, 1]. Occlusion
-  /// never makes a line invisible: `visible` and the fields above ignore occluders.
+  /// Fraction of the visible part of the centre line hidden by occluders (in the image or on
+  /// the plane), [0, 1]. Occlusion never makes a line invisible: `visible` and the fields
+  /// above ignore occluders.
   double occluded_fraction = 0.0;
 };
 
@@ -183,9 +244,10 @@ class SceneRenderer {
 
   /// Renders the target seen from `cMo`; `noise_seed` makes the noise reproducible.
   RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed) const;
-  /// The same with per-frame effects: occluders are painted over the scene, then the
-  /// illumination gradient, the light fall-off (vignetting, hot spot), gain and offset, blur and
-  /// noise are applied in that order. Throws
+  /// The same with per-frame effects: the plane occluders' shadows, the glares and the plane
+  /// occluders over the scene, then the image occluders, the illumination gradient, the light
+  /// fall-off (vignetting, hot spot), gain and offset, motion blur, blur and noise in that
+  /// order; the 8-bit frame is then compressed as a JPEG when asked. Throws
   /// std::invalid_argument if `effects` fails Check().
   RenderedFrame Render(const vpHomogeneousMatrix& cMo, std::uint64_t noise_seed,
                        const FrameEffects& effects) const;

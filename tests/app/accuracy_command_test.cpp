@@ -191,6 +191,42 @@ TEST(AccuracyCommands, OptionRanges) {
   }
 }
 
+// The rendered camera: --width/--height (the focal length in proportion unless --focal), or a
+// camera file's camera at its image size; what cannot go together is refused before the work.
+TEST(AccuracyCommands, TheRenderedCameraFollowsItsOptionsOrACameraFile) {
+  test::TestDir dir;
+  const test::OalservoRun wide = test::RunOalservo(
+      dir, "pose-accuracy --frames 1 --width 1280 --height 720 --out '" + dir / "wide.json" + "'");
+  ASSERT_EQ(wide.exit_code, 0) << wide.err;
+  const json options = json::parse(test::ReadText(dir / "wide.json")).at("options");
+  EXPECT_EQ(options.at("width"), 1280);
+  EXPECT_EQ(options.at("height"), 720);
+  EXPECT_EQ(options.at("focal_px"), 1200.0);
+
+  test::RenderChecked(test::ScaledRender(dir / "small", 1, 3, 320, 240));
+  const std::string camera = dir / "small/camera.xml";
+  const test::OalservoRun small =
+      test::RunOalservo(dir, "detect-accuracy --frames 1 --camera '" + camera + "' --out '" +
+                                 dir / "small.json" + "'");
+  ASSERT_EQ(small.exit_code, 0) << small.err;
+  const json small_options = json::parse(test::ReadText(dir / "small.json")).at("options");
+  EXPECT_EQ(small_options.at("width"), 320);
+  EXPECT_EQ(small_options.at("height"), 240);
+  EXPECT_TRUE(small_options.contains("camera"));
+
+  const test::OalservoRun focal =
+      test::RunOalservo(dir, "pose-accuracy --frames 1 --camera '" + camera + "' --focal 500");
+  EXPECT_EQ(focal.exit_code, 1);
+  EXPECT_THAT(focal.err, HasSubstr("--focal cannot be given with --camera " + camera));
+  const test::OalservoRun size = test::RunOalservo(
+      dir, "pose-accuracy --frames 1 --camera '" + camera + "' --width 640 --height 480");
+  EXPECT_EQ(size.exit_code, 1);
+  EXPECT_THAT(size.err, HasSubstr("disagree with --camera " + camera + ", calibrated at 320x240"));
+  EXPECT_TRUE(size.out.empty());
+  EXPECT_THAT(test::RunOalservo(dir, "pose-accuracy --frames 1 --width 9000").err,
+              HasSubstr("both <= 8192"));
+}
+
 // stdout on a full disk: exit 1 with a message, as `detect` and `pose` do (`compare` too).
 TEST(AccuracyCommands, AFullStdoutIsAnError) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";

@@ -208,6 +208,66 @@ TEST(Config, LoadConfigNamesTheFile) {
 }
 
 // ------------------------------------------------------------------------------------------
+// scene: a lived-in scene's conditions
+
+TEST(ConfigScene, ReadsTheLivedInConditions) {
+  const AppConfig config = ParseConfig(
+      "scene:\n"
+      "  occluders: {fraction: 0.6, kinds: [hand, pen], grey: [40, 200], texture_grey: 8,\n"
+      "              shadow_darkness: 0.2}\n"
+      "  glare: {fraction: 0.4, sigma_m: [0.01, 0.02], peak_grey: [300, 400]}\n"
+      "  exposure: {fraction: 0.3, gain: [0.4, 1.6]}\n"
+      "  motion_blur: {fraction: 0.5, length_px: [2, 10]}\n"
+      "  jpeg: {fraction: 0.25, quality: [50, 80]}\n",
+      "cfg.yaml");
+  const LivedInOptions& lived_in = config.scene.lived_in;
+  EXPECT_EQ(lived_in.occluders.fraction, 0.6);
+  ASSERT_EQ(lived_in.occluders.kinds.size(), 2u);
+  EXPECT_EQ(lived_in.occluders.kinds[1], OccluderKind::kPen);
+  EXPECT_EQ(lived_in.occluders.grey.hi, 200.0);
+  EXPECT_EQ(lived_in.occluders.texture_grey, 8.0);
+  EXPECT_EQ(lived_in.occluders.shadow_darkness, 0.2);
+  EXPECT_EQ(lived_in.glare.sigma_m.lo, 0.01);
+  EXPECT_EQ(lived_in.glare.peak_grey.hi, 400.0);
+  EXPECT_EQ(lived_in.exposure.gain.lo, 0.4);
+  EXPECT_EQ(lived_in.motion_blur.length_px.hi, 10.0);
+  EXPECT_EQ(lived_in.jpeg.fraction, 0.25);
+  EXPECT_EQ(lived_in.jpeg.quality.lo, 50.0);
+  EXPECT_FALSE(AppConfig().scene.lived_in.Any());
+}
+
+TEST(ConfigScene, TheShippedLivedInSceneLoads) {
+  const AppConfig config = LoadConfig(std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml");
+  EXPECT_EQ(config.scene.lived_in.occluders.fraction, 0.6);
+  EXPECT_EQ(config.scene.lived_in.glare.fraction, 0.4);
+  EXPECT_EQ(config.scene.lived_in.exposure.fraction, 0.3);
+  EXPECT_EQ(config.scene.lived_in.motion_blur.fraction, 0.5);
+  EXPECT_EQ(config.scene.lived_in.jpeg.fraction, 0.5);
+}
+
+TEST(ConfigScene, BadLivedInValuesNameFileLineAndKey) {
+  EXPECT_THAT(ErrorOf("scene:\n  glare:\n    sigma_m: [0.01, 0.02]\n    fraction: 1.5\n"),
+              HasSubstr("cfg.yaml:4: 'scene.glare.fraction' is invalid: 1.5"));
+  EXPECT_THAT(ErrorOf("scene:\n  jpeg:\n    quality: [40]\n"),
+              HasSubstr("cfg.yaml:3: 'scene.jpeg.quality' must be a range [lo, hi] of two "
+                        "numbers, got 'a sequence of 1'"));
+  EXPECT_THAT(ErrorOf("scene:\n  jpeg:\n    quality: [90, 40]\n"),
+              HasSubstr("cfg.yaml:3: 'scene.jpeg.quality' is invalid"));
+  EXPECT_THAT(ErrorOf("scene:\n  occluders:\n    kinds: [hand, foot]\n"),
+              HasSubstr("cfg.yaml:3: 'scene.occluders.kinds[1]' must be one of hand, pen, cable, "
+                        "tool, got 'foot'"));
+  EXPECT_THAT(ErrorOf("scene:\n  occluders:\n    kinds: []\n"),
+              HasSubstr("cfg.yaml:3: 'scene.occluders.kinds' must be a sequence of kinds"));
+  EXPECT_THAT(ErrorOf("scene:\n  motion_blur:\n    length_px: [3, fast]\n"),
+              HasSubstr("cfg.yaml:3: 'scene.motion_blur.length_px[1]' must be a number"));
+  EXPECT_THAT(ErrorOf("scene:\n  exposure: 0.3\n"),
+              HasSubstr("cfg.yaml:2: 'scene.exposure' must be a map of keys"));
+  EXPECT_THAT(ErrorOf("scene:\n  glare:\n    strength: 3\n"),
+              HasSubstr("cfg.yaml:3: key 'scene.glare.strength' is unknown (known: fraction, "
+                        "sigma_m, peak_grey)"));
+}
+
+// ------------------------------------------------------------------------------------------
 // target:
 
 void ExpectSameTarget(const LineTarget& a, const LineTarget& b) {

@@ -71,6 +71,50 @@ TEST(Render, WritesFramesTruthAndCamera) {
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
 
+// Through a camera file: its camera at its image size; --fx or --kdu with it is refused.
+TEST(Render, ThroughACameraFile) {
+  test::TestDir dir;
+  ASSERT_EQ(RenderDataset(SmallRender(dir / "small")), 3);
+  RenderCommandOptions again = test::ScaledRender(dir / "again", 1, 4, 640, 480);
+  again.camera_path = dir / "small/camera.xml";
+  ASSERT_EQ(RenderDataset(again), 1);
+  const CameraFile camera = LoadCameraFile(dir / "again/camera.xml");
+  EXPECT_EQ(camera.width, 160u);
+  EXPECT_EQ(camera.height, 120u);
+  EXPECT_DOUBLE_EQ(camera.camera.get_kdu(), 0.2);
+  EXPECT_EQ(cv::imread(dir / "again/frame_0000.png", cv::IMREAD_UNCHANGED).cols, 160);
+  const test::OalservoRun both =
+      test::RunOalservo(dir, "render --count 1 --camera '" + dir / "small/camera.xml" +
+                                 "' --fx 500 --out '" + dir / "refused" + "'");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_THAT(both.err, HasSubstr("--fx excludes --camera"));
+  EXPECT_FALSE(fs::exists(dir / "refused"));
+}
+
+// A config's lived-in scene: each frame's conditions drawn from the seed and recorded in its
+// truth with each line's occluded fraction.
+TEST(Render, ALivedInSceneRecordsEachFramesConditions) {
+  test::TestDir dir;
+  test::WriteText(dir / "lived-in.yaml",
+                  "target: {name: four-line-a3}\n"
+                  "scene:\n  occluders: {fraction: 1, kinds: [pen]}\n"
+                  "  jpeg: {fraction: 1, quality: [60, 60]}\n");
+  RenderCommandOptions options = SmallRender(dir / "data");
+  options.target.clear();
+  options.config = dir / "lived-in.yaml";
+  options.min_distance_m = 0.5;
+  options.max_distance_m = 0.8;
+  options.min_visible_px = 0.0;
+  ASSERT_EQ(RenderDataset(options), 3);
+  for (int i = 0; i < 3; ++i) {
+    const json truth =
+        json::parse(test::ReadText(options.out_dir + "/frame_000" + std::to_string(i) + ".json"));
+    EXPECT_EQ(truth.at("effects").at("plane_occluders").size(), 1u);
+    EXPECT_EQ(truth.at("effects").at("jpeg_quality"), 60);
+    EXPECT_TRUE(truth.at("lines")[0].contains("occluded_fraction"));
+  }
+}
+
 TEST(Render, SameSeedSameFiles) {
   test::TestDir dir;
   RenderCommandOptions a = SmallRender(dir / "a"), b = SmallRender(dir / "b");
