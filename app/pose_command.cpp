@@ -73,10 +73,10 @@ AppConfig LoadPoseConfig(const PoseCommandOptions& options, PoseSummary* summary
   return config;
 }
 
-// What lines 1-4 tell of the camera file's kdu: null without a pose or when they cannot tell
-// (all near the principal point, too few points).
+// What lines 1-4 tell of the camera file's kdu: null without a pose (kept, or refused by the
+// model check) or when they cannot tell (all near the principal point, too few points).
 Json LensJson(const TargetFrame& result) {
-  if (result.status != TargetStatus::kOk || !std::isfinite(result.lens.kdu_error_sd)) return Json();
+  if (!MeasuresLens(result) || !std::isfinite(result.lens.kdu_error_sd)) return Json();
   return Json{{"kdu_error", result.lens.kdu_error},
               {"kdu_error_sd", result.lens.kdu_error_sd},
               {"lines", result.lens.lines},
@@ -255,10 +255,8 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
                AnnotatePose(frame.gray, run->tracker.lines(), drawn, run->camera.camera,
                             run->undistorted_by, result.region));
     }
-    if (result.status == TargetStatus::kOk) {
-      ++summary->ok;
-      summary->lens.push_back(result.lens);
-    }
+    if (result.status == TargetStatus::kOk) ++summary->ok;
+    if (MeasuresLens(result)) summary->lens.push_back(result.lens);
     ++summary->frames;
   }
 }

@@ -216,10 +216,31 @@ void TargetTrackedFromGrabber(benchmark::State& state) {
   tally.Report(state);
 }
 
+// The pose refined on the stripes' points alone (servo/stripe_fit.h), from a tracked frame's
+// intersections' pose and feature points: its share of a tracked frame.
+void StripeFitAlone(benchmark::State& state) {
+  const TargetInputs& inputs = Inputs();
+  TargetPoseTracker tracker = MakeTracker(inputs);
+  tracker.Track(ViewOf(inputs.moving.front().image));
+  const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
+  const vpHomogeneousMatrix start = tracked.pose.cMo;
+  const std::vector<FramePoint> points = tracker.detector().feature_points();
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  int ok = 0;
+  for (auto _ : state) {
+    const StripeFit fit = FitStripes(start, layout, points, inputs.camera, true);
+    ok += fit.ok;
+    benchmark::DoNotOptimize(fit.cMo.data);
+  }
+  state.counters["ok_fraction"] = ok / static_cast<double>(state.iterations());
+  state.counters["points"] = static_cast<double>(points.size());
+}
+
 BENCHMARK(TargetFirstFrame)->Unit(benchmark::kMicrosecond);
 BENCHMARK(TargetFirstFrameFromGrabber)->Unit(benchmark::kMicrosecond);
 BENCHMARK(TargetTracked)->Unit(benchmark::kMicrosecond);
 BENCHMARK(TargetTrackedFromGrabber)->Unit(benchmark::kMicrosecond);
+BENCHMARK(StripeFitAlone)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace oal

@@ -1,5 +1,6 @@
 #include "calibration/sheet_view_finder.h"
 
+#include <algorithm>
 #include <array>
 
 #include "calibration/sheet_view.h"
@@ -14,6 +15,16 @@ constexpr std::array<double, 4> kGuessedFocalPerWidth = {0.9, 0.65, 1.3, 1.9};
 // a stripe a few pixels away from its chord.
 constexpr double kStripeTolerancePx = 6.0;
 
+// A guessed camera's pose only identifies the stripes: the model check lets a stripe lie a
+// quarter of its width off the line the guess puts it on (the unknown lens and focal length),
+// and the pose is not refined on the stripes' points (the guess could not hold them rigid).
+TargetTrackerOptions ForAGuessedCamera(TargetTrackerOptions tracking) {
+  tracking.fit_stripes = false;
+  tracking.stripe_tolerance_fraction = std::max(tracking.stripe_tolerance_fraction, 0.25);
+  tracking.stripe_width_tolerance = std::max(tracking.stripe_width_tolerance, 0.5);
+  return tracking;
+}
+
 }  // namespace
 
 SheetViewFinder::SheetViewFinder(const LineTarget& target, int width, int height,
@@ -24,7 +35,7 @@ SheetViewFinder::SheetViewFinder(const LineTarget& target, int width, int height
     vpCameraParameters guess;
     guess.initPersProjWithoutDistortion(focal_per_width * width, focal_per_width * width,
                                         0.5 * (width - 1), 0.5 * (height - 1));
-    trackers_.emplace_back(target, guess, detector, pose, tracking);
+    trackers_.emplace_back(target, guess, detector, pose, ForAGuessedCamera(tracking));
     // Every view on all its borders: the calibration wants every point along the stripes.
     trackers_.back().set_quick_scan(false);
   }

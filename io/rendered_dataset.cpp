@@ -166,7 +166,8 @@ Json EffectsJson(const FrameEffects& effects) {
                             {"semi_axes_m", {e.semi_a_m, e.semi_b_m}},
                             {"angle_rad", e.angle_rad}});
       }
-      on_plane.push_back({{"capsules", capsules},
+      on_plane.push_back({{"label", o.label},
+                          {"capsules", capsules},
                           {"ellipses", ellipses},
                           {"grey", o.grey},
                           {"texture_grey", o.texture_grey},

@@ -202,6 +202,7 @@ PlaneOccluder MakeOccluder(OccluderKind kind, const LineTarget& target, int grey
                            double texture_grey, double shadow_darkness,
                            const std::function<double()>& uniform) {
   PlaneOccluder o;
+  o.label = ToString(kind);
   o.grey = grey;
   o.texture_grey = texture_grey;
   o.texture_seed = static_cast<std::uint64_t>(uniform() * 0x1.0p53);

@@ -152,7 +152,8 @@ struct PlaneOccluder {
   };
   std::vector<Capsule> capsules;
   std::vector<Ellipse> ellipses;
-  int grey = 150;  ///< its mean grey level, [0, 255]
+  std::string label;  ///< what it is ("hand", "pen"...), for the truth files; may be empty
+  int grey = 150;     ///< its mean grey level, [0, 255]
   /// Its grey varies smoothly by up to +-texture_grey (value noise on 5 mm cells from
   /// texture_seed: skin, fabric, a printed pen). [0, 100]
   double texture_grey = 0.0;

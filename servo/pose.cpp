@@ -414,6 +414,11 @@ void SetAngles(const vpHomogeneousMatrix& cMo, const HashTarget& hash, PoseResul
 
 }  // namespace
 
+void ReplacePose(const vpHomogeneousMatrix& cMo, const LineTarget& target, PoseResult* result) {
+  result->cMo = cMo;
+  SetAngles(cMo, pose_internal::HashTargetFrom(target), result);
+}
+
 PoseResult EstimatePose(const std::vector<DetectedLine>& lines, const LineTarget& target,
                         const PoseOptions& options,
                         const std::optional<vpHomogeneousMatrix>& previous_cMo) {

@@ -200,6 +200,10 @@ struct PoseResult {
   double identification_margin = 0.0;  ///< runner-up's cost minus the winner's
 };
 
+/// `result`'s pose replaced by `cMo` (a refinement of it, e.g. servo/stripe_fit.h's), with the
+/// angles that follow from it (roll, yaw, pitch, plane angles); the rest is kept.
+void ReplacePose(const vpHomogeneousMatrix& cMo, const LineTarget& target, PoseResult* result);
+
 /// Step 1 only, with the corners (status kOk when identified; never kOk with fewer than 4
 /// lines). Fills status, message, line_index, corners_px, identification_cost and
 /// identification_margin. Throws std::invalid_argument if the options fail Check() or

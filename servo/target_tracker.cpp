@@ -15,30 +15,11 @@
 namespace oal {
 namespace {
 
-// Samples per stripe for the model check: across the stripe at its centre line and at this
-// fraction of its width either side (inside the ink: a pose a degree or two off moves these
-// onto the paper at the stripe's far end), and beside it, its half width plus a fraction of
-// its width (at least kMinBesideM) away, on the paper.
-constexpr int kStripeSamples = 16;
-constexpr double kInsideFraction = 0.3;
-constexpr double kBesideFraction = 0.5;
-constexpr double kMinBesideM = 0.003;
-// A stripe with fewer samples in view than this counts as not seen.
-constexpr int kMinStripeSamples = 4;
-
 constexpr double kDegPerRad = 180.0 / kPi;
 
 double Microseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
       .count();
-}
-
-// The grey level of the pixel nearest to p; false outside the image (a pixel's margin kept).
-bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
-  const double u = p.u + 0.5, v = p.v + 0.5;
-  if (!(u >= 1.0 && v >= 1.0 && u < image.width - 1.0 && v < image.height - 1.0)) return false;
-  *grey = image.at(static_cast<int>(u), static_cast<int>(v));
-  return true;
 }
 
 }  // namespace
@@ -99,6 +80,9 @@ void TargetTrackerOptions::Check() const {
   RequireOption(min_stripe_agreement >= 0.0 && min_stripe_agreement <= 1.0,
                 "TargetTrackerOptions::min_stripe_agreement", min_stripe_agreement,
                 "0 <= min_stripe_agreement <= 1");
+  RequireOption(min_stripe_seen >= 0.0 && min_stripe_seen <= 1.0,
+                "TargetTrackerOptions::min_stripe_seen", min_stripe_seen,
+                "0 <= min_stripe_seen <= 1");
   RequireOption(min_stripe_contrast >= 1 && min_stripe_contrast <= 255,
                 "TargetTrackerOptions::min_stripe_contrast", min_stripe_contrast,
                 "1 <= min_stripe_contrast <= 255");
@@ -106,6 +90,25 @@ void TargetTrackerOptions::Check() const {
                 max_jump_m, "0 <= max_jump_m <= 100");
   RequireOption(max_jump_deg >= 0.0 && max_jump_deg <= 180.0, "TargetTrackerOptions::max_jump_deg",
                 max_jump_deg, "0 <= max_jump_deg <= 180");
+  RequireOption(stripe_tolerance_px > 0.0 && stripe_tolerance_px <= 100.0,
+                "TargetTrackerOptions::stripe_tolerance_px", stripe_tolerance_px,
+                "0 < stripe_tolerance_px <= 100");
+  RequireOption(stripe_tolerance_fraction >= 0.0 && stripe_tolerance_fraction <= 1.0,
+                "TargetTrackerOptions::stripe_tolerance_fraction", stripe_tolerance_fraction,
+                "0 <= stripe_tolerance_fraction <= 1");
+  RequireOption(stripe_width_tolerance > 0.0 && stripe_width_tolerance <= 10.0,
+                "TargetTrackerOptions::stripe_width_tolerance", stripe_width_tolerance,
+                "0 < stripe_width_tolerance <= 10");
+  stripe_fit.Check();
+}
+
+StripeCheckOptions TargetTrackerOptions::StripeCheck() const {
+  StripeCheckOptions check;
+  check.min_contrast = min_stripe_contrast;
+  check.centre_tolerance_px = stripe_tolerance_px;
+  check.centre_tolerance_fraction = stripe_tolerance_fraction;
+  check.width_tolerance = stripe_width_tolerance;
+  return check;
 }
 
 namespace {
@@ -214,105 +217,6 @@ LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames) {
   return check;
 }
 
-double StripeAgreement::Worst() const {
-  double worst = 1.0;
-  for (int k = 0; k < 4; ++k) {
-    const int n = samples[static_cast<std::size_t>(k)];
-    if (n < kMinStripeSamples) return 0.0;
-    worst = std::min(worst, static_cast<double>(dark[static_cast<std::size_t>(k)]) / n);
-  }
-  return worst;
-}
-
-namespace {
-
-// Whether the point `across` metres off stripe k's centre line at `along` is in view, and its
-// grey level.
-bool StripeGrey(const GrayImageView& image, const TargetLayout& layout,
-                const PlaneProjector& projector, int k, double along, double across, int* grey) {
-  Point2d pixel;
-  return projector.Project(layout.OnStripe(k, along, across), &pixel) && GreyAt(image, pixel, grey);
-}
-
-// The part of stripe k's span whose centre line is in view, to kCoarseSteps of the span
-// (the whole span when both ends and the middle are; empty when no step is): a board's
-// stripe seen from near shows a tenth of its length, where evenly spread samples would miss.
-Interval StripeInView(const GrayImageView& image, const TargetLayout& layout,
-                      const PlaneProjector& projector, int k) {
-  constexpr int kCoarseSteps = 64;
-  const Interval span = layout.stripes[static_cast<std::size_t>(k)].along;
-  int grey = 0;
-  auto seen = [&](double along) {
-    return StripeGrey(image, layout, projector, k, along, 0.0, &grey);
-  };
-  if (seen(span.lo) && seen(span.hi) && seen(0.5 * (span.lo + span.hi))) return span;
-  const double step = (span.hi - span.lo) / kCoarseSteps;
-  int first = -1, last = -1;
-  for (int i = 0; i <= kCoarseSteps; ++i) {
-    if (!seen(span.lo + i * step)) continue;
-    if (first < 0) first = i;
-    last = i;
-  }
-  if (first < 0) return Interval{0.0, -1.0};
-  return Interval{span.lo + first * step, span.lo + last * step};
-}
-
-}  // namespace
-
-StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
-                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
-                             int min_contrast) {
-  StripeAgreement agreement;
-  const PlaneProjector projector(PlaneToImage(cMo), camera);
-  for (int k = 0; k < 4; ++k) {
-    const StripeSpan& stripe = layout.stripes[static_cast<std::size_t>(k)];
-    const double width = 2.0 * stripe.half;
-    const double beside = stripe.half + std::max(kBesideFraction * width, kMinBesideM);
-    // Where the other pair's stripes cross this one, with room for the paper beside.
-    const StripeSpan& cross1 = layout.stripes[static_cast<std::size_t>((k + 1) % 4)];
-    const StripeSpan& cross2 = layout.stripes[static_cast<std::size_t>((k + 3) % 4)];
-    auto near_crossing = [&](double along) {
-      for (const StripeSpan* other : {&cross1, &cross2}) {
-        const double other_beside =
-            other->half + std::max(kBesideFraction * 2.0 * other->half, kMinBesideM);
-        if (std::fabs(along - other->at) < other_beside + kMinBesideM) return true;
-      }
-      return false;
-    };
-    const Interval in_view = StripeInView(image, layout, projector, k);
-    if (!(in_view.hi > in_view.lo)) continue;
-    // Across the stripe: beside, inside, centre, inside, beside.
-    const double across[5] = {-beside, -kInsideFraction * width, 0.0, kInsideFraction * width,
-                              beside};
-    for (int i = 0; i < kStripeSamples; ++i) {
-      const double along = in_view.lo + (in_view.hi - in_view.lo) * (i + 0.5) / kStripeSamples;
-      if (near_crossing(along)) continue;
-      // The two points beside the stripe through the lens; the three inside it in proportion
-      // between them: across one stripe the projection is affine to far below a pixel, and
-      // projecting through the lens is most of the check's time.
-      Point2d left, right;
-      if (!projector.Project(layout.OnStripe(k, along, across[0]), &left) ||
-          !projector.Project(layout.OnStripe(k, along, across[4]), &right)) {
-        continue;
-      }
-      int grey[5] = {};
-      bool seen = true;
-      for (int j = 0; j < 5 && seen; ++j) {
-        const double t = (across[j] - across[0]) / (across[4] - across[0]);
-        seen = GreyAt(image, {left.u + t * (right.u - left.u), left.v + t * (right.v - left.v)},
-                      &grey[j]);
-      }
-      if (!seen) continue;
-      ++agreement.samples[static_cast<std::size_t>(k)];
-      const int darkest_paper = std::min(grey[0], grey[4]);
-      const int lightest_ink = std::max({grey[1], grey[2], grey[3]});
-      if (lightest_ink + min_contrast <= darkest_paper)
-        ++agreement.dark[static_cast<std::size_t>(k)];
-    }
-  }
-  return agreement;
-}
-
 TargetPoseTracker::TargetPoseTracker(const LineTarget& target, const vpCameraParameters& camera,
                                      const DetectorOptions& detector, const PoseOptions& pose,
                                      const TargetTrackerOptions& options)
@@ -386,6 +290,12 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   frame_.pose_us += Microseconds(start);
   frame_.agreement = StripeAgreement{};
   frame_.lens = RadialBend{};
+  frame_.fit = StripeFit{};
+  if (frame_.pose.status == PoseStatus::kOk && options_.fit_stripes) {
+    frame_.fit = FitStripes(frame_.pose.cMo, layout_, detector_.feature_points(), camera_,
+                            detector_.Undistorts(), options_.stripe_fit);
+    if (frame_.fit.ok) ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
+  }
   if (frame_.pose.status != PoseStatus::kOk) {
     frame_.status = TargetStatus::kNotFound;
     frame_.message = frame_.pose.message;
@@ -412,17 +322,23 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
       return false;
     }
   }
-  frame_.agreement =
-      CheckStripes(image, layout_, frame_.pose.cMo, camera_, options_.min_stripe_contrast);
-  if (frame_.agreement.Worst() < options_.min_stripe_agreement) {
+  frame_.agreement = CheckStripes(image, layout_, frame_.pose.cMo, camera_, options_.StripeCheck());
+  if (frame_.agreement.Worst() < options_.min_stripe_agreement ||
+      frame_.agreement.Seen() < options_.min_stripe_seen) {
     std::ostringstream message;
     message << "the image does not show the target where the pose puts it: ";
     for (int k = 0; k < 4; ++k) {
-      message << (k > 0 ? ", " : "") << "line " << k + 1 << " dark in "
-              << frame_.agreement.dark[static_cast<std::size_t>(k)] << " of "
+      message << (k > 0 ? ", " : "") << "line " << k + 1 << " seen in "
+              << frame_.agreement.dark[static_cast<std::size_t>(k)] << " and contradicted in "
+              << frame_.agreement.contradict[static_cast<std::size_t>(k)] << " of "
               << frame_.agreement.samples[static_cast<std::size_t>(k)] << " samples";
     }
-    message << " (min_stripe_agreement = " << options_.min_stripe_agreement << ")";
+    message << " (min_stripe_agreement = " << options_.min_stripe_agreement
+            << ", min_stripe_seen = " << options_.min_stripe_seen << ")";
+    if (ContradictsLens(frame_.lens)) {
+      message << "; the stripes bend as a lens the camera model misses would (its kdu off by "
+              << -frame_.lens.kdu_error << ")";
+    }
     frame_.status = TargetStatus::kModelMismatch;
     frame_.message = message.str();
     return false;

@@ -19,11 +19,12 @@
 //      (else the frame is kModelMismatch), and the one whose corners fit the target better
 //      (the lower residual) is the frame's; when only the whole image's does (a board seen from
 //      near, whose lines traverse the view), it stands.
-// A pose is accepted only when the image shows the target where it says: along each stripe's
-// projected centre line, between the crossings and the printed ends, the pixels must be darker
-// than the paper on both sides (min_stripe_agreement of the samples inside the image);
-// otherwise the frame's status is kModelMismatch. Without a caller's prediction, a pose found
-// on the borders of the last accepted one (step 1) that moved more than max_jump_m /
+// A pose is refined on the stripes' own feature points, the target held rigid (stripe_fit.h),
+// and accepted only when the image shows the target where it says (stripe_check.h): across
+// each stripe, between the crossings and the printed ends, its dark run where the pose puts it
+// (min_stripe_agreement of the samples that agree or contradict, min_stripe_seen of all the
+// samples in view); otherwise the frame's status is kModelMismatch. Without a caller's prediction,
+// a pose found on the borders of the last accepted one (step 1) that moved more than max_jump_m /
 // max_jump_deg from it is held (kJump) and accepted only when the next frame agrees with it:
 // one bad frame is refused, a real fast move costs one frame. A pose found afresh (steps 2-3,
 // after the last pose's borders showed nothing) is not held: the target has moved. ScanMode::kImage
@@ -47,6 +48,8 @@
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
 #include "servo/pose.h"
+#include "servo/stripe_check.h"
+#include "servo/stripe_fit.h"
 #include "servo/target_layout.h"
 #include "target/line_target.h"
 
@@ -105,27 +108,37 @@ struct TargetTrackerOptions {
   /// (DetectedLine::support): a line seen on a few borders only is too poorly placed to
   /// trust. Range [0, 1000].
   int min_line_support = 12;
-  /// Fraction of the samples along each stripe (inside the image) that must be darker than
-  /// the paper beside it. Range [0, 1].
+  /// The model check (stripe_check.h): of each stripe's samples that agree with the pose or
+  /// contradict it, the fraction that must agree (a sample under a hand or a glare does
+  /// neither). Range [0, 1].
   double min_stripe_agreement = 0.75;
-  /// A stripe sample is dark when at least this many grey levels below both sides. Range
+  /// ... and of all the stripes' samples in view, the fraction that must agree (the target
+  /// must be seen, not only not contradicted). Range [0, 1].
+  double min_stripe_seen = 0.35;
+  /// A stripe is darker than the paper beside it by at least this, grey levels. Range
   /// [1, 255].
   int min_stripe_contrast = 20;
+  /// A sample agrees when the stripe's dark run is where the pose puts it within the larger
+  /// of stripe_tolerance_px and stripe_tolerance_fraction of its width, and as wide within
+  /// stripe_width_tolerance (stripe_check.h). A camera model that leaves the lens's bend in
+  /// the stripes (the paper's uncorrected condition) needs a looser fraction. Ranges (0, 100],
+  /// [0, 1], (0, 10].
+  double stripe_tolerance_px = 1.0;
+  double stripe_tolerance_fraction = 0.1;
+  double stripe_width_tolerance = 0.35;
   /// Largest move of the pose between consecutive frames without a prediction, metres and
   /// degrees; 0 turns the check off. Ranges [0, 100], [0, 180].
   double max_jump_m = 0.05;
   double max_jump_deg = 10.0;
+  /// The intersections' pose refined on the stripes' feature points, the target held rigid
+  /// (stripe_fit.h); false: the intersections' pose as the paper gives it.
+  bool fit_stripes = true;
+  StripeFitOptions stripe_fit;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
-};
-
-/// Samples of the target model against the image for one pose (the model check).
-struct StripeAgreement {
-  std::array<int, 4> samples{};  ///< per line 1-4, inside the image
-  std::array<int, 4> dark{};     ///< ... of which darker than the paper on both sides
-  /// The smallest fraction over the lines (0 when a line has fewer than 4 samples in view).
-  double Worst() const;
+  /// The model check's options from the fields above.
+  StripeCheckOptions StripeCheck() const;
 };
 
 /// What the tracker did with one frame.
@@ -139,6 +152,7 @@ struct TargetFrame {
   int borders = 0;
   int candidates = 0;  ///< middle-cell candidates scanned
   StripeAgreement agreement;
+  StripeFit fit;  ///< the pose refined on the stripes' points (fit_stripes), when tried
   /// How straight lines 1-4 came out after the lens model's correction (nothing without a
   /// pose): the kdu error they show and the bend it puts on them (bend_px, the frame's
   /// straightness), over their feature points between the stripes' printed ends. Stripes bent
@@ -232,6 +246,14 @@ class TargetPoseTracker {
 /// leaves (0.1 and more), where a matching model's frames stay under 0.01 (docs/BENCHMARKS.md).
 inline constexpr double kLensMismatchKdu = 0.03;
 
+/// Whether a frame's lines 1-4 were measured for the lens: those of a pose, kept or refused by
+/// the model check (a camera model that misses the lens bends the stripes off the lines the
+/// check expects; the frame then says why).
+inline bool MeasuresLens(const TargetFrame& frame) {
+  return frame.status == TargetStatus::kOk ||
+         (frame.status == TargetStatus::kModelMismatch && std::isfinite(frame.lens.kdu_error_sd));
+}
+
 /// Whether one frame's lines say the camera model misses the lens.
 inline bool ContradictsLens(const RadialBend& lens) {
   return std::fabs(lens.kdu_error) - lens.kdu_error_sd >= kLensMismatchKdu;
@@ -249,13 +271,5 @@ struct LensCheck {
   bool mismatch = false;          ///< over half contradict, of at least min_frames frames
 };
 LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames = 3);
-
-/// The model check alone: how well `image` shows the target of `layout` at cMo. Each stripe
-/// is sampled at 16 points spread over the part of it in view (away from the crossings),
-/// five across each: a sample agrees when the three inside the ink are all min_contrast
-/// darker than the two on the paper beside it.
-StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
-                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
-                             int min_contrast);
 
 }  // namespace oal

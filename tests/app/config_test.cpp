@@ -210,6 +210,24 @@ TEST(Config, LoadConfigNamesTheFile) {
 // ------------------------------------------------------------------------------------------
 // scene: a lived-in scene's conditions
 
+TEST(ConfigTracking, TheStripeFitAndTheModelCheckKeys) {
+  const AppConfig config = ParseConfig(
+      "tracking:\n  fit_stripes: false\n  min_stripe_seen: 0.5\n  stripe_tolerance_px: 2\n"
+      "  stripe_tolerance_fraction: 0.2\n  stripe_width_tolerance: 0.4\n",
+      "cfg.yaml");
+  EXPECT_FALSE(config.tracking.fit_stripes);
+  EXPECT_EQ(config.tracking.min_stripe_seen, 0.5);
+  EXPECT_EQ(config.tracking.StripeCheck().centre_tolerance_px, 2.0);
+  EXPECT_EQ(config.tracking.StripeCheck().centre_tolerance_fraction, 0.2);
+  EXPECT_EQ(config.tracking.StripeCheck().width_tolerance, 0.4);
+  EXPECT_THAT(ErrorOf("tracking:\n  stripe_tolerance_fraction: 2\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.stripe_tolerance_fraction' is invalid: 2"));
+  EXPECT_THAT(ErrorOf("tracking:\n  min_stripe_seen: -0.1\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.min_stripe_seen' is invalid"));
+  EXPECT_THAT(ErrorOf("tracking:\n  fit_stripes: maybe\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.fit_stripes' must be true or false"));
+}
+
 TEST(ConfigScene, ReadsTheLivedInConditions) {
   const AppConfig config = ParseConfig(
       "scene:\n"

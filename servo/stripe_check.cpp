@@ -1,0 +1,259 @@
+#include "servo/stripe_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "base/check.h"
+
+namespace oal {
+namespace {
+
+// The profile reaches this far beyond each edge: a stripe's width, at least kMinBesideM.
+constexpr double kMinBesideM = 0.003;
+// Samples this close to a crossing stripe (beyond its half width plus its beside reach) are
+// left out: the profile would run into the other stripe.
+constexpr double kCrossingMarginM = 0.003;
+// A profile has at most this many points, about one a pixel.
+constexpr int kMaxProfile = 96;
+constexpr int kMinProfile = 12;
+// Grey levels at and above which a pixel is saturated (a glare).
+constexpr int kSaturated = 250;
+// A line agreeing in fewer samples than this has not been seen.
+constexpr int kMinAgreeing = 3;
+
+// The grey level nearest to the image point p; false outside the image (a pixel's margin kept).
+bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
+  const double u = p.u + 0.5, v = p.v + 0.5;
+  if (!(u >= 1.0 && v >= 1.0 && u < image.width - 1.0 && v < image.height - 1.0)) return false;
+  *grey = image.at(static_cast<int>(u), static_cast<int>(v));
+  return true;
+}
+
+// The part of stripe k's span whose centre line is in view, to kCoarseSteps of the span (the
+// whole span when both ends and the middle are; empty when no step is): a board's stripe seen
+// from near shows a tenth of its length, where evenly spread samples would miss.
+Interval StripeInView(const GrayImageView& image, const TargetLayout& layout,
+                      const PlaneProjector& projector, int k) {
+  constexpr int kCoarseSteps = 64;
+  const Interval span = layout.stripes[static_cast<std::size_t>(k)].along;
+  const auto seen = [&](double along) {
+    Point2d pixel;
+    int grey = 0;
+    return projector.Project(layout.OnStripe(k, along, 0.0), &pixel) && GreyAt(image, pixel, &grey);
+  };
+  if (seen(span.lo) && seen(span.hi) && seen(0.5 * (span.lo + span.hi))) return span;
+  const double step = (span.hi - span.lo) / kCoarseSteps;
+  int first = -1, last = -1;
+  for (int i = 0; i <= kCoarseSteps; ++i) {
+    if (!seen(span.lo + i * step)) continue;
+    if (first < 0) first = i;
+    last = i;
+  }
+  if (first < 0) return Interval{0.0, -1.0};
+  return Interval{span.lo + first * step, span.lo + last * step};
+}
+
+enum class Verdict { kAgrees, kContradicts, kUnknown, kFlatLight };
+
+// One profile across a stripe and where the pose puts the stripe's edges and middle on it
+// (indices, fractional).
+struct Profile {
+  std::array<int, kMaxProfile> grey{};
+  int n = 0;
+  double spacing_px = 1.0;
+  double low_edge = 0.0, centre = 0.0, high_edge = 0.0;
+};
+
+// Reads the profile from `from` to `to` (pixels) whose plane ends lie at depths z_from, z_to;
+// the plane offsets -half, 0, +half of a profile over [-reach, reach] are placed through the
+// segment's perspective (the image of the plane segment's point at s is at t = s z_to / ((1 -
+// s) z_from + s z_to) of the image segment). False when part of it is out of the image.
+bool ReadProfile(const GrayImageView& image, const Point2d& from, const Point2d& to, double z_from,
+                 double z_to, double half, double reach, Profile* profile) {
+  const double length = std::hypot(to.u - from.u, to.v - from.v);
+  profile->n = std::clamp(static_cast<int>(std::ceil(length)) + 1, kMinProfile, kMaxProfile);
+  profile->spacing_px = length / (profile->n - 1);
+  for (int i = 0; i < profile->n; ++i) {
+    const double t = static_cast<double>(i) / (profile->n - 1);
+    if (!GreyAt(image, {from.u + t * (to.u - from.u), from.v + t * (to.v - from.v)},
+                &profile->grey[static_cast<std::size_t>(i)])) {
+      return false;
+    }
+  }
+  const auto index = [&](double offset) {
+    const double s = (offset + reach) / (2.0 * reach);
+    const double t = s * z_to / ((1.0 - s) * z_from + s * z_to);
+    return t * (profile->n - 1);
+  };
+  profile->low_edge = index(-half);
+  profile->centre = index(0.0);
+  profile->high_edge = index(half);
+  return true;
+}
+
+// Where the profile crosses `threshold` between indices i and i + 1 (they lie on either side).
+double Crossing(const Profile& p, int i, double threshold) {
+  const double a = p.grey[static_cast<std::size_t>(i)], b = p.grey[static_cast<std::size_t>(i + 1)];
+  return i + (a - threshold) / (a - b);
+}
+
+// What one profile says of the pose (see the header). kFlatLight: light and flat, to be judged
+// against the paper of the agreeing samples.
+Verdict Judge(const Profile& p, const StripeCheckOptions& options, int* light_level) {
+  const auto at = [&p](int i) { return p.grey[static_cast<std::size_t>(i)]; };
+  const int n = p.n;
+  const int light_a = std::max({at(0), at(1), at(2)});
+  const int light_b = std::max({at(n - 1), at(n - 2), at(n - 3)});
+  const int light = std::min(light_a, light_b);
+  int darkest = 255, darkest_at = 0;
+  for (int i = 0; i < n; ++i) {
+    if (at(i) < darkest) {
+      darkest = at(i);
+      darkest_at = i;
+    }
+  }
+  *light_level = light;
+  if (darkest >= kSaturated) return Verdict::kUnknown;  // a glare over it all
+  if (light - darkest < options.min_contrast) return Verdict::kFlatLight;
+  const double threshold = 0.5 * (light + darkest);
+  // The dark run nearest to the stripe's middle (the one holding it, if any).
+  int seed = static_cast<int>(std::lround(std::clamp(p.centre, 0.0, n - 1.0)));
+  if (!(at(seed) < threshold)) {
+    int best = -1;
+    for (int i = 0; i < n; ++i) {
+      if (at(i) < threshold && (best < 0 || std::abs(i - seed) < std::abs(best - seed))) best = i;
+    }
+    seed = best < 0 ? darkest_at : best;
+  }
+  int lo = seed, hi = seed;
+  while (lo > 0 && at(lo - 1) < threshold) --lo;
+  while (hi < n - 1 && at(hi + 1) < threshold) ++hi;
+  if (lo == 0 || hi == n - 1) return Verdict::kUnknown;  // dark beyond the profile: covered
+  const double low = Crossing(p, lo - 1, threshold), high = Crossing(p, hi, threshold);
+  const double predicted = p.high_edge - p.low_edge;
+  const double tolerance = std::max(options.centre_tolerance_px / p.spacing_px,
+                                    options.centre_tolerance_fraction * predicted);
+  const double ratio = (high - low) / predicted;
+  if (std::fabs(0.5 * (low + high) - p.centre) <= tolerance &&
+      std::fabs(ratio - 1.0) <= options.width_tolerance) {
+    return Verdict::kAgrees;
+  }
+  // Wider: the stripe and something dark against it, one edge still the stripe's.
+  if (ratio > 1.0 + options.width_tolerance &&
+      (std::fabs(low - p.low_edge) <= tolerance || std::fabs(high - p.high_edge) <= tolerance)) {
+    return Verdict::kAgrees;
+  }
+  return Verdict::kContradicts;
+}
+
+}  // namespace
+
+void StripeCheckOptions::Check() const {
+  RequireOption(samples >= 4 && samples <= 256, "StripeCheckOptions::samples", samples,
+                "4 <= samples <= 256");
+  RequireOption(min_contrast >= 1 && min_contrast <= 255, "StripeCheckOptions::min_contrast",
+                min_contrast, "1 <= min_contrast <= 255");
+  RequireOption(centre_tolerance_px > 0.0 && centre_tolerance_px <= 100.0,
+                "StripeCheckOptions::centre_tolerance_px", centre_tolerance_px,
+                "0 < centre_tolerance_px <= 100");
+  RequireOption(centre_tolerance_fraction >= 0.0 && centre_tolerance_fraction <= 1.0,
+                "StripeCheckOptions::centre_tolerance_fraction", centre_tolerance_fraction,
+                "0 <= centre_tolerance_fraction <= 1");
+  RequireOption(width_tolerance > 0.0 && width_tolerance <= 10.0,
+                "StripeCheckOptions::width_tolerance", width_tolerance,
+                "0 < width_tolerance <= 10");
+}
+
+double StripeAgreement::Worst() const {
+  double worst = 1.0;
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t i = static_cast<std::size_t>(k);
+    if (dark[i] < kMinAgreeing) return 0.0;
+    worst = std::min(worst, static_cast<double>(dark[i]) / (dark[i] + contradict[i]));
+  }
+  return worst;
+}
+
+double StripeAgreement::Seen() const {
+  int in_view = 0, agreeing = 0;
+  for (int k = 0; k < 4; ++k) {
+    in_view += samples[static_cast<std::size_t>(k)];
+    agreeing += dark[static_cast<std::size_t>(k)];
+  }
+  return in_view > 0 ? static_cast<double>(agreeing) / in_view : 0.0;
+}
+
+StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
+                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
+                             const StripeCheckOptions& options) {
+  StripeAgreement agreement;
+  const PlaneProjector projector(PlaneToImage(cMo), camera);
+  const auto depth = [&cMo](const Point2d& plane) {
+    return cMo[2][0] * plane.u + cMo[2][1] * plane.v + cMo[2][3];
+  };
+  // Light, flat profiles: where only paper shows, or a light object; judged once the paper's
+  // level is known from the samples that agree.
+  std::vector<std::pair<int, int>> flat;  // (line, light level)
+  std::vector<int> paper;
+  Profile profile;
+  for (int k = 0; k < 4; ++k) {
+    const StripeSpan& stripe = layout.stripes[static_cast<std::size_t>(k)];
+    const double reach = stripe.half + std::max(2.0 * stripe.half, kMinBesideM);
+    const auto near_crossing = [&](double along) {
+      for (const StripeSpan& other : layout.stripes) {
+        if (other.along_b != stripe.along_b &&
+            std::fabs(along - other.at) <
+                other.half + std::max(2.0 * other.half, kMinBesideM) + kCrossingMarginM) {
+          return true;
+        }
+      }
+      return false;
+    };
+    const Interval in_view = StripeInView(image, layout, projector, k);
+    if (!(in_view.hi > in_view.lo)) continue;
+    for (int i = 0; i < options.samples; ++i) {
+      const double along = in_view.lo + (in_view.hi - in_view.lo) * (i + 0.5) / options.samples;
+      if (near_crossing(along)) continue;
+      const Point2d from_plane = layout.OnStripe(k, along, -reach);
+      const Point2d to_plane = layout.OnStripe(k, along, reach);
+      Point2d from, to;
+      if (!projector.Project(from_plane, &from) || !projector.Project(to_plane, &to) ||
+          !ReadProfile(image, from, to, depth(from_plane), depth(to_plane), stripe.half, reach,
+                       &profile)) {
+        continue;
+      }
+      ++agreement.samples[static_cast<std::size_t>(k)];
+      int light = 0;
+      switch (Judge(profile, options, &light)) {
+        case Verdict::kAgrees:
+          ++agreement.dark[static_cast<std::size_t>(k)];
+          paper.push_back(light);
+          break;
+        case Verdict::kContradicts:
+          ++agreement.contradict[static_cast<std::size_t>(k)];
+          break;
+        case Verdict::kFlatLight:
+          flat.emplace_back(k, light);
+          break;
+        case Verdict::kUnknown:
+          break;
+      }
+    }
+  }
+  // A flat profile as light as the paper beside the agreeing samples: paper where the ink
+  // should be.
+  if (!paper.empty()) {
+    const auto middle = paper.begin() + static_cast<std::ptrdiff_t>(paper.size() / 2);
+    std::nth_element(paper.begin(), middle, paper.end());
+    const int paper_level = *middle;
+    for (const auto& [k, light] : flat) {
+      if (light >= paper_level - options.min_contrast && light < kSaturated) {
+        ++agreement.contradict[static_cast<std::size_t>(k)];
+      }
+    }
+  }
+  return agreement;
+}
+
+}  // namespace oal

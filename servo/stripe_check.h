@@ -1,0 +1,69 @@
+// The model check: does the image show the target's stripes where a pose puts them?
+//
+// Each stripe is sampled at `samples` places spread over the part of it in view, off the
+// crossings. At each, the grey levels across the stripe are read from beyond one edge to beyond
+// the other (a profile, sampled about every pixel, through the lens), and the sample says one of
+// three things:
+//   - agrees: the profile has the stripe's dark run where the pose puts it: light paper on both
+//     sides, and a run darker than both by min_contrast whose middle is within the tolerance of
+//     the stripe's projected centre line and whose width is within width_tolerance of the
+//     stripe's projected width; or a wider dark run (the stripe and something dark lying against
+//     it: a pen, a finger, a shadow) one of whose edges is where the stripe's edge is;
+//   - contradicts: the stripe is visible but not there (a dark run with paper on both sides,
+//     off by more than the tolerance, or as wide as no stripe and neither edge in place), or
+//     there is only paper where the ink should be (the profile light and flat, as light as the
+//     paper of the samples that agree);
+//   - tells nothing: something covers the place (a hand, a tool, a cable, a dark shadow: no
+//     paper on one side), a glare saturates it, or it is out of view.
+// A pose a degree or two off moves the far end of a stripe by several pixels off its ink; an
+// occluder only hides stretches. So a right pose under a hand has samples that tell nothing and
+// a few that contradict (a light occluder looks like paper), and a wrong pose has samples that
+// contradict along whole stripes.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <array>
+
+#include "detector/image_view.h"
+#include "servo/target_layout.h"
+
+namespace oal {
+
+struct StripeCheckOptions {
+  /// Samples per stripe, over the part of it in view. Range [4, 256].
+  int samples = 16;
+  /// A stripe is darker than the paper beside it by at least this, grey levels. Range [1, 255].
+  int min_contrast = 20;
+  /// A sample's dark run agrees when its middle is within the larger of these of the stripe's
+  /// projected centre line: pixels, and a fraction of the stripe's projected width. Ranges
+  /// (0, 100], [0, 1].
+  double centre_tolerance_px = 1.0;
+  double centre_tolerance_fraction = 0.1;
+  /// ... and its width within this fraction of the stripe's projected width. Range (0, 10].
+  double width_tolerance = 0.35;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+/// What the samples of each of lines 1-4 said.
+struct StripeAgreement {
+  std::array<int, 4> samples{};  ///< per line 1-4, in view
+  std::array<int, 4> dark{};     ///< ... that agree (the stripe's dark run where the pose puts it)
+  std::array<int, 4> contradict{};  ///< ... that contradict the pose
+  /// The smallest, over lines 1-4, of the samples agreeing among those that agree or
+  /// contradict (0 for a line with fewer than 3 agreeing samples): 1 when no sample
+  /// contradicts.
+  double Worst() const;
+  /// Of all the samples in view, the fraction that agree.
+  double Seen() const;
+};
+
+/// The model check of `layout` at cMo in `image` (`camera`'s lens: distorted pixels).
+StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
+                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
+                             const StripeCheckOptions& options = {});
+
+}  // namespace oal

@@ -1,0 +1,401 @@
+#include "servo/stripe_fit.h"
+
+#include <visp3/core/vpPixelMeterConversion.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "base/check.h"
+
+namespace oal {
+namespace {
+
+// Tukey's biweight constant (95 % efficiency for Gaussian residuals), and the cut of the
+// points counted as kept, in robust scales.
+constexpr double kTukey = 4.685;
+constexpr double kKeptScales = 2.5;
+// Points this close to a crossing's stripe (beyond its half width), metres, are left out: a
+// run there may have merged with the crossing stripe.
+constexpr double kCrossingMarginM = 0.002;
+// A step smaller than this (radians, and metres over the target's distance) has converged.
+constexpr double kConverged = 1e-7;
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Mat36 = Eigen::Matrix<double, 3, 6>;
+using Row6 = Eigen::Matrix<double, 1, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+// A pose as a rotation and a translation (cMo: X_c = R X_o + t).
+struct Pose {
+  Mat3 r;
+  Vec3 t;
+
+  static Pose Of(const vpHomogeneousMatrix& cMo) {
+    Pose pose;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) pose.r(i, j) = cMo[i][j];
+      pose.t(i) = cMo[i][3];
+    }
+    return pose;
+  }
+  vpHomogeneousMatrix Matrix() const {
+    vpHomogeneousMatrix cMo;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) cMo[i][j] = r(i, j);
+      cMo[i][3] = t(i);
+    }
+    return cMo;
+  }
+  Vec3 Of(const Point2d& plane) const { return r.col(0) * plane.u + r.col(1) * plane.v + t; }
+  // Moved by the camera-frame motion (v, w): R' = exp(w) R, t' = exp(w) t + v.
+  void Move(const Vec6& step) {
+    const Vec3 w = step.tail<3>();
+    const double angle = w.norm();
+    const Mat3 turn =
+        angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Mat3::Identity();
+    r = turn * r;
+    t = turn * t + step.head<3>();
+  }
+};
+
+// The image line (homogeneous, normalised coordinates) through the images of two camera-frame
+// points, and its derivative under the camera-frame motion (v, w): X' = X + v + w x X.
+struct ImageLine {
+  Vec3 n;
+  Mat36 d;
+};
+Mat36 MotionDerivative(const Vec3& x) {
+  Mat36 d;
+  d.leftCols<3>().setIdentity();
+  d.rightCols<3>() << 0.0, x(2), -x(1), -x(2), 0.0, x(0), x(1), -x(0), 0.0;
+  return d;
+}
+ImageLine Through(const Vec3& a, const Vec3& b) {
+  const Mat36 da = MotionDerivative(a), db = MotionDerivative(b);
+  ImageLine line;
+  line.n = a.cross(b);
+  for (int j = 0; j < 6; ++j) {
+    line.d.col(j) = Vec3(da.col(j)).cross(b) + a.cross(Vec3(db.col(j)));
+  }
+  return line;
+}
+
+double Median(std::vector<double>* values) {
+  if (values->empty()) return 0.0;
+  const auto middle = values->begin() + static_cast<std::ptrdiff_t>(values->size() / 2);
+  std::nth_element(values->begin(), middle, values->end());
+  return *middle;
+}
+
+// A stripe's points, in normalised coordinates, their runs' middles moved onto the centre
+// line's locus, and their place along the stripe ('#' coordinate).
+struct StripePoints {
+  std::vector<Vec3> p;
+  std::vector<double> along;
+};
+
+class Fitter {
+ public:
+  Fitter(const TargetLayout& layout, const vpCameraParameters& camera,
+         const StripeFitOptions& options)
+      : layout_(layout), camera_(camera), options_(options) {
+    const double det = layout.axis_a.u * layout.axis_b.v - layout.axis_a.v * layout.axis_b.u;
+    inverse_ = {layout.axis_b.v / det, -layout.axis_b.u / det, -layout.axis_a.v / det,
+                layout.axis_a.u / det};
+    inv_px2_ = 1.0 / (camera.get_px() * camera.get_px());
+    inv_py2_ = 1.0 / (camera.get_py() * camera.get_py());
+    focal_ = std::sqrt(camera.get_px() * camera.get_py());
+  }
+
+  // Sorts `points` onto the stripes where `pose` puts them.
+  void Assign(const Pose& pose, const std::vector<FramePoint>& points, bool undistorted,
+              std::array<StripePoints, 4>* stripes) const {
+    Mat3 homography;
+    homography << pose.r.col(0), pose.r.col(1), pose.t;
+    const Mat3 image_to_plane = homography.inverse();
+    std::array<StripeSight, 4> sights;
+    for (int k = 0; k < 4; ++k) {
+      StripePoints& s = (*stripes)[static_cast<std::size_t>(k)];
+      s.p.clear();
+      s.along.clear();
+      s.p.reserve(points.size());
+      s.along.reserve(points.size());
+      sights[static_cast<std::size_t>(k)] = SightOf(pose, k);
+    }
+    for (const FramePoint& source : points) {
+      if (!source.straight || (source.across_u == 0.0f && source.across_v == 0.0f)) continue;
+      Vec3 p(0.0, 0.0, 1.0);
+      if (undistorted) {
+        p(0) = (source.p.u - camera_.get_u0()) / camera_.get_px();
+        p(1) = (source.p.v - camera_.get_v0()) / camera_.get_py();
+      } else {
+        vpPixelMeterConversion::convertPoint(camera_, source.p.u, source.p.v, p(0), p(1));
+      }
+      const Vec3 q = image_to_plane * p;
+      if (!(q(2) > 0.0)) continue;
+      const double X = q(0) / q(2) - layout_.origin.u, Y = q(1) / q(2) - layout_.origin.v;
+      const double a = inverse_[0] * X + inverse_[1] * Y, b = inverse_[2] * X + inverse_[3] * Y;
+      // The corridor on the plane, generously: a pixel is depth / f metres face on, more when
+      // the plane is seen at a slant (the residual below decides in pixels).
+      const double corridor_m = 4.0 * options_.corridor_px / (q(2) * focal_);
+      for (int k = 0; k < 4; ++k) {
+        const StripeSpan& span = layout_.stripes[static_cast<std::size_t>(k)];
+        const double along = span.along_b ? b : a, across = (span.along_b ? a : b) - span.at;
+        if (std::fabs(across) > span.half + corridor_m || along < span.along.lo ||
+            along > span.along.hi || NearCrossing(span, along)) {
+          continue;
+        }
+        const StripeSight& sight = sights[static_cast<std::size_t>(k)];
+        Vec3 shifted;
+        if (!OnLocus(source, p, sight, &shifted) || !WidthAgrees(sight, along, source)) continue;
+        (*stripes)[static_cast<std::size_t>(k)].p.push_back(shifted);
+        (*stripes)[static_cast<std::size_t>(k)].along.push_back(along);
+        break;  // the stripes lie apart: a run is on one of them at most
+      }
+    }
+  }
+
+  // The pixel length of the image line n's unit normal in normalised coordinates.
+  double Scale(const Vec3& n) const {
+    return std::sqrt(n(0) * n(0) * inv_px2_ + n(1) * n(1) * inv_py2_);
+  }
+
+  double inv_px2() const { return inv_px2_; }
+  double inv_py2() const { return inv_py2_; }
+
+ private:
+  // A stripe as a pose shows it: its centre line and edges (normalised), the centre line's
+  // unit normal in pixels, and its width across in pixels at its ends and middle.
+  struct StripeSight {
+    Vec3 centre, low, high;
+    double nu = 0.0, nv = 0.0;
+    double lo = 0.0, hi = 0.0;  // the span's ends ('#' coordinate)
+    std::array<double, 3> width{};
+  };
+
+  StripeSight SightOf(const Pose& pose, int k) const {
+    const StripeSpan& span = layout_.stripes[static_cast<std::size_t>(k)];
+    StripeSight sight;
+    const auto line = [&](double across) {
+      return pose.Of(layout_.OnStripe(k, span.along.lo, across))
+          .cross(pose.Of(layout_.OnStripe(k, span.along.hi, across)));
+    };
+    sight.centre = line(0.0);
+    sight.low = line(-span.half);
+    sight.high = line(span.half);
+    const double nu = sight.centre(0) / camera_.get_px(), nv = sight.centre(1) / camera_.get_py();
+    const double norm = std::sqrt(nu * nu + nv * nv);
+    sight.nu = nu / norm;
+    sight.nv = nv / norm;
+    sight.lo = span.along.lo;
+    sight.hi = span.along.hi;
+    for (int i = 0; i < 3; ++i) {
+      const double along = span.along.lo + 0.5 * i * (span.along.hi - span.along.lo);
+      const Vec3 lo = pose.Of(layout_.OnStripe(k, along, -span.half));
+      const Vec3 hi = pose.Of(layout_.OnStripe(k, along, span.half));
+      // Behind the camera: no width (a run there is never the stripe's).
+      sight.width[static_cast<std::size_t>(i)] =
+          lo(2) > 0.0 && hi(2) > 0.0
+              ? std::fabs(camera_.get_px() * (hi(0) / hi(2) - lo(0) / lo(2)) * sight.nu +
+                          camera_.get_py() * (hi(1) / hi(2) - lo(1) / lo(2)) * sight.nv)
+              : 0.0;
+    }
+    return sight;
+  }
+
+  bool NearCrossing(const StripeSpan& span, double along) const {
+    for (const StripeSpan& other : layout_.stripes) {
+      if (other.along_b != span.along_b &&
+          std::fabs(along - other.at) < other.half + kCrossingMarginM) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The run's middle p moved along its run onto the centre line's locus (under perspective the
+  // middle between converging edges is off the centre line's image), when within the corridor.
+  bool OnLocus(const FramePoint& source, const Vec3& p, const StripeSight& sight,
+               Vec3* shifted) const {
+    const double length = std::sqrt(static_cast<double>(source.across_u) * source.across_u +
+                                    static_cast<double>(source.across_v) * source.across_v);
+    const double du = source.across_u / length / camera_.get_px();
+    const double dv = source.across_v / length / camera_.get_py();
+    const auto along = [&](const Vec3& line) {
+      const double towards = line(0) * du + line(1) * dv;
+      return std::fabs(towards) > 1e-15 ? -line.dot(p) / towards : 0.0;
+    };
+    *shifted = p;
+    const double shift = along(sight.centre) - 0.5 * (along(sight.low) + along(sight.high));
+    if (std::fabs(shift) < 1.0) {  // pixels; larger: a pose too far off to say
+      (*shifted)(0) += shift * du;
+      (*shifted)(1) += shift * dv;
+    }
+    return std::fabs(sight.centre.dot(*shifted)) <= options_.corridor_px * Scale(sight.centre);
+  }
+
+  // Whether the run is about as wide across the stripe as the stripe is there (its width
+  // interpolated between its ends and middle: it changes slowly along the stripe).
+  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source) const {
+    const double t = 2.0 * (along - sight.lo) / (sight.hi - sight.lo) - 1.0;  // [-1, 1]
+    const std::array<double, 3>& w = sight.width;
+    if (!(w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0)) return false;
+    const double predicted =
+        w[1] + 0.5 * t * (w[2] - w[0]) + 0.5 * t * t * (w[0] + w[2] - 2.0 * w[1]);
+    const double measured = WidthAcross(source, sight.nu, sight.nv);
+    return measured > 0.0 && predicted > 0.0 &&
+           std::max(measured, predicted) <=
+               options_.max_width_ratio * std::min(measured, predicted);
+  }
+
+  const TargetLayout& layout_;
+  const vpCameraParameters& camera_;
+  const StripeFitOptions& options_;
+  std::array<double, 4> inverse_{};
+  double inv_px2_ = 1.0, inv_py2_ = 1.0, focal_ = 1.0;
+};
+
+}  // namespace
+
+void StripeFitOptions::Check() const {
+  RequireOption(corridor_px > 0.0 && corridor_px <= 1000.0, "StripeFitOptions::corridor_px",
+                corridor_px, "0 < corridor_px <= 1000");
+  RequireOption(min_scale_px > 0.0 && min_scale_px <= 100.0, "StripeFitOptions::min_scale_px",
+                min_scale_px, "0 < min_scale_px <= 100");
+  RequireOption(max_width_ratio >= 1.0 && max_width_ratio <= 100.0,
+                "StripeFitOptions::max_width_ratio", max_width_ratio,
+                "1 <= max_width_ratio <= 100");
+  RequireOption(max_iterations >= 1 && max_iterations <= 100, "StripeFitOptions::max_iterations",
+                max_iterations, "1 <= max_iterations <= 100");
+  RequireOption(min_points >= 2 && min_points <= 1000, "StripeFitOptions::min_points", min_points,
+                "2 <= min_points <= 1000");
+}
+
+StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
+                     const std::vector<FramePoint>& points, const vpCameraParameters& camera,
+                     bool points_undistorted, const StripeFitOptions& options) {
+  options.Check();
+  StripeFit fit;
+  fit.cMo = start;
+  const Fitter fitter(layout, camera, options);
+  Pose pose = Pose::Of(start);
+  // Which stripe each point is on, from the starting pose: a step moves the lines by a
+  // fraction of the corridor at most, and points must not hop between stripes as it goes.
+  std::array<StripePoints, 4> stripes;
+  fitter.Assign(pose, points, points_undistorted, &stripes);
+
+  std::vector<double> magnitudes;
+  double scale = options.min_scale_px;
+  std::array<Vec3, 4> centre_a, centre_b;  // the centre lines' ends on the plane
+  for (int k = 0; k < 4; ++k) {
+    const StripeSpan& span = layout.stripes[static_cast<std::size_t>(k)];
+    const Point2d a = layout.OnStripe(k, span.along.lo, 0.0);
+    const Point2d b = layout.OnStripe(k, span.along.hi, 0.0);
+    centre_a[static_cast<std::size_t>(k)] = Vec3(a.u, a.v, 0.0);
+    centre_b[static_cast<std::size_t>(k)] = Vec3(b.u, b.v, 0.0);
+  }
+  std::array<ImageLine, 4> lines;
+  std::array<double, 4> inv_scale{};
+  const auto look = [&] {
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Point2d a{centre_a[k](0), centre_a[k](1)}, b{centre_b[k](0), centre_b[k](1)};
+      lines[k] = Through(pose.Of(a), pose.Of(b));
+      inv_scale[k] = 1.0 / fitter.Scale(lines[k].n);
+    }
+  };
+  for (fit.iterations = 0; fit.iterations < options.max_iterations;) {
+    look();
+    magnitudes.clear();
+    for (std::size_t k = 0; k < 4; ++k) {
+      for (const Vec3& p : stripes[k].p)
+        magnitudes.push_back(std::fabs(lines[k].n.dot(p)) * inv_scale[k]);
+    }
+    scale = std::max(options.min_scale_px, 1.4826 * Median(&magnitudes));
+    const double cut = kTukey * scale, inv_cut2 = 1.0 / (cut * cut);
+    // Point i of stripe k: r = s n.p (s = 1 / |n| in pixels), and its row of the Jacobian
+    // dr = s p^T (dn - n ds / s^2 ...) = s p^T M, M = dn - n g, g = (n0 dn0 / px^2 + n1 dn1 /
+    // py^2) s^2: so J^T W J = s^2 M^T (sum w p p^T) M and J^T W r = s M^T (sum w r p), and a
+    // point costs a 3 x 3 sum.
+    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
+    Vec6 gradient = Vec6::Zero();
+    for (std::size_t k = 0; k < 4; ++k) {
+      const ImageLine& line = lines[k];
+      const double s = inv_scale[k];
+      double xx = 0.0, xy = 0.0, x1 = 0.0, yy = 0.0, y1 = 0.0, w1 = 0.0;
+      Vec3 weighted_r = Vec3::Zero();
+      for (const Vec3& p : stripes[k].p) {
+        const double r = line.n.dot(p) * s;
+        const double r2 = r * r * inv_cut2;
+        if (!(r2 < 1.0)) continue;
+        const double w = (1.0 - r2) * (1.0 - r2);
+        const double wx = w * p(0), wy = w * p(1);
+        xx += wx * p(0);
+        xy += wx * p(1);
+        x1 += wx;
+        yy += wy * p(1);
+        y1 += wy;
+        w1 += w;
+        weighted_r += (w * r) * p;
+      }
+      if (w1 <= 0.0) continue;
+      Mat3 sum;
+      sum << xx, xy, x1, xy, yy, y1, x1, y1, w1;
+      const Row6 g = (line.n(0) * fitter.inv_px2() * line.d.row(0) +
+                      line.n(1) * fitter.inv_py2() * line.d.row(1)) *
+                     (s * s);
+      const Mat36 m = line.d - line.n * g;
+      normal.noalias() += (s * s) * (m.transpose() * sum * m);
+      gradient.noalias() += s * (m.transpose() * weighted_r);
+    }
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
+    const Vec6 step = solver.solve(-gradient);
+    if (solver.info() != Eigen::Success || !step.allFinite() ||
+        !(solver.vectorD().minCoeff() > 1e-12 * solver.vectorD().maxCoeff())) {
+      fit.message = "the stripes' points do not fix the pose";
+      return fit;
+    }
+    pose.Move(step);
+    ++fit.iterations;
+    const double depth = std::max(std::fabs(pose.t(2)), 1e-3);
+    if (step.tail<3>().norm() < kConverged && step.head<3>().norm() < kConverged * depth) break;
+  }
+
+  // The points kept, their spread along each stripe, and the RMS, from the final pose.
+  look();
+  double sum2 = 0.0;
+  int kept = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (std::size_t i = 0; i < stripes[k].p.size(); ++i) {
+      const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
+      if (!(std::fabs(r) <= kKeptScales * scale)) continue;
+      ++fit.points[k];
+      lo = std::min(lo, stripes[k].along[i]);
+      hi = std::max(hi, stripes[k].along[i]);
+      sum2 += r * r;
+      ++kept;
+    }
+    const StripeSpan& span = layout.stripes[k];
+    fit.extent[k] =
+        fit.points[k] > 1 ? std::min(1.0, (hi - lo) / (span.along.hi - span.along.lo)) : 0.0;
+  }
+  fit.scale_px = scale;
+  fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;
+  fit.cMo = pose.Matrix();
+  for (int k = 0; k < 4; ++k) {
+    if (fit.points[static_cast<std::size_t>(k)] < options.min_points) {
+      std::ostringstream message;
+      message << "line " << k + 1 << " keeps " << fit.points[static_cast<std::size_t>(k)]
+              << " of its stripe's points (min_points = " << options.min_points << ")";
+      fit.message = message.str();
+      return fit;
+    }
+  }
+  fit.ok = true;
+  return fit;
+}
+
+}  // namespace oal

@@ -1,0 +1,77 @@
+// The pose refined on the stripes' own feature points, the target held rigid.
+//
+// The intersections' pose (pose.h) rests on four lines, each fitted on its own to the feature
+// points near it; on a far sheet a line pulled by a pixel tilts the pose by degrees, and a run
+// merged with a finger, a pen or a shadow beside a stripe pulls its line that much. Here every
+// run middle the detector found on a stripe's printed stretch pulls that stripe's projected
+// centre line towards it, and the pose's six parameters move the four lines together: the
+// points of one stripe that the other three stripes, and the rest of its own, do not agree
+// with are let go (Tukey's biweight on a robust scale), however many borders they came from.
+// The same points tell how much of each stripe the image shows where the pose puts it.
+//
+// Points: the detector's feature points (detector/line_fit.h FramePoint) in its pixels
+// (undistorted when it corrects the lens, else the image's, then converted with the camera's
+// kdu). Only runs along one side of a border (a run round a border's corner gives the middle of
+// its ends, off the stripe) whose width across the stripe is within a factor of the stripe's
+// width where the pose puts it, between the stripe's printed ends and off the crossings. Each
+// run's middle is moved onto the image of the centre line's locus first: under perspective
+// the middle between converging edges is off it (a few hundredths of a pixel, up to half a
+// pixel for a wide stripe seen at a slant), as the corners are in pose.h.
+#pragma once
+
+#include <visp3/core/vpCameraParameters.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "detector/line_fit.h"
+#include "servo/target_layout.h"
+
+namespace oal {
+
+struct StripeFitOptions {
+  /// Feature points farther than this from a stripe's projected centre line (where the
+  /// starting pose puts it) are not the stripe's, pixels. Range (0, 1000].
+  double corridor_px = 4.0;
+  /// The residuals' robust scale never goes below this, pixels: a clean frame's points lie
+  /// within a tenth of a pixel of the line, and the biweight's cut (4.685 scales) must not
+  /// let the stripe's own points go. Range (0, 100].
+  double min_scale_px = 0.25;
+  /// A run is the stripe's only when its width across the stripe is within this factor of
+  /// the stripe's width where the pose puts it (blur and the threshold change a width a
+  /// little; a run merged with a finger or a pen changes it a lot). Range [1, 100].
+  double max_width_ratio = 1.7;
+  /// Gauss-Newton steps at most. Range [1, 100].
+  int max_iterations = 12;
+  /// Each stripe needs at least this many points kept. Range [2, 1000].
+  int min_points = 4;
+
+  /// Throws std::invalid_argument naming the field, its value and the violated constraint.
+  void Check() const;
+};
+
+struct StripeFit {
+  bool ok = false;
+  std::string message;  ///< why not, when not ok
+  vpHomogeneousMatrix cMo;
+  std::array<int, 4> points{};  ///< points kept on lines 1-4 (within 2.5 robust scales)
+  /// The fraction of each stripe's printed length (between the crossings and its ends, both
+  /// arms) that its kept points span: a stripe half hidden under a hand shows about 0.5.
+  std::array<double, 4> extent{};
+  double rms_px = 0.0;    ///< of the kept points' distances to their lines, pixels
+  double scale_px = 0.0;  ///< the residuals' robust scale at the end, pixels
+  int iterations = 0;
+};
+
+/// The pose that best puts lines 1-4 of `layout` through their stripes' feature points in
+/// `points`, from `start` (near enough for its projected stripes to lie within corridor_px of
+/// their points). `points_undistorted`: the points are in undistorted pixels (the detector
+/// corrects the lens). Not ok when a stripe keeps fewer than min_points, the points cannot
+/// fix the pose, or the steps diverge (the message says which).
+StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
+                     const std::vector<FramePoint>& points, const vpCameraParameters& camera,
+                     bool points_undistorted, const StripeFitOptions& options = {});
+
+}  // namespace oal

@@ -1,0 +1,197 @@
+// The pose refined on the stripes' own points (servo/stripe_fit.h) and the model check
+// (servo/stripe_check.h), on rendered frames of the A3 sheet through the real detector.
+#include "servo/stripe_fit.h"
+
+#include <gtest/gtest.h>
+#include <visp3/core/vpMath.h>
+#include <visp3/core/vpThetaUVector.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "scene/scene.h"
+#include "servo/stripe_check.h"
+#include "servo/target_tracker.h"
+#include "tests/scene/scene_test_util.h"
+
+namespace oal {
+namespace {
+
+using testing::FrontoParallel;
+
+const vpCameraParameters kCamera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+
+RenderOptions Render() {
+  RenderOptions render;
+  render.camera = kCamera;
+  render.noise_sigma = 3.0;
+  render.blur_sigma_px = 0.8;
+  return render;
+}
+
+// A sheet 0.6 m away, rolled, and tilted by 25 degrees about the point the camera looks at.
+vpHomogeneousMatrix Tilted() {
+  const vpHomogeneousMatrix tilt = vpHomogeneousMatrix(0.0, 0.0, 0.6, 0.0, 0.0, 0.0) *
+                                   vpHomogeneousMatrix(0.0, 0.0, 0.0, vpMath::rad(25.0), 0.0, 0.0) *
+                                   vpHomogeneousMatrix(0.0, 0.0, -0.6, 0.0, 0.0, 0.0);
+  return tilt * FrontoParallel(0.6, 0.01, -0.005, 0.4);
+}
+
+std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
+                                    const vpHomogeneousMatrix& truth) {
+  const double t = (cMo.getTranslationVector() - truth.getTranslationVector()).frobeniusNorm();
+  const double r =
+      vpMath::deg(vpThetaUVector((cMo * truth.inverse()).getRotationMatrix()).getTheta());
+  return {t, r};
+}
+
+// The tracker's feature points of `frame` (found with no prior) and its pose.
+struct Tracked {
+  std::vector<FramePoint> points;
+  TargetFrame frame;
+};
+Tracked Track(const RenderedFrame& rendered, TargetTrackerOptions options = {}) {
+  PoseOptions pose;
+  pose.camera = kCamera;
+  TargetPoseTracker tracker(FourLineA3Target(), kCamera, DetectorOptions(), pose, options);
+  Tracked tracked;
+  tracked.frame = tracker.Track(ViewOf(rendered.image));
+  tracked.points = tracker.detector().feature_points();
+  return tracked;
+}
+
+TEST(StripeFit, ConvergesToTheTruthFromAPoseADegreeOff) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 3);
+  const Tracked tracked = Track(rendered);
+  ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  // Off by 1 degree about the optical axis and 2 mm: the stripes' ends a few pixels away.
+  const vpHomogeneousMatrix start =
+      vpHomogeneousMatrix(0.002, 0.0, 0.0, 0.0, 0.0, vpMath::rad(0.5)) * rendered.cMo;
+  const StripeFit fit = FitStripes(start, layout, tracked.points, kCamera, true);
+  ASSERT_TRUE(fit.ok) << fit.message;
+  const auto [t, r] = PoseError(fit.cMo, rendered.cMo);
+  EXPECT_LT(t, 0.6e-3);
+  EXPECT_LT(r, 0.05);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_GE(fit.points[static_cast<std::size_t>(k)], 12) << "line " << k + 1;
+    EXPECT_GT(fit.extent[static_cast<std::size_t>(k)], 0.7) << "line " << k + 1;
+  }
+  EXPECT_LT(fit.rms_px, 0.2);
+}
+
+// Runs merged with something dark lying against one stripe (their middles a few pixels off)
+// are let go: the pose stays where the other points put it.
+TEST(StripeFit, LetsGoOfRunsPulledOffTheirStripe) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 4);
+  const Tracked tracked = Track(rendered);
+  ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const StripeFit clean = FitStripes(tracked.frame.pose.cMo, layout, tracked.points, kCamera, true);
+  ASSERT_TRUE(clean.ok) << clean.message;
+  // A third of the points moved 3 px along their runs, as a run merged with a pen 6 px wide
+  // lying against the stripe would.
+  std::vector<FramePoint> pulled = tracked.points;
+  for (std::size_t i = 0; i < pulled.size(); i += 3) {
+    const double length = std::hypot(pulled[i].across_u, pulled[i].across_v);
+    if (length <= 0.0) continue;
+    pulled[i].p.u += 3.0 * pulled[i].across_u / length;
+    pulled[i].p.v += 3.0 * pulled[i].across_v / length;
+  }
+  const StripeFit fit = FitStripes(tracked.frame.pose.cMo, layout, pulled, kCamera, true);
+  ASSERT_TRUE(fit.ok) << fit.message;
+  const auto [t, r] = PoseError(fit.cMo, rendered.cMo);
+  EXPECT_LT(t, 1e-3);
+  EXPECT_LT(r, 0.1);
+}
+
+TEST(StripeFit, AStripeWithoutPointsIsNamed) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 5);
+  const Tracked tracked = Track(rendered);
+  ASSERT_EQ(tracked.frame.status, TargetStatus::kOk);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const StripeFit all = FitStripes(rendered.cMo, layout, tracked.points, kCamera, true);
+  ASSERT_TRUE(all.ok);
+  // The points are in undistorted pixels, as the truth's ideal lines.
+  std::vector<FramePoint> without;
+  const std::vector<TruthLine>& truth = rendered.truth;
+  for (const FramePoint& point : tracked.points) {
+    if (std::fabs(truth[2].ideal.SignedDistance(point.p.u, point.p.v)) > 20.0) {
+      without.push_back(point);
+    }
+  }
+  const StripeFit fit = FitStripes(rendered.cMo, layout, without, kCamera, true);
+  EXPECT_FALSE(fit.ok);
+  EXPECT_NE(fit.message.find("line 3 keeps 0 of its stripe's points"), std::string::npos)
+      << fit.message;
+}
+
+TEST(StripeFit, BadOptionsNameTheField) {
+  StripeFitOptions options;
+  options.corridor_px = 0.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options = StripeFitOptions();
+  options.min_points = 1;
+  try {
+    options.Check();
+    FAIL();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("StripeFitOptions::min_points = 1"),
+              std::string::npos);
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// The model check.
+
+TEST(StripeCheck, TheTruthAgreesAlongEveryStripe) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 6);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const StripeAgreement agreement =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_GE(agreement.samples[static_cast<std::size_t>(k)], 8) << "line " << k + 1;
+    EXPECT_EQ(agreement.dark[static_cast<std::size_t>(k)],
+              agreement.samples[static_cast<std::size_t>(k)])
+        << "line " << k + 1;
+  }
+  EXPECT_EQ(agreement.Worst(), 1.0);
+  EXPECT_EQ(agreement.Seen(), 1.0);
+}
+
+// A pose a degree and a half off moves the stripes' far ends off their ink: contradicted.
+TEST(StripeCheck, APoseADegreeAndAHalfOffIsContradicted) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 7);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const vpHomogeneousMatrix off =
+      vpHomogeneousMatrix(0.0, 0.0, 0.0, 0.0, vpMath::rad(1.5), 0.0) * rendered.cMo;
+  const StripeAgreement agreement = CheckStripes(ViewOf(rendered.image), layout, off, kCamera);
+  EXPECT_LT(agreement.Worst(), 0.75);
+}
+
+// A hand over part of a stripe tells nothing there; a glare saturating ink and paper neither.
+TEST(StripeCheck, AHandOrAGlareHidesWithoutContradicting) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  FrameEffects effects;
+  PlaneOccluder palm;
+  palm.ellipses.push_back({-0.09, 0.10, 0.05, 0.04, 0.3});  // over line 1's lower arm
+  palm.grey = 140;
+  effects.plane_occluders.push_back(palm);
+  effects.glares.push_back({0.15, -0.062, 0.015, 600.0});  // on line 2's right arm
+  const RenderedFrame rendered = renderer.Render(Tilted(), 8, effects);
+  const StripeAgreement agreement =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera);
+  EXPECT_LT(agreement.dark[0], agreement.samples[0]);  // the hand hides some of line 1
+  EXPECT_LT(agreement.dark[1], agreement.samples[1]);  // the glare some of line 2
+  EXPECT_EQ(agreement.contradict[0] + agreement.contradict[1], 0);
+  EXPECT_EQ(agreement.Worst(), 1.0);
+}
+
+}  // namespace
+}  // namespace oal
