@@ -535,6 +535,8 @@ std::string ToString(PoseMethod method) {
       return "previous";
     case PoseMethod::kHomography:
       return "homography";
+    case PoseMethod::kStripes:
+      return "stripes";
   }
   return "unknown";
 }

@@ -76,11 +76,14 @@ enum class PoseStatus {
 
 /// Which pose was refined into the result: a linear method's (vpPose::DEMENTHON or LAGRANGE),
 /// the previous pose alone (PoseOptions::previous_accept_px), or, without one, the pose of the
-/// four corners' homography alone (PoseOptions::homography_accept_px).
-enum class PoseMethod { kNone, kDementhon, kLagrange, kPrevious, kHomography };
+/// four corners' homography alone (PoseOptions::homography_accept_px); kStripes: no four lines
+/// to intersect, the pose fitted to the stripes' points from where the target was expected
+/// (servo/target_tracker.h).
+enum class PoseMethod { kNone, kDementhon, kLagrange, kPrevious, kHomography, kStripes };
 
 /// The one place where these enums meet strings ("ok", "not-enough-lines",
-/// "not-identifiable", "degenerate"; "none", "dementhon", "lagrange", "previous", "homography").
+/// "not-identifiable", "degenerate"; "none", "dementhon", "lagrange", "previous", "homography",
+/// "stripes").
 std::string ToString(PoseStatus status);
 std::string ToString(PoseMethod method);
 

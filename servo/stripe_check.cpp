@@ -98,9 +98,26 @@ double Crossing(const Profile& p, int i, double threshold) {
   return i + (a - threshold) / (a - b);
 }
 
+// A profile's light ends over its darkest point, grey levels.
+int Contrast(const Profile& p) {
+  const auto at = [&p](int i) { return p.grey[static_cast<std::size_t>(i)]; };
+  const int n = p.n;
+  const int light =
+      std::min(std::max({at(0), at(1), at(2)}), std::max({at(n - 1), at(n - 2), at(n - 3)}));
+  return light - *std::min_element(p.grey.begin(), p.grey.begin() + n);
+}
+
+int MedianOf(std::vector<int>* values) {
+  if (values->empty()) return 0;
+  const auto middle = values->begin() + static_cast<std::ptrdiff_t>(values->size() / 2);
+  std::nth_element(values->begin(), middle, values->end());
+  return *middle;
+}
+
 // What one profile says of the pose (see the header). kFlatLight: light and flat, to be judged
 // against the paper of the agreeing samples.
-Verdict Judge(const Profile& p, const StripeCheckOptions& options, int* light_level) {
+Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contrast,
+              int* light_level) {
   const auto at = [&p](int i) { return p.grey[static_cast<std::size_t>(i)]; };
   const int n = p.n;
   const int light_a = std::max({at(0), at(1), at(2)});
@@ -115,7 +132,7 @@ Verdict Judge(const Profile& p, const StripeCheckOptions& options, int* light_le
   }
   *light_level = light;
   if (darkest >= kSaturated) return Verdict::kUnknown;  // a glare over it all
-  if (light - darkest < options.min_contrast) return Verdict::kFlatLight;
+  if (light - darkest < min_contrast) return Verdict::kFlatLight;
   const double threshold = 0.5 * (light + darkest);
   // The dark run nearest to the stripe's middle (the one holding it, if any).
   int seed = static_cast<int>(std::lround(std::clamp(p.centre, 0.0, n - 1.0)));
@@ -192,10 +209,10 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
   const auto depth = [&cMo](const Point2d& plane) {
     return cMo[2][0] * plane.u + cMo[2][1] * plane.v + cMo[2][3];
   };
-  // Light, flat profiles: where only paper shows, or a light object; judged once the paper's
-  // level is known from the samples that agree.
-  std::vector<std::pair<int, int>> flat;  // (line, light level)
-  std::vector<int> paper;
+  // Every profile first: how dark the stripes are in this frame (the light, the exposure, the
+  // blur) says how dark a run must be to be one, and how light the paper is.
+  std::vector<std::pair<int, Profile>> profiles;  // (line, profile), in order along each line
+  profiles.reserve(4 * static_cast<std::size_t>(options.samples));
   Profile profile;
   for (int k = 0; k < 4; ++k) {
     const StripeSpan& stripe = layout.stripes[static_cast<std::size_t>(k)];
@@ -224,33 +241,47 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
         continue;
       }
       ++agreement.samples[static_cast<std::size_t>(k)];
-      int light = 0;
-      switch (Judge(profile, options, &light)) {
-        case Verdict::kAgrees:
-          ++agreement.dark[static_cast<std::size_t>(k)];
-          paper.push_back(light);
-          break;
-        case Verdict::kContradicts:
-          ++agreement.contradict[static_cast<std::size_t>(k)];
-          break;
-        case Verdict::kFlatLight:
-          flat.emplace_back(k, light);
-          break;
-        case Verdict::kUnknown:
-          break;
-      }
+      profiles.emplace_back(k, profile);
     }
   }
-  // A flat profile as light as the paper beside the agreeing samples: paper where the ink
-  // should be.
-  if (!paper.empty()) {
-    const auto middle = paper.begin() + static_cast<std::ptrdiff_t>(paper.size() / 2);
-    std::nth_element(paper.begin(), middle, paper.end());
-    const int paper_level = *middle;
-    for (const auto& [k, light] : flat) {
-      if (light >= paper_level - options.min_contrast && light < kSaturated) {
-        ++agreement.contradict[static_cast<std::size_t>(k)];
-      }
+  std::vector<int> contrasts;
+  for (const auto& [k, p] : profiles) {
+    const int contrast = Contrast(p);
+    if (contrast >= options.min_contrast) contrasts.push_back(contrast);
+  }
+  const int min_contrast = std::max(options.min_contrast, MedianOf(&contrasts) / 2);
+  std::vector<Verdict> verdicts;
+  std::vector<int> lights, paper;
+  verdicts.reserve(profiles.size());
+  lights.reserve(profiles.size());
+  for (const auto& [k, p] : profiles) {
+    int light = 0;
+    verdicts.push_back(Judge(p, options, min_contrast, &light));
+    lights.push_back(light);
+    if (verdicts.back() == Verdict::kAgrees) paper.push_back(light);
+  }
+  // A light, flat profile as light as the paper beside the agreeing samples: paper where the
+  // ink should be; darker, a light object over the stripe.
+  const int paper_level = MedianOf(&paper);
+  for (std::size_t i = 0; i < verdicts.size(); ++i) {
+    if (verdicts[i] != Verdict::kFlatLight) continue;
+    const bool as_paper =
+        !paper.empty() && lights[i] >= paper_level - min_contrast / 2 && lights[i] < kSaturated;
+    verdicts[i] = as_paper ? Verdict::kContradicts : Verdict::kUnknown;
+  }
+  // A sample that contradicts next to one that tells nothing lies at the rim of something
+  // covering the stripe (a finger's edge across the profile): excused. The samples of a line
+  // follow each other along it.
+  for (std::size_t i = 0; i < verdicts.size(); ++i) {
+    const std::size_t k = static_cast<std::size_t>(profiles[i].first);
+    if (verdicts[i] == Verdict::kAgrees) {
+      ++agreement.dark[k];
+    } else if (verdicts[i] == Verdict::kContradicts) {
+      const auto covered = [&](std::size_t j) {
+        return profiles[j].first == profiles[i].first && verdicts[j] == Verdict::kUnknown;
+      };
+      const bool at_rim = (i > 0 && covered(i - 1)) || (i + 1 < verdicts.size() && covered(i + 1));
+      ++(at_rim ? agreement.excused[k] : agreement.contradict[k]);
     }
   }
   return agreement;

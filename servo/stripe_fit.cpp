@@ -95,6 +95,7 @@ double Median(std::vector<double>* values) {
 struct StripePoints {
   std::vector<Vec3> p;
   std::vector<double> along;
+  std::vector<double> width_ratio;  // the run's width across over the stripe's, there
 };
 
 class Fitter {
@@ -121,8 +122,10 @@ class Fitter {
       StripePoints& s = (*stripes)[static_cast<std::size_t>(k)];
       s.p.clear();
       s.along.clear();
+      s.width_ratio.clear();
       s.p.reserve(points.size());
       s.along.reserve(points.size());
+      s.width_ratio.reserve(points.size());
       sights[static_cast<std::size_t>(k)] = SightOf(pose, k);
     }
     for (const FramePoint& source : points) {
@@ -150,9 +153,14 @@ class Fitter {
         }
         const StripeSight& sight = sights[static_cast<std::size_t>(k)];
         Vec3 shifted;
-        if (!OnLocus(source, p, sight, &shifted) || !WidthAgrees(sight, along, source)) continue;
-        (*stripes)[static_cast<std::size_t>(k)].p.push_back(shifted);
-        (*stripes)[static_cast<std::size_t>(k)].along.push_back(along);
+        double ratio = 0.0;
+        if (!OnLocus(source, p, sight, &shifted) || !WidthAgrees(sight, along, source, &ratio)) {
+          continue;
+        }
+        StripePoints& stripe = (*stripes)[static_cast<std::size_t>(k)];
+        stripe.p.push_back(shifted);
+        stripe.along.push_back(along);
+        stripe.width_ratio.push_back(ratio);
         break;  // the stripes lie apart: a run is on one of them at most
       }
     }
@@ -239,13 +247,15 @@ class Fitter {
 
   // Whether the run is about as wide across the stripe as the stripe is there (its width
   // interpolated between its ends and middle: it changes slowly along the stripe).
-  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source) const {
+  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source,
+                   double* ratio) const {
     const double t = 2.0 * (along - sight.lo) / (sight.hi - sight.lo) - 1.0;  // [-1, 1]
     const std::array<double, 3>& w = sight.width;
     if (!(w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0)) return false;
     const double predicted =
         w[1] + 0.5 * t * (w[2] - w[0]) + 0.5 * t * t * (w[0] + w[2] - 2.0 * w[1]);
     const double measured = WidthAcross(source, sight.nu, sight.nv);
+    *ratio = predicted > 0.0 ? measured / predicted : 0.0;
     return measured > 0.0 && predicted > 0.0 &&
            std::max(measured, predicted) <=
                options_.max_width_ratio * std::min(measured, predicted);
@@ -369,15 +379,18 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   int kept = 0;
   for (std::size_t k = 0; k < 4; ++k) {
     double lo = HUGE_VAL, hi = -HUGE_VAL;
+    magnitudes.clear();  // the kept points' width ratios
     for (std::size_t i = 0; i < stripes[k].p.size(); ++i) {
       const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
       if (!(std::fabs(r) <= kKeptScales * scale)) continue;
       ++fit.points[k];
+      magnitudes.push_back(stripes[k].width_ratio[i]);
       lo = std::min(lo, stripes[k].along[i]);
       hi = std::max(hi, stripes[k].along[i]);
       sum2 += r * r;
       ++kept;
     }
+    fit.width_ratio[k] = Median(&magnitudes);
     const StripeSpan& span = layout.stripes[k];
     fit.extent[k] =
         fit.points[k] > 1 ? std::min(1.0, (hi - lo) / (span.along.hi - span.along.lo)) : 0.0;

@@ -60,6 +60,10 @@ struct StripeFit {
   /// The fraction of each stripe's printed length (between the crossings and its ends, both
   /// arms) that its kept points span: a stripe half hidden under a hand shows about 0.5.
   std::array<double, 4> extent{};
+  /// The median, over each stripe's kept points, of its run's width across over the stripe's
+  /// width there where the pose puts it: about 1 for the right pose, the ratio of two stripes'
+  /// widths for one that takes a stripe for another (turned by 180 degrees).
+  std::array<double, 4> width_ratio{};
   double rms_px = 0.0;    ///< of the kept points' distances to their lines, pixels
   double scale_px = 0.0;  ///< the residuals' robust scale at the end, pixels
   int iterations = 0;

@@ -116,6 +116,26 @@ std::optional<vpHomography> FourPointHomography(const std::array<Point2d, 4>& pl
   return result;
 }
 
+std::optional<vpHomogeneousMatrix> PlanePose(const vpHomography& h) {
+  Eigen::Matrix3d columns;
+  for (int r = 0; r < 3; ++r) columns.row(r) << h[r][0], h[r][1], h[r][2];
+  const double scale = std::sqrt(columns.col(0).norm() * columns.col(1).norm());
+  if (!(scale > 0.0) || !std::isfinite(scale)) return std::nullopt;
+  columns /= scale;
+  Eigen::Matrix3d rotation;
+  rotation << columns.col(0), columns.col(1), columns.col(0).cross(columns.col(1));
+  // The nearest rotation (the homography of measured points is not exactly a rigid one).
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(rotation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  rotation = svd.matrixU() * svd.matrixV().transpose();
+  if (rotation.determinant() < 0.0) return std::nullopt;
+  vpHomogeneousMatrix cMo;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) cMo[r][c] = rotation(r, c);
+    cMo[r][3] = columns(r, 2);
+  }
+  return cMo;
+}
+
 Point2d TargetLayout::ToPlane(double a, double b) const {
   return Point2d{origin.u + a * axis_a.u + b * axis_b.u, origin.v + a * axis_a.v + b * axis_b.v};
 }

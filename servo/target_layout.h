@@ -74,6 +74,12 @@ struct TargetLayout {
 /// coordinates of a camera at cMo: H = [r1 r2 t].
 vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo);
 
+/// The pose of a plane seen through `plane_to_image` (target plane -> normalised coordinates,
+/// in front of the camera where its third coordinate is positive): its first two columns
+/// scaled to the rotation's, the nearest rotation to them and their cross product. Nullopt
+/// when the homography is degenerate or would put the camera behind the plane.
+std::optional<vpHomogeneousMatrix> PlanePose(const vpHomography& plane_to_image);
+
 /// The homography taking four plane points exactly onto four image points, solved with
 /// Eigen's LU on its eight unknowns, the ninth fixed by h(origin) having third coordinate 1
 /// (`origin` lies inside the quadrilateral, so in front of the camera); nullopt when the

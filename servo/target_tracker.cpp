@@ -1,5 +1,6 @@
 #include "servo/target_tracker.h"
 
+#include <visp3/core/vpPixelMeterConversion.h>
 #include <visp3/core/vpThetaUVector.h>
 
 #include <algorithm>
@@ -16,6 +17,11 @@ namespace oal {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / kPi;
+// A fit from an expected pose that may be turned by 180 degrees: the other way round must fit
+// the runs' widths worse by this (FitExpected's score).
+constexpr double kWaysRoundMargin = 0.1;
+// ... and its first fit takes points in a corridor this many times the fit's.
+constexpr double kExpectedCorridorScale = 3.0;
 
 double Microseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
@@ -275,8 +281,8 @@ std::vector<LineSeed> TargetPoseTracker::SeedsFrom(const vpHomography& plane_to_
 
 bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& borders,
                                 const std::vector<LineSeed>& seeds,
-                                const std::optional<vpHomogeneousMatrix>& prior,
-                                ScanSource source) {
+                                const std::optional<vpHomogeneousMatrix>& prior, ScanSource source,
+                                const std::optional<Expected>& expected) {
   auto start = std::chrono::steady_clock::now();
   const std::vector<DetectedLine>& lines = detector_.Detect(image, seeds, borders);
   frame_.detect_us += Microseconds(start);
@@ -296,11 +302,123 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
                             detector_.Undistorts(), options_.stripe_fit);
     if (frame_.fit.ok) ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
   }
-  if (frame_.pose.status != PoseStatus::kOk) {
+  if (frame_.pose.status != PoseStatus::kOk && !(expected && FitExpected(*expected))) {
     frame_.status = TargetStatus::kNotFound;
     frame_.message = frame_.pose.message;
     return false;
   }
+  return Verify(image);
+}
+
+bool TargetPoseTracker::FitExpected(const Expected& expected) {
+  // The target turned by 180 degrees about the '#''s middle.
+  const vpHomogeneousMatrix to_middle(layout_.origin.u, layout_.origin.v, 0.0, 0.0, 0.0, 0.0);
+  const vpHomogeneousMatrix turned = expected.cMo * to_middle *
+                                     vpHomogeneousMatrix(0.0, 0.0, 0.0, 0.0, 0.0, kPi) *
+                                     to_middle.inverse();
+  std::optional<StripeFit> best;
+  double best_score = HUGE_VAL, other_score = HUGE_VAL;
+  std::string failure;
+  for (const vpHomogeneousMatrix& start : {expected.cMo, turned}) {
+    if (!expected.either_way && best) break;
+    // Where the target was expected is a few pixels off at the stripes' ends (a candidate's
+    // corners, a prediction): a first fit in a wider corridor, then the fit from there.
+    StripeFitOptions wide = options_.stripe_fit;
+    wide.corridor_px *= kExpectedCorridorScale;
+    StripeFit fit = FitStripes(start, layout_, detector_.feature_points(), camera_,
+                               detector_.Undistorts(), wide);
+    if (fit.ok) {
+      fit = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
+                       detector_.Undistorts(), options_.stripe_fit);
+    }
+    if (!fit.ok) {
+      if (failure.empty()) failure = fit.message;
+      continue;
+    }
+    // How far the runs' widths are from their stripes' (log ratios: a stripe taken for one
+    // 1.5 times as wide scores 0.16).
+    double score = 0.0;
+    for (const double ratio : fit.width_ratio) score += std::pow(std::log(ratio), 2);
+    if (score < best_score) {
+      other_score = best_score;
+      best_score = score;
+      best = std::move(fit);
+    } else {
+      other_score = std::min(other_score, score);
+    }
+    if (!expected.either_way) break;
+  }
+  const std::string why = frame_.pose.message;
+  if (!best) {
+    frame_.pose.message = why +
+                          "; fitted to the stripes' points from where the target was "
+                          "expected: " +
+                          failure;
+    return false;
+  }
+  // The widths must tell the way round (each ratio of the other is 1.5 or 1.17 for the
+  // built-in targets: a score of 0.37 against about 0).
+  if (expected.either_way && other_score < best_score + kWaysRoundMargin) {
+    std::ostringstream message;
+    message << why << "; fitted to the stripes' points, their widths do not tell which way round "
+            << "the target lies (scores " << best_score << " and " << other_score << ")";
+    frame_.pose.message = message.str();
+    return false;
+  }
+  if (best->rms_px > pose_options_.max_residual_px) {
+    std::ostringstream message;
+    message << why << "; fitted to the stripes' points, their residual " << best->rms_px
+            << " px > max_residual_px = " << pose_options_.max_residual_px;
+    frame_.pose.message = message.str();
+    return false;
+  }
+  frame_.fit = *best;
+  // The four lines are the stripes' centre lines where the fit puts them.
+  const vpHomography plane_to_image = PlaneToImage(best->cMo);
+  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(plane_to_image);
+  std::vector<DetectedLine> lines;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (!ends[k]) {
+      frame_.pose.message =
+          why + "; the fitted pose puts line " + std::to_string(k + 1) + " behind the camera";
+      return false;
+    }
+    DetectedLine line;
+    line.line = LineThrough(ends[k]->a, ends[k]->b);
+    line.end_a = line.support_a = ends[k]->a;
+    line.end_b = line.support_b = ends[k]->b;
+    line.support = best->points[k];
+    line.seed_id = static_cast<int>(k);
+    lines.push_back(line);
+  }
+  lines_ = std::move(lines);
+  PoseResult& pose = frame_.pose;
+  pose.line_index = {0, 1, 2, 3};
+  for (std::size_t k = 0; k < 4; ++k) {
+    Point2d& corner = pose.corners_px[k];
+    Intersect(lines_[k].line, lines_[(k + 1) % 4].line, &corner);
+    double x = 0.0, y = 0.0;
+    if (detector_.Undistorts()) {
+      x = (corner.u - camera_.get_u0()) / camera_.get_px();
+      y = (corner.v - camera_.get_v0()) / camera_.get_py();
+    } else {
+      vpPixelMeterConversion::convertPoint(camera_, corner.u, corner.v, x, y);
+    }
+    pose.corners_m[k] = vpColVector(2);
+    pose.corners_m[k][0] = x;
+    pose.corners_m[k][1] = y;
+  }
+  pose.residual_px = best->rms_px;
+  pose.method = PoseMethod::kStripes;
+  pose.identification_cost = best_score;
+  pose.identification_margin = other_score - best_score;
+  ReplacePose(best->cMo, target_, &pose);
+  pose.status = PoseStatus::kOk;
+  pose.message.clear();
+  return true;
+}
+
+bool TargetPoseTracker::Verify(const GrayImageView& image) {
   std::array<LineParams, 4> identified;
   for (std::size_t k = 0; k < identified.size(); ++k) {
     identified[k] = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
@@ -351,6 +469,12 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
 bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
                                          const vpHomography& plane_to_image, ScanSource source) {
   const std::vector<LineSeed> seeds = SeedsFrom(plane_to_image);
+  // Where the candidate puts the target, should its lines give no pose: a middle cell either
+  // way round, the whole image's pose as it is.
+  std::optional<Expected> expected;
+  if (const std::optional<vpHomogeneousMatrix> cMo = PlanePose(plane_to_image)) {
+    expected = Expected{*cMo, source == ScanSource::kMiddleCell};
+  }
   // quick_max_identification_cost 0 could never keep a quick scan: none is made.
   const bool quick = quick_scan_ && options_.quick_max_identification_cost > 0.0 &&
                      options_.tracked_borders < options_.borders;
@@ -362,7 +486,7 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
     if (borders_.empty()) return false;
     if (scan == 0 && source == ScanSource::kMiddleCell) ++frame_.candidates;
     // Each candidate on its own: a prior that failed above says nothing about it.
-    const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source);
+    const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source, expected);
     if (count >= options_.borders) return accepted;
     if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
       return true;
@@ -385,7 +509,8 @@ const TargetFrame& TargetPoseTracker::Track(
       const vpHomography plane_to_image = PlaneToImage(*prior);
       TargetBorders(layout_, plane_to_image, camera_, options_.tracked_borders, &borders_);
       if (!borders_.empty()) {
-        found = Attempt(image, borders_, SeedsFrom(plane_to_image), prior, ScanSource::kPrior);
+        found = Attempt(image, borders_, SeedsFrom(plane_to_image), prior, ScanSource::kPrior,
+                        Expected{*prior, false});
       }
     }
     if (!found) {

@@ -164,6 +164,13 @@ struct TargetFrame {
 
 class TargetPoseTracker {
  public:
+  /// Where the target is expected when its lines give no pose: a pose, and whether it may be
+  /// turned by 180 degrees (a middle cell maps onto itself so turned; a prior pose does not).
+  struct Expected {
+    vpHomogeneousMatrix cMo;
+    bool either_way = false;
+  };
+
   /// Throws std::invalid_argument for options failing Check(), detector or pose options
   /// failing theirs, or a target that is not a '#' whose stripes reach past the crossings.
   TargetPoseTracker(const LineTarget& target, const vpCameraParameters& camera,
@@ -201,9 +208,21 @@ class TargetPoseTracker {
  private:
   /// Detects in `borders` (the whole image when empty) and estimates the pose from `prior`;
   /// true when the pose is accepted by the model check.
+  /// When the lines give no pose and `expected` says where the target should be (the prior,
+  /// or a candidate's), the pose is fitted to the stripes' feature points from there
+  /// (FitExpected).
   bool Attempt(const GrayImageView& image, const ScanBorders& borders,
                const std::vector<LineSeed>& seeds, const std::optional<vpHomogeneousMatrix>& prior,
-               ScanSource source);
+               ScanSource source, const std::optional<Expected>& expected = std::nullopt);
+  /// The pose fitted to the last scan's stripe points from `expected`, both ways round when it
+  /// may be turned by 180 degrees (the one whose runs are as wide as its stripes): a stripe
+  /// hidden on one side of the crossings, under a hand, gives no line (a border crosses it only
+  /// there) but its points on the other side. Its four lines are the stripes' where it puts
+  /// them. False (the frame's pose and message say why) when no fit holds.
+  bool FitExpected(const Expected& expected);
+  /// The checks on the frame's pose: enough points on each line, the model check; the lens
+  /// told from the lines.
+  bool Verify(const GrayImageView& image);
   /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.

@@ -282,6 +282,30 @@ TEST(TargetPoseTracker, TheStripesPointsLieOnTheirCentreLines) {
 }
 
 // The sheet slides out of view (no pose, never a wrong one) and comes back (found again).
+// A hand lying over one side of a stripe, from its crossing to its end: every border meets
+// that stripe there, so no border pairs its points into a line; its points on the other side
+// still fit the pose, the target held rigid, from where the middle cell puts it. Right, and
+// the hand's samples excused by the model check.
+TEST(TargetPoseTracker, AStripeHiddenOnOneSideIsFittedFromTheOther) {
+  const LineTarget target = FourLineA3Target();
+  const SceneRenderer renderer(target, BenchRender(5));
+  TargetPoseTracker tracker = TrackerFor(renderer);
+  FrameEffects effects;
+  PlaneOccluder arm;  // over line 4 (y = +0.062) from x = 0.101 to beyond the sheet's edge
+  arm.capsules.push_back({0.126, 0.062, 0.30, 0.062, 0.025});
+  arm.grey = 120;
+  arm.texture_grey = 10.0;
+  effects.plane_occluders.push_back(arm);
+  const vpHomogeneousMatrix cMo(0.01, -0.02, 0.55, 0.2, -0.15, 0.3);
+  const RenderedFrame frame = renderer.Render(cMo, 4, effects);
+  ASSERT_GT(frame.truth[3].occluded_fraction, 0.2);  // all of it right of the crossing
+  const TargetFrame& found = tracker.Track(ViewOf(frame.image));
+  ExpectRightPose(found, cMo, "line 4 half hidden");
+  EXPECT_EQ(found.pose.method, PoseMethod::kStripes);
+  EXPECT_GT(found.fit.points[3], 0);
+  EXPECT_LT(found.fit.extent[3], 0.7);  // only its other side
+}
+
 TEST(TargetPoseTracker, LosesTheSheetOutOfViewAndFindsItAgain) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(7));
   TargetPoseTracker tracker = TrackerFor(renderer);
