@@ -6,12 +6,12 @@
 // puts them), centred on the sheet: 0.038 m squares on A3 (0.380 x 0.266 m), in proportion on
 // a smaller sheet (A4 0.0269 m), the white paper around it.
 //
-// The pose, as OpenCV's ChArUco tutorial does it: detectMarkers (default parameters),
-// refineDetectedMarkers (the markers the board's layout says were missed: 197 frames with a
-// pose of 200 instead of 179 on the tidy A3 bench), interpolateCornersCharuco with the camera
-// (pose-based interpolation, then cornerSubPix; 2 adjacent markers a corner) and
-// estimatePoseCharucoBoard (at least 4 corners, solvePnP), the board's frame moved to the
-// sheet's centre.
+// The pose, as OpenCV's ChArUco sample (detect_board_charuco) does it with its refinement on:
+// detectMarkers (default parameters), refineDetectedMarkers (the markers the board's layout
+// says were missed: 197 frames with a pose of 200 instead of 179 on the tidy A3 bench),
+// interpolateCornersCharuco with the camera (pose-based interpolation, then cornerSubPix; 2
+// adjacent markers a corner) and estimatePoseCharucoBoard (at least 4 corners, solvePnP), the
+// board's frame moved to the sheet's centre.
 //
 // The lens. OpenCV's camera matrix from px, py, u0, v0, and its distortion coefficients
 // (k1, k2, 0, 0, k3) fitted to the rendered lens over the image (KduAsOpenCvDistortion): the
