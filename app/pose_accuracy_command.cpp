@@ -80,6 +80,42 @@ std::string Table(const PoseAccuracyReport& r) {
   return out.str();
 }
 
+// A marker's report: the rows of ours that a printed marker has (no lines, no scan sources),
+// and how often all of it was in view.
+std::string MarkerTable(const PoseAccuracyReport& r) {
+  std::ostringstream out;
+  const auto count = [&r](MarkerStatus status) {
+    const auto found = r.status_counts.find(ToString(status));
+    return found == r.status_counts.end() ? 0 : found->second;
+  };
+  const double frames = std::max(1, r.frames);
+  out << std::fixed << std::setprecision(2) << "| measure | value |\n|---|---:|\n"
+      << "| marker | " << ToString(r.options.marker) << ": " << r.marker_description << " |\n"
+      << "| sheet | " << r.options.target.name << "'s board, without its stripes |\n"
+      << "| frames | " << r.frames << " |\n"
+      << "| frames with a pose | " << r.posed() << " (" << 100.0 * r.posed() / frames << " %) |\n"
+      << "| wrong poses (> " << r.options.wrong_translation_pct << " % or > "
+      << r.options.wrong_rotation_deg << " deg) | " << r.wrong_frames.size() << " |\n"
+      << "| frames without a pose | " << ToString(MarkerStatus::kNotFound) << ' '
+      << count(MarkerStatus::kNotFound) << ", " << ToString(MarkerStatus::kNoPose) << ' '
+      << count(MarkerStatus::kNoPose) << " |\n"
+      << "| frames with all of the marker in view / of them with a pose | " << r.marker_in_view
+      << " (" << 100.0 * r.marker_in_view / frames << " %) / " << r.posed_in_view << " |\n";
+  out << std::setprecision(3) << "| translation error median / p95 (% of distance) | "
+      << Quantile(r.translation_error_pct, 0.5) << " / " << Quantile(r.translation_error_pct, 0.95)
+      << " |\n"
+      << "| rotation error median / p95 (deg) | " << Quantile(r.rotation_error_deg, 0.5) << " / "
+      << Quantile(r.rotation_error_deg, 0.95) << " |\n"
+      << "| roll error median / max (deg) | " << Quantile(r.roll_error_deg, 0.5) << " / "
+      << Quantile(r.roll_error_deg, 1.0) << " |\n"
+      << "| frames with roll off by > 45 deg | " << r.roll_flips << " |\n"
+      << std::setprecision(1) << "| time median / p95 (us): detect + pose | "
+      << Quantile(r.total_time_us, 0.5) << " / " << Quantile(r.total_time_us, 0.95) << " |\n"
+      << "| — detect / pose medians (us) | " << Quantile(r.detect_time_us, 0.5) << " / "
+      << Quantile(r.pose_time_us, 0.5) << " |\n";
+  return out.str();
+}
+
 nlohmann::json ToJson(const PoseAccuracyReport& r, const std::string& config_path) {
   const PoseAccuracyOptions& o = r.options;
   nlohmann::json options = RenderedFrameJson(o);
@@ -117,6 +153,24 @@ nlohmann::json ToJson(const PoseAccuracyReport& r, const std::string& config_pat
           {"estimated_kdu", o.estimate_distortion && r.estimate_failed.empty()
                                 ? nlohmann::json(r.estimated_kdu)
                                 : nlohmann::json()}};
+}
+
+// A marker's report: ours' keys that a printed marker has, the marker, its time's p95 and how
+// often all of it was in view.
+nlohmann::json MarkerJson(const PoseAccuracyReport& r, const std::string& config_path) {
+  nlohmann::json json = ToJson(r, config_path);
+  for (const char* key : {"pose_status_counts", "source_counts", "lines_found",
+                          "find_time_us_median", "estimated_kdu"}) {
+    json.erase(key);
+  }
+  json["options"].erase("scan");
+  json["options"].erase("max_residual_px");
+  json["options"]["marker"] = ToString(r.options.marker);
+  json["marker"] = r.marker_description;
+  json["marker_in_view"] = r.marker_in_view;
+  json["posed_in_view"] = r.posed_in_view;
+  json["time_us_p95"] = Quantile(r.total_time_us, 0.95);
+  return json;
 }
 
 // The evaluation conditions a target is made for, where the command line leaves them open:
@@ -164,7 +218,9 @@ int RunPoseAccuracy(int argc, char** argv) {
       "on photographs of a bench among printed sheets and tools, with its shadow, under a cheap "
       "lens corrected by its camera file (kdu 0.15), noise 2-8 and blur 0.5-1.5 "
       "varying per frame, light fall-off, from the near to the far end of its range with its "
-      "crossings in view; the 2 m board as the paper's condition (0.3-1.0 m, kdu 0.33, noise 8).",
+      "crossings in view; the 2 m board as the paper's condition (0.3-1.0 m, kdu 0.33, noise 8). "
+      "--marker puts what users would print instead on the same frames: an AprilTag or a "
+      "ChArUco board, each found and posed by its own library.",
       "oalservo pose-accuracy"};
   PoseAccuracyOptions options;
   std::string target_name = options.target.name, config_path, out_path;
@@ -210,6 +266,13 @@ int RunPoseAccuracy(int argc, char** argv) {
                  "frames with the target that --estimate-distortion tells the lens from")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
+  std::string marker_name = ToString(SheetMarker::kOal);
+  cli.add_option("--marker", marker_name,
+                 "what the sheet carries, on the same frames (poses, bench, lived-in effects, "
+                 "noise): oal (our '#' stripes, found by the target tracker), apriltag (an "
+                 "AprilTag 36h11 found and posed by ViSP's detector) or charuco (a 10x7 ChArUco "
+                 "board found and posed by OpenCV) printed on the target's sheet instead")
+      ->capture_default_str();
   cli.footer(
       "Examples:\n"
       "  oalservo pose-accuracy --frames 1000 --seed 1 --out out/pose-a3.json\n"
@@ -217,8 +280,26 @@ int RunPoseAccuracy(int argc, char** argv) {
       "  oalservo pose-accuracy --target four-line-board --frames 1000 --seed 1\n"
       "  oalservo pose-accuracy --config config/scene-dark-table.yaml --frames 1000 --seed 3\n"
       "  oalservo pose-accuracy --frames 1000 --seed 4 --save-missed out/missed\n"
+      "  oalservo pose-accuracy --frames 1000 --seed 1 --marker apriltag   # the same frames\n"
       "  oalservo pose out/missed   # the missed frames again, one JSON line each");
   if (auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
+  try {
+    options.marker = SheetMarkerFromString(marker_name);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(std::string("--marker: ") + error.what());
+  }
+  if (options.marker != SheetMarker::kOal) {
+    if (!missed_dir.empty()) {
+      throw UsageError(
+          "--save-missed keeps frames for `oalservo pose`, which runs our tracker: "
+          "only with --marker oal");
+    }
+    if (options.estimate_distortion) {
+      throw UsageError(
+          "--estimate-distortion tells the lens from our target's stripes: only "
+          "with --marker oal (a marker's method is given the rendered camera)");
+    }
+  }
   ApplyRenderedCameraOptions(cli, camera_path, &options);
 
   // Everything that can fail before the evaluation's minutes of work.
@@ -256,7 +337,11 @@ int RunPoseAccuracy(int argc, char** argv) {
     WriteFileAtomically(missed->dir() / "target.yaml", TargetYaml(options.target));
     missed->Commit();
   }
-  PrintAccuracyReport(Table(report), ToJson(report, config_path), out_path);
+  if (options.marker == SheetMarker::kOal) {
+    PrintAccuracyReport(Table(report), ToJson(report, config_path), out_path);
+  } else {
+    PrintAccuracyReport(MarkerTable(report), MarkerJson(report, config_path), out_path);
+  }
   if (missed) {
     const std::size_t missed_frames = report.failed_frames.size() + report.wrong_frames.size();
     std::cerr << "oalservo pose-accuracy: " << missed_frames

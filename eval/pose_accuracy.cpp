@@ -3,9 +3,11 @@
 #include <visp3/core/vpRzyxVector.h>
 #include <visp3/core/vpThetaUVector.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "base/pose_distance.h"
@@ -80,6 +82,9 @@ void PoseAccuracyOptions::Check() const {
   RequireOption(estimate_frames >= 1 && estimate_frames <= 100,
                 "PoseAccuracyOptions::estimate_frames", estimate_frames,
                 "1 <= estimate_frames <= 100");
+  RequireOption(marker == SheetMarker::kOal || !estimate_distortion,
+                "PoseAccuracyOptions::estimate_distortion", estimate_distortion,
+                "false with a marker (the lens is told from our target's stripes)");
 }
 
 namespace {
@@ -121,12 +126,103 @@ vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
   return WithLens(pinhole, *told.lens);
 }
 
+// A found pose's errors against the truth, added to `report`.
+struct PoseErrors {
+  double translation_pct = 0.0, rotation_deg = 0.0;
+  bool wrong = false;
+};
+PoseErrors RecordPose(const vpHomogeneousMatrix& cMo_true, const vpHomogeneousMatrix& cMo,
+                      int frame, const PoseAccuracyOptions& options, PoseAccuracyReport* report) {
+  const PoseDistance error = Distance(cMo_true, cMo);
+  PoseErrors errors;
+  errors.translation_pct =
+      100.0 * error.translation_m / cMo_true.getTranslationVector().frobeniusNorm();
+  errors.rotation_deg = vpMath::deg(error.rotation_rad);
+  report->translation_error_pct.push_back(errors.translation_pct);
+  report->rotation_error_deg.push_back(errors.rotation_deg);
+  double roll_error = std::fabs(RollDeg(cMo) - RollDeg(cMo_true));
+  roll_error = std::fmod(roll_error, 360.0);
+  roll_error = std::min(roll_error, 360.0 - roll_error);
+  report->roll_error_deg.push_back(roll_error);
+  report->roll_flips += roll_error > 45.0;
+  errors.wrong = errors.translation_pct > options.wrong_translation_pct ||
+                 errors.rotation_deg > options.wrong_rotation_deg;
+  if (errors.wrong) report->wrong_frames.push_back(frame);
+  return errors;
+}
+
+// Whether every corner of `outline` (plane points) is in front of the camera and inside the
+// distorted image of `render`.
+bool OutlineInView(const RenderOptions& render, const vpHomogeneousMatrix& cMo,
+                   const std::array<std::array<double, 2>, 4>& outline) {
+  for (const auto& corner : outline) {
+    const double z = cMo[2][0] * corner[0] + cMo[2][1] * corner[1] + cMo[2][3];
+    if (!(z > 0.0)) return false;
+    const double x = (cMo[0][0] * corner[0] + cMo[0][1] * corner[1] + cMo[0][3]) / z;
+    const double y = (cMo[1][0] * corner[0] + cMo[1][1] * corner[1] + cMo[1][3]) / z;
+    const Point2d pixel = DistortedPixel(render.camera, x, y);
+    if (!(pixel.u >= 0.0 && pixel.u <= render.width - 1 && pixel.v >= 0.0 &&
+          pixel.v <= render.height - 1)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The marker's frames: the poses, effects and noise of our target's frames (the same calls in
+// the same order), the marker printed on the board instead of the stripes.
+PoseAccuracyReport EvaluateMarkerPoseAccuracy(const PoseAccuracyOptions& options,
+                                              const std::function<void(int, int)>& progress) {
+  const EvaluationScenes scenes(options.target, options);
+  const RenderOptions& render = scenes.For(0).options();
+  const std::unique_ptr<MarkerMethod> method =
+      MakeMarkerMethod(options.marker, options.target, render.camera, render.width, render.height);
+  const MarkerPrint& print = method->Print();
+  const EvaluationScenes printed(MarkerSheet(options.target, *method), options, print.picture);
+
+  PoseAccuracyReport report;
+  report.options = options;
+  report.marker_description = print.description;
+  for (const MarkerStatus status :
+       {MarkerStatus::kOk, MarkerStatus::kNotFound, MarkerStatus::kNoPose}) {
+    report.status_counts[ToString(status)] = 0;
+  }
+  std::uint64_t state = options.seed;
+  for (int frame = 0; frame < options.frames; ++frame) {
+    const vpHomogeneousMatrix cMo_true = SamplePose(scenes.For(frame), options.sampling, &state);
+    const std::uint64_t noise_seed = options.seed * 7919ULL + frame;
+    const FrameEffects effects = scenes.EffectsFor(frame);
+    const SceneRenderer& renderer = printed.For(frame);
+    const RenderedFrame rendered = renderer.Render(cMo_true, noise_seed, effects);
+    const bool in_view = OutlineInView(renderer.options(), cMo_true, print.outline_m);
+
+    const auto start = std::chrono::steady_clock::now();
+    const MarkerPose found = method->Find(rendered.image);
+    report.total_time_us.push_back(MicrosecondsSince(start));
+    report.detect_time_us.push_back(found.detect_us);
+    report.pose_time_us.push_back(found.pose_us);
+
+    ++report.frames;
+    ++report.status_counts[ToString(found.status)];
+    report.marker_in_view += in_view;
+    if (found.status != MarkerStatus::kOk) {
+      report.failed_frames.push_back(frame);
+    } else {
+      report.posed_in_view += in_view;
+      RecordPose(cMo_true, found.cMo, frame, options, &report);
+    }
+    if (progress) progress(frame + 1, options.frames);
+  }
+  return report;
+}
+
 }  // namespace
 
 PoseAccuracyReport EvaluatePoseAccuracy(
     const PoseAccuracyOptions& options, const std::function<void(int, int)>& progress,
     const std::function<void(const PoseAccuracyMiss&)>& on_miss) {
   options.Check();
+  if (options.marker != SheetMarker::kOal) return EvaluateMarkerPoseAccuracy(options, progress);
   const EvaluationScenes scenes(options.target, options);
   PoseAccuracyReport report;
   const vpCameraParameters camera = options.estimate_distortion
@@ -174,22 +270,8 @@ PoseAccuracyReport EvaluatePoseAccuracy(
       missed(false, 0.0, 0.0);
     } else {
       ++report.source_counts[ToString(result.source)];
-      const vpHomogeneousMatrix& cMo = result.pose.cMo;
-      const PoseDistance error = Distance(cMo_true, cMo);
-      const double t_pct =
-          100.0 * error.translation_m / cMo_true.getTranslationVector().frobeniusNorm();
-      const double r_deg = vpMath::deg(error.rotation_rad);
-      report.translation_error_pct.push_back(t_pct);
-      report.rotation_error_deg.push_back(r_deg);
-      double roll_error = std::fabs(RollDeg(cMo) - RollDeg(cMo_true));
-      roll_error = std::fmod(roll_error, 360.0);
-      roll_error = std::min(roll_error, 360.0 - roll_error);
-      report.roll_error_deg.push_back(roll_error);
-      report.roll_flips += roll_error > 45.0;
-      if (t_pct > options.wrong_translation_pct || r_deg > options.wrong_rotation_deg) {
-        report.wrong_frames.push_back(frame);
-        missed(true, t_pct, r_deg);
-      }
+      const PoseErrors errors = RecordPose(cMo_true, result.pose.cMo, frame, options, &report);
+      if (errors.wrong) missed(true, errors.translation_pct, errors.rotation_deg);
     }
     if (progress) progress(frame + 1, options.frames);
   }

@@ -1,7 +1,9 @@
 // The pose's accuracy evaluation: rendered frames of a four-line target (by default the A3
 // sheet on photographs of a bench) at random poses, each found on its own by the target
 // tracker (servo/target_tracker.h: the sheet's middle cell, borders on its plane, the checks),
-// errors against the rendered cMo. Deterministic for a given seed.
+// errors against the rendered cMo. Deterministic for a given seed. Or, on the same frames, a
+// marker users would print on the sheet instead (eval/marker_method.h: an AprilTag, a ChArUco
+// board) and its own detection and pose.
 #pragma once
 
 #include <array>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "detector/options.h"
+#include "eval/marker_method.h"
 #include "eval/rendered_frames.h"
 #include "loop/lens_estimate.h"  // kLensFrames
 #include "scene/bench_scene.h"   // SheetSampling
@@ -41,19 +44,30 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
   /// finds it in, then used for every frame (loop/lens_estimate.h).
   bool estimate_distortion = false;
   int estimate_frames = kLensFrames;  ///< Range [1, 100].
+  /// What the sheet carries: our stripes, or a marker printed instead (kAprilTag, kCharuco),
+  /// posed by its own method on the same frames: the same poses (drawn for `target`, its
+  /// crossings in view), bench, lived-in effects and noise, the frame rendered with `target`'s
+  /// board carrying the marker instead of the stripes (MarkerSheet). A marker's method is given
+  /// the rendered camera, lens included (estimate_distortion is for our stripes only); the
+  /// detector, pose and tracking options are ours and do not apply to it.
+  SheetMarker marker = SheetMarker::kOal;
 
   /// The paper's board (its first evaluation): 0.3-1.0 m, tilt up to 40 deg, any roll, every
   /// line crossing 150 px of the image.
   static PoseSampling BoardSampling();
   /// RenderedFrameOptions::Check(), the detector's, the pose's (with the camera) and the
-  /// tracking's options.
+  /// tracking's options; no estimate_distortion with a marker.
   void Check() const;
 };
 
+/// With a marker, the fields of our tracker (pose_status_counts, source_counts, lines_found,
+/// find_time_us, the estimated lens) stay empty.
 struct PoseAccuracyReport {
   PoseAccuracyOptions options;
   int frames = 0;
-  std::map<std::string, int> status_counts;       ///< by TargetStatus ("ok", "not-found", ...)
+  /// By TargetStatus ("ok", "not-found", ...); with a marker, by MarkerStatus ("ok",
+  /// "not-found", "no-pose").
+  std::map<std::string, int> status_counts;
   std::map<std::string, int> pose_status_counts;  ///< of the frames without a pose, by PoseStatus
   std::map<std::string, int> source_counts;       ///< of the frames with a pose, by ScanSource
   std::vector<double> translation_error_pct;      ///< |t - t_true| / |t_true|, frames with a pose
@@ -68,6 +82,12 @@ struct PoseAccuracyReport {
   /// standard deviation, and why not.
   double estimated_kdu = 0.0, estimated_kdu_sd = 0.0;
   std::string estimate_failed;
+  /// With a marker: what was printed (MarkerPrint::description), the frames that show all of
+  /// its outline, and of those the frames with a pose (the poses are drawn for our target's
+  /// crossings: a large marker is partly out of the nearest views).
+  std::string marker_description;
+  int marker_in_view = 0;
+  int posed_in_view = 0;
 
   int posed() const;
 };
@@ -84,7 +104,8 @@ struct PoseAccuracyMiss {
   double translation_error_pct = 0.0, rotation_error_deg = 0.0;  ///< of a wrong pose
 };
 
-/// `on_miss` sees each frame without a pose or with a wrong one, to keep it for a replay.
+/// `on_miss` sees each frame without a pose or with a wrong one, to keep it for a replay (our
+/// target's frames only: a marker's are not kept).
 PoseAccuracyReport EvaluatePoseAccuracy(
     const PoseAccuracyOptions& options, const std::function<void(int, int)>& progress = {},
     const std::function<void(const PoseAccuracyMiss&)>& on_miss = {});

@@ -63,11 +63,13 @@ RenderOptions MakeRenderOptions(const RenderedFrameOptions& options) {
   return render;
 }
 
-EvaluationScenes::EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options)
+EvaluationScenes::EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options,
+                                   const PrintedPicture& picture)
     : options_(options), target_(target) {
   std::vector<std::string> paths = options.backgrounds;
   if (paths.empty() && !options.scene.background.empty()) paths = {options.scene.background};
-  const RenderOptions base = MakeRenderOptions(options);
+  RenderOptions base = MakeRenderOptions(options);
+  base.printed_picture = picture;
   if (paths.empty()) {
     renderers_.emplace_back(target, base);
     names_.push_back("uniform grey");

@@ -58,8 +58,10 @@ RenderOptions MakeRenderOptions(const RenderedFrameOptions& options);
 /// The renderers of an evaluation, one per background (or one), and each frame's effects.
 class EvaluationScenes {
  public:
-  /// Reads the backgrounds; throws std::runtime_error naming an unreadable one.
-  EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options);
+  /// Reads the backgrounds; throws std::runtime_error naming an unreadable one. `picture` is
+  /// printed on the target's board (RenderOptions::printed_picture; none by default).
+  EvaluationScenes(const LineTarget& target, const RenderedFrameOptions& options,
+                   const PrintedPicture& picture = PrintedPicture());
   /// The renderer of frame `frame` (backgrounds in turn).
   const SceneRenderer& For(int frame) const;
   /// Frame `frame`'s noise and blur, and the scene's lived-in conditions (FrameEffects),

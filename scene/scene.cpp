@@ -696,10 +696,13 @@ class Decal {
  public:
   // `grey` and `alpha` (0: transparent, 255: opaque) of one size, one texel = texel_m on the
   // plane; the picture's centre lies at (centre_x, centre_y), its rows run along angle_rad from
-  // the object x axis and its columns along angle_rad + pi/2.
+  // the object x axis and its columns along angle_rad + pi/2. With `sharp_texels`, a texel is
+  // a sharp square where a pixel is smaller than it (a printed marker), not a sample
+  // interpolated bilinearly with its neighbours.
   Decal(const cv::Mat1b& grey, const cv::Mat1b& alpha, double texel_m, double centre_x,
-        double centre_y, double angle_rad)
-      : texel_m_(texel_m),
+        double centre_y, double angle_rad, bool sharp_texels = false)
+      : sharp_texels_(sharp_texels),
+        texel_m_(texel_m),
         width_m_(grey.cols * texel_m),
         height_m_(grey.rows * texel_m),
         cos_(std::cos(angle_rad)),
@@ -731,6 +734,13 @@ class Decal {
     if (!box_.Contains(X, Y)) return under;
     const double dx = X - origin_x_, dy = Y - origin_y_;
     const double lx = cos_ * dx + sin_ * dy, ly = -sin_ * dx + cos_ * dy;
+    if (sharp_texels_ && footprint_m < texel_m_) {
+      // The box of side footprint_m around the point over sharp texels: the bilinear weights
+      // steepened by texel / footprint (equal to them at footprint = texel, where the pyramid
+      // takes over).
+      const cv::Vec2d texel = Sample(0, lx, ly, texel_m_ / std::max(footprint_m, 1e-300));
+      return under * (1.0 - texel[1]) + texel[0];
+    }
     const double lod = std::log2(std::max(footprint_m / texel_m_, 1.0));
     const int last = static_cast<int>(levels_.size()) - 1;
     const int l0 = std::min(static_cast<int>(lod), last);
@@ -744,14 +754,19 @@ class Decal {
 
  private:
   // Bilinear (premultiplied grey, alpha) of level `level` at the local point (lx, ly) metres;
-  // transparent outside the picture.
-  cv::Vec2d Sample(int level, double lx, double ly) const {
+  // transparent outside the picture. `steepen` > 1 moves the weights away from 1/2 by that
+  // factor (clamped to [0, 1]): the mean over a box that many times smaller than a texel.
+  cv::Vec2d Sample(int level, double lx, double ly, double steepen = 1.0) const {
     const cv::Mat& m = levels_[level];
     const double cx = lx / width_m_ * m.cols - 0.5, cy = ly / height_m_ * m.rows - 0.5;
     if (!(cx > -1.0 && cy > -1.0 && cx < m.cols && cy < m.rows)) return cv::Vec2d(0.0, 0.0);
     const double fx = std::floor(cx), fy = std::floor(cy);
     const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fy);
-    const double ax = cx - fx, ay = cy - fy;
+    double ax = cx - fx, ay = cy - fy;
+    if (steepen != 1.0) {
+      ax = std::clamp((ax - 0.5) * steepen + 0.5, 0.0, 1.0);
+      ay = std::clamp((ay - 0.5) * steepen + 0.5, 0.0, 1.0);
+    }
     const auto at = [&m](int i, int j) {
       if (i < 0 || j < 0 || i >= m.cols || j >= m.rows) return cv::Vec2d(0.0, 0.0);
       return cv::Vec2d(m.at<cv::Vec2f>(j, i));
@@ -760,6 +775,7 @@ class Decal {
            ay * ((1.0 - ax) * at(i0, j0 + 1) + ax * at(i0 + 1, j0 + 1));
   }
 
+  bool sharp_texels_;
   double texel_m_, width_m_, height_m_, cos_, sin_;
   double origin_x_ = 0.0, origin_y_ = 0.0;  // plane point of the picture's (0, 0) corner
   Box box_;
@@ -928,13 +944,17 @@ cv::Mat1b ScaleBarMask(double length_m) {
 }
 
 // Where annotation marks may go: inside the board by kAnnotationEdgeM, kAnnotationClearanceM
-// clear of every stripe and kAnnotationGapM clear of the marks placed before.
+// clear of every stripe (and of a printed picture) and kAnnotationGapM clear of the marks
+// placed before.
 class AnnotationSpace {
  public:
   explicit AnnotationSpace(const LineTarget& target)
       : half_w_(0.5 * target.board_width_m - kAnnotationEdgeM),
         half_h_(0.5 * target.board_height_m - kAnnotationEdgeM),
         stripes_(StripeQuads(target)) {}
+
+  // Marks keep kAnnotationClearanceM clear of `quad` too, as of a stripe.
+  void KeepClearOf(const Quad& quad) { stripes_.push_back(quad); }
 
   // An axis-aligned mark of half sizes (hx, hy) centred at (cx, cy). A square grown by the
   // clearance contains the disc grown by it, so no overlap means at least the clearance.
@@ -987,10 +1007,11 @@ class AnnotationSpace {
 
 // The annotations `oalservo target` prints (approximately): line numbers beside both ends of
 // each stripe, the name and "print at 100 %" near the top-left corner, the scale bar near the
-// bottom-left one.
-std::vector<Decal> LayOutAnnotations(const LineTarget& target, int grey) {
+// bottom-left one; all clear of `picture` (the printed picture's outline) when it is given.
+std::vector<Decal> LayOutAnnotations(const LineTarget& target, int grey, const Quad* picture) {
   std::vector<Decal> decals;
   AnnotationSpace space(target);
+  if (picture != nullptr) space.KeepClearOf(*picture);
   const auto add = [&](const cv::Mat1b& mask, double cx, double cy) {
     const double hx = 0.5 * mask.cols * kAnnotationTexelM, hy = 0.5 * mask.rows * kAnnotationTexelM;
     space.Take(cx, cy, hx, hy);
@@ -1116,9 +1137,11 @@ bool DiscNearRect(double cx, double cy, double r, double hw, double hh, double g
 // Everything on the board plane besides the board and its stripes, laid out once by the
 // renderer's constructor.
 struct SceneDressing {
-  // On the board.
+  // On the board: the paper's texture, then the printed picture (none, or one), then the
+  // annotations.
   double paper_texture_grey = 0.0;
   std::uint64_t paper_seed = 0;
+  std::vector<Decal> picture;
   std::vector<Decal> annotations;
   // On the surface, in drawing order: sheets, then objects; `clutter` bins them (ids: sheets
   // first).
@@ -1133,6 +1156,7 @@ struct SceneDressing {
   double Paper(double board, const PlaneSample& s, double footprint_m) const {
     double value = board;
     if (paper_texture_grey > 0.0) value += paper_texture_grey * PaperNoise(s.X, s.Y, paper_seed);
+    for (const Decal& decal : picture) value = decal.Over(value, s.X, s.Y, footprint_m);
     for (const Decal& decal : annotations) value = decal.Over(value, s.X, s.Y, footprint_m);
     return value;
   }
@@ -1168,7 +1192,22 @@ namespace {
 
 bool NeedsDressing(const RenderOptions& o) {
   return o.paper_texture_grey > 0.0 || o.annotations || o.shadow_darkness > 0.0 ||
-         o.clutter_sheets > 0 || o.clutter_objects > 0;
+         o.clutter_sheets > 0 || o.clutter_objects > 0 || !o.printed_picture.empty();
+}
+
+// The printed picture as a decal of the target's ink: opaque where the picture is black, the
+// paper showing through where it is white; its outline on the plane in *outline.
+Decal PrintedPictureDecal(const LineTarget& target, const RenderOptions& options, Quad* outline) {
+  const vpImage<unsigned char>& picture = *options.printed_picture.image;
+  const int rows = static_cast<int>(picture.getHeight()),
+            cols = static_cast<int>(picture.getWidth());
+  const cv::Mat1b grey(rows, cols, const_cast<unsigned char*>(picture.bitmap));
+  cv::Mat1b ink;
+  cv::subtract(cv::Scalar(255), grey, ink);
+  const double texel_m = options.printed_picture.width_m / cols;
+  *outline = RotatedRect(0.0, 0.0, 0.0, 0.5 * cols * texel_m, 0.5 * rows * texel_m);
+  return Decal(cv::Mat1b(rows, cols, static_cast<unsigned char>(target.line_grey)), ink, texel_m,
+               0.0, 0.0, 0.0, /*sharp_texels=*/true);
 }
 
 // Other sheets and objects on the surface, drawn from options.scene_seed.
@@ -1235,7 +1274,14 @@ std::shared_ptr<const SceneDressing> BuildDressing(const LineTarget& target,
   auto d = std::make_shared<SceneDressing>();
   d->paper_texture_grey = options.paper_texture_grey;
   d->paper_seed = Mix(options.scene_seed ^ 0x7061706572ull);
-  if (options.annotations) d->annotations = LayOutAnnotations(target, options.annotation_grey);
+  Quad picture_outline{};
+  if (!options.printed_picture.empty()) {
+    d->picture.push_back(PrintedPictureDecal(target, options, &picture_outline));
+  }
+  if (options.annotations) {
+    d->annotations = LayOutAnnotations(target, options.annotation_grey,
+                                       d->picture.empty() ? nullptr : &picture_outline);
+  }
   LayOutClutter(target, options, d.get());
   d->shadow_darkness = options.shadow_darkness;
   d->shadow_x = options.shadow_offset_m * std::cos(options.shadow_angle_rad);
@@ -1442,6 +1488,11 @@ void RenderOptions::Check() const {
                 "0 <= clutter_objects <= 50");
   RequireOption(clutter_reach_m > 0.0 && clutter_reach_m <= 10.0, "RenderOptions::clutter_reach_m",
                 clutter_reach_m, "0 < clutter_reach_m <= 10");
+  if (!printed_picture.empty()) {
+    RequireOption(printed_picture.width_m > 0.0 && printed_picture.width_m <= 100.0,
+                  "RenderOptions::printed_picture.width_m", printed_picture.width_m,
+                  "0 < width_m <= 100 with a picture");
+  }
 }
 
 bool Occluder::Contains(double u, double v) const {

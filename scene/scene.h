@@ -18,9 +18,10 @@
 // sides; the camera sees its front when the object z axis points away from the camera.
 //
 // Scene dressing (RenderOptions: the surface's image, clutter, the board's shadow, the paper's
-// texture and annotations) is sampled where the pixel centre's ray meets the plane, pictures
-// through an area-averaged pyramid chosen by the pixel's footprint and objects anti-aliased from
-// their distance to the pixel centre: close to, not exactly, a box filter. The stripes and the
+// texture and annotations, a printed picture) is sampled where the pixel centre's ray meets the
+// plane, pictures through an area-averaged pyramid chosen by the pixel's footprint (a printed
+// picture's texels, larger than a pixel, as sharp squares) and objects anti-aliased from their
+// distance to the pixel centre: close to, not exactly, a box filter. The stripes and the
 // board's edges stay exact, and the ground truth never depends on the dressing.
 #pragma once
 
@@ -39,6 +40,25 @@
 #include "target/line_target.h"
 
 namespace oal {
+
+/// A picture printed on the paper, instead of the stripes or beside them (a marker users would
+/// print instead of ours: an AprilTag, a ChArUco board). Texel grey g lays the target's ink
+/// (LineTarget::line_grey) over the fraction 1 - g / 255 of its square and lets the paper (its
+/// grey and texture) show through the rest: 0 is full ink, 255 bare paper. Centred on the
+/// board's origin, its columns along the object x axis and its rows along y: texel (column i,
+/// row j) covers x in [-w/2 + i t, -w/2 + (i + 1) t] and y in [-h/2 + j t, -h/2 + (j + 1) t],
+/// t = width_m / columns (texels square), w and h its width and height. Each texel is printed
+/// as a sharp square, as a marker is scaled for print (no smoothing between texels); a pixel
+/// sees the mean of the texels under it through the area-averaged pyramid of the other
+/// pictures on the plane. The annotations keep clear of it; the ground truth is unchanged.
+struct PrintedPicture {
+  /// Grey, any size; null or empty: no picture. Shared, not copied, by copies of the options
+  /// and by the renderer.
+  std::shared_ptr<const vpImage<unsigned char>> image;
+  double width_m = 0.0;  ///< its width along x, metres, (0, 100] with a picture
+
+  bool empty() const { return image == nullptr || image->getSize() == 0; }
+};
 
 struct RenderOptions {
   int width = 640;                                        ///< pixels, [16, 8192]
@@ -102,6 +122,10 @@ struct RenderOptions {
   /// of the printed layout, not a copy of it. The ground truth is unchanged.
   bool annotations = false;
   int annotation_grey = 110;  ///< the annotations' ink, [0, 255]
+
+  // A picture printed on the board. -----------------------------------------------------------
+  /// None by default (PrintedPicture: a marker users would print instead of the stripes).
+  PrintedPicture printed_picture;
 
   // Clutter on the surface, outside the board. ------------------------------------------------
   /// Other printed sheets (A4 and A5, light paper with rows of dark text) and dark objects

@@ -110,6 +110,49 @@ TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
 
+// --marker apriltag: the AprilTag printed on the sheet instead of the stripes, on the same three
+// frames, in the same report (the frames, the poses, the times) with the marker named.
+TEST(PoseAccuracy, AMarkerIsReportedOnTheSameFrames) {
+  test::TestDir dir;
+  const test::OalservoRun run = test::RunOalservo(
+      dir, "pose-accuracy --marker apriltag --frames 3 --out '" + dir / "tag.json" + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json report = json::parse(test::ReadText(dir / "tag.json"));
+  EXPECT_EQ(report.at("frames"), 3);
+  EXPECT_EQ(report.at("options").at("marker"), "apriltag");
+  EXPECT_EQ(report.at("options").at("target"), "four-line-a3");
+  EXPECT_EQ(report.at("status_counts").size(), 3u);
+  for (const char* key :
+       {"posed", "wrong_poses", "translation_error_pct_median", "rotation_error_deg_p95",
+        "time_us_median", "time_us_p95", "marker_in_view", "posed_in_view"}) {
+    EXPECT_TRUE(report.contains(key)) << key;
+  }
+  EXPECT_THAT(report.at("marker").get<std::string>(), HasSubstr("AprilTag 36h11 id 0"));
+  EXPECT_THAT(run.out, HasSubstr("| frames | 3 |"));
+  EXPECT_THAT(run.out, HasSubstr("| marker | apriltag: AprilTag 36h11 id 0, black square 0.250 m"));
+  EXPECT_THAT(run.out, HasSubstr("| time median / p95 (us): detect + pose |"));
+}
+
+// A --marker that is none of the markers is refused before any work, naming the option and the
+// accepted values; so are the options that only our target has.
+TEST(AccuracyCommands, ABadMarkerIsRefused) {
+  test::TestDir dir;
+  const test::OalservoRun bad = test::RunOalservo(dir, "pose-accuracy --frames 1 --marker qr");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.err,
+              HasSubstr("--marker: unknown marker 'qr' (accepted: oal, apriltag, charuco)"));
+  EXPECT_TRUE(bad.out.empty()) << bad.out;
+  const test::OalservoRun missed = test::RunOalservo(
+      dir, "pose-accuracy --frames 1 --marker charuco --save-missed '" + dir / "missed" + "'");
+  EXPECT_EQ(missed.exit_code, 2);
+  EXPECT_THAT(missed.err, HasSubstr("only with --marker oal"));
+  const test::OalservoRun lens =
+      test::RunOalservo(dir, "pose-accuracy --frames 1 --marker charuco --estimate-distortion");
+  EXPECT_EQ(lens.exit_code, 2);
+  EXPECT_THAT(lens.err, HasSubstr("--estimate-distortion"));
+  EXPECT_FALSE(fs::exists(dir / "missed"));
+}
+
 // A section the command would ignore is an error naming the file, the line and the section.
 TEST(AccuracyCommands, ConfigSectionsTheyDoNotReadAreRejected) {
   test::TestDir dir;

@@ -263,6 +263,18 @@ TEST(ConfigScene, TheShippedLivedInSceneLoads) {
   EXPECT_EQ(config.scene.lived_in.jpeg.fraction, 0.5);
 }
 
+TEST(ConfigScene, TheShippedOccludedSceneHasAnOccluderInEveryFrameAndNothingElse) {
+  const AppConfig config = LoadConfig(std::string(OAL_SOURCE_DIR) + "/config/scene-occluded.yaml");
+  const LivedInOptions& lived_in = config.scene.lived_in;
+  EXPECT_EQ(lived_in.occluders.fraction, 1.0);
+  EXPECT_EQ(lived_in.occluders.kinds.size(), 4u);
+  EXPECT_EQ(lived_in.glare.fraction, 0.0);
+  EXPECT_EQ(lived_in.exposure.fraction, 0.0);
+  EXPECT_EQ(lived_in.motion_blur.fraction, 0.0);
+  EXPECT_EQ(lived_in.jpeg.fraction, 0.0);
+  EXPECT_TRUE(config.scene.annotations);
+}
+
 TEST(ConfigScene, BadLivedInValuesNameFileLineAndKey) {
   EXPECT_THAT(ErrorOf("scene:\n  glare:\n    sigma_m: [0.01, 0.02]\n    fraction: 1.5\n"),
               HasSubstr("cfg.yaml:4: 'scene.glare.fraction' is invalid: 1.5"));

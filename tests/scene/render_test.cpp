@@ -338,6 +338,30 @@ TEST(RenderRegression, BackgroundFileGivesTheFrameOfBefore) {
   EXPECT_EQ(a, 0x824b16d68999c6d4ull);
 }
 
+// The sheet dressed as the evaluations' bench (paper texture, annotations, shadow, clutter,
+// light fall-off) on a photograph, near and far: the frames of before the printed picture
+// (RenderOptions::printed_picture) shared the dressing's code.
+TEST(RenderRegression, DressedBenchGivesTheFramesOfBefore) {
+  const std::string path = std::string(OAL_VISP_IMAGES_DIR) + "/Klimt/Klimt.pgm";
+  if (!std::ifstream(path).good()) GTEST_SKIP() << "ViSP test image missing: " << path;
+  RenderOptions options = OldEffects();
+  options.background = testing::ReadPgm(path);
+  options.vignetting = 0.3;
+  options.shadow_darkness = 0.3;
+  options.paper_texture_grey = 3.0;
+  options.annotations = true;
+  options.clutter_sheets = 2;
+  options.clutter_objects = 4;
+  options.clutter_reach_m = 0.25;
+  options.scene_seed = 3;
+  const SceneRenderer sheet(FourLineA3Target(), options);
+  const std::uint64_t near =
+      ImageChecksum(sheet.Render(TiltedView(0.35, -0.12, 0.08, 0.4), 2, OldFrameEffects()).image);
+  const std::uint64_t far = ImageChecksum(sheet.Render(TiltedView(0.9, 0.02, -0.03, 2.0), 4).image);
+  EXPECT_EQ(near, 0xdb38ac6f0498f246ull);
+  EXPECT_EQ(far, 0x5033d4e4865dc388ull);
+}
+
 // ---------------------------------------------------------------------------------------------
 // A sheet on a bench: background image, light fall-off, shadow, paper, annotations, clutter.
 
