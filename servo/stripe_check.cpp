@@ -21,6 +21,9 @@ constexpr int kMinProfile = 12;
 constexpr int kSaturated = 250;
 // A line agreeing in fewer samples than this has not been seen.
 constexpr int kMinAgreeing = 3;
+// A run of contradicting samples at an end of a line's samples is excused up to this long, or a
+// third of them.
+constexpr std::size_t kExcusedEndRun = 2;
 
 // The grey level nearest to the image point p; false outside the image (a pixel's margin kept).
 bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
@@ -270,19 +273,32 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
     verdicts[i] = as_paper ? Verdict::kContradicts : Verdict::kUnknown;
   }
   // A sample that contradicts next to one that tells nothing lies at the rim of something
-  // covering the stripe (a finger's edge across the profile): excused. The samples of a line
-  // follow each other along it.
-  for (std::size_t i = 0; i < verdicts.size(); ++i) {
-    const std::size_t k = static_cast<std::size_t>(profiles[i].first);
-    if (verdicts[i] == Verdict::kAgrees) {
-      ++agreement.dark[k];
-    } else if (verdicts[i] == Verdict::kContradicts) {
-      const auto covered = [&](std::size_t j) {
-        return profiles[j].first == profiles[i].first && verdicts[j] == Verdict::kUnknown;
-      };
-      const bool at_rim = (i > 0 && covered(i - 1)) || (i + 1 < verdicts.size() && covered(i + 1));
-      ++(at_rim ? agreement.excused[k] : agreement.contradict[k]);
+  // covering the stripe (a finger's edge across the profile), and a short run of them at an
+  // end of the stripe's samples runs under something lying over the stripe's end (a pale
+  // hand looks like paper): excused. The samples of a line follow each other along it.
+  for (std::size_t first = 0; first < verdicts.size();) {
+    const int k = profiles[first].first;
+    std::size_t end = first;
+    while (end < verdicts.size() && profiles[end].first == k) ++end;
+    const std::size_t n = end - first;
+    const std::size_t short_run = std::max<std::size_t>(kExcusedEndRun, n / 3);
+    std::size_t leading = 0, trailing = 0;
+    while (leading < n && verdicts[first + leading] == Verdict::kContradicts) ++leading;
+    while (trailing < n && verdicts[end - 1 - trailing] == Verdict::kContradicts) ++trailing;
+    for (std::size_t i = first; i < end; ++i) {
+      const std::size_t s = static_cast<std::size_t>(k);
+      if (verdicts[i] == Verdict::kAgrees) {
+        ++agreement.dark[s];
+        continue;
+      }
+      if (verdicts[i] != Verdict::kContradicts) continue;
+      const bool at_rim = (i > first && verdicts[i - 1] == Verdict::kUnknown) ||
+                          (i + 1 < end && verdicts[i + 1] == Verdict::kUnknown);
+      const bool at_end = (i - first < leading && leading <= short_run) ||
+                          (end - 1 - i < trailing && trailing <= short_run);
+      ++((at_rim || at_end) && leading < n ? agreement.excused[s] : agreement.contradict[s]);
     }
+    first = end;
   }
   return agreement;
 }

@@ -21,6 +21,9 @@ constexpr double kKeptScales = 2.5;
 constexpr double kCrossingMarginM = 0.002;
 // A step smaller than this (radians, and metres over the target's distance) has converged.
 constexpr double kConverged = 1e-7;
+// A guided point may lie this fraction of its stripe's length beyond its ends as the starting
+// pose puts them (the start may be a few percent off in scale).
+constexpr double kGuideSpanMargin = 0.1;
 
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
@@ -113,7 +116,7 @@ class Fitter {
 
   // Sorts `points` onto the stripes where `pose` puts them.
   void Assign(const Pose& pose, const std::vector<FramePoint>& points, bool undistorted,
-              std::array<StripePoints, 4>* stripes) const {
+              const StripeGuides* guides, std::array<StripePoints, 4>* stripes) const {
     Mat3 homography;
     homography << pose.r.col(0), pose.r.col(1), pose.t;
     const Mat3 image_to_plane = homography.inverse();
@@ -144,7 +147,38 @@ class Fitter {
       // The corridor on the plane, generously: a pixel is depth / f metres face on, more when
       // the plane is seen at a slant (the residual below decides in pixels).
       const double corridor_m = 4.0 * options_.corridor_px / (q(2) * focal_);
+      // On a guide line: the stripe's, wherever the pose puts it (off the crossings and a
+      // little beyond its ends at most, as the pose places them).
+      if (guides != nullptr) {
+        int guided = -1;
+        for (int k = 0; k < 4 && guided < 0; ++k) {
+          const std::optional<LineParams>& guide = (*guides)[static_cast<std::size_t>(k)];
+          if (!guide || !(std::fabs(guide->SignedDistance(source.p.u, source.p.v)) <=
+                          options_.guide_tolerance_px)) {
+            continue;
+          }
+          const StripeSpan& span = layout_.stripes[static_cast<std::size_t>(k)];
+          const double along = span.along_b ? b : a;
+          const double margin = kGuideSpanMargin * (span.along.hi - span.along.lo);
+          if (along < span.along.lo - margin || along > span.along.hi + margin ||
+              NearCrossing(span, along)) {
+            continue;
+          }
+          guided = k;
+          const StripeSight& sight = sights[static_cast<std::size_t>(k)];
+          Vec3 shifted;
+          double ratio = 0.0;
+          OnLocus(source, p, sight, &shifted);
+          if (!WidthAgrees(sight, along, source, &ratio)) continue;
+          StripePoints& stripe = (*stripes)[static_cast<std::size_t>(k)];
+          stripe.p.push_back(shifted);
+          stripe.along.push_back(along);
+          stripe.width_ratio.push_back(ratio);
+        }
+        if (guided >= 0) continue;
+      }
       for (int k = 0; k < 4; ++k) {
+        if (guides != nullptr && (*guides)[static_cast<std::size_t>(k)]) continue;
         const StripeSpan& span = layout_.stripes[static_cast<std::size_t>(k)];
         const double along = span.along_b ? b : a, across = (span.along_b ? a : b) - span.at;
         if (std::fabs(across) > span.half + corridor_m || along < span.along.lo ||
@@ -282,11 +316,15 @@ void StripeFitOptions::Check() const {
                 max_iterations, "1 <= max_iterations <= 100");
   RequireOption(min_points >= 2 && min_points <= 1000, "StripeFitOptions::min_points", min_points,
                 "2 <= min_points <= 1000");
+  RequireOption(guide_tolerance_px > 0.0 && guide_tolerance_px <= 100.0,
+                "StripeFitOptions::guide_tolerance_px", guide_tolerance_px,
+                "0 < guide_tolerance_px <= 100");
 }
 
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const vpCameraParameters& camera,
-                     bool points_undistorted, const StripeFitOptions& options) {
+                     bool points_undistorted, const StripeFitOptions& options,
+                     const StripeGuides* guides) {
   options.Check();
   StripeFit fit;
   fit.cMo = start;
@@ -295,7 +333,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   // Which stripe each point is on, from the starting pose: a step moves the lines by a
   // fraction of the corridor at most, and points must not hop between stripes as it goes.
   std::array<StripePoints, 4> stripes;
-  fitter.Assign(pose, points, points_undistorted, &stripes);
+  fitter.Assign(pose, points, points_undistorted, guides, &stripes);
 
   std::vector<double> magnitudes;
   double scale = options.min_scale_px;

@@ -23,6 +23,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,9 @@ struct StripeFitOptions {
   int max_iterations = 12;
   /// Each stripe needs at least this many points kept. Range [2, 1000].
   int min_points = 4;
+  /// A feature point this close to a stripe's guide line (FitStripes' `guides`) is the
+  /// stripe's, wherever the starting pose puts the stripe, pixels. Range (0, 100].
+  double guide_tolerance_px = 2.0;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
@@ -74,8 +78,16 @@ struct StripeFit {
 /// their points). `points_undistorted`: the points are in undistorted pixels (the detector
 /// corrects the lens). Not ok when a stripe keeps fewer than min_points, the points cannot
 /// fix the pose, or the steps diverge (the message says which).
+/// Lines known to be lines 1-4 (a detected line identified with a stripe), in the points'
+/// pixels; a stripe without one is found by the corridor alone.
+using StripeGuides = std::array<std::optional<LineParams>, 4>;
+
+/// `guides`, when given, take each stripe's points near its guide line (guide_tolerance_px,
+/// between its printed ends as `start` puts them, wide enough) however far `start` puts the
+/// stripe: a start tens of pixels off still converges when the stripes' lines were told.
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const vpCameraParameters& camera,
-                     bool points_undistorted, const StripeFitOptions& options = {});
+                     bool points_undistorted, const StripeFitOptions& options = {},
+                     const StripeGuides* guides = nullptr);
 
 }  // namespace oal

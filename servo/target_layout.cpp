@@ -181,6 +181,38 @@ TargetLayout TargetLayout::Of(const LineTarget& target) {
                         layout.ToPlane(cell_a.hi, cell_b.hi), layout.ToPlane(cell_a.lo, cell_b.hi)};
   std::vector<Point2d> cell(layout.middle_cell.begin(), layout.middle_cell.end());
   if (SignedArea(cell) < 0.0) std::reverse(layout.middle_cell.begin(), layout.middle_cell.end());
+  const double half_w = 0.5 * target.board_width_m, half_h = 0.5 * target.board_height_m;
+  // Where the board's edge is from `from` along `direction` (the board centred on the object
+  // origin, its sides along x and y).
+  const auto to_edge = [&](const Point2d& from, const Point2d& direction) {
+    double t = HUGE_VAL;
+    if (direction.u > 1e-12) t = std::min(t, (half_w - from.u) / direction.u);
+    if (direction.u < -1e-12) t = std::min(t, (-half_w - from.u) / direction.u);
+    if (direction.v > 1e-12) t = std::min(t, (half_h - from.v) / direction.v);
+    if (direction.v < -1e-12) t = std::min(t, (-half_h - from.v) / direction.v);
+    return Point2d{from.u + t * direction.u, from.v + t * direction.v};
+  };
+  // Beyond the lower stripe of the pair 2/4 (along -b), between lines 1 and 3; beyond the lower
+  // of 1/3 (along -a), between lines 2 and 4.
+  const StripeSpan& low_b = line2.at <= line4.at ? line2 : line4;
+  const StripeSpan& low_a = line1.at <= line3.at ? line1 : line3;
+  const double out_b = low_b.at - low_b.half, out_a = low_a.at - low_a.half;
+  const Point2d minus_b{-layout.axis_b.u, -layout.axis_b.v};
+  const Point2d minus_a{-layout.axis_a.u, -layout.axis_a.v};
+  const std::array<std::array<Point2d, 2>, 2> inner = {
+      std::array<Point2d, 2>{layout.ToPlane(cell_a.lo, out_b), layout.ToPlane(cell_a.hi, out_b)},
+      std::array<Point2d, 2>{layout.ToPlane(out_a, cell_b.hi), layout.ToPlane(out_a, cell_b.lo)}};
+  for (std::size_t e = 0; e < 2; ++e) {
+    const Point2d& direction = e == 0 ? minus_b : minus_a;
+    TargetLayout::EdgeCell& edge = layout.edge_cells[e];
+    edge.corners = {inner[e][0], inner[e][1], to_edge(inner[e][1], direction),
+                    to_edge(inner[e][0], direction)};
+    edge.outer = 2;
+    if (SignedArea({edge.corners.begin(), edge.corners.end()}) < 0.0) {
+      std::reverse(edge.corners.begin(), edge.corners.end());
+      edge.outer = 0;
+    }
+  }
   return layout;
 }
 
@@ -291,6 +323,28 @@ std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, con
     }
   }
   return best;
+}
+
+std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
+                                                     const LightQuad& cell,
+                                                     const vpCameraParameters& camera) {
+  if (cell.ClosedSideCount() != 3) return std::nullopt;
+  int open = 0;
+  while ((cell.closed_sides >> open) & 1) ++open;
+  std::array<Point2d, 4> image, plane;
+  Point2d centre{0.0, 0.0};
+  for (int k = 0; k < 4; ++k) {
+    // The cell's outer side onto the quadrilateral's open one.
+    const std::size_t i = static_cast<std::size_t>((k + open - edge.outer + 4) % 4);
+    const Point2d& corner = cell.corners[i];
+    Point2d& normalised = image[static_cast<std::size_t>(k)];
+    vpPixelMeterConversion::convertPoint(camera, corner.u, corner.v, normalised.u, normalised.v);
+    if (!std::isfinite(normalised.u) || !std::isfinite(normalised.v)) return std::nullopt;
+    plane[static_cast<std::size_t>(k)] = edge.corners[static_cast<std::size_t>(k)];
+    centre = Point2d{centre.u + 0.25 * plane[static_cast<std::size_t>(k)].u,
+                     centre.v + 0.25 * plane[static_cast<std::size_t>(k)].v};
+  }
+  return FourPointHomography(plane, image, centre);
 }
 
 }  // namespace oal

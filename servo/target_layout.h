@@ -59,6 +59,18 @@ struct TargetLayout {
   /// The middle cell, bounded by the four stripes' inner edges: corners on the target plane
   /// (object x, y in metres), in the image borders' turning sense (region.h).
   std::array<Point2d, 4> middle_cell{};
+  /// The paper beyond one stripe of each pair, between the other pair's inner edges, out to
+  /// the board's edge: the cells a sheet finder sees closed in on three sides (two stripes
+  /// and the one they cross) when the middle cell is broken (a hand over a crossing, a glare
+  /// across a stripe). [0] lies beyond line 2 or 4, [1] beyond line 1 or 3 (the ones on the
+  /// lower side of their '#' coordinate; the cells beyond their partners are these turned by
+  /// 180 degrees about the origin, for a '#' centred on its board). Corners as middle_cell's;
+  /// `outer` is the side (from corner outer to outer + 1) on the board's edge.
+  struct EdgeCell {
+    std::array<Point2d, 4> corners{};
+    int outer = 0;
+  };
+  std::array<EdgeCell, 2> edge_cells{};
 
   /// Object-plane point of '#' coordinates (a, b).
   Point2d ToPlane(double a, double b) const;
@@ -106,6 +118,14 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
 /// Nothing when the corners cannot be undistorted or the homography is degenerate.
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
                                                  const vpCameraParameters& camera);
+
+/// The plane-to-image homography (normalised coordinates) that maps `edge`, an edge cell of
+/// the layout, onto `cell`, a light quadrilateral closed in on three sides: its open side on
+/// the cell's outer side (the board's edge). Nothing unless exactly one side is open, or when
+/// the corners cannot be undistorted or the homography is degenerate.
+std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
+                                                     const LightQuad& cell,
+                                                     const vpCameraParameters& camera);
 
 /// The image of a target point seen through `plane_to_image` and the lens: distorted pixels;
 /// false when it lies behind the camera or beyond the lens model's reach.

@@ -20,8 +20,13 @@ constexpr double kDegPerRad = 180.0 / kPi;
 // A fit from an expected pose that may be turned by 180 degrees: the other way round must fit
 // the runs' widths worse by this (FitExpected's score).
 constexpr double kWaysRoundMargin = 0.1;
-// ... and its first fit takes points in a corridor this many times the fit's.
-constexpr double kExpectedCorridorScale = 3.0;
+// A detected line guides a stripe's first fit when within this fraction of the spacing of the
+// stripe and its parallel partner of where the expected pose puts the stripe (over the
+// stripe's ends and middle), and this close in angle.
+constexpr double kGuideReach = 0.3;
+constexpr double kGuideMaxAngleRad = 8.0 * kPi / 180.0;
+// ... and its fits take points in corridors these many times the fit's, in turn.
+constexpr std::array<double, 3> kExpectedCorridorScales = {6.0, 2.5, 1.0};
 
 double Microseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
@@ -42,6 +47,8 @@ std::string ToString(ScanSource source) {
       return "prior";
     case ScanSource::kMiddleCell:
       return "middle-cell";
+    case ScanSource::kEdgeCell:
+      return "edge-cell";
     case ScanSource::kImage:
       return "image";
   }
@@ -267,6 +274,45 @@ std::array<std::optional<LineExtent>, 4> TargetPoseTracker::StripeEnds(
   return extents;
 }
 
+StripeGuides TargetPoseTracker::GuidesFrom(const vpHomography& plane_to_image) const {
+  StripeGuides guides;
+  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(plane_to_image);
+  std::array<bool, 4> have{};
+  for (std::size_t k = 0; k < 4; ++k) have[k] = ends[k].has_value();
+  if (!(have[0] && have[1] && have[2] && have[3])) return guides;
+  std::vector<bool> taken(lines_.size(), false);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const LineExtent& end = *ends[k];
+    const LineParams predicted = LineThrough(end.a, end.b);
+    const Point2d middle{0.5 * (end.a.u + end.b.u), 0.5 * (end.a.v + end.b.v)};
+    // Less than a third of the way to the parallel stripe: no other stripe is nearer.
+    const LineExtent& partner = *ends[(k + 2) % 4];
+    const double spacing = std::fabs(predicted.SignedDistance(0.5 * (partner.a.u + partner.b.u),
+                                                              0.5 * (partner.a.v + partner.b.v)));
+    double best = kGuideReach * spacing;
+    int best_line = -1;
+    for (std::size_t i = 0; i < lines_.size(); ++i) {
+      const DetectedLine& line = lines_[i];
+      if (taken[i] || !(line.width_px > 0.0) ||
+          AngleBetween(line.line, predicted) > kGuideMaxAngleRad) {
+        continue;
+      }
+      const double distance = std::max({std::fabs(line.line.SignedDistance(end.a.u, end.a.v)),
+                                        std::fabs(line.line.SignedDistance(end.b.u, end.b.v)),
+                                        std::fabs(line.line.SignedDistance(middle.u, middle.v))});
+      if (distance < best) {
+        best = distance;
+        best_line = static_cast<int>(i);
+      }
+    }
+    if (best_line >= 0) {
+      guides[k] = lines_[static_cast<std::size_t>(best_line)].line;
+      taken[static_cast<std::size_t>(best_line)] = true;
+    }
+  }
+  return guides;
+}
+
 std::vector<LineSeed> TargetPoseTracker::SeedsFrom(const vpHomography& plane_to_image) const {
   std::vector<LineSeed> seeds;
   const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(plane_to_image);
@@ -302,7 +348,8 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
                             detector_.Undistorts(), options_.stripe_fit);
     if (frame_.fit.ok) ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
   }
-  if (frame_.pose.status != PoseStatus::kOk && !(expected && FitExpected(*expected))) {
+  if (frame_.pose.status != PoseStatus::kOk &&
+      !(options_.fit_stripes && expected && FitExpected(*expected))) {
     frame_.status = TargetStatus::kNotFound;
     frame_.message = frame_.pose.message;
     return false;
@@ -321,15 +368,20 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
   std::string failure;
   for (const vpHomogeneousMatrix& start : {expected.cMo, turned}) {
     if (!expected.either_way && best) break;
-    // Where the target was expected is a few pixels off at the stripes' ends (a candidate's
-    // corners, a prediction): a first fit in a wider corridor, then the fit from there.
-    StripeFitOptions wide = options_.stripe_fit;
-    wide.corridor_px *= kExpectedCorridorScale;
-    StripeFit fit = FitStripes(start, layout_, detector_.feature_points(), camera_,
-                               detector_.Undistorts(), wide);
-    if (fit.ok) {
-      fit = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
-                       detector_.Undistorts(), options_.stripe_fit);
+    // Where the target was expected can be pixels, or tens of pixels, off at the stripes'
+    // ends (a candidate's corners, a prediction): fits in corridors narrowing from wide to
+    // the fit's own, each from the last.
+    // The lines the scan found near where `start` puts each stripe guide the first fit.
+    const StripeGuides guides = GuidesFrom(PlaneToImage(start));
+    StripeFit fit;
+    fit.cMo = start;
+    for (const double scale : kExpectedCorridorScales) {
+      StripeFitOptions corridor = options_.stripe_fit;
+      corridor.corridor_px *= scale;
+      fit =
+          FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_, detector_.Undistorts(),
+                     corridor, scale == kExpectedCorridorScales[0] ? &guides : nullptr);
+      if (!fit.ok) break;
     }
     if (!fit.ok) {
       if (failure.empty()) failure = fit.message;
@@ -473,7 +525,7 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
   // way round, the whole image's pose as it is.
   std::optional<Expected> expected;
   if (const std::optional<vpHomogeneousMatrix> cMo = PlanePose(plane_to_image)) {
-    expected = Expected{*cMo, source == ScanSource::kMiddleCell};
+    expected = Expected{*cMo, source != ScanSource::kImage};
   }
   // quick_max_identification_cost 0 could never keep a quick scan: none is made.
   const bool quick = quick_scan_ && options_.quick_max_identification_cost > 0.0 &&
@@ -528,6 +580,13 @@ const TargetFrame& TargetPoseTracker::Track(
             (found = AttemptCandidate(image, *plane_to_image, ScanSource::kMiddleCell))) {
           break;
         }
+        // Closed in on three sides: the middle cell broken open (a hand, a glare), or a cell
+        // beyond a stripe whose fourth side is the sheet's edge.
+        for (const TargetLayout::EdgeCell& edge : layout_.edge_cells) {
+          const std::optional<vpHomography> beyond = PlaneToImageFromEdgeCell(edge, cell, camera_);
+          if (beyond && (found = AttemptCandidate(image, *beyond, ScanSource::kEdgeCell))) break;
+        }
+        if (found) break;
       }
     }
     if (!found && options_.image_fallback) {

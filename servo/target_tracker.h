@@ -65,6 +65,7 @@ enum class ScanSource {
   kNone,        ///< nothing was scanned
   kPrior,       ///< borders from the prior pose
   kMiddleCell,  ///< borders from a middle-cell candidate of the sheet finder
+  kEdgeCell,    ///< ... from a candidate closed in on three sides taken as an edge cell
   kImage,       ///< the whole image
 };
 
@@ -76,7 +77,7 @@ enum class TargetStatus {
 };
 
 /// The one place where these enums meet strings ("target", "image"; "none", "prior",
-/// "middle-cell", "image"; "ok", "not-found", "model-mismatch", "jump").
+/// "middle-cell", "edge-cell", "image"; "ok", "not-found", "model-mismatch", "jump").
 std::string ToString(ScanMode mode);
 std::string ToString(ScanSource source);
 std::string ToString(TargetStatus status);
@@ -131,7 +132,8 @@ struct TargetTrackerOptions {
   double max_jump_m = 0.05;
   double max_jump_deg = 10.0;
   /// The intersections' pose refined on the stripes' feature points, the target held rigid
-  /// (stripe_fit.h); false: the intersections' pose as the paper gives it.
+  /// (stripe_fit.h), and, where the lines give none, the pose fitted to those points from
+  /// where the target was expected; false: the intersections' pose as the paper gives it.
   bool fit_stripes = true;
   StripeFitOptions stripe_fit;
 
@@ -236,6 +238,10 @@ class TargetPoseTracker {
   std::array<std::optional<LineExtent>, 4> StripeEnds(const vpHomography& plane_to_image) const;
   /// The four lines where `plane_to_image` puts them, in the detector's coordinates.
   std::vector<LineSeed> SeedsFrom(const vpHomography& plane_to_image) const;
+  /// The last scan's lines near where `plane_to_image` puts lines 1-4 (each the nearest of
+  /// the stripe-like lines within a fraction of the way to its parallel partner, each line for
+  /// one stripe at most).
+  StripeGuides GuidesFrom(const vpHomography& plane_to_image) const;
   /// Whether poses `a` and `b` lie within max_jump_m and max_jump_deg of each other (a bound
   /// of 0 is no bound), and how far apart they are.
   bool WithinJump(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b, double* metres,

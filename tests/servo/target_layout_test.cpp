@@ -1,6 +1,7 @@
 // Points of the target's plane projected through a lens (servo/target_layout.h): the pixel
 // PlaneProjector gives maps back, through ViSP's own pixel-to-metre conversion, to the ideal
-// point the homography gives, for barrel and pincushion lenses, near and far from the centre.
+// point the homography gives, for barrel and pincushion lenses, near and far from the centre;
+// the edge cells of an A3 sheet and the homography from one seen through its open side.
 #include "servo/target_layout.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <visp3/core/vpRxyzVector.h>
 
 #include <cmath>
+#include <optional>
 
 #include "detector/lens.h"  // CameraWithKdu
 
@@ -44,6 +46,61 @@ TEST(PlaneProjector, ItsPixelsAreViSPsDistortedProjection) {
     }
     EXPECT_GT(projected, 300) << "kdu " << kdu;
   }
+}
+
+}  // namespace
+}  // namespace oal
+
+namespace oal {
+namespace {
+
+// An A3 sheet's edge cells: between two stripes' inner edges, from the stripe they cross out to
+// the sheet's edge; a quadrilateral seen at their corners, its open side on the sheet's edge,
+// maps the plane as the pose does.
+TEST(TargetLayout, EdgeCellsReachTheSheetsEdgeAndMapBackThroughTheirOpenSide) {
+  const LineTarget target = FourLineA3Target();
+  const TargetLayout layout = TargetLayout::Of(target);
+  // [0] beyond line 2 (y = -0.062, 12 mm), between lines 1 and 3's inner edges; [1] beyond
+  // line 1 (x = -0.090, 24 mm), between lines 2 and 4's inner edges.
+  const TargetLayout::EdgeCell& above = layout.edge_cells[0];
+  const TargetLayout::EdgeCell& left = layout.edge_cells[1];
+  double min_y = HUGE_VAL, max_y = -HUGE_VAL, min_x = HUGE_VAL;
+  for (const Point2d& c : above.corners) {
+    min_y = std::min(min_y, c.v);
+    max_y = std::max(max_y, c.v);
+  }
+  for (const Point2d& c : left.corners) min_x = std::min(min_x, c.u);
+  EXPECT_NEAR(min_y, -0.1485, 1e-9);         // the sheet's edge
+  EXPECT_NEAR(max_y, -0.062 - 0.006, 1e-9);  // line 2's outer edge
+  EXPECT_NEAR(min_x, -0.21, 1e-9);
+  const vpCameraParameters camera(600.0, 600.0, 319.5, 239.5);
+  const vpHomogeneousMatrix cMo(0.01, 0.02, 0.5, 0.2, -0.1, 0.7);
+  const vpHomography truth = PlaneToImage(cMo);
+  for (const TargetLayout::EdgeCell& edge : layout.edge_cells) {
+    for (int open_at = 0; open_at < 4; ++open_at) {
+      // The quadrilateral as a finder would give it, its corners turned to start anywhere.
+      LightQuad quad;
+      for (int k = 0; k < 4; ++k) {
+        const Point2d& plane =
+            edge.corners[static_cast<std::size_t>((k + edge.outer - open_at + 4) % 4)];
+        ASSERT_TRUE(
+            ProjectPlanePoint(truth, camera, plane, &quad.corners[static_cast<std::size_t>(k)]));
+      }
+      quad.closed_sides = static_cast<std::uint8_t>(0xF & ~(1u << open_at));
+      const std::optional<vpHomography> found = PlaneToImageFromEdgeCell(edge, quad, camera);
+      ASSERT_TRUE(found.has_value());
+      for (const Point2d& plane : layout.middle_cell) {
+        Point2d a, b;
+        ASSERT_TRUE(ProjectPlanePoint(*found, camera, plane, &a));
+        ASSERT_TRUE(ProjectPlanePoint(truth, camera, plane, &b));
+        EXPECT_NEAR(a.u, b.u, 1e-6);
+        EXPECT_NEAR(a.v, b.v, 1e-6);
+      }
+    }
+  }
+  LightQuad closed;
+  closed.closed_sides = 0xF;
+  EXPECT_FALSE(PlaneToImageFromEdgeCell(above, closed, camera).has_value());
 }
 
 }  // namespace

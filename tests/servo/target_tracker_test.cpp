@@ -306,6 +306,22 @@ TEST(TargetPoseTracker, AStripeHiddenOnOneSideIsFittedFromTheOther) {
   EXPECT_LT(found.fit.extent[3], 0.7);  // only its other side
 }
 
+// A lamp's glare across a stripe between two crossings joins the middle cell to the paper
+// beyond it: no cell is closed in on four sides, and the cells closed in on three are taken
+// for the cells beyond a stripe, out to the sheet's edge.
+TEST(TargetPoseTracker, AGlareAcrossTheMiddleCellsSideFindsTheSheetFromAnEdgeCell) {
+  const LineTarget target = FourLineA3Target();
+  const SceneRenderer renderer(target, BenchRender(6));
+  TargetPoseTracker tracker = TrackerFor(renderer);
+  FrameEffects effects;
+  effects.glares.push_back({0.0, -0.062, 0.02, 900.0});  // on line 2 between lines 1 and 3
+  const vpHomogeneousMatrix cMo(0.0, 0.01, 0.6, -0.15, 0.2, 1.1);
+  const RenderedFrame frame = renderer.Render(cMo, 5, effects);
+  const TargetFrame& found = tracker.Track(ViewOf(frame.image));
+  ExpectRightPose(found, cMo, "glare across line 2");
+  EXPECT_EQ(found.source, ScanSource::kEdgeCell);
+}
+
 TEST(TargetPoseTracker, LosesTheSheetOutOfViewAndFindsItAgain) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(7));
   TargetPoseTracker tracker = TrackerFor(renderer);
