@@ -556,7 +556,7 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
   // Appends a point, built in place (copying in a just-built local point stalled on store
   // forwarding); false once the border has its maximum.
   auto push = [&](const Point2d& pixel, double run_px, std::uint16_t sides, bool straight,
-                  const Point2d& along) {
+                  const Point2d& along, double background_step) {
     if (added >= options.max_points_per_border) return false;
     BorderPoint& point = points->emplace_back();
     point.pixel = pixel;
@@ -564,6 +564,7 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
     point.sides = sides;
     point.straight = straight;
     point.along = along;
+    point.background_step = static_cast<float>(background_step);
     ++added;
     return true;
   };
@@ -582,8 +583,8 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
       if (length >= p - options.min_width_px) continue;
       Point2d a, b;
       const std::uint16_t sides_a = geometry.Locate(s_a, &a), sides_b = geometry.Locate(s_b, &b);
-      if (!push(a, 0.0, sides_a, true, Point2d{})) break;
-      if (!push(b, 0.0, sides_b, true, Point2d{})) break;
+      if (!push(a, 0.0, sides_a, true, Point2d{}, 0.0)) break;
+      if (!push(b, 0.0, sides_b, true, Point2d{}, 0.0)) break;
       continue;
     }
     if (longer_than_max_run(length)) continue;
@@ -592,6 +593,7 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
     Point2d pixel, along;
     std::uint16_t sides = 0;
     double run_px = length;
+    double background_step = 0.0;
     if (straight) {
       // The weights: each sample's contrast to the threshold, or (centre_from_background) to
       // the background beside the run, over the run and one sample either side, which a
@@ -611,6 +613,13 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
       const double centre =
           light ? WeightedCentre<true>(samples.data(), p, weighted, reference, s_a, s_b)
                 : WeightedCentre<false>(samples.data(), p, weighted, reference, s_a, s_b);
+      // f < 0 beside the run: its magnitude is the background's contrast to the threshold.
+      const double before = -0.5 * (f(run.first - 3) + f(run.first - 2));
+      const double after = -0.5 * (f(run.last + 2) + f(run.last + 3));
+      double depth = 0.0;
+      for (int i = run.first; i <= run.last; ++i) depth = std::max(depth, f(i));
+      const double drop = std::max(before, after) + depth;  // the lighter side to the run's ink
+      if (drop > 0.0) background_step = std::fabs(before - after) / drop;
       sides = geometry.Locate(centre, &pixel);
       along = geometry.Along(centre, sides);
       run_px = length * geometry.Spacing(centre);
@@ -619,7 +628,7 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
       sides = static_cast<std::uint16_t>(geometry.Locate(s_a, &a) | geometry.Locate(s_b, &b));
       pixel = Point2d{0.5 * (a.u + b.u), 0.5 * (a.v + b.v)};
     }
-    if (!push(pixel, run_px, sides, straight, along)) break;
+    if (!push(pixel, run_px, sides, straight, along, background_step)) break;
   }
   return added;
 }

@@ -51,6 +51,10 @@ struct BorderPoint {
   bool straight = true;     ///< the run lies on one side (its width can be measured)
   /// Unit direction of the side the run lies on; (0, 0) when it is not on one side only.
   Point2d along;
+  /// How much lighter one side of the run is than the other (beside it, two samples each),
+  /// over the run's depth below the lighter: 0 on even paper; a glare's slope or a shadow's
+  /// edge beside a stripe moves its middle. 0 when unknown (edges, runs round a corner).
+  float background_step = 0.0f;
 };
 
 /// Copies the loop's pixels, in loop order, into `samples` (resized; no allocation once it

@@ -273,6 +273,7 @@ void OalDetector::AddBorderPoints(int border) {
     frame_point.sides = point.sides;
     frame_point.straight = point.straight;
     frame_point.border = static_cast<std::int16_t>(border);
+    frame_point.background_step = point.background_step;
   }
   VotePairs(border, first_point);
 }

@@ -22,6 +22,8 @@ struct FramePoint {
   std::uint16_t sides = 0;  ///< sides of the border the point is on (BorderPoint::sides)
   bool straight = true;     ///< the run lay on one side of the border
   std::int16_t border = 0;  ///< index of the border, 0 = outermost
+  /// BorderPoint::background_step: how much lighter one side of its run is than the other.
+  float background_step = 0.0f;
 };
 
 struct SupportStats {

@@ -21,9 +21,9 @@ constexpr int kMinProfile = 12;
 constexpr int kSaturated = 250;
 // A line agreeing in fewer samples than this has not been seen.
 constexpr int kMinAgreeing = 3;
-// A run of contradicting samples at an end of a line's samples is excused up to this long, or a
-// third of them.
-constexpr std::size_t kExcusedEndRun = 2;
+// A run of contradicting samples at the rim of something covering a stripe is excused up to
+// this long, or a third of the stripe's samples.
+constexpr std::size_t kExcusedRun = 2;
 
 // The grey level nearest to the image point p; false outside the image (a pixel's margin kept).
 bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
@@ -272,31 +272,35 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
         !paper.empty() && lights[i] >= paper_level - min_contrast / 2 && lights[i] < kSaturated;
     verdicts[i] = as_paper ? Verdict::kContradicts : Verdict::kUnknown;
   }
-  // A sample that contradicts next to one that tells nothing lies at the rim of something
-  // covering the stripe (a finger's edge across the profile), and a short run of them at an
-  // end of the stripe's samples runs under something lying over the stripe's end (a pale
-  // hand looks like paper): excused. The samples of a line follow each other along it.
+  // A short run of contradicting samples that ends at a covered one, or at an end of the
+  // stripe's samples, lies at the rim of something covering the stripe (a finger's edge across
+  // the profile leaves a partial dark run; a pale hand over the stripe's end passes for paper):
+  // excused. Two samples, or a third of the stripe's, on a line in all; a run between agreeing
+  // samples is not.
+  // The samples of a line follow each other along it.
   for (std::size_t first = 0; first < verdicts.size();) {
     const int k = profiles[first].first;
+    const std::size_t s = static_cast<std::size_t>(k);
     std::size_t end = first;
     while (end < verdicts.size() && profiles[end].first == k) ++end;
-    const std::size_t n = end - first;
-    const std::size_t short_run = std::max<std::size_t>(kExcusedEndRun, n / 3);
-    std::size_t leading = 0, trailing = 0;
-    while (leading < n && verdicts[first + leading] == Verdict::kContradicts) ++leading;
-    while (trailing < n && verdicts[end - 1 - trailing] == Verdict::kContradicts) ++trailing;
-    for (std::size_t i = first; i < end; ++i) {
-      const std::size_t s = static_cast<std::size_t>(k);
-      if (verdicts[i] == Verdict::kAgrees) {
-        ++agreement.dark[s];
+    const std::size_t short_run = std::max<std::size_t>(kExcusedRun, (end - first) / 3);
+    std::size_t excused_here = 0;  // at most one short run's worth on a line
+    for (std::size_t i = first; i < end;) {
+      if (verdicts[i] == Verdict::kAgrees) ++agreement.dark[s];
+      if (verdicts[i] != Verdict::kContradicts) {
+        ++i;
         continue;
       }
-      if (verdicts[i] != Verdict::kContradicts) continue;
-      const bool at_rim = (i > first && verdicts[i - 1] == Verdict::kUnknown) ||
-                          (i + 1 < end && verdicts[i + 1] == Verdict::kUnknown);
-      const bool at_end = (i - first < leading && leading <= short_run) ||
-                          (end - 1 - i < trailing && trailing <= short_run);
-      ++((at_rim || at_end) && leading < n ? agreement.excused[s] : agreement.contradict[s]);
+      std::size_t j = i;
+      while (j < end && verdicts[j] == Verdict::kContradicts) ++j;
+      const bool open_before = i == first || verdicts[i - 1] == Verdict::kUnknown;
+      const bool open_after = j == end || verdicts[j] == Verdict::kUnknown;
+      const bool whole = i == first && j == end;
+      const bool excused =
+          (open_before || open_after) && !whole && excused_here + (j - i) <= short_run;
+      if (excused) excused_here += j - i;
+      (excused ? agreement.excused[s] : agreement.contradict[s]) += static_cast<int>(j - i);
+      i = j;
     }
     first = end;
   }

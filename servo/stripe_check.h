@@ -16,11 +16,11 @@
 //   - tells nothing: something covers the place (a hand, a tool, a cable, a dark shadow: no
 //     paper on one side; a flat profile darker than the paper), a glare saturates it, or it is
 //     out of view.
-// A sample that contradicts beside one that tells nothing, along the stripe, lies at the rim of
-// what covers it (a finger's edge crossing the profile leaves a partial dark run), and a short
-// run of them at an end of the stripe's samples (two, or a third of them) runs under
-// something lying over the stripe's end (a pale hand passes for paper): excused. A pose off by
-// a degree or more is contradicted along much more of its stripes.
+// A short run of contradicting samples (two, or a third of the stripe's) that ends, along the
+// stripe, at one that tells nothing or at the end of its samples lies at the rim of what covers
+// it (a finger's edge crossing the profile leaves a partial dark run; a pale hand over the
+// stripe's end passes for paper): excused. A run between agreeing samples is not, nor a whole
+// stripe contradicted (a pose turned by 180 degrees).
 // How dark a run must be is set by the frame: half the median contrast of its profiles, at
 // least min_contrast (the texture of a hand or a tool is no stripe).
 // A pose a degree or two off moves the far end of a stripe by several pixels off its ink; an
@@ -61,8 +61,8 @@ struct StripeAgreement {
   std::array<int, 4> samples{};  ///< per line 1-4, in view
   std::array<int, 4> dark{};     ///< ... that agree (the stripe's dark run where the pose puts it)
   std::array<int, 4> contradict{};  ///< ... that contradict the pose
-  /// ... that contradict it at the rim of something covering the stripe (next to a sample
-  /// that tells nothing, or in a short run at an end of its samples), not counted against it.
+  /// ... that contradict it at the rim of something covering the stripe (a short run next to
+  /// a sample that tells nothing, or at an end of its samples), not counted against it.
   std::array<int, 4> excused{};
   /// The smallest, over lines 1-4, of the samples agreeing among those that agree or
   /// contradict (0 for a line with fewer than 3 agreeing samples): 1 when no sample

@@ -132,7 +132,10 @@ class Fitter {
       sights[static_cast<std::size_t>(k)] = SightOf(pose, k);
     }
     for (const FramePoint& source : points) {
-      if (!source.straight || (source.across_u == 0.0f && source.across_v == 0.0f)) continue;
+      if (!source.straight || (source.across_u == 0.0f && source.across_v == 0.0f) ||
+          !(source.background_step <= options_.max_background_step)) {
+        continue;
+      }
       Vec3 p(0.0, 0.0, 1.0);
       if (undistorted) {
         p(0) = (source.p.u - camera_.get_u0()) / camera_.get_px();
@@ -312,6 +315,9 @@ void StripeFitOptions::Check() const {
   RequireOption(max_width_ratio >= 1.0 && max_width_ratio <= 100.0,
                 "StripeFitOptions::max_width_ratio", max_width_ratio,
                 "1 <= max_width_ratio <= 100");
+  RequireOption(max_background_step > 0.0 && max_background_step <= 1e9,
+                "StripeFitOptions::max_background_step", max_background_step,
+                "0 < max_background_step <= 1e9");
   RequireOption(max_iterations >= 1 && max_iterations <= 100, "StripeFitOptions::max_iterations",
                 max_iterations, "1 <= max_iterations <= 100");
   RequireOption(min_points >= 2 && min_points <= 1000, "StripeFitOptions::min_points", min_points,
@@ -319,6 +325,23 @@ void StripeFitOptions::Check() const {
   RequireOption(guide_tolerance_px > 0.0 && guide_tolerance_px <= 100.0,
                 "StripeFitOptions::guide_tolerance_px", guide_tolerance_px,
                 "0 < guide_tolerance_px <= 100");
+}
+
+vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo) {
+  const Pose pose = Pose::Of(cMo);
+  const double distance = pose.t.norm();
+  if (!(distance > 0.0)) return cMo;
+  const Vec3 sight = pose.t / distance;
+  const Vec3 normal = pose.r.col(2);
+  // The normal reflected about the line of sight, and the least turn taking one to the other.
+  const Vec3 mirrored = 2.0 * normal.dot(sight) * sight - normal;
+  const Vec3 axis = normal.cross(mirrored);
+  const double sine = axis.norm();
+  if (sine < 1e-9) return cMo;
+  const double angle = std::atan2(sine, normal.dot(mirrored));
+  Pose turned = pose;
+  turned.r = Eigen::AngleAxisd(angle, axis / sine).toRotationMatrix() * pose.r;
+  return turned.Matrix();
 }
 
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,

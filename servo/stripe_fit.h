@@ -13,7 +13,9 @@
 // (undistorted when it corrects the lens, else the image's, then converted with the camera's
 // kdu). Only runs along one side of a border (a run round a border's corner gives the middle of
 // its ends, off the stripe) whose width across the stripe is within a factor of the stripe's
-// width where the pose puts it, between the stripe's printed ends and off the crossings. Each
+// width where the pose puts it, between the stripe's printed ends and off the crossings, and
+// with paper as light on both sides (beside a glare's slope a run's middle is pulled off its
+// stripe: a few such runs at one end of a far sheet's stripe tilt its pose by degrees). Each
 // run's middle is moved onto the image of the centre line's locus first: under perspective
 // the middle between converging edges is off it (a few hundredths of a pixel, up to half a
 // pixel for a wide stripe seen at a slant), as the corners are in pose.h.
@@ -39,11 +41,15 @@ struct StripeFitOptions {
   /// The residuals' robust scale never goes below this, pixels: a clean frame's points lie
   /// within a tenth of a pixel of the line, and the biweight's cut (4.685 scales) must not
   /// let the stripe's own points go. Range (0, 100].
-  double min_scale_px = 0.25;
+  double min_scale_px = 0.1;
   /// A run is the stripe's only when its width across the stripe is within this factor of
   /// the stripe's width where the pose puts it (blur and the threshold change a width a
   /// little; a run merged with a finger or a pen changes it a lot). Range [1, 100].
   double max_width_ratio = 1.7;
+  /// A run one side of which is lighter than the other by more than this fraction of its
+  /// depth (FramePoint::background_step: a glare's slope, a shadow's edge beside the stripe)
+  /// is not centred on its stripe and is left out. Range (0, 1e9].
+  double max_background_step = 0.2;
   /// Gauss-Newton steps at most. Range [1, 100].
   int max_iterations = 12;
   /// Each stripe needs at least this many points kept. Range [2, 1000].
@@ -73,15 +79,21 @@ struct StripeFit {
   int iterations = 0;
 };
 
+/// Lines known to be lines 1-4 (a detected line identified with a stripe), in the points'
+/// pixels; a stripe without one is found by the corridor alone.
+using StripeGuides = std::array<std::optional<LineParams>, 4>;
+
+/// The other pose a plane's view is nearly as well explained by (the planar ambiguity: the
+/// plane tilted the other way about the line of sight to its origin, its origin where it is):
+/// where a fit from `cMo` may have settled instead of the right one when the tilt is small or
+/// the target far. `cMo` itself when the plane faces the camera.
+vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo);
+
 /// The pose that best puts lines 1-4 of `layout` through their stripes' feature points in
 /// `points`, from `start` (near enough for its projected stripes to lie within corridor_px of
 /// their points). `points_undistorted`: the points are in undistorted pixels (the detector
 /// corrects the lens). Not ok when a stripe keeps fewer than min_points, the points cannot
 /// fix the pose, or the steps diverge (the message says which).
-/// Lines known to be lines 1-4 (a detected line identified with a stripe), in the points'
-/// pixels; a stripe without one is found by the corridor alone.
-using StripeGuides = std::array<std::optional<LineParams>, 4>;
-
 /// `guides`, when given, take each stripe's points near its guide line (guide_tolerance_px,
 /// between its printed ends as `start` puts them, wide enough) however far `start` puts the
 /// stripe: a start tens of pixels off still converges when the stripes' lines were told.

@@ -25,6 +25,12 @@ constexpr double kWaysRoundMargin = 0.1;
 // stripe's ends and middle), and this close in angle.
 constexpr double kGuideReach = 0.3;
 constexpr double kGuideMaxAngleRad = 8.0 * kPi / 180.0;
+// A pose fitted without four lines: each stripe's runs within this log ratio of its width
+// (0.22: 0.8 to 1.25 times; a stripe taken for its partner is 1.5 or 0.67 times), and its
+// points spanning this fraction of it at least (the borders cross one side of the crossings
+// over about a quarter of a stripe).
+constexpr double kMaxFittedWidthLog = 0.22;
+constexpr double kMinFittedExtent = 0.12;
 // ... and its fits take points in corridors these many times the fit's, in turn.
 constexpr std::array<double, 3> kExpectedCorridorScales = {6.0, 2.5, 1.0};
 
@@ -346,6 +352,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   if (frame_.pose.status == PoseStatus::kOk && options_.fit_stripes) {
     frame_.fit = FitStripes(frame_.pose.cMo, layout_, detector_.feature_points(), camera_,
                             detector_.Undistorts(), options_.stripe_fit);
+    if (frame_.fit.ok && !prior) frame_.fit = OtherTiltIfBetter(frame_.fit);
     if (frame_.fit.ok) ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
   }
   if (frame_.pose.status != PoseStatus::kOk &&
@@ -355,6 +362,28 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     return false;
   }
   return Verify(image);
+}
+
+StripeFit TargetPoseTracker::FitNarrowing(const vpHomogeneousMatrix& start,
+                                          const StripeGuides* guides) const {
+  StripeFit fit;
+  fit.cMo = start;
+  for (const double scale : kExpectedCorridorScales) {
+    StripeFitOptions corridor = options_.stripe_fit;
+    corridor.corridor_px *= scale;
+    fit = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_, detector_.Undistorts(),
+                     corridor, scale == kExpectedCorridorScales[0] ? guides : nullptr);
+    if (!fit.ok) break;
+  }
+  return fit;
+}
+
+StripeFit TargetPoseTracker::OtherTiltIfBetter(const StripeFit& fit) const {
+  StripeFit other = FitNarrowing(MirroredTilt(fit.cMo), nullptr);
+  if (!other.ok) return fit;
+  const int kept = fit.points[0] + fit.points[1] + fit.points[2] + fit.points[3];
+  const int other_kept = other.points[0] + other.points[1] + other.points[2] + other.points[3];
+  return other_kept > kept || (other_kept == kept && other.rms_px < fit.rms_px) ? other : fit;
 }
 
 bool TargetPoseTracker::FitExpected(const Expected& expected) {
@@ -368,21 +397,9 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
   std::string failure;
   for (const vpHomogeneousMatrix& start : {expected.cMo, turned}) {
     if (!expected.either_way && best) break;
-    // Where the target was expected can be pixels, or tens of pixels, off at the stripes'
-    // ends (a candidate's corners, a prediction): fits in corridors narrowing from wide to
-    // the fit's own, each from the last.
     // The lines the scan found near where `start` puts each stripe guide the first fit.
     const StripeGuides guides = GuidesFrom(PlaneToImage(start));
-    StripeFit fit;
-    fit.cMo = start;
-    for (const double scale : kExpectedCorridorScales) {
-      StripeFitOptions corridor = options_.stripe_fit;
-      corridor.corridor_px *= scale;
-      fit =
-          FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_, detector_.Undistorts(),
-                     corridor, scale == kExpectedCorridorScales[0] ? &guides : nullptr);
-      if (!fit.ok) break;
-    }
+    StripeFit fit = FitNarrowing(start, &guides);
     if (!fit.ok) {
       if (failure.empty()) failure = fit.message;
       continue;
@@ -417,6 +434,20 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
     frame_.pose.message = message.str();
     return false;
   }
+  // Its runs as wide as their stripes (a stripe taken for one half as wide again is not), and
+  // each stripe seen over a good part of it: the lines' identification and support, for a pose
+  // that has no four lines.
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (std::fabs(std::log(best->width_ratio[k])) > kMaxFittedWidthLog ||
+        best->extent[k] < kMinFittedExtent) {
+      std::ostringstream message;
+      message << why << "; fitted to the stripes' points, line " << k + 1 << "'s runs are "
+              << best->width_ratio[k] << " times its width and span " << best->extent[k]
+              << " of it";
+      frame_.pose.message = message.str();
+      return false;
+    }
+  }
   if (best->rms_px > pose_options_.max_residual_px) {
     std::ostringstream message;
     message << why << "; fitted to the stripes' points, their residual " << best->rms_px
@@ -424,6 +455,7 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
     frame_.pose.message = message.str();
     return false;
   }
+  if (expected.either_way) best = OtherTiltIfBetter(*best);
   frame_.fit = *best;
   // The four lines are the stripes' centre lines where the fit puts them.
   const vpHomography plane_to_image = PlaneToImage(best->cMo);
@@ -480,16 +512,29 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
       identified, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px,
       StripeEnds(PlaneToImage(frame_.pose.cMo)), Point2d{camera_.get_u0(), camera_.get_v0()},
       std::sqrt(camera_.get_px() * camera_.get_py()));
-  for (int k = 0; k < 4; ++k) {
-    const DetectedLine& line =
-        lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
-    if (line.support < options_.min_line_support) {
+  if (frame_.pose.method == PoseMethod::kStripes) {
+    // The four stripes held together: their points in all (each stripe has its fit's minimum).
+    const int points =
+        frame_.fit.points[0] + frame_.fit.points[1] + frame_.fit.points[2] + frame_.fit.points[3];
+    if (points < 2 * options_.min_line_support) {
       frame_.status = TargetStatus::kNotFound;
-      frame_.message =
-          "line " + std::to_string(k + 1) + " has " + std::to_string(line.support) +
-          " feature points on it (min_line_support = " + std::to_string(options_.min_line_support) +
-          "): too few to trust the pose";
+      frame_.message = "the stripes keep " + std::to_string(points) +
+                       " feature points in all (2 min_line_support = " +
+                       std::to_string(2 * options_.min_line_support) +
+                       "): too few to trust the pose fitted to them";
       return false;
+    }
+  } else {
+    for (int k = 0; k < 4; ++k) {
+      const DetectedLine& line =
+          lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
+      if (line.support < options_.min_line_support) {
+        frame_.status = TargetStatus::kNotFound;
+        frame_.message = "line " + std::to_string(k + 1) + " has " + std::to_string(line.support) +
+                         " feature points on it (min_line_support = " +
+                         std::to_string(options_.min_line_support) + "): too few to trust the pose";
+        return false;
+      }
     }
   }
   frame_.agreement = CheckStripes(image, layout_, frame_.pose.cMo, camera_, options_.StripeCheck());

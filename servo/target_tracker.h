@@ -107,7 +107,8 @@ struct TargetTrackerOptions {
   bool image_fallback = true;
   /// Each of the four lines the pose uses needs at least this many feature points on it
   /// (DetectedLine::support): a line seen on a few borders only is too poorly placed to
-  /// trust. Range [0, 1000].
+  /// trust; a pose fitted to the stripes' points alone (no four lines) needs twice this in
+  /// all. Range [0, 1000].
   int min_line_support = 12;
   /// The model check (stripe_check.h): of each stripe's samples that agree with the pose or
   /// contradict it, the fraction that must agree (a sample under a hand or a glare does
@@ -222,6 +223,14 @@ class TargetPoseTracker {
   /// there) but its points on the other side. Its four lines are the stripes' where it puts
   /// them. False (the frame's pose and message say why) when no fit holds.
   bool FitExpected(const Expected& expected);
+  /// The last scan's points fitted from `start`, in corridors narrowing from wide to the
+  /// fit's own, each fit from the last (the first guided by `guides`, when given): `start`
+  /// may be pixels, or tens of pixels, off at the stripes' ends (a candidate's corners, a
+  /// prediction).
+  StripeFit FitNarrowing(const vpHomogeneousMatrix& start, const StripeGuides* guides) const;
+  /// `fit`, or the fit from the pose tilted the other way (MirroredTilt) when it keeps more of
+  /// the stripes' points, or as many closer: without a prior, the planar ambiguity.
+  StripeFit OtherTiltIfBetter(const StripeFit& fit) const;
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
   /// told from the lines.
   bool Verify(const GrayImageView& image);

@@ -118,6 +118,22 @@ TEST(BorderScan, RunCentreWeightedByContrastToThePaperBesideIt) {
   EXPECT_NEAR(points[0].pixel.u, 12.0, kSubPixelTol);
 }
 
+// How much lighter one side of a run is than the other, over its depth below the lighter: 0
+// on even paper, large beside a glare's slope (which moves the run's middle).
+TEST(BorderScan, ARunsBackgroundStepComparesItsTwoSides) {
+  const BorderRect rect = BorderAt(100, 100, 0);
+  std::vector<std::uint8_t> samples(rect.Perimeter(), 200);
+  for (int i = 11; i <= 13; ++i) samples[static_cast<std::size_t>(i)] = 20;
+  std::vector<BorderPoint> points;
+  ASSERT_EQ(FindBorderPoints(samples, rect, 128, LineOptions(), &points), 1);
+  EXPECT_EQ(points[0].background_step, 0.0f);
+  // One side lit to 250 (samples 14 on), the other at 200: (250 - 200) / (250 - 20).
+  for (int i = 14; i < 30; ++i) samples[static_cast<std::size_t>(i)] = 250;
+  points.clear();
+  ASSERT_EQ(FindBorderPoints(samples, rect, 128, LineOptions(), &points), 1);
+  EXPECT_NEAR(points[0].background_step, 50.0 / 230.0, 1e-6);
+}
+
 // The weighted centres are summed 16 samples at a time where SSE2 is available: runs spanning
 // several windows, short runs, and runs in the last 16 samples of the loop (whose window is
 // moved back to end at the loop's end) must give the brute-force centroids, for both
