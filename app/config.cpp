@@ -243,6 +243,7 @@ const std::vector<Field<DetectorOptions>>& DetectorFields() {
       IntField("max_points_per_border", &O::max_points_per_border),
       BoolField("centre_from_background", &O::centre_from_background),
       IntField("region_max_borders", &O::region_max_borders),
+      IntField("region_sample_step", &O::region_sample_step),
       BoolField("skip_same_side_pairs", &O::skip_same_side_pairs),
       DoubleField("max_pair_width_ratio", &O::max_pair_width_ratio),
       DoubleField("angle_change_deg", &O::angle_change_deg),
@@ -912,6 +913,7 @@ const std::vector<Field<TargetTrackerOptions>>& TrackingFields() {
        [](const Value& value, O* options) {
          options->scan = value.Choice(&ScanModeFromString, "target, image");
        }},
+      DoubleField("reference_focal_px", &O::reference_focal_px),
       IntField("borders", &O::borders),
       IntField("tracked_borders", &O::tracked_borders),
       DoubleField("quick_max_identification_cost", &O::quick_max_identification_cost),

@@ -1,9 +1,10 @@
 // Detect + pose of a printed A3 sheet (four-line-a3) on a bench, through TargetPoseTracker:
 // a first frame (no prior: the sheet finder, its candidates' borders, the pose, the model
-// check) and tracked frames (borders from the last pose). 640x480, px = 600, kdu 0.15
-// corrected, noise 2-8, blur 0.5-1.5, vignetting, the sheet's shadow and printed marks,
-// clutter, on photographs of Debian's visp-images-data (uniform grey when it is missing).
-// Frames are rendered once, outside the timed loops.
+// check) and tracked frames (borders from the last pose), at 640x480 (px = 600, 56 degrees
+// across) and 1920x1080 (px = 1371, a 70 degree webcam): the benchmarks' argument is the
+// image's width. kdu 0.15 corrected, noise 2-8, blur 0.5-1.5, vignetting, the sheet's shadow
+// and printed marks, clutter, on photographs of Debian's visp-images-data (uniform grey when
+// it is missing). Frames are rendered once, outside the timed loops.
 //   build/bench/bench_target --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 #include <visp3/core/vpImageConvert.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -43,9 +45,18 @@ std::vector<std::shared_ptr<const vpImage<unsigned char>>> BenchPhotos() {
   return photos;
 }
 
-RenderOptions BenchRender(std::shared_ptr<const vpImage<unsigned char>> photo, int index) {
+// The camera of a benchmark's image width: 640x480 at 56 degrees across, or 1920x1080 at 70.
+vpCameraParameters CameraOfWidth(int width) {
+  if (width == 1920) return CameraWithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
+  return CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+}
+
+RenderOptions BenchRender(std::shared_ptr<const vpImage<unsigned char>> photo, int index,
+                          int width) {
   RenderOptions render;
-  render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  render.camera = CameraOfWidth(width);
+  render.width = width;
+  render.height = width == 1920 ? 1080 : 480;
   render.background = std::move(photo);
   DressAsBench(&render, 1 + static_cast<std::uint64_t>(index));
   return render;
@@ -64,44 +75,52 @@ struct TargetInputs {
   std::vector<RenderedFrame> moving;  ///< a smooth sweep between two random poses
 };
 
-const TargetInputs& Inputs() {
-  static const TargetInputs inputs = [] {
-    TargetInputs built;
-    const LineTarget target = FourLineA3Target();
-    std::vector<SceneRenderer> renderers;
-    int index = 0;
-    for (auto& photo : BenchPhotos()) renderers.emplace_back(target, BenchRender(photo, index++));
-    built.camera = renderers.front().options().camera;
-    PoseSampling sampling = SheetSampling(target);  // as pose-accuracy views an A3 sheet
-    std::uint64_t state = 1;
-    for (int frame = 0; frame < kFrames; ++frame) {
-      const SceneRenderer& renderer = renderers[frame % renderers.size()];
-      built.still.push_back(
-          renderer.Render(SamplePose(renderer, sampling, &state), frame, EffectsOf(frame)));
-    }
-    // About 3 mm and 0.3 deg a frame: a camera on an arm moving at a walking hand's pace.
-    sampling.min_distance_m = 0.45;
-    sampling.max_distance_m = 0.6;
-    sampling.max_tilt_deg = 15.0;
-    const SceneRenderer& renderer = renderers.front();
-    const vpHomogeneousMatrix from = SamplePose(renderer, sampling, &state);
-    const vpHomogeneousMatrix to = vpHomogeneousMatrix(0.05, -0.03, 0.04, 0.05, -0.05, 0.15) * from;
-    const vpColVector xi = Se3Log(to * from.inverse());
-    for (int frame = 0; frame < kFrames; ++frame) {
-      const vpHomogeneousMatrix cMo = Se3Exp(xi * (frame / (kFrames - 1.0))) * from;
-      built.moving.push_back(renderer.Render(cMo, 100 + frame, EffectsOf(frame)));
-    }
-    return built;
-  }();
-  return inputs;
+TargetInputs Render(int width) {
+  TargetInputs built;
+  const LineTarget target = FourLineA3Target();
+  std::vector<SceneRenderer> renderers;
+  int index = 0;
+  for (auto& photo : BenchPhotos()) {
+    renderers.emplace_back(target, BenchRender(photo, index++, width));
+  }
+  built.camera = renderers.front().options().camera;
+  PoseSampling sampling = SheetSampling(target);  // as pose-accuracy views an A3 sheet
+  std::uint64_t state = 1;
+  for (int frame = 0; frame < kFrames; ++frame) {
+    const SceneRenderer& renderer = renderers[frame % renderers.size()];
+    built.still.push_back(
+        renderer.Render(SamplePose(renderer, sampling, &state), frame, EffectsOf(frame)));
+  }
+  // About 3 mm and 0.3 deg a frame: a camera on an arm moving at a walking hand's pace.
+  sampling.min_distance_m = 0.45;
+  sampling.max_distance_m = 0.6;
+  sampling.max_tilt_deg = 15.0;
+  const SceneRenderer& renderer = renderers.front();
+  const vpHomogeneousMatrix from = SamplePose(renderer, sampling, &state);
+  const vpHomogeneousMatrix to = vpHomogeneousMatrix(0.05, -0.03, 0.04, 0.05, -0.05, 0.15) * from;
+  const vpColVector xi = Se3Log(to * from.inverse());
+  for (int frame = 0; frame < kFrames; ++frame) {
+    const vpHomogeneousMatrix cMo = Se3Exp(xi * (frame / (kFrames - 1.0))) * from;
+    built.moving.push_back(renderer.Render(cMo, 100 + frame, EffectsOf(frame)));
+  }
+  return built;
+}
+
+// The frames of a benchmark's image width, rendered on first use.
+const TargetInputs& Inputs(const benchmark::State& state) {
+  static std::map<int, TargetInputs> inputs;
+  const int width = static_cast<int>(state.range(0));
+  auto found = inputs.find(width);
+  if (found == inputs.end()) found = inputs.emplace(width, Render(width)).first;
+  return found->second;
 }
 
 TargetPoseTracker MakeTracker(const TargetInputs& inputs) {
   DetectorOptions detector;
   PoseOptions pose;
   pose.camera = inputs.camera;
-  pose.image_width = 640;
-  pose.image_height = 480;
+  pose.image_width = static_cast<int>(inputs.still.front().image.getWidth());
+  pose.image_height = static_cast<int>(inputs.still.front().image.getHeight());
   pose.compute_covariance = false;
   return TargetPoseTracker(FourLineA3Target(), inputs.camera, detector, pose);
 }
@@ -130,7 +149,7 @@ struct StepTally {
 
 // A frame with no prior: what `oalservo pose` does on one image.
 void TargetFirstFrame(benchmark::State& state) {
-  const TargetInputs& inputs = Inputs();
+  const TargetInputs& inputs = Inputs(state);
   TargetPoseTracker tracker = MakeTracker(inputs);
   std::size_t frame = 0;
   StepTally tally;
@@ -147,7 +166,7 @@ void TargetFirstFrame(benchmark::State& state) {
 // As TargetFirstFrame, with each frame first copied into one image, untimed, as a camera
 // delivers it (see TargetTrackedFromGrabber): `pose` on the first frame of a live camera.
 void TargetFirstFrameFromGrabber(benchmark::State& state) {
-  const TargetInputs& inputs = Inputs();
+  const TargetInputs& inputs = Inputs(state);
   TargetPoseTracker tracker = MakeTracker(inputs);
   vpImage<unsigned char> delivered = inputs.still.front().image;
   std::size_t frame = 0;
@@ -169,7 +188,7 @@ void TargetFirstFrameFromGrabber(benchmark::State& state) {
 // Frames of a moving camera, each tracked from the last pose; the sequence's first frame (found
 // afresh) is not timed.
 void TargetTracked(benchmark::State& state) {
-  const TargetInputs& inputs = Inputs();
+  const TargetInputs& inputs = Inputs(state);
   TargetPoseTracker tracker = MakeTracker(inputs);
   tracker.Track(ViewOf(inputs.moving.front().image));
   std::size_t frame = 1;
@@ -193,7 +212,7 @@ void TargetTracked(benchmark::State& state) {
 // frames arrive: vpV4l2Grabber::acquire converts the driver's buffer (YUYV or MJPG) into the
 // caller's vpImage, so the tracker reads a frame the CPU has just written.
 void TargetTrackedFromGrabber(benchmark::State& state) {
-  const TargetInputs& inputs = Inputs();
+  const TargetInputs& inputs = Inputs(state);
   TargetPoseTracker tracker = MakeTracker(inputs);
   vpImage<unsigned char> delivered = inputs.moving.front().image;
   tracker.Track(ViewOf(delivered));
@@ -219,28 +238,30 @@ void TargetTrackedFromGrabber(benchmark::State& state) {
 // The pose refined on the stripes' points alone (servo/stripe_fit.h), from a tracked frame's
 // intersections' pose and feature points: its share of a tracked frame.
 void StripeFitAlone(benchmark::State& state) {
-  const TargetInputs& inputs = Inputs();
+  const TargetInputs& inputs = Inputs(state);
   TargetPoseTracker tracker = MakeTracker(inputs);
   tracker.Track(ViewOf(inputs.moving.front().image));
   const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
   const vpHomogeneousMatrix start = tracked.pose.cMo;
   const std::vector<FramePoint> points = tracker.detector().feature_points();
   const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
-  int ok = 0;
+  int ok = 0, iterations = 0;
   for (auto _ : state) {
     const StripeFit fit = FitStripes(start, layout, points, inputs.camera, true);
     ok += fit.ok;
+    iterations = fit.iterations;
     benchmark::DoNotOptimize(fit.cMo.data);
   }
   state.counters["ok_fraction"] = ok / static_cast<double>(state.iterations());
   state.counters["points"] = static_cast<double>(points.size());
+  state.counters["iterations"] = iterations;
 }
 
-BENCHMARK(TargetFirstFrame)->Unit(benchmark::kMicrosecond);
-BENCHMARK(TargetFirstFrameFromGrabber)->Unit(benchmark::kMicrosecond);
-BENCHMARK(TargetTracked)->Unit(benchmark::kMicrosecond);
-BENCHMARK(TargetTrackedFromGrabber)->Unit(benchmark::kMicrosecond);
-BENCHMARK(StripeFitAlone)->Unit(benchmark::kMicrosecond);
+BENCHMARK(TargetFirstFrame)->Arg(640)->Arg(1920)->Unit(benchmark::kMicrosecond);
+BENCHMARK(TargetFirstFrameFromGrabber)->Arg(640)->Arg(1920)->Unit(benchmark::kMicrosecond);
+BENCHMARK(TargetTracked)->Arg(640)->Arg(1920)->Unit(benchmark::kMicrosecond);
+BENCHMARK(TargetTrackedFromGrabber)->Arg(640)->Arg(1920)->Unit(benchmark::kMicrosecond);
+BENCHMARK(StripeFitAlone)->Arg(640)->Arg(1920)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace oal

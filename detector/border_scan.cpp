@@ -497,6 +497,9 @@ class RectGeometry {
     return horizontal ? Point2d{1.0, 0.0} : Point2d{0.0, 1.0};
   }
   double Spacing(double) const { return 1.0; }
+  int Stride() const { return 1; }
+  bool RereadsRuns() const { return false; }
+  bool ReadPixels(int, int, std::uint8_t*) const { return false; }
 
  private:
   const BorderRect& rect_;
@@ -505,7 +508,8 @@ class RectGeometry {
 
 class PolygonGeometry {
  public:
-  explicit PolygonGeometry(const PolygonLoop& loop) : loop_(loop) {}
+  PolygonGeometry(const PolygonLoop& loop, const GrayImageView* image)
+      : loop_(loop), image_(image) {}
   bool HasCornerInside(const Run& run, int) const {
     return loop_.HasCornerInside(run.first, run.last);
   }
@@ -515,10 +519,55 @@ class PolygonGeometry {
     return loop_.Direction(s);
   }
   double Spacing(double s) const { return loop_.Spacing(s); }
+  int Stride() const { return loop_.SampleStep(); }
+  bool RereadsRuns() const { return image_ != nullptr && loop_.SampleStep() > 1; }
+  // The image's pixels from loop coordinate `first` on (PolygonLoop::GatherPixels).
+  bool ReadPixels(int first, int count, std::uint8_t* out) const {
+    return loop_.GatherPixels(*image_, first, count, out);
+  }
 
  private:
   const PolygonLoop& loop_;
+  const GrayImageView* image_;
 };
+
+// A run of a loop read every `stride` pixels, read again at every pixel from two samples
+// before it to two after: the dark stretch around its middle there, its ends where it crosses
+// `threshold`, and its centre weighted by the contrast to `reference` (the paper beside it)
+// over it and a pixel either side, as on the samples. Writes the centre (loop coordinates)
+// and returns the length (samples); 0 when the stretch is not found (the samples' stand).
+template <typename Geometry>
+double RereadRun(const Geometry& geometry, const Run& run, int threshold, int reference, bool light,
+                 double* centre) {
+  constexpr int kMaxPixels = 1024;
+  const int stride = geometry.Stride();
+  const int lo = run.first - 2;
+  const int n = (run.last - run.first + 4) * stride + 1;
+  std::array<std::uint8_t, kMaxPixels> grey;
+  if (n > kMaxPixels || !geometry.ReadPixels(lo, n, grey.data())) return 0.0;
+  const auto f = [&](int i) {
+    const int value = grey[static_cast<std::size_t>(i)];
+    return light ? value - threshold : threshold - value;  // > 0: the run's
+  };
+  const int middle = static_cast<int>(std::lround((*centre - lo) * stride));
+  if (middle <= 0 || middle >= n - 1 || f(middle) <= 0) return 0.0;
+  int first = middle, last = middle;
+  while (first > 0 && f(first - 1) > 0) --first;
+  while (last < n - 1 && f(last + 1) > 0) ++last;
+  if (first == 0 || last == n - 1) return 0.0;
+  const double a = first - 1 + static_cast<double>(-f(first - 1)) / (f(first) - f(first - 1));
+  const double b = last + static_cast<double>(f(last)) / (f(last) - f(last + 1));
+  double weight_sum = 0.0, weighted = 0.0;
+  for (int i = first - 1; i <= last + 1; ++i) {
+    const int value = grey[static_cast<std::size_t>(i)];
+    const double w = std::max(0, light ? value - reference : reference - value);
+    weight_sum += w;
+    weighted += w * i;
+  }
+  const double fine = weight_sum > 0.0 ? weighted / weight_sum : 0.5 * (a + b);
+  *centre = lo + fine / stride;
+  return (b - a) / stride;
+}
 
 template <typename Geometry>
 int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometry, int threshold,
@@ -532,7 +581,11 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
     return light ? static_cast<double>(value - threshold) : static_cast<double>(threshold - value);
   };
 
-  const int min_gap = static_cast<int>(std::ceil(options.min_width_px));
+  // Widths in samples: a sample every `stride` pixels along the border's longer axis.
+  const double stride = geometry.Stride();
+  const double min_width = options.min_width_px / stride;
+  const double max_width = options.max_width_px / stride;
+  const int min_gap = std::max(1, static_cast<int>(std::ceil(min_width)));
   constexpr int kMaxRuns = 2 * 64 + 2;
   Run runs[kMaxRuns];
   int run_count = light ? ScanRuns<true>(samples.data(), p, threshold, min_gap, runs, kMaxRuns)
@@ -548,8 +601,8 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
 
   // (Computed only for runs wider than max_width_px, which are rare: sin is not cheap.)
   auto longer_than_max_run = [&](double length) {
-    return length > options.max_width_px &&
-           length > options.max_width_px / std::sin(options.min_crossing_angle_deg * kPi / 180.0);
+    return length > max_width &&
+           length > max_width / std::sin(options.min_crossing_angle_deg * kPi / 180.0);
   };
   const bool edges = options.polarity == Polarity::kEdges;
   int added = 0;
@@ -576,11 +629,11 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
     const double f_last = f(run.last), f_after = f(run.last + 1);
     const double s_a = run.first - 1 + (-f_before) / (f_first - f_before);
     const double s_b = run.last + f_last / (f_last - f_after);
-    const double length = s_b - s_a;
-    if (length < options.min_width_px) continue;
+    double length = s_b - s_a;
+    if (length < min_width) continue;
 
     if (edges) {
-      if (length >= p - options.min_width_px) continue;
+      if (length >= p - min_width) continue;
       Point2d a, b;
       const std::uint16_t sides_a = geometry.Locate(s_a, &a), sides_b = geometry.Locate(s_b, &b);
       if (!push(a, 0.0, sides_a, true, Point2d{}, 0.0)) break;
@@ -592,7 +645,7 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
     const bool straight = !geometry.HasCornerInside(run, p);
     Point2d pixel, along;
     std::uint16_t sides = 0;
-    double run_px = length;
+    double run_px = length * stride;
     double background_step = 0.0;
     if (straight) {
       // The weights: each sample's contrast to the threshold, or (centre_from_background) to
@@ -610,9 +663,13 @@ int FindPoints(const std::vector<std::uint8_t>& samples, const Geometry& geometr
         reference = static_cast<int>(std::lround(light ? threshold + beside : threshold - beside));
         reference = std::clamp(reference, 0, 255);
       }
-      const double centre =
-          light ? WeightedCentre<true>(samples.data(), p, weighted, reference, s_a, s_b)
-                : WeightedCentre<false>(samples.data(), p, weighted, reference, s_a, s_b);
+      double centre = light
+                          ? WeightedCentre<true>(samples.data(), p, weighted, reference, s_a, s_b)
+                          : WeightedCentre<false>(samples.data(), p, weighted, reference, s_a, s_b);
+      if (geometry.RereadsRuns()) {
+        const double reread_length = RereadRun(geometry, run, threshold, reference, light, &centre);
+        if (reread_length > 0.0) length = reread_length;
+      }
       // f < 0 beside the run: its magnitude is the background's contrast to the threshold.
       const double before = -0.5 * (f(run.first - 3) + f(run.first - 2));
       const double after = -0.5 * (f(run.last + 2) + f(run.last + 3));
@@ -643,8 +700,8 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
 
 int FindBorderPoints(const std::vector<std::uint8_t>& samples, const PolygonLoop& loop,
                      int threshold, const DetectorOptions& options,
-                     std::vector<BorderPoint>* points) {
-  return FindPoints(samples, PolygonGeometry(loop), threshold, options, points);
+                     std::vector<BorderPoint>* points, const GrayImageView* image) {
+  return FindPoints(samples, PolygonGeometry(loop, image), threshold, options, points);
 }
 
 }  // namespace oal

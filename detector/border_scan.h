@@ -101,8 +101,12 @@ int FindBorderPoints(const std::vector<std::uint8_t>& samples, const BorderRect&
                      int threshold, const DetectorOptions& options,
                      std::vector<BorderPoint>* points);
 /// The same for a border of a region (region.h), as PolygonLoop::Gather wrote its samples.
+/// A loop read every few pixels (PolygonLoop::SampleStep() > 1) finds its runs on its
+/// samples; with `image` (the one it was gathered from) each straight run is read again at
+/// every pixel to place its ends and centre (a sharp stripe edge between samples three pixels
+/// apart would move its point by up to half a pixel).
 int FindBorderPoints(const std::vector<std::uint8_t>& samples, const PolygonLoop& loop,
                      int threshold, const DetectorOptions& options,
-                     std::vector<BorderPoint>* points);
+                     std::vector<BorderPoint>* points, const GrayImageView* image = nullptr);
 
 }  // namespace oal

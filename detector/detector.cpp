@@ -199,6 +199,7 @@ const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
   if (region.empty()) return DetectInRegion(image, seeds);
   region.Check();
   PrepareFor(image.width, image.height);
+  region_borders_.set_sample_step(options_.region_sample_step);
   region_borders_.Build(region, image.width, image.height, options_.start_px, options_.step_px,
                         options_.region_max_borders);
   in_region_ = true;
@@ -212,6 +213,7 @@ const std::vector<DetectedLine>& OalDetector::Detect(const GrayImageView& image,
   if (borders.empty()) return DetectInRegion(image, seeds);
   borders.Check();
   PrepareFor(image.width, image.height);
+  region_borders_.set_sample_step(options_.region_sample_step);
   region_borders_.Assign(borders, image.width, image.height, borders.image_margin_px,
                          borders.image_margin_step_px);
   in_region_ = true;
@@ -304,7 +306,7 @@ void OalDetector::ScanRegionBorder(const GrayImageView& image, int border) {
   int threshold = 0;
   if (BorderThreshold(region_samples_, &threshold)) {
     border_points_.clear();
-    FindBorderPoints(region_samples_, loop, threshold, options_, &border_points_);
+    FindBorderPoints(region_samples_, loop, threshold, options_, &border_points_, &image);
     AddBorderPoints(border);
   }
   if (!options_.count_visible_borders_only) {

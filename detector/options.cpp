@@ -1,5 +1,7 @@
 #include "detector/options.h"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -59,6 +61,8 @@ void DetectorOptions::Check() const {
           max_points_per_border, "2 <= max_points_per_border <= 64");
   Require(region_max_borders >= 0 && region_max_borders <= 1000, "region_max_borders",
           region_max_borders, "0 <= region_max_borders <= 1000");
+  Require(region_sample_step >= 1 && region_sample_step <= 16, "region_sample_step",
+          region_sample_step, "1 <= region_sample_step <= 16");
   Require(
       max_pair_width_ratio == 0.0 || (max_pair_width_ratio >= 1.0 && max_pair_width_ratio <= 100.0),
       "max_pair_width_ratio", max_pair_width_ratio,
@@ -80,6 +84,24 @@ void DetectorOptions::Check() const {
           duplicate_angle_deg, "0 < duplicate_angle_deg <= 90");
   Require(duplicate_r_px > 0 && duplicate_r_px <= 1000, "duplicate_r_px", duplicate_r_px,
           "0 < duplicate_r_px <= 1000");
+}
+
+DetectorOptions DetectorOptions::ScaledBy(double scale) const {
+  RequireOption(scale > 0.0 && scale <= 100.0, "DetectorOptions::ScaledBy scale", scale,
+                "0 < scale <= 100");
+  DetectorOptions scaled = *this;
+  const auto whole = [scale](int px, int at_least) {
+    return std::max(at_least, static_cast<int>(std::lround(px * scale)));
+  };
+  scaled.start_px = whole(start_px, 0);
+  scaled.step_px = whole(step_px, 1);
+  scaled.min_width_px = std::max(1.0, min_width_px * scale);
+  scaled.max_width_px = std::max(scaled.min_width_px, max_width_px * scale);
+  scaled.r_change_px = r_change_px * scale;
+  scaled.support_tolerance_px = support_tolerance_px * scale;
+  scaled.duplicate_r_px = duplicate_r_px * scale;
+  scaled.region_sample_step = std::clamp(static_cast<int>(region_sample_step * scale), 1, 16);
+  return scaled;
 }
 
 DetectorOptions DetectorOptions::Paper() {

@@ -60,6 +60,10 @@ struct DetectorOptions {
   /// what a smaller one does; the full-image scan always uses step_px). 0: no limit.
   /// Range [0, 1000].
   int region_max_borders = 16;
+  /// A region's borders are read every this many pixels along (the whole image's every
+  /// pixel): where the lines are several pixels wide, fewer samples place them as well, and
+  /// a frame of a larger image costs about what a smaller one does. Range [1, 16].
+  int region_sample_step = 1;
 
   // --- Step 2: pairwise correlation ------------------------------------------------------
   /// Two points on the same side of a border rectangle span that side, never a line that
@@ -106,6 +110,14 @@ struct DetectorOptions {
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
+
+  /// These options for an image whose lines are `scale` times as many pixels across as the
+  /// ones these were set for (a camera of `scale` times the focal length): every length in
+  /// pixels (the borders' start and spacing, the runs' widths, rchange, the support
+  /// tolerance, the duplicates' distance) times `scale`, the spacing and the narrowest run
+  /// a pixel at least; a region's borders read every whole `scale` pixels
+  /// (region_sample_step); counts, angles and grey levels as they are. `scale` in (0, 100].
+  DetectorOptions ScaledBy(double scale) const;
 
   /// The paper's algorithm: every remedy switch off (min_crossing_angle_deg 90,
   /// skip_same_side_pairs, max_pair_width_ratio, count_visible_borders_only, refit_lines,

@@ -233,7 +233,8 @@ void PolygonLoop::AddEdge(const Point2d& a, const Point2d& b) {
   edge.first = perimeter_;
   edge.direction = length > 0.0 ? Point2d{du / length, dv / length} : Point2d{1.0, 0.0};
   edge.mostly_horizontal = std::fabs(du) >= std::fabs(dv);
-  // Samples at the integer coordinates of the longer axis in [a, b), in its direction.
+  // Samples at every sample_step_-th integer coordinate of the longer axis in [a, b), in its
+  // direction.
   const double from = edge.mostly_horizontal ? a.u : a.v;
   const double to = edge.mostly_horizontal ? b.u : b.v;
   const double delta = to - from;
@@ -241,22 +242,25 @@ void PolygonLoop::AddEdge(const Point2d& a, const Point2d& b) {
     const double sign = delta > 0.0 ? 1.0 : -1.0;
     const double first = sign > 0.0 ? std::ceil(from) : std::floor(from);
     const double last = sign > 0.0 ? std::ceil(to) - 1.0 : std::floor(to) + 1.0;
-    edge.count = std::max(0, static_cast<int>(std::lround((last - first) * sign)) + 1);
+    const long pixels = std::lround((last - first) * sign);
+    edge.count = pixels < 0 ? 0 : static_cast<int>(pixels / sample_step_) + 1;
     const double slope = (edge.mostly_horizontal ? dv : du) / std::fabs(delta);
     const double t = (first - from) * sign;  // along the longer axis from a
+    const double step = sign * sample_step_, step_across = slope * sample_step_;
     if (edge.mostly_horizontal) {
       edge.start = Point2d{first, a.v + t * slope};
-      edge.step = Point2d{sign, slope};
+      edge.step = Point2d{step, step_across};
     } else {
       edge.start = Point2d{a.u + t * slope, first};
-      edge.step = Point2d{slope, sign};
+      edge.step = Point2d{step_across, step};
     }
   }
   perimeter_ += edge.count;
   edges_.push_back(edge);
 }
 
-void PolygonLoop::Assign(const std::vector<Point2d>& polygon) {
+void PolygonLoop::Assign(const std::vector<Point2d>& polygon, int sample_step) {
+  sample_step_ = std::max(1, sample_step);
   vertices_.assign(polygon.begin(), polygon.end());
   edges_.clear();
   perimeter_ = 0;
@@ -309,7 +313,8 @@ void PolygonLoop::Gather(const GrayImageView& image, std::vector<std::uint8_t>* 
     const auto step_fx = static_cast<std::int64_t>(std::llround(step_across * kOne));
     const std::int64_t end_fx = start_fx + step_fx * (edge.count - 1);
     const int along = static_cast<int>(std::lround(horizontal ? edge.start.u : edge.start.v));
-    const int along_step = (horizontal ? edge.step.u : edge.step.v) > 0.0 ? 1 : -1;
+    const int along_step =
+        (horizontal ? edge.step.u : edge.step.v) > 0.0 ? sample_step_ : -sample_step_;
     const std::ptrdiff_t major = horizontal ? along_step : along_step * stride;
     const std::ptrdiff_t minor = horizontal ? stride : 1;
     const std::uint8_t* origin = image.data + (horizontal ? along : along * stride);
@@ -356,6 +361,40 @@ Point2d PolygonLoop::SampleAt(int k) const {
   const Edge& edge = edges_[static_cast<std::size_t>(EdgeAt(k))];
   const double j = k - edge.first;
   return Point2d{edge.start.u + j * edge.step.u, edge.start.v + j * edge.step.v};
+}
+
+bool PolygonLoop::GatherPixels(const GrayImageView& image, int first, int count,
+                               std::uint8_t* out) const {
+  if (first < 0 || count <= 0 || first >= perimeter_) return false;
+  const Edge& edge = edges_[static_cast<std::size_t>(EdgeAt(first))];
+  const int j = first - edge.first;  // the edge's sample
+  if (j < 0 || j * sample_step_ + count - 1 > (edge.count - 1) * sample_step_) return false;
+  constexpr double kOne = 65536.0;
+  const bool horizontal = edge.mostly_horizontal;
+  const double start_across = horizontal ? edge.start.v : edge.start.u;
+  const double step_across = (horizontal ? edge.step.v : edge.step.u) / sample_step_;  // a pixel's
+  const int limit = (horizontal ? image.height : image.width) - 2;
+  const auto start_fx = static_cast<std::int64_t>(
+      std::llround((start_across + j * sample_step_ * step_across) * kOne));
+  const auto step_fx = static_cast<std::int64_t>(std::llround(step_across * kOne));
+  const std::int64_t end_fx = start_fx + step_fx * (count - 1);
+  if (std::min(start_fx, end_fx) < 0 || (std::max(start_fx, end_fx) >> 16) > limit) return false;
+  const int sign = (horizontal ? edge.step.u : edge.step.v) > 0.0 ? 1 : -1;
+  const int along = static_cast<int>(std::lround(horizontal ? edge.start.u : edge.start.v)) +
+                    sign * j * sample_step_;
+  const int along_end = along + sign * (count - 1);
+  const int along_limit = (horizontal ? image.width : image.height) - 1;
+  if (std::min(along, along_end) < 0 || std::max(along, along_end) > along_limit) return false;
+  const std::ptrdiff_t stride = image.stride;
+  const std::ptrdiff_t major = horizontal ? sign : sign * stride;
+  const std::ptrdiff_t minor = horizontal ? stride : 1;
+  const std::uint8_t* origin = image.data + (horizontal ? along : along * stride);
+  if (horizontal) {
+    SampleEdge<false>(origin, major, minor, start_fx, step_fx, count, out);
+  } else {
+    SampleEdge<true>(origin, major, minor, start_fx, step_fx, count, out);
+  }
+  return true;
 }
 
 std::uint16_t PolygonLoop::Locate(double s, Point2d* pixel, double corner_px) const {
@@ -495,7 +534,7 @@ bool RegionBorders::Append(const std::vector<Point2d>& polygon) {
     loops_.emplace_back();
   }
   polygons_[i].assign(polygon.begin(), polygon.end());
-  loops_[i].Assign(polygons_[i]);
+  loops_[i].Assign(polygons_[i], sample_step_);
   if (loops_[i].Perimeter() < 4) return false;
   ++count_;
   return true;

@@ -10,8 +10,10 @@
 // region leaves the image), walked as one loop from the polygon's first vertex in the same
 // turning sense as the image borders (top row left to right, then down the right side).
 //
-// Sampling: along an edge one sample per pixel of its longer axis (integer columns for an
-// edge nearer the horizontal, integer rows otherwise), each linearly interpolated across the
+// Sampling: along an edge one sample per pixel of its longer axis, or every sample_step
+// pixels (integer columns for an edge nearer the horizontal, integer rows otherwise: where
+// the lines are many pixels wide, fewer samples place them as well), each linearly
+// interpolated across the
 // other axis, so the samples lie exactly on the edge and a run's centre maps back to the
 // edge without the half-pixel staircase of nearest-pixel sampling.
 #pragma once
@@ -84,22 +86,31 @@ class PolygonLoop {
  public:
   PolygonLoop() = default;
   /// `polygon`: convex, the image borders' turning sense, at most 16 vertices, inside
-  /// [0, width-1] x [0, height-1] of the image it will be read from.
-  explicit PolygonLoop(const std::vector<Point2d>& polygon) { Assign(polygon); }
+  /// [0, width-1] x [0, height-1] of the image it will be read from. `sample_step`: a sample
+  /// every this many pixels of an edge's longer axis, >= 1.
+  explicit PolygonLoop(const std::vector<Point2d>& polygon, int sample_step = 1) {
+    Assign(polygon, sample_step);
+  }
   /// Makes this the loop of `polygon`, reusing the memory it holds.
-  void Assign(const std::vector<Point2d>& polygon);
+  void Assign(const std::vector<Point2d>& polygon, int sample_step = 1);
 
   int Perimeter() const { return perimeter_; }
+  int SampleStep() const { return sample_step_; }
   int Edges() const { return static_cast<int>(edges_.size()); }
   /// Reads the loop's samples from `image` into `samples` (resized).
   void Gather(const GrayImageView& image, std::vector<std::uint8_t>* samples) const;
+  /// Reads `count` pixels from the whole loop coordinate `first` on, one at every pixel of
+  /// the edge's longer axis (SampleStep() of them between samples), as Gather reads its
+  /// samples. False (nothing read) unless they all lie on one edge, inside the image.
+  bool GatherPixels(const GrayImageView& image, int first, int count, std::uint8_t* out) const;
 
   /// Position of loop coordinate s and the bits (1 << edge) of the edges holding it; within
   /// `corner_px` samples of a vertex both of its edges are set.
   std::uint16_t Locate(double s, Point2d* pixel, double corner_px = 0.5) const;
   /// Unit direction of the edge holding s (the loop's direction).
   Point2d Direction(double s) const;
-  /// Pixels between consecutive samples of the edge holding s (1 to sqrt 2).
+  /// Pixels between consecutive samples of the edge holding s (1 to sqrt 2 times the
+  /// sample step).
   double Spacing(double s) const;
   /// Whether a vertex lies strictly inside the loop interval (first, last); first may be
   /// negative (a run across the loop's seam), last < Perimeter() + first.
@@ -124,6 +135,7 @@ class PolygonLoop {
   std::vector<Point2d> vertices_;
   std::vector<Edge> edges_;
   int perimeter_ = 0;
+  int sample_step_ = 1;
 };
 
 /// The concentric borders of a region, rebuilt for every frame in memory kept from frame to
@@ -140,6 +152,9 @@ class RegionBorders {
   /// a border with nothing of 2 px across left is dropped. inside() is the first one clipped
   /// to the image.
   void Assign(const ScanBorders& borders, int width, int height, int first_px, int step_px);
+
+  /// The borders built from now on are read every `step` pixels along (PolygonLoop), >= 1.
+  void set_sample_step(int step) { sample_step_ = step; }
 
   int count() const { return count_; }
   /// Border k's polygon (0 = outermost) and loop.
@@ -169,6 +184,7 @@ class RegionBorders {
   std::vector<Point2d> scratch_, probe_;
   std::vector<std::vector<Point2d>> polygons_;
   std::vector<PolygonLoop> loops_;
+  int sample_step_ = 1;
   std::vector<Point2d> inside_;
   int count_ = 0;
 };

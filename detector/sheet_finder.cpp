@@ -203,6 +203,14 @@ void SheetFinderOptions::Check() const {
                 max_candidates, "1 <= max_candidates <= 16");
 }
 
+SheetFinderOptions SheetFinderOptions::ScaledBy(double scale) const {
+  RequireOption(scale > 0.0 && scale <= 100.0, "SheetFinderOptions::ScaledBy scale", scale,
+                "0 < scale <= 100");
+  SheetFinderOptions scaled = *this;
+  scaled.cell_px = std::clamp(static_cast<int>(std::lround(cell_px * scale)), 2, 64);
+  return scaled;
+}
+
 SheetFinder::SheetFinder(const SheetFinderOptions& options)
     : options_((options.Check(), options)) {}
 
@@ -212,26 +220,30 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
   grid_height_ = image.height / c;
   cells_.assign(static_cast<std::size_t>(grid_width_) * grid_height_, 0);
   std::vector<std::uint32_t> sums(static_cast<std::size_t>(grid_width_));
-  // Every fourth row of each cell (from the middle of the first four): the mean of a quarter
-  // of its pixels is plenty to tell paper from ink.
+  // Two rows of each cell (every fourth row of a small one) and at most sixteen pixels of each
+  // row, in the cell's middle: the mean of a few dozen pixels is plenty to tell paper from ink,
+  // and a frame's cost follows its cells, not its area (the cells grow with the image).
   const int first_row = std::min(1, c - 1);
-  const int rows_used = (c - first_row + 3) / 4;
-  const std::uint32_t count = static_cast<std::uint32_t>(rows_used * c);
+  const int row_step = std::max(4, c / 2);
+  const int rows_used = (c - first_row + row_step - 1) / row_step;
+  const int window = c >= 16 ? 16 : (c >= 8 ? 8 : c);
+  const int offset = (c - window) / 2;
+  const std::uint32_t count = static_cast<std::uint32_t>(rows_used * window);
   for (int gy = 0; gy < grid_height_; ++gy) {
     std::fill(sums.begin(), sums.end(), 0u);
-    for (int r = first_row; r < c; r += 4) {
+    for (int r = first_row; r < c; r += row_step) {
       const int y = gy * c + r;
       const std::uint8_t* row = image.data + static_cast<std::ptrdiff_t>(y) * image.stride;
-      // The row two used rows below, asked for now: a frame just out of memory costs more
-      // to wait for than to sum, and the rows used are too far apart for the hardware to guess.
-      if (y + 8 < image.height) {
-        const std::uint8_t* ahead = row + 8 * static_cast<std::ptrdiff_t>(image.stride);
+      // The next row used, asked for now: a frame just out of memory costs more to wait for
+      // than to sum, and the rows used are too far apart for the hardware to guess.
+      if (y + row_step < image.height) {
+        const std::uint8_t* ahead = row + row_step * static_cast<std::ptrdiff_t>(image.stride);
         for (int x = 0; x < image.width; x += 64) __builtin_prefetch(ahead + x);
       }
       int gx = 0;
 #if OAL_HAVE_SSE2
+      const __m128i zero = _mm_setzero_si128();
       if (c == 8) {  // one psadbw sums two cells' eight pixels
-        const __m128i zero = _mm_setzero_si128();
         for (; gx + 1 < grid_width_; gx += 2) {
           const __m128i pixels = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + gx * 8));
           const __m128i sad = _mm_sad_epu8(pixels, zero);
@@ -239,12 +251,27 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
           sums[static_cast<std::size_t>(gx) + 1] +=
               static_cast<std::uint32_t>(_mm_extract_epi16(sad, 4));
         }
+      } else if (window == 16) {  // one psadbw sums a cell's sixteen, in two halves
+        for (; gx < grid_width_; ++gx) {
+          const __m128i pixels =
+              _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + gx * c + offset));
+          const __m128i sad = _mm_sad_epu8(pixels, zero);
+          sums[static_cast<std::size_t>(gx)] +=
+              static_cast<std::uint32_t>(_mm_cvtsi128_si32(sad) + _mm_extract_epi16(sad, 4));
+        }
+      } else if (window == 8) {
+        for (; gx < grid_width_; ++gx) {
+          const __m128i pixels =
+              _mm_loadl_epi64(reinterpret_cast<const __m128i*>(row + gx * c + offset));
+          sums[static_cast<std::size_t>(gx)] +=
+              static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_sad_epu8(pixels, zero)));
+        }
       }
 #endif
       for (; gx < grid_width_; ++gx) {
-        const std::uint8_t* p = row + gx * c;
+        const std::uint8_t* p = row + gx * c + offset;
         std::uint32_t s = 0;
-        for (int k = 0; k < c; ++k) s += p[k];
+        for (int k = 0; k < window; ++k) s += p[k];
         sums[static_cast<std::size_t>(gx)] += s;
       }
     }

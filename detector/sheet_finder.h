@@ -7,7 +7,8 @@
 // clean light quadrilateral whatever lies around the sheet (a light bench, a bright photo
 // beside it, a shadow), and from it the target's geometry predicts where the rest of the
 // target lies. The finder works on a grid of cells (cell_px x cell_px pixel means, about 5000
-// for 640 x 480, from every fourth row):
+// for 640 x 480, each from two rows of at most 16 of its pixels: a larger image with larger
+// cells costs what a small one does):
 //   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
 //      Otsu's over the light class again (a light bench, a bright photo), while the classes
 //      differ by at least min_contrast and no quadrilateral closed in on all four sides has
@@ -51,6 +52,10 @@ struct SheetFinderOptions {
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
+  /// These options for an image `scale` times as many pixels across (DetectorOptions::
+  /// ScaledBy): the cells `scale` times as wide, as many of them over the sheet. `scale` in
+  /// (0, 100].
+  SheetFinderOptions ScaledBy(double scale) const;
 };
 
 /// A light quadrilateral of the frame.

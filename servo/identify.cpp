@@ -541,6 +541,16 @@ std::string ToString(PoseMethod method) {
   return "unknown";
 }
 
+PoseOptions PoseOptions::ScaledBy(double scale) const {
+  RequireOption(scale > 0.0 && scale <= 100.0, "PoseOptions::ScaledBy scale", scale,
+                "0 < scale <= 100");
+  PoseOptions scaled = *this;
+  scaled.max_outside_px = max_outside_px * scale;
+  scaled.min_side_px = min_side_px * scale;
+  scaled.max_residual_px = max_residual_px * scale;
+  return scaled;
+}
+
 void PoseOptions::Check() const {
   CheckPerspectiveCamera(camera, "PoseOptions::camera");
   RequireOption(max_candidate_lines >= 4 && max_candidate_lines <= 12,

@@ -161,6 +161,11 @@ struct PoseOptions {
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
+  /// These options for an image `scale` times as many pixels across (a camera of `scale`
+  /// times the focal length): the corners' bounds in pixels (max_outside_px, min_side_px) and
+  /// the largest residual (max_residual_px: blur and a stripe's edges spread with the pixels)
+  /// times `scale`. `scale` in (0, 100].
+  PoseOptions ScaledBy(double scale) const;
 };
 
 struct PoseResult {

@@ -82,6 +82,10 @@ ScanMode ScanModeFromString(const std::string& text) {
 }
 
 void TargetTrackerOptions::Check() const {
+  RequireOption(
+      reference_focal_px == 0.0 || (reference_focal_px >= 1.0 && reference_focal_px <= 1e5),
+      "TargetTrackerOptions::reference_focal_px", reference_focal_px,
+      "0 or 1 <= reference_focal_px <= 1e5");
   finder.Check();
   RequireOption(borders >= 2 && borders <= 64, "TargetTrackerOptions::borders", borders,
                 "2 <= borders <= 64");
@@ -119,6 +123,22 @@ void TargetTrackerOptions::Check() const {
                 "TargetTrackerOptions::stripe_width_tolerance", stripe_width_tolerance,
                 "0 < stripe_width_tolerance <= 10");
   stripe_fit.Check();
+}
+
+double TargetTrackerOptions::PixelScale(const vpCameraParameters& camera) const {
+  if (reference_focal_px == 0.0) return 1.0;
+  return std::clamp(std::sqrt(camera.get_px() * camera.get_py()) / reference_focal_px, 0.01, 100.0);
+}
+
+TargetTrackerOptions TargetTrackerOptions::ScaledBy(double scale) const {
+  RequireOption(scale > 0.0 && scale <= 100.0, "TargetTrackerOptions::ScaledBy scale", scale,
+                "0 < scale <= 100");
+  TargetTrackerOptions scaled = *this;
+  scaled.finder = finder.ScaledBy(scale);
+  scaled.stripe_tolerance_px = stripe_tolerance_px * scale;
+  scaled.stripe_fit.corridor_px = stripe_fit.corridor_px * scale;
+  scaled.stripe_fit.guide_tolerance_px = stripe_fit.guide_tolerance_px * scale;
+  return scaled;
 }
 
 StripeCheckOptions TargetTrackerOptions::StripeCheck() const {
@@ -242,10 +262,11 @@ TargetPoseTracker::TargetPoseTracker(const LineTarget& target, const vpCameraPar
     : target_(target),
       camera_(camera),
       layout_(TargetLayout::Of(target)),
-      pose_options_(pose),
-      options_((options.Check(), options)),
-      detector_(detector, camera),
-      finder_(options.finder) {
+      pixel_scale_((options.Check(), options.PixelScale(camera))),
+      pose_options_(pose.ScaledBy(pixel_scale_)),
+      options_(options.ScaledBy(pixel_scale_)),
+      detector_(detector.ScaledBy(pixel_scale_), camera),
+      finder_(options_.finder) {
   pose_options_.camera = camera;
   pose_options_.lines_undistorted = detector_.Undistorts();
   pose_options_.Check();
@@ -378,8 +399,36 @@ StripeFit TargetPoseTracker::FitNarrowing(const vpHomogeneousMatrix& start,
   return fit;
 }
 
+double TargetPoseTracker::StripeEndsApart(const vpHomogeneousMatrix& a,
+                                          const vpHomogeneousMatrix& b) const {
+  const vpHomography a_to_image = PlaneToImage(a), b_to_image = PlaneToImage(b);
+  double apart = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const StripeSpan& stripe = layout_.stripes[static_cast<std::size_t>(k)];
+    for (const double along : {stripe.along.lo, stripe.along.hi}) {
+      const Point2d plane = layout_.OnStripe(k, along, 0.0);
+      const PlaneImage in_a = ThroughHomography(a_to_image, plane);
+      const PlaneImage in_b = ThroughHomography(b_to_image, plane);
+      if (!(in_a.w > 1e-9 && in_b.w > 1e-9)) return HUGE_VAL;
+      apart = std::max(apart, std::hypot(camera_.get_px() * (in_a.x - in_b.x),
+                                         camera_.get_py() * (in_a.y - in_b.y)));
+    }
+  }
+  return apart;
+}
+
 StripeFit TargetPoseTracker::OtherTiltIfBetter(const StripeFit& fit) const {
-  StripeFit other = FitNarrowing(MirroredTilt(fit.cMo), nullptr);
+  // The other tilt explains the view nearly as well only where it puts the stripes near
+  // where this one does (a small or far sheet): farther than the widest corridor, its fit
+  // would keep fewer points, and it is not tried.
+  const vpHomogeneousMatrix mirrored = MirroredTilt(fit.cMo);
+  const double corridor = options_.stripe_fit.corridor_px;
+  const double apart = StripeEndsApart(fit.cMo, mirrored);
+  if (!(apart <= kExpectedCorridorScales[0] * corridor)) return fit;
+  StripeFit other = apart <= corridor
+                        ? FitStripes(mirrored, layout_, detector_.feature_points(), camera_,
+                                     detector_.Undistorts(), options_.stripe_fit)
+                        : FitNarrowing(mirrored, nullptr);
   if (!other.ok) return fit;
   const int kept = fit.points[0] + fit.points[1] + fit.points[2] + fit.points[3];
   const int other_kept = other.points[0] + other.points[1] + other.points[2] + other.points[3];

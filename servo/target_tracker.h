@@ -85,6 +85,13 @@ std::string ToString(TargetStatus status);
 ScanMode ScanModeFromString(const std::string& text);
 
 struct TargetTrackerOptions {
+  /// Every setting in pixels (the detector's, the sheet finder's cells, the pose's pixel
+  /// bounds, the model check's and the stripe fit's tolerances) is given for a camera of this
+  /// focal length, pixels, and the tracker scales it by the camera's focal length over this:
+  /// the stripes, their runs and their blur are that many times as many pixels across (a
+  /// 1920x1080 webcam 70 degrees across, 1371 px, scans its borders 2.3 times as far apart).
+  /// 0: the settings are used as they are given. Range 0 or [1, 1e5].
+  double reference_focal_px = 600.0;
   ScanMode scan = ScanMode::kTarget;
   /// Borders on the target plane (target_layout.h) when the target is looked for (no prior,
   /// or the prior failed) and a candidate's first scan on tracked_borders gave no pose.
@@ -142,6 +149,11 @@ struct TargetTrackerOptions {
   void Check() const;
   /// The model check's options from the fields above.
   StripeCheckOptions StripeCheck() const;
+  /// The factor the settings in pixels take for `camera` (reference_focal_px).
+  double PixelScale(const vpCameraParameters& camera) const;
+  /// These options with their settings in pixels (stripe_tolerance_px, the finder's, the
+  /// stripe fit's corridor and guide tolerance) times `scale`. `scale` in (0, 100].
+  TargetTrackerOptions ScaledBy(double scale) const;
 };
 
 /// What the tracker did with one frame.
@@ -231,6 +243,8 @@ class TargetPoseTracker {
   /// `fit`, or the fit from the pose tilted the other way (MirroredTilt) when it keeps more of
   /// the stripes' points, or as many closer: without a prior, the planar ambiguity.
   StripeFit OtherTiltIfBetter(const StripeFit& fit) const;
+  /// How far apart poses `a` and `b` put the stripes' ends, the farthest, pixels.
+  double StripeEndsApart(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) const;
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
   /// told from the lines.
   bool Verify(const GrayImageView& image);
@@ -261,6 +275,7 @@ class TargetPoseTracker {
   LineTarget target_;
   vpCameraParameters camera_;
   TargetLayout layout_;
+  double pixel_scale_ = 1.0;  ///< TargetTrackerOptions::PixelScale for the camera
   PoseOptions pose_options_;
   TargetTrackerOptions options_;
   bool quick_scan_ = true;

@@ -91,6 +91,33 @@ TEST(OalDetector, InvalidOptionsThrowNamingTheField) {
   }
 }
 
+// For an image whose lines are 2.3 times as many pixels across (1920x1080 at 70 degrees,
+// against 640x480 at 56): every length in pixels 2.3 times, the region's borders read every
+// second pixel, counts and angles as they were; a third as many pixels keeps a pixel's spacing
+// and narrowest run.
+TEST(OalDetector, OptionsScaledWithTheImageScaleTheirLengthsOnly) {
+  const DetectorOptions options;
+  const DetectorOptions scaled = options.ScaledBy(2.285);
+  EXPECT_EQ(scaled.start_px, 23);
+  EXPECT_EQ(scaled.step_px, 11);
+  EXPECT_DOUBLE_EQ(scaled.max_width_px, options.max_width_px * 2.285);
+  EXPECT_DOUBLE_EQ(scaled.min_width_px, options.min_width_px * 2.285);
+  EXPECT_DOUBLE_EQ(scaled.r_change_px, options.r_change_px * 2.285);
+  EXPECT_DOUBLE_EQ(scaled.support_tolerance_px, options.support_tolerance_px * 2.285);
+  EXPECT_DOUBLE_EQ(scaled.duplicate_r_px, options.duplicate_r_px * 2.285);
+  EXPECT_EQ(scaled.region_sample_step, 2);
+  EXPECT_EQ(scaled.max_lines, options.max_lines);
+  EXPECT_EQ(scaled.min_support, options.min_support);
+  EXPECT_DOUBLE_EQ(scaled.angle_change_deg, options.angle_change_deg);
+  EXPECT_NO_THROW(scaled.Check());
+  const DetectorOptions small = options.ScaledBy(0.3);
+  EXPECT_EQ(small.step_px, 2);
+  EXPECT_DOUBLE_EQ(small.min_width_px, 1.0);
+  EXPECT_EQ(small.region_sample_step, 1);
+  EXPECT_NO_THROW(small.Check());
+  EXPECT_THROW(options.ScaledBy(0.0), std::invalid_argument);
+}
+
 TEST(OalDetector, ImageSmallerThanFirstBorderGivesNoLine) {
   testing::TestImage image(15, 15, 200);
   OalDetector detector;

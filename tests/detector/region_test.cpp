@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -147,6 +148,43 @@ TEST(PolygonLoop, AStripeAcrossATurnedBorderGivesAPointOnItsCentreLine) {
       if (point.straight && crossing > 0.0) {
         EXPECT_NEAR(point.run_px * crossing, 9.0, 0.3) << angle;
       }
+    }
+  }
+}
+
+// Read every third pixel along: a third of the samples, each where the every-pixel loop has
+// its sample 3k, and a stripe's point and width as the every-pixel loop gives them (its
+// width in pixels, not in samples), its run read again at every pixel.
+TEST(PolygonLoop, ASampleStepReadsEveryNthPixelAndPlacesAStripeAsWell) {
+  TestImage image(300, 300, 210);
+  const LineParams stripe = LineThrough({40, 250}, {260, 70});
+  PaintStripe(&image, stripe, 21.0, 30);
+  for (const double angle : {0.0, 0.3, 0.9}) {
+    const std::vector<Point2d> polygon = ConvexHull(TurnedSquare(150, 150, 80, angle));
+    const PolygonLoop every(polygon), third(polygon, 3);
+    EXPECT_EQ(third.SampleStep(), 3);
+    EXPECT_NEAR(third.Perimeter(), every.Perimeter() / 3.0, 4.0) << angle;
+    Point2d a, b;
+    third.Locate(2.0, &a);
+    every.Locate(6.0, &b);
+    EXPECT_NEAR(Distance(a, b), 0.0, 1e-9) << angle;
+    EXPECT_NEAR(third.Spacing(2.0), 3.0 * every.Spacing(6.0), 1e-9) << angle;
+
+    DetectorOptions options;
+    std::array<std::vector<BorderPoint>, 2> points;
+    std::vector<std::uint8_t> samples;
+    every.Gather(image.View(), &samples);
+    FindBorderPoints(samples, every, 120, options, &points[0]);
+    third.Gather(image.View(), &samples);
+    const GrayImageView view = image.View();
+    FindBorderPoints(samples, third, 120, options, &points[1], &view);
+    ASSERT_EQ(points[0].size(), 2u) << angle;
+    ASSERT_EQ(points[1].size(), 2u) << angle;
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (!points[1][i].straight) continue;
+      EXPECT_NEAR(stripe.SignedDistance(points[1][i].pixel.u, points[1][i].pixel.v), 0.0, 0.3)
+          << angle;
+      EXPECT_NEAR(points[1][i].run_px, points[0][i].run_px, 1.0) << angle;
     }
   }
 }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "scene/bench_scene.h"
@@ -320,6 +321,28 @@ TEST(TargetPoseTracker, AGlareAcrossTheMiddleCellsSideFindsTheSheetFromAnEdgeCel
   const TargetFrame& found = tracker.Track(ViewOf(frame.image));
   ExpectRightPose(found, cMo, "glare across line 2");
   EXPECT_EQ(found.source, ScanSource::kEdgeCell);
+}
+
+// The settings in pixels follow the camera: a 1920x1080 webcam 70 degrees across (1371 px)
+// gets the detector's and the sheet finder's settings of a 600 px camera 2.285 times; with
+// reference_focal_px 0 they are used as given.
+TEST(TargetPoseTracker, ItsSettingsInPixelsFollowTheCamerasFocalLength) {
+  const vpCameraParameters camera = CameraWithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
+  PoseOptions pose;
+  pose.camera = camera;
+  const TargetPoseTracker scaled(FourLineA3Target(), camera, DetectorOptions(), pose);
+  EXPECT_EQ(scaled.detector().options().step_px, DetectorOptions().ScaledBy(2.285).step_px);
+  EXPECT_DOUBLE_EQ(scaled.detector().options().max_width_px, 80.0 * 2.285);
+  EXPECT_EQ(scaled.detector().options().region_sample_step, 2);
+  TargetTrackerOptions as_given;
+  as_given.reference_focal_px = 0.0;
+  const TargetPoseTracker unscaled(FourLineA3Target(), camera, DetectorOptions(), pose, as_given);
+  EXPECT_EQ(unscaled.detector().options().step_px, DetectorOptions().step_px);
+  EXPECT_DOUBLE_EQ(as_given.PixelScale(camera), 1.0);
+  EXPECT_DOUBLE_EQ(TargetTrackerOptions().ScaledBy(2.0).finder.cell_px, 16);
+  TargetTrackerOptions bad;
+  bad.reference_focal_px = 0.5;
+  EXPECT_THROW(bad.Check(), std::invalid_argument);
 }
 
 TEST(TargetPoseTracker, LosesTheSheetOutOfViewAndFindsItAgain) {
