@@ -235,12 +235,18 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
     for (int i = 0; i < options.samples; ++i) {
       const double along = in_view.lo + (in_view.hi - in_view.lo) * (i + 0.5) / options.samples;
       if (near_crossing(along)) continue;
-      const Point2d from_plane = layout.OnStripe(k, along, -reach);
-      const Point2d to_plane = layout.OnStripe(k, along, reach);
-      Point2d from, to;
-      if (!projector.Project(from_plane, &from) || !projector.Project(to_plane, &to) ||
-          !ReadProfile(image, from, to, depth(from_plane), depth(to_plane), stripe.half, reach,
-                       &profile)) {
+      // Beside a stripe running along the image's edge, a shorter profile: half a stripe's
+      // width of paper either side still tells the stripe from what is not.
+      const auto read = [&](double across) {
+        const Point2d from_plane = layout.OnStripe(k, along, -across);
+        const Point2d to_plane = layout.OnStripe(k, along, across);
+        Point2d from, to;
+        return projector.Project(from_plane, &from) && projector.Project(to_plane, &to) &&
+               ReadProfile(image, from, to, depth(from_plane), depth(to_plane), stripe.half, across,
+                           &profile);
+      };
+      if (!read(reach) && !(options.short_profiles_at_edge &&
+                            read(stripe.half + std::max(0.5 * stripe.half, kMinBesideM / 2.0)))) {
         continue;
       }
       ++agreement.samples[static_cast<std::size_t>(k)];

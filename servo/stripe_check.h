@@ -51,6 +51,11 @@ struct StripeCheckOptions {
   double centre_tolerance_fraction = 0.1;
   /// ... and its width within this fraction of the stripe's projected width. Range (0, 10].
   double width_tolerance = 0.35;
+  /// Where a sample's profile (a stripe's width of paper either side) would leave the image,
+  /// a shorter one, half a stripe's width either side: a stripe running along the image's
+  /// edge is read too. false: such a sample is not read (a pose that rests on fewer
+  /// measurements, fitted to the stripes alone, is held to the full profiles).
+  bool short_profiles_at_edge = true;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;

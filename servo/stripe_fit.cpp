@@ -24,6 +24,15 @@ constexpr double kConverged = 1e-7;
 // A guided point may lie this fraction of its stripe's length beyond its ends as the starting
 // pose puts them (the start may be a few percent off in scale).
 constexpr double kGuideSpanMargin = 0.1;
+// A stripe's points all this close to their own straight line, pixels, need no sorting out;
+// farther, the line most of them lie on decides which are the stripe's (something dark lying
+// along the stripe lines up a run of points a pixel or two off it).
+constexpr double kCollinearPx = 1.0;
+// ... the points kept then: within this many of the line's robust scales, or half a pixel.
+constexpr double kCollinearScales = 3.0;
+constexpr double kCollinearMinPx = 0.5;
+// At most this many of a stripe's points (evenly along it) propose the candidate lines.
+constexpr std::size_t kCollinearProposers = 16;
 
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
@@ -100,6 +109,86 @@ struct StripePoints {
   std::vector<double> along;
   std::vector<double> width_ratio;  // the run's width across over the stripe's, there
 };
+
+// A line through pixel points: unit normal (nu, nv) and offset, nu u + nv v = c.
+struct PixelLine {
+  double nu = 0.0, nv = 1.0, c = 0.0;
+  double Distance(double u, double v) const { return std::fabs(nu * u + nv * v - c); }
+};
+
+// The total-least-squares line through the points `used` of (u, v).
+PixelLine FitLine(const std::vector<double>& u, const std::vector<double>& v,
+                  const std::vector<std::size_t>& used) {
+  double mu = 0.0, mv = 0.0;
+  for (const std::size_t i : used) {
+    mu += u[i];
+    mv += v[i];
+  }
+  mu /= static_cast<double>(used.size());
+  mv /= static_cast<double>(used.size());
+  double suu = 0.0, suv = 0.0, svv = 0.0;
+  for (const std::size_t i : used) {
+    suu += (u[i] - mu) * (u[i] - mu);
+    suv += (u[i] - mu) * (v[i] - mv);
+    svv += (v[i] - mv) * (v[i] - mv);
+  }
+  // The normal is the direction of least spread.
+  const double along = 0.5 * std::atan2(2.0 * suv, suu - svv);
+  PixelLine line{-std::sin(along), std::cos(along), 0.0};
+  line.c = line.nu * mu + line.nv * mv;
+  return line;
+}
+
+// Keeps the stripe's points on the line most of them lie on (least median of distances over
+// the lines through pairs of them), when they are not all close to one line.
+void KeepCollinear(double px, double py, StripePoints* stripe) {
+  const std::size_t n = stripe->p.size();
+  if (n < 4) return;
+  std::vector<double> u(n), v(n);
+  std::vector<std::size_t> all(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    u[i] = stripe->p[i](0) * px;
+    v[i] = stripe->p[i](1) * py;
+    all[i] = i;
+  }
+  const PixelLine least_squares = FitLine(u, v, all);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, least_squares.Distance(u[i], v[i]));
+  if (worst <= kCollinearPx) return;
+
+  std::sort(all.begin(), all.end(),
+            [&](std::size_t a, std::size_t b) { return stripe->along[a] < stripe->along[b]; });
+  const std::size_t proposers = std::min(n, kCollinearProposers);
+  std::vector<double> distances(n);
+  PixelLine best;
+  double best_median = HUGE_VAL;
+  for (std::size_t a = 0; a < proposers; ++a) {
+    for (std::size_t b = a + 1; b < proposers; ++b) {
+      const std::size_t i = all[a * (n - 1) / (proposers - 1)];
+      const std::size_t j = all[b * (n - 1) / (proposers - 1)];
+      const double du = u[j] - u[i], dv = v[j] - v[i], length = std::hypot(du, dv);
+      if (!(length > 0.0)) continue;
+      PixelLine line{-dv / length, du / length, 0.0};
+      line.c = line.nu * u[i] + line.nv * v[i];
+      for (std::size_t k = 0; k < n; ++k) distances[k] = line.Distance(u[k], v[k]);
+      const double median = Median(&distances);
+      if (median < best_median) {
+        best_median = median;
+        best = line;
+      }
+    }
+  }
+  if (!(best_median < HUGE_VAL)) return;
+  const double keep = std::max(kCollinearMinPx, kCollinearScales * 1.4826 * best_median);
+  StripePoints kept;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (best.Distance(u[i], v[i]) > keep) continue;
+    kept.p.push_back(stripe->p[i]);
+    kept.along.push_back(stripe->along[i]);
+    kept.width_ratio.push_back(stripe->width_ratio[i]);
+  }
+  *stripe = std::move(kept);
+}
 
 class Fitter {
  public:
@@ -357,6 +446,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   // fraction of the corridor at most, and points must not hop between stripes as it goes.
   std::array<StripePoints, 4> stripes;
   fitter.Assign(pose, points, points_undistorted, guides, &stripes);
+  for (StripePoints& stripe : stripes) KeepCollinear(camera.get_px(), camera.get_py(), &stripe);
 
   std::vector<double> magnitudes;
   double scale = options.min_scale_px;

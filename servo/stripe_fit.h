@@ -18,7 +18,10 @@
 // stripe: a few such runs at one end of a far sheet's stripe tilt its pose by degrees). Each
 // run's middle is moved onto the image of the centre line's locus first: under perspective
 // the middle between converging edges is off it (a few hundredths of a pixel, up to half a
-// pixel for a wide stripe seen at a slant), as the corners are in pose.h.
+// pixel for a wide stripe seen at a slant), as the corners are in pose.h. A stripe whose
+// points are not all within a pixel of one straight line (something dark lying along it lines
+// up runs of its own a pixel or two off) keeps those on the line most of them lie on (least
+// median of distances), before the fit weighs them.
 #pragma once
 
 #include <visp3/core/vpCameraParameters.h>

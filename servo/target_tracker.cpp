@@ -27,8 +27,8 @@ constexpr double kGuideReach = 0.3;
 constexpr double kGuideMaxAngleRad = 8.0 * kPi / 180.0;
 // A pose fitted without four lines: each stripe's runs within this log ratio of its width
 // (0.22: 0.8 to 1.25 times; a stripe taken for its partner is 1.5 or 0.67 times), and its
-// points spanning this fraction of it at least (the borders cross one side of the crossings
-// over about a quarter of a stripe).
+// points spanning this fraction of it at least (a stripe seen over less, its other stretches
+// under a hand or beyond the image, leaves the pose's tilt about it poorly told).
 constexpr double kMaxFittedWidthLog = 0.22;
 constexpr double kMinFittedExtent = 0.12;
 // ... and its fits take points in corridors these many times the fit's, in turn.
@@ -399,36 +399,11 @@ StripeFit TargetPoseTracker::FitNarrowing(const vpHomogeneousMatrix& start,
   return fit;
 }
 
-double TargetPoseTracker::StripeEndsApart(const vpHomogeneousMatrix& a,
-                                          const vpHomogeneousMatrix& b) const {
-  const vpHomography a_to_image = PlaneToImage(a), b_to_image = PlaneToImage(b);
-  double apart = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    const StripeSpan& stripe = layout_.stripes[static_cast<std::size_t>(k)];
-    for (const double along : {stripe.along.lo, stripe.along.hi}) {
-      const Point2d plane = layout_.OnStripe(k, along, 0.0);
-      const PlaneImage in_a = ThroughHomography(a_to_image, plane);
-      const PlaneImage in_b = ThroughHomography(b_to_image, plane);
-      if (!(in_a.w > 1e-9 && in_b.w > 1e-9)) return HUGE_VAL;
-      apart = std::max(apart, std::hypot(camera_.get_px() * (in_a.x - in_b.x),
-                                         camera_.get_py() * (in_a.y - in_b.y)));
-    }
-  }
-  return apart;
-}
-
 StripeFit TargetPoseTracker::OtherTiltIfBetter(const StripeFit& fit) const {
-  // The other tilt explains the view nearly as well only where it puts the stripes near
-  // where this one does (a small or far sheet): farther than the widest corridor, its fit
-  // would keep fewer points, and it is not tried.
+  // Tried wherever the other tilt puts the stripes: from tens of pixels off, its fit in the
+  // narrowing corridors still settles where it explains the points best.
   const vpHomogeneousMatrix mirrored = MirroredTilt(fit.cMo);
-  const double corridor = options_.stripe_fit.corridor_px;
-  const double apart = StripeEndsApart(fit.cMo, mirrored);
-  if (!(apart <= kExpectedCorridorScales[0] * corridor)) return fit;
-  StripeFit other = apart <= corridor
-                        ? FitStripes(mirrored, layout_, detector_.feature_points(), camera_,
-                                     detector_.Undistorts(), options_.stripe_fit)
-                        : FitNarrowing(mirrored, nullptr);
+  StripeFit other = FitNarrowing(mirrored, nullptr);
   if (!other.ok) return fit;
   const int kept = fit.points[0] + fit.points[1] + fit.points[2] + fit.points[3];
   const int other_kept = other.points[0] + other.points[1] + other.points[2] + other.points[3];
@@ -586,7 +561,9 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
       }
     }
   }
-  frame_.agreement = CheckStripes(image, layout_, frame_.pose.cMo, camera_, options_.StripeCheck());
+  StripeCheckOptions check = options_.StripeCheck();
+  check.short_profiles_at_edge = frame_.pose.method != PoseMethod::kStripes;
+  frame_.agreement = CheckStripes(image, layout_, frame_.pose.cMo, camera_, check);
   if (frame_.agreement.Worst() < options_.min_stripe_agreement ||
       frame_.agreement.Seen() < options_.min_stripe_seen) {
     std::ostringstream message;

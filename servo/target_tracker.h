@@ -243,8 +243,6 @@ class TargetPoseTracker {
   /// `fit`, or the fit from the pose tilted the other way (MirroredTilt) when it keeps more of
   /// the stripes' points, or as many closer: without a prior, the planar ambiguity.
   StripeFit OtherTiltIfBetter(const StripeFit& fit) const;
-  /// How far apart poses `a` and `b` put the stripes' ends, the farthest, pixels.
-  double StripeEndsApart(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) const;
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
   /// told from the lines.
   bool Verify(const GrayImageView& image);

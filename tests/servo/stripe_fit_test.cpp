@@ -229,6 +229,27 @@ TEST(StripeCheck, TheTruthAgreesAlongEveryStripe) {
   EXPECT_EQ(agreement.Seen(), 1.0);
 }
 
+// Line 1 running along the image's left edge, its middle 35 px in: a stripe's width of paper
+// beside it would leave the image, half of one does not. Read with the shorter profiles it
+// agrees; without them it is not read at all (a pose fitted to the stripes alone is held to
+// the full profiles).
+TEST(StripeCheck, AStripeAlongTheImagesEdgeIsReadWithShorterProfiles) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const vpHomogeneousMatrix cMo = FrontoParallel(0.4, 0.09967, 0.0, 0.0);
+  const RenderedFrame rendered = renderer.Render(cMo, 8);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const StripeAgreement short_profiles =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera);
+  EXPECT_GE(short_profiles.dark[0], 8);
+  EXPECT_EQ(short_profiles.contradict[0], 0);
+  StripeCheckOptions full_only;
+  full_only.short_profiles_at_edge = false;
+  const StripeAgreement full_profiles =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera, full_only);
+  EXPECT_EQ(full_profiles.samples[0], 0);
+  EXPECT_EQ(full_profiles.Worst(), 0.0);
+}
+
 // A pose a degree and a half off moves the stripes' far ends off their ink: contradicted.
 TEST(StripeCheck, APoseADegreeAndAHalfOffIsContradicted) {
   const SceneRenderer renderer(FourLineA3Target(), Render());
