@@ -374,7 +374,15 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     frame_.fit = FitStripes(frame_.pose.cMo, layout_, detector_.feature_points(), camera_,
                             detector_.Undistorts(), options_.stripe_fit);
     if (frame_.fit.ok && !prior) frame_.fit = OtherTiltIfBetter(frame_.fit);
-    if (frame_.fit.ok) ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
+    if (frame_.fit.ok) {
+      ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
+    } else {
+      // The lines' pose puts a stripe where too few runs as wide as it lie (a line drawn
+      // through runs merged with fingers or a pen beside the stripe): not taken.
+      frame_.pose.status = PoseStatus::kDegenerate;
+      frame_.pose.message =
+          "the stripes' points do not hold the lines' pose: " + frame_.fit.message;
+    }
   }
   if (frame_.pose.status != PoseStatus::kOk &&
       !(options_.fit_stripes && expected && FitExpected(*expected))) {
