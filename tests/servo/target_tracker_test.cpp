@@ -374,6 +374,27 @@ TEST(TargetPoseTracker, LosesTheSheetOutOfViewAndFindsItAgain) {
 }
 
 // A bench with sheets of text and tools but no target: no pose, from any of the scans.
+// A lines' pose that the stripes' own points do not hold (here: no stripe can keep the
+// thousand points the fit is told to need) is not taken, and the frame says why.
+TEST(TargetPoseTracker, ALinesPoseTheStripesPointsDoNotHoldIsNotTaken) {
+  const SceneRenderer renderer(FourLineA3Target(), BenchRender(9));
+  PoseOptions pose;
+  pose.camera = renderer.options().camera;
+  TargetTrackerOptions options;
+  options.stripe_fit.min_points = 1000;
+  options.image_fallback = false;
+  TargetPoseTracker tracker(renderer.target(), renderer.options().camera, DetectorOptions(), pose,
+                            options);
+  const vpHomogeneousMatrix cMo(0.01, -0.02, 0.55, 0.1, -0.05, 0.3);
+  const TargetFrame& found = tracker.Track(ViewOf(renderer.Render(cMo, 3).image));
+  EXPECT_NE(found.status, TargetStatus::kOk);
+  EXPECT_NE(found.message.find("keeps"), std::string::npos) << found.message;
+  options.stripe_fit.min_points = 4;
+  TargetPoseTracker holding(renderer.target(), renderer.options().camera, DetectorOptions(), pose,
+                            options);
+  ExpectRightPose(holding.Track(ViewOf(renderer.Render(cMo, 3).image)), cMo, "min_points 4");
+}
+
 TEST(TargetPoseTracker, NoPoseFromClutterWithoutATarget) {
   RenderOptions render = BenchRender(9);
   render.clutter_sheets = 6;
