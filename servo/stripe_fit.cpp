@@ -555,6 +555,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       message << "line " << k + 1 << " keeps " << fit.points[static_cast<std::size_t>(k)]
               << " of its stripe's points (min_points = " << options.min_points << ")";
       fit.message = message.str();
+      fit.starved_line = k;
       return fit;
     }
   }

@@ -79,6 +79,9 @@ struct StripeFit {
   std::array<double, 4> width_ratio{};
   double rms_px = 0.0;    ///< of the kept points' distances to their lines, pixels
   double scale_px = 0.0;  ///< the residuals' robust scale at the end, pixels
+  /// The line (0-3) that kept fewer than min_points, when that is why the fit is not ok; -1
+  /// otherwise.
+  int starved_line = -1;
   int iterations = 0;
 };
 

@@ -376,9 +376,10 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     if (frame_.fit.ok && !prior) frame_.fit = OtherTiltIfBetter(frame_.fit);
     if (frame_.fit.ok) {
       ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
-    } else {
+    } else if (frame_.fit.starved_line >= 0 && source != ScanSource::kImage) {
       // The lines' pose puts a stripe where too few runs as wide as it lie (a line drawn
-      // through runs merged with fingers or a pen beside the stripe): not taken.
+      // through runs merged with fingers or a pen beside the stripe): not taken. (A whole
+      // image's pose is scanned again on the target's plane, where this applies.)
       frame_.pose.status = PoseStatus::kDegenerate;
       frame_.pose.message =
           "the stripes' points do not hold the lines' pose: " + frame_.fit.message;
