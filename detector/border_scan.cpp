@@ -557,14 +557,9 @@ double RereadRun(const Geometry& geometry, const Run& run, int threshold, int re
   if (first == 0 || last == n - 1) return 0.0;
   const double a = first - 1 + static_cast<double>(-f(first - 1)) / (f(first) - f(first - 1));
   const double b = last + static_cast<double>(f(last)) / (f(last) - f(last + 1));
-  double weight_sum = 0.0, weighted = 0.0;
-  for (int i = first - 1; i <= last + 1; ++i) {
-    const int value = grey[static_cast<std::size_t>(i)];
-    const double w = std::max(0, light ? value - reference : reference - value);
-    weight_sum += w;
-    weighted += w * i;
-  }
-  const double fine = weight_sum > 0.0 ? weighted / weight_sum : 0.5 * (a + b);
+  const Run weighted{first - 1, last + 1};
+  const double fine = light ? WeightedCentre<true>(grey.data(), n, weighted, reference, a, b)
+                            : WeightedCentre<false>(grey.data(), n, weighted, reference, a, b);
   *centre = lo + fine / stride;
   return (b - a) / stride;
 }

@@ -295,48 +295,67 @@ void SampleEdge(const std::uint8_t* origin, std::ptrdiff_t major_step, std::ptrd
 
 }  // namespace
 
+bool PolygonLoop::SampleStretch(const GrayImageView& image, const Edge& edge, int offset_px,
+                                int pixels_apart, int count, bool clamp, std::uint8_t* out) const {
+  // The coordinate across the edge's longer axis in 16.16 fixed point; along it the samples
+  // step by whole pixels.
+  constexpr double kOne = 65536.0;
+  const bool horizontal = edge.mostly_horizontal;
+  const double start_across = horizontal ? edge.start.v : edge.start.u;
+  const double sample_across = horizontal ? edge.step.v : edge.step.u;  // one sample_step_'s
+  const double step_across =
+      pixels_apart == sample_step_ ? sample_across : sample_across / sample_step_ * pixels_apart;
+  const int limit = (horizontal ? image.height : image.width) - 2;  // last pixel with a neighbour
+  const auto start_fx = static_cast<std::int64_t>(std::llround(
+      (offset_px == 0 ? start_across : start_across + offset_px * (sample_across / sample_step_)) *
+      kOne));
+  const auto step_fx = static_cast<std::int64_t>(std::llround(step_across * kOne));
+  const std::int64_t end_fx = start_fx + step_fx * (count - 1);
+  const int sign = (horizontal ? edge.step.u : edge.step.v) > 0.0 ? 1 : -1;
+  const int along =
+      static_cast<int>(std::lround(horizontal ? edge.start.u : edge.start.v)) + sign * offset_px;
+  const std::ptrdiff_t stride = image.stride;
+  const std::ptrdiff_t major = horizontal ? sign * pixels_apart : sign * pixels_apart * stride;
+  const std::ptrdiff_t minor = horizontal ? stride : 1;
+  const std::uint8_t* origin = image.data + (horizontal ? along : along * stride);
+  if (std::min(start_fx, end_fx) >= 0 && (std::max(start_fx, end_fx) >> 16) <= limit) {
+    if (!clamp) {
+      const int along_end = along + sign * pixels_apart * (count - 1);
+      const int along_limit = (horizontal ? image.width : image.height) - 1;
+      if (std::min(along, along_end) < 0 || std::max(along, along_end) > along_limit) {
+        return false;
+      }
+    }
+    if (horizontal) {
+      SampleEdge<false>(origin, major, minor, start_fx, step_fx, count, out);
+    } else {
+      SampleEdge<true>(origin, major, minor, start_fx, step_fx, count, out);
+    }
+    return true;
+  }
+  if (!clamp) return false;
+  // Where the last pixel row (column) would need its neighbour beyond the image, the
+  // fraction is moved to the pixel before it.
+  for (int k = 0; k < count; ++k) {
+    const std::int64_t across_fx = start_fx + step_fx * k;
+    std::ptrdiff_t whole = static_cast<std::ptrdiff_t>(across_fx >> 16);
+    int f = static_cast<int>((across_fx >> 8) & 255);
+    if (whole < 0) whole = 0, f = 0;
+    if (whole > limit) whole = limit, f = 256;
+    const std::uint8_t* p = origin + k * major + whole * minor;
+    const int a = p[0];
+    *out++ = static_cast<std::uint8_t>(a + (((p[minor] - a) * f + 128) >> 8));
+  }
+  return true;
+}
+
 void PolygonLoop::Gather(const GrayImageView& image, std::vector<std::uint8_t>* samples) const {
   samples->resize(static_cast<std::size_t>(perimeter_));
   std::uint8_t* out = samples->data();
-  const std::ptrdiff_t stride = image.stride;
   for (const Edge& edge : edges_) {
     if (edge.count == 0) continue;
-    // The coordinate across the edge's longer axis in 16.16 fixed point; along it the
-    // samples step by whole pixels. Where the last pixel row (column) would need its
-    // neighbour beyond the image, the fraction is moved to the pixel before it.
-    constexpr double kOne = 65536.0;
-    const bool horizontal = edge.mostly_horizontal;
-    const double start_across = horizontal ? edge.start.v : edge.start.u;
-    const double step_across = horizontal ? edge.step.v : edge.step.u;
-    const int limit = (horizontal ? image.height : image.width) - 2;  // last pixel with a neighbour
-    const auto start_fx = static_cast<std::int64_t>(std::llround(start_across * kOne));
-    const auto step_fx = static_cast<std::int64_t>(std::llround(step_across * kOne));
-    const std::int64_t end_fx = start_fx + step_fx * (edge.count - 1);
-    const int along = static_cast<int>(std::lround(horizontal ? edge.start.u : edge.start.v));
-    const int along_step =
-        (horizontal ? edge.step.u : edge.step.v) > 0.0 ? sample_step_ : -sample_step_;
-    const std::ptrdiff_t major = horizontal ? along_step : along_step * stride;
-    const std::ptrdiff_t minor = horizontal ? stride : 1;
-    const std::uint8_t* origin = image.data + (horizontal ? along : along * stride);
-    if (std::min(start_fx, end_fx) >= 0 && (std::max(start_fx, end_fx) >> 16) <= limit) {
-      if (horizontal) {
-        SampleEdge<false>(origin, major, minor, start_fx, step_fx, edge.count, out);
-      } else {
-        SampleEdge<true>(origin, major, minor, start_fx, step_fx, edge.count, out);
-      }
-      out += edge.count;
-      continue;
-    }
-    for (int k = 0; k < edge.count; ++k) {  // an edge along the image's own border
-      const std::int64_t across_fx = start_fx + step_fx * k;
-      std::ptrdiff_t whole = static_cast<std::ptrdiff_t>(across_fx >> 16);
-      int f = static_cast<int>((across_fx >> 8) & 255);
-      if (whole < 0) whole = 0, f = 0;
-      if (whole > limit) whole = limit, f = 256;
-      const std::uint8_t* p = origin + k * major + whole * minor;
-      const int a = p[0];
-      *out++ = static_cast<std::uint8_t>(a + (((p[minor] - a) * f + 128) >> 8));
-    }
+    SampleStretch(image, edge, 0, sample_step_, edge.count, true, out);
+    out += edge.count;
   }
 }
 
@@ -369,32 +388,7 @@ bool PolygonLoop::GatherPixels(const GrayImageView& image, int first, int count,
   const Edge& edge = edges_[static_cast<std::size_t>(EdgeAt(first))];
   const int j = first - edge.first;  // the edge's sample
   if (j < 0 || j * sample_step_ + count - 1 > (edge.count - 1) * sample_step_) return false;
-  constexpr double kOne = 65536.0;
-  const bool horizontal = edge.mostly_horizontal;
-  const double start_across = horizontal ? edge.start.v : edge.start.u;
-  const double step_across = (horizontal ? edge.step.v : edge.step.u) / sample_step_;  // a pixel's
-  const int limit = (horizontal ? image.height : image.width) - 2;
-  const auto start_fx = static_cast<std::int64_t>(
-      std::llround((start_across + j * sample_step_ * step_across) * kOne));
-  const auto step_fx = static_cast<std::int64_t>(std::llround(step_across * kOne));
-  const std::int64_t end_fx = start_fx + step_fx * (count - 1);
-  if (std::min(start_fx, end_fx) < 0 || (std::max(start_fx, end_fx) >> 16) > limit) return false;
-  const int sign = (horizontal ? edge.step.u : edge.step.v) > 0.0 ? 1 : -1;
-  const int along = static_cast<int>(std::lround(horizontal ? edge.start.u : edge.start.v)) +
-                    sign * j * sample_step_;
-  const int along_end = along + sign * (count - 1);
-  const int along_limit = (horizontal ? image.width : image.height) - 1;
-  if (std::min(along, along_end) < 0 || std::max(along, along_end) > along_limit) return false;
-  const std::ptrdiff_t stride = image.stride;
-  const std::ptrdiff_t major = horizontal ? sign : sign * stride;
-  const std::ptrdiff_t minor = horizontal ? stride : 1;
-  const std::uint8_t* origin = image.data + (horizontal ? along : along * stride);
-  if (horizontal) {
-    SampleEdge<false>(origin, major, minor, start_fx, step_fx, count, out);
-  } else {
-    SampleEdge<true>(origin, major, minor, start_fx, step_fx, count, out);
-  }
-  return true;
+  return SampleStretch(image, edge, j * sample_step_, 1, count, false, out);
 }
 
 std::uint16_t PolygonLoop::Locate(double s, Point2d* pixel, double corner_px) const {

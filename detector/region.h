@@ -131,6 +131,13 @@ class PolygonLoop {
   /// The edge whose samples, or the gap after them, hold s (s in [0, perimeter)).
   int EdgeAt(double s) const;
   Point2d SampleAt(int k) const;
+  /// Reads `count` pixels of `edge`, the first `offset_px` pixels of its longer axis from its
+  /// first sample, then every `pixels_apart` pixels, each interpolated across the axis. Where
+  /// one would need a pixel beyond the image: with `clamp`, the fraction is moved to the
+  /// pixel before it (an edge along the image's own border); without, nothing is read and
+  /// false returned.
+  bool SampleStretch(const GrayImageView& image, const Edge& edge, int offset_px, int pixels_apart,
+                     int count, bool clamp, std::uint8_t* out) const;
 
   std::vector<Point2d> vertices_;
   std::vector<Edge> edges_;

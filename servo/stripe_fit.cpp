@@ -116,21 +116,21 @@ struct PixelLine {
   double Distance(double u, double v) const { return std::fabs(nu * u + nv * v - c); }
 };
 
-// The total-least-squares line through the points `used` of (u, v).
-PixelLine FitLine(const std::vector<double>& u, const std::vector<double>& v,
-                  const std::vector<std::size_t>& used) {
+// The total-least-squares line through the points `p` (normalised) in pixels (px, py).
+PixelLine FitLine(const std::vector<Vec3>& p, double px, double py) {
   double mu = 0.0, mv = 0.0;
-  for (const std::size_t i : used) {
-    mu += u[i];
-    mv += v[i];
+  for (const Vec3& q : p) {
+    mu += q(0) * px;
+    mv += q(1) * py;
   }
-  mu /= static_cast<double>(used.size());
-  mv /= static_cast<double>(used.size());
+  mu /= static_cast<double>(p.size());
+  mv /= static_cast<double>(p.size());
   double suu = 0.0, suv = 0.0, svv = 0.0;
-  for (const std::size_t i : used) {
-    suu += (u[i] - mu) * (u[i] - mu);
-    suv += (u[i] - mu) * (v[i] - mv);
-    svv += (v[i] - mv) * (v[i] - mv);
+  for (const Vec3& q : p) {
+    const double du = q(0) * px - mu, dv = q(1) * py - mv;
+    suu += du * du;
+    suv += du * dv;
+    svv += dv * dv;
   }
   // The normal is the direction of least spread.
   const double along = 0.5 * std::atan2(2.0 * suv, suu - svv);
@@ -144,6 +144,12 @@ PixelLine FitLine(const std::vector<double>& u, const std::vector<double>& v,
 void KeepCollinear(double px, double py, StripePoints* stripe) {
   const std::size_t n = stripe->p.size();
   if (n < 4) return;
+  const PixelLine least_squares = FitLine(stripe->p, px, py);
+  double worst = 0.0;
+  for (const Vec3& q : stripe->p)
+    worst = std::max(worst, least_squares.Distance(q(0) * px, q(1) * py));
+  if (worst <= kCollinearPx) return;
+
   std::vector<double> u(n), v(n);
   std::vector<std::size_t> all(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -151,11 +157,6 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
     v[i] = stripe->p[i](1) * py;
     all[i] = i;
   }
-  const PixelLine least_squares = FitLine(u, v, all);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, least_squares.Distance(u[i], v[i]));
-  if (worst <= kCollinearPx) return;
-
   std::sort(all.begin(), all.end(),
             [&](std::size_t a, std::size_t b) { return stripe->along[a] < stripe->along[b]; });
   const std::size_t proposers = std::min(n, kCollinearProposers);

@@ -70,6 +70,7 @@ struct StripeFit {
   std::string message;  ///< why not, when not ok
   vpHomogeneousMatrix cMo;
   std::array<int, 4> points{};  ///< points kept on lines 1-4 (within 2.5 robust scales)
+  int TotalPoints() const { return points[0] + points[1] + points[2] + points[3]; }
   /// The fraction of each stripe's printed length (between the crossings and its ends, both
   /// arms) that its kept points span: a stripe half hidden under a hand shows about 0.5.
   std::array<double, 4> extent{};

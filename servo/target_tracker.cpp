@@ -414,8 +414,7 @@ StripeFit TargetPoseTracker::OtherTiltIfBetter(const StripeFit& fit) const {
   const vpHomogeneousMatrix mirrored = MirroredTilt(fit.cMo);
   StripeFit other = FitNarrowing(mirrored, nullptr);
   if (!other.ok) return fit;
-  const int kept = fit.points[0] + fit.points[1] + fit.points[2] + fit.points[3];
-  const int other_kept = other.points[0] + other.points[1] + other.points[2] + other.points[3];
+  const int kept = fit.TotalPoints(), other_kept = other.TotalPoints();
   return other_kept > kept || (other_kept == kept && other.rms_px < fit.rms_px) ? other : fit;
 }
 
@@ -547,8 +546,7 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
       std::sqrt(camera_.get_px() * camera_.get_py()));
   if (frame_.pose.method == PoseMethod::kStripes) {
     // The four stripes held together: their points in all (each stripe has its fit's minimum).
-    const int points =
-        frame_.fit.points[0] + frame_.fit.points[1] + frame_.fit.points[2] + frame_.fit.points[3];
+    const int points = frame_.fit.TotalPoints();
     if (points < 2 * options_.min_line_support) {
       frame_.status = TargetStatus::kNotFound;
       frame_.message = "the stripes keep " + std::to_string(points) +
