@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
 #include <visp3/core/vpMeterPixelConversion.h>
-#include <visp3/core/vpThetaUVector.h>
 
 #include <cmath>
 #include <functional>
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "base/pose_distance.h"
 #include "detector/line.h"  // kPi
 #include "scene/bench_scene.h"
 #include "scene/scene.h"
@@ -241,13 +241,12 @@ std::vector<Condition> Conditions() {
   return conditions;
 }
 
+// Translation error over the distance, and rotation error in degrees.
 std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
                                     const vpHomogeneousMatrix& cMo_true) {
-  const vpTranslationVector t_true = cMo_true.getTranslationVector();
-  const double t = (cMo.getTranslationVector() - t_true).frobeniusNorm() / t_true.frobeniusNorm();
-  const double r =
-      vpMath::deg(vpThetaUVector((cMo * cMo_true.inverse()).getRotationMatrix()).getTheta());
-  return {t, r};
+  const PoseDistance d = Distance(cMo, cMo_true);
+  return {d.translation_m / cMo_true.getTranslationVector().frobeniusNorm(),
+          vpMath::deg(d.rotation_rad)};
 }
 
 struct Case {

@@ -4,11 +4,11 @@
 
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
-#include <visp3/core/vpThetaUVector.h>
 
 #include <stdexcept>
 #include <string>
 
+#include "base/pose_distance.h"
 #include "scene/scene.h"
 #include "servo/stripe_check.h"
 #include "servo/target_tracker.h"
@@ -37,12 +37,11 @@ vpHomogeneousMatrix Tilted() {
   return tilt * FrontoParallel(0.6, 0.01, -0.005, 0.4);
 }
 
+// Translation error in metres, rotation error in degrees.
 std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
                                     const vpHomogeneousMatrix& truth) {
-  const double t = (cMo.getTranslationVector() - truth.getTranslationVector()).frobeniusNorm();
-  const double r =
-      vpMath::deg(vpThetaUVector((cMo * truth.inverse()).getRotationMatrix()).getTheta());
-  return {t, r};
+  const PoseDistance d = Distance(cMo, truth);
+  return {d.translation_m, vpMath::deg(d.rotation_rad)};
 }
 
 // The tracker's feature points of `frame` (found with no prior) and its pose.
