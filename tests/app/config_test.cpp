@@ -228,6 +228,20 @@ TEST(ConfigTracking, TheStripeFitAndTheModelCheckKeys) {
               HasSubstr("cfg.yaml:2: 'tracking.fit_stripes' must be true or false"));
 }
 
+// The settings in pixels and the focal length they are given for; a region's sample step.
+TEST(ConfigTracking, TheReferenceFocalLengthAndTheRegionSampleStep) {
+  const AppConfig config = ParseConfig(
+      "tracking:\n  reference_focal_px: 914\ndetector:\n  region_sample_step: 3\n", "cfg.yaml");
+  EXPECT_EQ(config.tracking.reference_focal_px, 914.0);
+  EXPECT_EQ(config.detector.region_sample_step, 3);
+  EXPECT_THAT(ErrorOf("tracking:\n  reference_focal_px: 0.5\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.reference_focal_px' is invalid: 0.5"));
+  EXPECT_THAT(ErrorOf("tracking:\n  reference_focal_px: wide\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.reference_focal_px'"));
+  EXPECT_THAT(ErrorOf("detector:\n  region_sample_step: 0\n"),
+              HasSubstr("cfg.yaml:2: 'detector.region_sample_step' is invalid: 0"));
+}
+
 TEST(ConfigScene, ReadsTheLivedInConditions) {
   const AppConfig config = ParseConfig(
       "scene:\n"
