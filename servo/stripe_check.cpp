@@ -19,6 +19,9 @@ constexpr int kMaxProfile = 96;
 constexpr int kMinProfile = 12;
 // Grey levels at and above which a pixel is saturated (a glare).
 constexpr int kSaturated = 250;
+// A sheet whose paper is this close to saturation is over-exposed: a saturated profile there
+// is no glare.
+constexpr int kGlareMargin = 20;
 // A line agreeing in fewer samples than this has not been seen.
 constexpr int kMinAgreeing = 3;
 // A run of contradicting samples at the rim of something covering a stripe is excused up to
@@ -146,11 +149,14 @@ Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contr
     }
     seed = best < 0 ? darkest_at : best;
   }
+  // Each edge halfway between the darkest point and the paper on its own side: under a glare's
+  // slope or a shadow's the paper is lighter on one side, and so is the ink next to it.
+  const double threshold_lo = 0.5 * (light_a + darkest), threshold_hi = 0.5 * (light_b + darkest);
   int lo = seed, hi = seed;
-  while (lo > 0 && at(lo - 1) < threshold) --lo;
-  while (hi < n - 1 && at(hi + 1) < threshold) ++hi;
+  while (lo > 0 && at(lo - 1) < threshold_lo) --lo;
+  while (hi < n - 1 && at(hi + 1) < threshold_hi) ++hi;
   if (lo == 0 || hi == n - 1) return Verdict::kUnknown;  // dark beyond the profile: covered
-  const double low = Crossing(p, lo - 1, threshold), high = Crossing(p, hi, threshold);
+  const double low = Crossing(p, lo - 1, threshold_lo), high = Crossing(p, hi, threshold_hi);
   const double predicted = p.high_edge - p.low_edge;
   const double tolerance = std::max(options.centre_tolerance_px / p.spacing_px,
                                     options.centre_tolerance_fraction * predicted);
@@ -270,12 +276,24 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
     if (verdicts.back() == Verdict::kAgrees) paper.push_back(light);
   }
   // A light, flat profile as light as the paper beside the agreeing samples: paper where the
-  // ink should be; darker, a light object over the stripe.
+  // ink should be; darker, a light object over the stripe; lighter, a glare washing the stripe
+  // out (paper lit more than the rest of the sheet is).
+  // A profile reaching saturation where the sheet's paper does not (or lit well above that
+  // paper) lies under a glare, which washes the ink out and bends its edges: it tells nothing
+  // either way. (Where the whole sheet saturates, an over-exposed frame, saturation is no sign.)
   const int paper_level = MedianOf(&paper);
+  const auto under_glare = [&](std::size_t i) {
+    const Profile& p = profiles[i].second;
+    return !paper.empty() &&
+           (lights[i] > paper_level + min_contrast ||
+            (paper_level < kSaturated - kGlareMargin &&
+             *std::max_element(p.grey.begin(), p.grey.begin() + p.n) >= kSaturated));
+  };
   for (std::size_t i = 0; i < verdicts.size(); ++i) {
+    if (verdicts[i] == Verdict::kContradicts && under_glare(i)) verdicts[i] = Verdict::kUnknown;
     if (verdicts[i] != Verdict::kFlatLight) continue;
     const bool as_paper =
-        !paper.empty() && lights[i] >= paper_level - min_contrast / 2 && lights[i] < kSaturated;
+        !paper.empty() && !under_glare(i) && lights[i] >= paper_level - min_contrast / 2;
     verdicts[i] = as_paper ? Verdict::kContradicts : Verdict::kUnknown;
   }
   // A short run of contradicting samples that ends at a covered one, or at an end of the

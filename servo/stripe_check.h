@@ -14,8 +14,11 @@
 //     there is only paper where the ink should be (the profile light and flat, as light as the
 //     paper of the samples that agree);
 //   - tells nothing: something covers the place (a hand, a tool, a cable, a dark shadow: no
-//     paper on one side; a flat profile darker than the paper), a glare saturates it, or it is
-//     out of view.
+//     paper on one side; a flat profile darker than the paper), a glare washes it out (the
+//     profile saturates where the sheet's paper does not, or is lit well above that paper), or
+//     it is out of view.
+// Each edge of a dark run lies halfway between the darkest point and the paper on its own side
+// (under a glare's or a shadow's slope the paper is lighter on one side, and the ink with it).
 // A short run of contradicting samples (two, or a third of the stripe's) that ends, along the
 // stripe, at one that tells nothing or at the end of its samples lies at the rim of what covers
 // it (a finger's edge crossing the profile leaves a partial dark run; a pale hand over the

@@ -279,5 +279,23 @@ TEST(StripeCheck, AHandOrAGlareHidesWithoutContradicting) {
   EXPECT_EQ(agreement.Worst(), 1.0);
 }
 
+// A glare beside a stripe lights the paper on one side of it and the ink next to it: each of
+// the stripe's edges is read against the paper on its own side, and where the glare washes
+// the ink out its profile is brighter than the sheet's paper and tells nothing.
+TEST(StripeCheck, AGlaresSlopeAcrossAStripeDoesNotContradictIt) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  for (const double offset : {0.012, 0.02, 0.03}) {
+    FrameEffects effects;
+    const Point2d beside = layout.OnStripe(1, 0.12, offset);
+    effects.glares.push_back({beside.u, beside.v, 0.02, 500.0});
+    const RenderedFrame rendered = renderer.Render(Tilted(), 9, effects);
+    const StripeAgreement agreement =
+        CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera);
+    EXPECT_EQ(agreement.contradict[1], 0) << "glare " << offset << " m beside line 2";
+    EXPECT_EQ(agreement.Worst(), 1.0) << "glare " << offset << " m beside line 2";
+  }
+}
+
 }  // namespace
 }  // namespace oal
