@@ -799,6 +799,8 @@ const std::vector<Field<ServoLoopOptions>>& ServoFields() {
       DoubleField("max_pose_jump_deg", &O::max_pose_jump_deg),
       DoubleField("max_step_m", &O::max_step_m),
       DoubleField("max_step_deg", &O::max_step_deg),
+      DoubleField("max_lost_s", &O::max_lost_s),
+      IntField("max_lost_frames", &O::max_lost_frames),
   };
   return fields;
 }

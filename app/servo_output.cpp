@@ -90,6 +90,16 @@ std::string ServoPlotScript(const ServoRunReport& report, const ServoOptions& la
      << "set logscale y\nset grid\nset key top right\nset xlabel 'frame'\n"
      << "set xtics 1\nset xrange [-0.3:" << std::max<std::size_t>(report.iterations.size(), 2) - 0.7
      << "]\n";
+  // The frames the loop held at (nothing commanded), shaded in both panels.
+  int held = 0;
+  for (const ServoIteration& row : report.iterations) {
+    if (row.status != "held") continue;
+    gp << "set object " << ++held << " rect from " << row.iteration - 0.5 << ", graph 0 to "
+       << row.iteration + 0.5 << ", graph 1 behind fc rgb '#f2d0d0' fs solid noborder\n";
+  }
+  if (held > 0) {
+    gp << "set label 'shaded: held, nothing commanded' at graph 0.01, graph 0.04 front\n";
+  }
   const auto panel = [&](const char* label, int estimated, int true_column, double tolerance) {
     gp << "set ylabel " << GnuplotQuoted(label) << "\n"
        << "plot $errors using 1:" << estimated

@@ -222,46 +222,34 @@ ServoIteration RowAt(const LoopRobot& robot, bool knows_truth, int iteration,
   return row;
 }
 
-// Steps 3 and 4: no pose, or a pose that disagrees with the odometry's prediction;
-// `confirming`: the frame that confirms the first pose (the robot has not moved yet).
-std::optional<Stop> PoseStop(const TargetFrame& tracked,
-                             const std::optional<vpHomogeneousMatrix>& predicted_cMo,
-                             const ServoLoopOptions& loop, int iteration, bool confirming) {
+// Why a frame's pose cannot command the robot: none (the tracker's reason), or it disagrees
+// with `reference` (the odometry's prediction, or the pose it should confirm) beyond
+// servo.max_pose_jump_m / max_pose_jump_deg. Empty when it can.
+std::string NoPoseReason(const TargetFrame& tracked) {
   const PoseResult& pose = tracked.pose;
-  if (tracked.status != TargetStatus::kOk) {
-    // The pose's own status when it failed, else what the tracker refused it for.
-    const bool pose_failed = pose.status != PoseStatus::kOk;
-    const std::string& message = pose_failed ? pose.message : tracked.message;
-    return Stop{ServoRunStatus::kTargetLost,
-                "target lost at iteration " + std::to_string(iteration) + ": " +
-                    (pose_failed ? ToString(pose.status) : ToString(tracked.status)) +
-                    (message.empty() ? "" : " (" + message + ")")};
-  }
-  if (!predicted_cMo) return std::nullopt;
-  const PoseDistance jump = Distance(*predicted_cMo, pose.cMo);
+  // The pose's own status when it failed, else what the tracker refused it for.
+  const bool pose_failed = pose.status != PoseStatus::kOk;
+  const std::string& message = pose_failed ? pose.message : tracked.message;
+  return (pose_failed ? ToString(pose.status) : ToString(tracked.status)) +
+         (message.empty() ? "" : " (" + message + ")");
+}
+
+std::optional<PoseDistance> Disagreement(const vpHomogeneousMatrix& cMo,
+                                         const vpHomogeneousMatrix& reference,
+                                         const ServoLoopOptions& loop) {
+  const PoseDistance jump = Distance(reference, cMo);
   if (jump.translation_m <= loop.max_pose_jump_m &&
       vpMath::deg(jump.rotation_rad) <= loop.max_pose_jump_deg) {
     return std::nullopt;
   }
-  if (confirming) {
-    return Stop{ServoRunStatus::kPoseJump,
-                "pose not confirmed at iteration " + std::to_string(iteration) +
-                    ": estimated on its own, this frame puts the target " +
-                    Fixed(jump.translation_m * 1e3, 1) + " mm and " +
-                    Fixed(vpMath::deg(jump.rotation_rad), 2) +
-                    " deg from where the first frame did, the robot still (limits " +
-                    Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " +
-                    Fixed(loop.max_pose_jump_deg, 2) +
-                    " deg: servo.max_pose_jump_m, max_pose_jump_deg); the pose is ambiguous or "
-                    "wrong, the robot was not moved"};
-  }
-  return Stop{ServoRunStatus::kPoseJump,
-              "pose jump at iteration " + std::to_string(iteration) + ": the estimate is " +
-                  Fixed(jump.translation_m * 1e3, 1) + " mm and " +
-                  Fixed(vpMath::deg(jump.rotation_rad), 2) +
-                  " deg from the previous one moved by the robot (limits " +
-                  Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " +
-                  Fixed(loop.max_pose_jump_deg, 2) + " deg)"};
+  return jump;
+}
+
+std::string Apart(const PoseDistance& jump, const ServoLoopOptions& loop) {
+  return Fixed(jump.translation_m * 1e3, 1) + " mm and " +
+         Fixed(vpMath::deg(jump.rotation_rad), 2) + " deg (limits " +
+         Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " + Fixed(loop.max_pose_jump_deg, 2) +
+         " deg: servo.max_pose_jump_m, max_pose_jump_deg)";
 }
 
 // A motion that failed: refused before it began (`started` false: the robot did not move),
@@ -361,15 +349,31 @@ void Table3Columns(const vpHomogeneousMatrix& wMc, double* x_mm, double* y_mm, d
   *roll_deg = vpMath::deg(std::atan2(-M[0][1], M[0][0]));
 }
 
+namespace {
+
+// A CSV field: quoted, its quotes doubled, when it holds a comma, a quote or a line break.
+std::string CsvQuoted(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + '"';
+}
+
+}  // namespace
+
 void WriteServoCsv(const ServoRunReport& report, std::ostream& out) {
   out << "iteration,x_mm,y_mm,z_mm,pitch_deg,roll_deg,yaw_deg,translation_error_mm,"
-         "rotation_error_deg,true_translation_error_mm,true_rotation_error_deg,status\n";
+         "rotation_error_deg,true_translation_error_mm,true_rotation_error_deg,held,status\n";
   for (const ServoIteration& row : report.iterations) {
     out << row.iteration << ',' << Fixed(row.x_mm, 4) << ',' << Fixed(row.y_mm, 4) << ','
         << Fixed(row.z_mm, 4) << ',' << Fixed(row.pitch_deg, 5) << ',' << Fixed(row.roll_deg, 5)
         << ',' << Fixed(row.yaw_deg, 5) << ',' << Fixed(row.translation_error_mm, 5) << ','
         << Fixed(row.rotation_error_deg, 6) << ',' << Fixed(row.true_translation_error_mm, 5) << ','
-        << Fixed(row.true_rotation_error_deg, 6) << ',' << row.status << '\n';
+        << Fixed(row.true_rotation_error_deg, 6) << ',' << CsvQuoted(row.held) << ',' << row.status
+        << '\n';
   }
 }
 
@@ -395,6 +399,11 @@ void ServoLoopOptions::Check() const {
                 max_step_m, "max_step_m > 0");
   RequireOption(max_step_deg > 0.0 && max_step_deg <= 180.0, "ServoLoopOptions::max_step_deg",
                 max_step_deg, "0 < max_step_deg <= 180");
+  RequireOption(max_lost_s >= 0.0 && max_lost_s <= 3600.0, "ServoLoopOptions::max_lost_s",
+                max_lost_s, "0 <= max_lost_s <= 3600");
+  RequireOption(max_lost_frames >= 0 && max_lost_frames <= 1000000,
+                "ServoLoopOptions::max_lost_frames", max_lost_frames,
+                "0 <= max_lost_frames <= 1000000");
 }
 
 TargetPoseTracker MakeTracker(const ServoSetup& setup) {
@@ -490,13 +499,16 @@ class ServoRun {
     const auto start = std::chrono::steady_clock::now();
     const int iteration_limit = setup_.loop.IterationLimit(setup_.open_loop);
     log_ << "frame 0 finds the target; frame 1, the robot still, confirms it; then each frame "
-            "commands one move. Errors to the goal: est by the estimated pose"
+            "commands one move. A frame without a pose, or whose pose disagrees with the "
+            "robot's motion, holds the robot until the target is found and confirmed again. "
+            "Errors to the goal: est by the estimated pose"
          << (columns_.truth ? ", true by the simulation's truth" : "") << ".\n";
     LogHeader(columns_, log_);
     for (int iteration = 0;; ++iteration) {
       if (std::optional<Stop> stop = Interrupted(iteration)) return Finish(*stop);
-      if (std::optional<Stop> stop =
-              LimitReached(setup_.loop, iteration_limit, iteration, start, frames_)) {
+      // Frames held count towards the hold's own limits, not the law's.
+      if (std::optional<Stop> stop = LimitReached(
+              setup_.loop, iteration_limit, iteration - report_.held_frames, start, frames_)) {
         return Finish(*stop);
       }
       if (std::optional<Stop> stop = Iterate(iteration)) return Finish(*stop);
@@ -575,17 +587,16 @@ class ServoRun {
     moved_since_row_ = false;
     ServoIteration& current = report_.iterations.back();
 
-    // Where the robot's motion since the last estimate puts the target.
+    // Where the robot's motion since the last confirmed estimate puts the target.
     std::optional<vpHomogeneousMatrix> predicted_cMo;
     if (previous_cMo_) predicted_cMo = wMc.inverse() * previous_wMc_ * *previous_cMo_;
-    // The frame that confirms the first pose: the robot has not moved since the first frame.
-    const bool confirming = !Confirmed() && previous_cMo_.has_value();
-    // The prediction places the borders on the target and seeds the accumulator list and the
+    // A pose found on the last frame, the robot still since, is confirmed by this one, found
+    // on its own, so that a wrong pose cannot seed its own confirmation. Otherwise the
+    // prediction places the borders on the target and seeds the accumulator list and the
     // estimate: the lines' identities and the solution of the planar pose ambiguity carried
     // through the move (after a move that rolled the camera by 60 deg, the pose before it is
     // nearer a 90-deg-turned assignment of a near-square target's lines than the right one).
-    // The confirming frame is found on its own, so that a wrong first pose cannot seed its
-    // own confirmation.
+    const bool confirming = candidate_cMo_.has_value();
     if (confirming) tracker_.Reset();
     const TargetFrame& tracked =
         tracker_.Track(ViewOf(gray_), confirming ? std::nullopt : predicted_cMo);
@@ -596,18 +607,32 @@ class ServoRun {
       step = ComputeServoStep(pose.cMo, report_.cdMo, setup_.loop.law);
       current.translation_error_mm = step->translation_error_m * 1e3;
       current.rotation_error_deg = vpMath::deg(step->rotation_error_rad);
-      if (step->status == ServoStatus::kConverged) current.status = "converged";
+    }
+    const Verdict verdict = Judge(tracked, predicted_cMo, confirming, iteration);
+    if (verdict.hold) {
+      Hold(iteration, *verdict.hold, &current);
+    } else if (step->status == ServoStatus::kConverged) {
+      current.status = "converged";
+    } else if (verdict.found) {
+      current.status = "found";
     }
     if (hooks_.on_frame) {
       hooks_.on_frame(ServoFrame{gray_, tracker_.lines(), pose, tracked, current, camera_,
                                  setup_.target, report_.cdMo, tracker_.detector().Undistorts()});
     }
-    std::optional<Stop> stop = PoseStop(tracked, predicted_cMo, setup_.loop, iteration, confirming);
+    std::optional<Stop> stop = verdict.stop;
+    if (!stop && verdict.hold) stop = HeldTooLong();
     if (stop) current.status = ToString(stop->status);
     LogRow(current, columns_, log_);
     if (stop) return stop;
-    previous_cMo_ = pose.cMo;
-    previous_wMc_ = wMc;
+    if (verdict.hold) return HoldStill(iteration);
+    if (verdict.found) {
+      if (step->status != ServoStatus::kConverged) return std::nullopt;  // the next confirms it
+    } else {
+      EndHold(iteration);
+      previous_cMo_ = pose.cMo;
+      previous_wMc_ = wMc;
+    }
     if (step->status == ServoStatus::kConverged) {
       return Stop{ServoRunStatus::kConverged,
                   "within the tolerances after " + Counted(report_.moves, "move") + " (" +
@@ -616,15 +641,140 @@ class ServoRun {
                       Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"};
     }
     if (setup_.open_loop) return std::nullopt;
-    if (!confirmed_) {
-      if (!confirming) return std::nullopt;  // the first frame: the next one confirms its pose
-      confirmed_ = true;
-    }
     return Move(iteration, wMc, *step);
   }
 
-  // Nothing moves before the first pose is confirmed (a replay moves nothing at all).
-  bool Confirmed() const { return setup_.open_loop || confirmed_; }
+  // What a frame's pose may do: command the robot, wait for the next frame's confirmation
+  // (found), hold the robot (why, in the user's words, and the status a stop would have), or
+  // stop the run.
+  struct HoldReason {
+    std::string why;
+    ServoRunStatus status = ServoRunStatus::kTargetLost;
+    bool found_again = false;  ///< a pose to be confirmed: the hold's reason stays the last
+  };
+  struct Verdict {
+    bool found = false;
+    std::optional<HoldReason> hold;
+    std::optional<Stop> stop;
+  };
+
+  Verdict Judge(const TargetFrame& tracked, const std::optional<vpHomogeneousMatrix>& predicted_cMo,
+                bool confirming, int iteration) {
+    Verdict verdict;
+    if (tracked.status != TargetStatus::kOk) {
+      candidate_cMo_.reset();
+      verdict.hold = HoldReason{"no pose: " + NoPoseReason(tracked), ServoRunStatus::kTargetLost};
+      return verdict;
+    }
+    const vpHomogeneousMatrix& cMo = tracked.pose.cMo;
+    if (setup_.open_loop) {
+      // A replay moves nothing and confirms nothing: the prediction is the last estimate, and
+      // after a hold the next pose is taken as it is.
+      if (predicted_cMo && !hold_) {
+        if (std::optional<PoseDistance> jump = Disagreement(cMo, *predicted_cMo, setup_.loop)) {
+          previous_cMo_.reset();
+          verdict.hold = HoldReason{
+              "pose jump: the estimate is " + Apart(*jump, setup_.loop) + " from the previous one",
+              ServoRunStatus::kPoseJump};
+        }
+      }
+      return verdict;
+    }
+    if (confirming) {
+      const vpHomogeneousMatrix candidate = *candidate_cMo_;
+      candidate_cMo_.reset();
+      if (std::optional<PoseDistance> jump = Disagreement(cMo, candidate, setup_.loop)) {
+        candidate_cMo_ = cMo;  // the next frame may confirm this one
+        verdict.hold = HoldReason{
+            "pose not confirmed: estimated on its own, this frame puts the "
+            "target " +
+                Apart(*jump, setup_.loop) +
+                " from where the last frame did, the robot still (the "
+                "pose is ambiguous or wrong)",
+            ServoRunStatus::kPoseJump};
+        return verdict;
+      }
+      if (predicted_cMo) {
+        if (std::optional<PoseDistance> jump = Disagreement(cMo, *predicted_cMo, setup_.loop)) {
+          verdict.stop =
+              Stop{ServoRunStatus::kPoseJump,
+                   "pose jump at iteration " + std::to_string(iteration) +
+                       ": found again and confirmed by two frames, the target is " +
+                       Apart(*jump, setup_.loop) +
+                       " from where the robot's motion puts it: the target or the robot was moved "
+                       "while the loop held; the robot was not moved since"};
+        }
+      }
+      confirmed_ = !verdict.stop;  // it commands
+      return verdict;
+    }
+    if (!confirmed_) {
+      // The first pose, or the first found again after a hold: the next frame confirms it.
+      candidate_cMo_ = cMo;
+      verdict.found = !hold_;
+      if (hold_) {
+        verdict.hold = HoldReason{"found again: the next frame, the robot still, confirms it",
+                                  hold_->reason.status, true};
+      }
+      return verdict;
+    }
+    if (predicted_cMo) {
+      if (std::optional<PoseDistance> jump = Disagreement(cMo, *predicted_cMo, setup_.loop)) {
+        verdict.hold = HoldReason{"pose jump: the estimate is " + Apart(*jump, setup_.loop) +
+                                      " from the previous one moved by the robot",
+                                  ServoRunStatus::kPoseJump};
+      }
+    }
+    return verdict;
+  }
+
+  // The loop holds at this frame: nothing commanded from it, the confirmation starts again.
+  void Hold(int iteration, const HoldReason& reason, ServoIteration* row) {
+    if (!hold_) {
+      hold_ = HoldState{iteration, std::chrono::steady_clock::now(), 0, reason};
+      ++report_.holds;
+      log_ << "holding at frame " << iteration << ", nothing commanded: " << reason.why << '\n';
+    }
+    if (!reason.found_again) hold_->reason = reason;
+    ++hold_->frames;
+    ++report_.held_frames;
+    confirmed_ = false;
+    row->status = "held";
+    row->held = reason.why;
+  }
+
+  // A hold past servo.max_lost_frames or max_lost_s ends the run.
+  std::optional<Stop> HeldTooLong() const {
+    const ServoLoopOptions& loop = setup_.loop;
+    const double held_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - hold_->since).count();
+    if (hold_->frames <= loop.max_lost_frames && held_s <= loop.max_lost_s) return std::nullopt;
+    const bool lost = hold_->reason.status == ServoRunStatus::kTargetLost;
+    return Stop{hold_->reason.status,
+                std::string(lost ? "target lost" : "no pose confirmed") + ": held " +
+                    Counted(hold_->frames, "frame") + " (" + Fixed(held_s, 2) +
+                    " s) since iteration " + std::to_string(hold_->since_iteration) +
+                    " without a confirmed pose (servo.max_lost_frames = " +
+                    std::to_string(loop.max_lost_frames) + ", max_lost_s = " +
+                    Number(loop.max_lost_s) + "); the last reason: " + hold_->reason.why};
+  }
+
+  // While the loop holds, a velocity law commands zero (a position move has ended already).
+  std::optional<Stop> HoldStill(int iteration) {
+    if (setup_.open_loop || setup_.loop.law.mode != ServoMode::kVelocity) return std::nullopt;
+    const RobotResult held = robot_.SetVelocity(RobotFrame::kCamera, vpColVector(6, 0.0)).result;
+    if (!held.ok()) return RefusalStop(held, false, robot_, iteration, hooks_);
+    return std::nullopt;
+  }
+
+  // A pose that commands again after a hold: said once.
+  void EndHold(int iteration) {
+    if (!hold_) return;
+    log_ << "carrying on at frame " << iteration
+         << " after holding " + Counted(hold_->frames, "frame") + " since frame "
+         << hold_->since_iteration << ": the target found again and confirmed\n";
+    hold_.reset();
+  }
 
   // The lens check over the first frames with a pose, said once: a camera file that misses
   // the lens biases every pose, which the loop cannot see otherwise.
@@ -675,8 +825,14 @@ class ServoRun {
     report_.status = stop.status;
     const RobotResult stopped = guard_ ? guard_->Stop() : robot_.Stop();
     report_.robot_stopped = stopped.ok();
+    // (A run that ends holding says so in its own message.)
+    const std::string held = report_.holds == 0 || hold_
+                                 ? ""
+                                 : "; held " + Counted(report_.holds, "time") + " on the way (" +
+                                       Counted(report_.held_frames, "frame") +
+                                       " in all, nothing commanded)";
     report_.message =
-        std::move(stop.message) + StopOutcome(stopped, stop.status, guard_.has_value());
+        std::move(stop.message) + held + StopOutcome(stopped, stop.status, guard_.has_value());
     if (!report_.iterations.empty()) report_.iterations.back().status = ToString(stop.status);
     if (guard_) {
       const RobotPose where = TrueCameraPose(robot_, setup_.true_eMc);
@@ -709,7 +865,17 @@ class ServoRun {
   ServoRunReport report_;
   std::optional<StopGuard> guard_;  ///< from Connect() on; declared after robot_
   bool moved_since_row_ = false;    ///< a motion was commanded after the last row
-  bool confirmed_ = false;          ///< the first pose confirmed by a second frame
+  bool confirmed_ = false;          ///< the pose confirmed by a second frame, commanding
+  /// A pose found with nothing to confirm it yet: the next frame, the robot still, must agree.
+  std::optional<vpHomogeneousMatrix> candidate_cMo_;
+  struct HoldState {
+    int since_iteration = 0;
+    std::chrono::steady_clock::time_point since;
+    int frames = 0;
+    HoldReason reason;
+  };
+  std::optional<HoldState> hold_;  ///< holding: nothing commanded since since_iteration
+  /// The last confirmed pose and where the camera was: the odometry's prediction starts here.
   std::optional<vpHomogeneousMatrix> previous_cMo_;
   vpHomogeneousMatrix previous_wMc_;
   std::vector<RadialBend> lens_frames_;

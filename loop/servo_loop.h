@@ -32,7 +32,8 @@ namespace oal {
 /// The law and the loop's stop conditions (a configuration's `servo:` section).
 struct ServoLoopOptions {
   ServoOptions law;
-  /// Frames processed before iteration-limit, [0, 1e6]; 0: the law's own (IterationLimit).
+  /// Frames processed before iteration-limit, not counting those the loop held at, [0, 1e6];
+  /// 0: the law's own (IterationLimit).
   int max_iterations = 0;
   double max_time_s = 60.0;        ///< wall time before time-limit, s, > 0
   double max_pose_jump_m = 0.05;   ///< estimate vs odometry prediction, m, > 0
@@ -41,6 +42,14 @@ struct ServoLoopOptions {
   /// stops the run (limit) before the robot moves. m, > 0.
   double max_step_m = 0.5;
   double max_step_deg = 60.0;  ///< ... and degrees, (0, 180]
+  /// A frame without a pose, or whose pose disagrees with the robot's motion, holds the robot
+  /// (nothing more is commanded; a velocity law commands zero) while the loop keeps looking;
+  /// it carries on once a pose is found and confirmed again (two frames, the robot still,
+  /// agreeing with each other and with where the motion puts the target). The run stops
+  /// after holding this long: seconds on the wall clock, [0, 3600], or frames, [0, 1e6],
+  /// whichever comes first (0 frames: the first such frame stops it).
+  double max_lost_s = 2.0;
+  int max_lost_frames = 60;
 
   /// The iteration limit in force: max_iterations when set; else none for a replay (it runs
   /// to its end), 300 frames for the velocity law (its error falls by e in 1/gain s: from
@@ -146,9 +155,12 @@ struct ServoIteration {
   double translation_error_mm = 0, rotation_error_deg = 0;
   /// Error to the goal from the true pose (simulation ground truth).
   double true_translation_error_mm = 0, true_rotation_error_deg = 0;
-  /// "running", "converged", the stop status, or "stopped" for the row after the stop
-  /// (where the robot stopped; no frame).
+  /// "running", "converged", "held" (nothing commanded: `held` says why), "found" (a pose
+  /// to be confirmed by the next frame, nothing commanded), the stop status, or "stopped" for
+  /// the row after the stop (where the robot stopped; no frame).
   std::string status;
+  /// Why the loop held at this frame, in the user's words (empty unless status is "held").
+  std::string held;
 };
 
 struct ServoRunReport {
@@ -166,6 +178,10 @@ struct ServoRunReport {
   /// Motion commands the robot began: position moves it was polled in, velocity cycles it
   /// took; not those it refused (the message says so).
   int moves = 0;
+  /// Times the loop held (nothing commanded until a pose was found and confirmed again), and
+  /// the frames it held at in all.
+  int holds = 0;
+  int held_frames = 0;
   /// For a robot on a serial link (the Scorbot) once connected: what the run cost on it, one
   /// line; else empty.
   std::string link_summary;

@@ -478,6 +478,14 @@ TEST(ServoOutput, PlotScriptHasBothSeriesAndTheTolerances) {
   EXPECT_THAT(script, HasSubstr("set output 'it''s.png'"));
   EXPECT_THAT(script, HasSubstr(", 2 with lines dt 2"));                // the 2 mm tolerance
   EXPECT_THAT(script, ::testing::Not(HasSubstr("true (simulation)")));  // no truth: no series
+  EXPECT_THAT(script, ::testing::Not(HasSubstr("held")));               // nothing held
+  // A frame the loop held at is shaded, and the plot says what the shade means.
+  row.iteration = 1;
+  row.status = "held";
+  report.iterations.push_back(row);
+  const std::string held = ServoPlotScript(report, law, "held.png");
+  EXPECT_THAT(held, HasSubstr("set object 1 rect from 0.5, graph 0 to 1.5, graph 1 behind"));
+  EXPECT_THAT(held, HasSubstr("shaded: held, nothing commanded"));
 }
 
 // Convergence from random starts (0.3-0.8 m, up to 30 deg off), image in the loop,
@@ -545,7 +553,8 @@ namespace {
 
 // Failure injection during the run: the frame is changed before detection.
 ServoRunReport RunWithFrameChange(int from_iteration, const std::function<void(cv::Mat*)>& change) {
-  const ServoAppConfig config = Small(DefaultServoConfig());
+  ServoAppConfig config = Small(DefaultServoConfig());
+  config.servo.max_lost_frames = 3;
   ServoRunHooks hooks;
   hooks.on_grab = [&](int iteration, cv::Mat* gray) {
     if (iteration >= from_iteration) change(gray);
@@ -558,7 +567,9 @@ TEST(ServoFailureInjection, TargetLeavingTheViewStopsTheRobot) {
   const ServoRunReport report =
       RunWithFrameChange(3, [](cv::Mat* gray) { gray->setTo(cv::Scalar(200)); });
   EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 3: not-enough-lines"));
+  EXPECT_THAT(report.message, HasSubstr("target lost: held 4 frames"));
+  EXPECT_THAT(report.message, HasSubstr("since iteration 3"));
+  EXPECT_THAT(report.message, HasSubstr("the last reason: no pose: not-enough-lines"));
   EXPECT_THAT(report.message, HasSubstr("robot stopped"));
   EXPECT_EQ(report.moves, 2);  // frames 1 and 2 moved; none after the frame without the target
   EXPECT_TRUE(report.robot_stopped);
@@ -571,7 +582,7 @@ TEST(ServoFailureInjection, OccludedLinesStopTheRobot) {
     (*gray)(cv::Rect(gray->cols / 2, 0, gray->cols / 2, gray->rows)).setTo(cv::Scalar(215));
   });
   EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 2"));
+  EXPECT_THAT(report.message, HasSubstr("since iteration 2"));
   EXPECT_EQ(report.moves, 1);
   EXPECT_TRUE(report.robot_stopped);
 }

@@ -127,6 +127,11 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
               HasSubstr("servo.yaml:2: 'servo.max_step_deg' is invalid"));
   EXPECT_THAT(ErrorOf("servo:\n  max_step_m: fast\n"),
               HasSubstr("servo.yaml:2: 'servo.max_step_m'"));
+  EXPECT_THAT(ErrorOf("servo:\n  delta: 0.5\n  max_lost_s: -2\n"),
+              HasSubstr("servo.yaml:3: 'servo.max_lost_s' is invalid: -2 (needs 0 <= max_lost_s "
+                        "<= 3600)"));
+  EXPECT_THAT(ErrorOf("servo:\n  max_lost_frames: 1.5\n"),
+              HasSubstr("servo.yaml:2: 'servo.max_lost_frames'"));
   EXPECT_THAT(ErrorOf("servo:\n  mode: sideways\n"),
               HasSubstr("servo.yaml:2: 'servo.mode' must be one of point-and-go, exponential"));
   EXPECT_THAT(ErrorOf("camera:\n  px: 600\n  width: 8\n"),
@@ -325,11 +330,14 @@ TEST(ServoLoop, TargetOutOfViewStopsWithTargetLost) {
   // Looking up, away from the table.
   config.robot.start_wMc =
       vpHomogeneousMatrix(vpTranslationVector(0.5, 0.0, 0.6), vpRotationMatrix());
+  config.servo.max_lost_frames = 4;
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   EXPECT_EQ(report.status, ServoRunStatus::kTargetLost);
-  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 0"));
+  EXPECT_THAT(report.message, HasSubstr("target lost: held 5 frames"));
+  EXPECT_THAT(report.message, HasSubstr("since iteration 0 without a confirmed pose"));
   EXPECT_THAT(report.message, HasSubstr("robot stopped"));
+  EXPECT_EQ(report.iterations.size(), 5u);
   EXPECT_TRUE(report.robot_stopped);
   EXPECT_EQ(report.moves, 0);
   EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));
@@ -371,8 +379,9 @@ TEST(ServoLoop, PointAndGoAndVelocityLawsConvergeToo) {
   }
 }
 
-// The frame after a move disagrees with the odometry: the image slid by 40 px (~65 mm at 0.5 m).
-TEST(ServoLoop, PoseJumpBeyondTheBoundStops) {
+// A frame after a move disagrees with the odometry (the image slid by 40 px, ~65 mm at
+// 0.5 m): the loop holds, finds the target again, confirms it, and carries on.
+TEST(ServoLoop, AOneFramePoseJumpIsHeldAndTheRunCarriesOn) {
   const ServoAppConfig config = Small(DefaultServoConfig());
   ServoRunHooks hooks;
   hooks.on_grab = [](int iteration, cv::Mat* gray) {
@@ -382,34 +391,89 @@ TEST(ServoLoop, PoseJumpBeyondTheBoundStops) {
     cv::warpAffine(*gray, moved, shift, gray->size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
     moved.copyTo(*gray);
   };
+  std::vector<int> moved_at;
+  hooks.on_move = [&](int iteration) { moved_at.push_back(iteration); };
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log, hooks);
+  EXPECT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  ASSERT_GE(report.iterations.size(), 5u);
+  EXPECT_EQ(report.iterations[2].status, "held");
+  EXPECT_THAT(report.iterations[2].held, HasSubstr("pose jump: the estimate is "));
+  EXPECT_EQ(report.iterations[3].status, "held");  // found again, to be confirmed
+  EXPECT_THAT(report.iterations[3].held, HasSubstr("found again"));
+  // Frame 1 moved; 2 and 3 held; 4 confirmed frame 3 and moved.
+  ASSERT_GE(moved_at.size(), 2u);
+  EXPECT_EQ(moved_at[0], 1);
+  EXPECT_EQ(moved_at[1], 4);
+  EXPECT_EQ(report.holds, 1);
+  EXPECT_EQ(report.held_frames, 2);
+  EXPECT_THAT(report.message, HasSubstr("held 1 time on the way (2 frames in all"));
+  EXPECT_THAT(log.str(), HasSubstr("holding at frame 2, nothing commanded: pose jump"));
+  EXPECT_THAT(log.str(), HasSubstr("carrying on at frame 4 after holding 2 frames since frame 2"));
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
+}
+
+// The target slides for good (someone moved the sheet): the pose found again, confirmed by
+// two frames, disagrees with the robot's motion, and the run stops without another move.
+TEST(ServoLoop, ATargetMovedWhileTheLoopHeldStopsTheRun) {
+  const ServoAppConfig config = Small(DefaultServoConfig());
+  ServoRunHooks hooks;
+  hooks.on_grab = [](int iteration, cv::Mat* gray) {
+    if (iteration < 2) return;
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 40, 0, 1, 0);
+    cv::Mat moved;
+    cv::warpAffine(*gray, moved, shift, gray->size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    moved.copyTo(*gray);
+  };
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log, hooks);
   EXPECT_EQ(report.status, ServoRunStatus::kPoseJump) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("pose jump at iteration 2: the estimate is "));
+  EXPECT_THAT(report.message, HasSubstr("pose jump at iteration 4: found again and confirmed"));
+  EXPECT_THAT(report.message, HasSubstr("the target or the robot was moved while the loop held"));
   EXPECT_THAT(report.message, HasSubstr("robot stopped"));
   EXPECT_TRUE(report.robot_stopped);
   EXPECT_EQ(report.moves, 1);
 }
 
-// Any disagreement between two frames (image noise) exceeds this bound: the first pose is
-// never confirmed and the robot never moves.
+// Any disagreement between two frames (image noise) exceeds this bound: no pose is ever
+// confirmed, the robot never moves, and the run stops once it has held servo.max_lost_frames.
 TEST(ServoLoop, AnUnconfirmedFirstPoseStopsBeforeTheRobotMoves) {
   ServoAppConfig config = Small(DefaultServoConfig());
   config.servo.max_pose_jump_m = 1e-7;
+  config.servo.max_lost_frames = 3;
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log);
   EXPECT_EQ(report.status, ServoRunStatus::kPoseJump) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("pose not confirmed at iteration 1: estimated on its own"));
-  EXPECT_THAT(report.message, HasSubstr("the robot was not moved; robot stopped"));
+  EXPECT_THAT(report.message, HasSubstr("no pose confirmed: held 4 frames (")) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("since iteration 1"));
+  EXPECT_THAT(report.message, HasSubstr("pose not confirmed: estimated on its own"));
+  EXPECT_THAT(report.message, HasSubstr("robot stopped"));
   EXPECT_EQ(report.moves, 0);
-  ASSERT_EQ(report.iterations.size(), 2u);  // no "stopped" row: nothing moved
+  ASSERT_EQ(report.iterations.size(), 5u);  // no "stopped" row: nothing moved
+  EXPECT_EQ(report.iterations[0].status, "found");
   EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));
+}
+
+// servo.max_lost_frames 0: the first frame the loop would hold at stops the run.
+TEST(ServoLoop, NoFramesToHoldStopsAtTheFirstPoseJump) {
+  ServoAppConfig config = Small(DefaultServoConfig());
+  config.servo.max_lost_frames = 0;
+  ServoRunHooks hooks;
+  hooks.on_grab = [](int iteration, cv::Mat* gray) {
+    if (iteration == 2) gray->setTo(cv::Scalar(200));
+  };
+  std::ostringstream log;
+  const ServoRunReport report = RunServo(config, log, hooks);
+  EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("target lost: held 1 frame ("));
+  EXPECT_THAT(report.message, HasSubstr("since iteration 2"));
+  EXPECT_EQ(report.moves, 1);
 }
 
 // The planar pose ambiguity: frame 0 shows the target as the other solution would (its tilt
 // mirrored about the optical axis, the same image to first order), a pose estimated with
 // status ok. Point-and-go would send the robot the whole wrong way in one move; the second
-// frame, estimated on its own, contradicts it and nothing moves.
+// frame, estimated on its own, contradicts it and nothing moves until a third confirms it.
 TEST(ServoLoop, AFlippedFirstPoseIsNotConfirmedAndTheRobotDoesNotMove) {
   ServoAppConfig config = Small(DefaultServoConfig());
   config.servo.law.mode = ServoMode::kPointAndGo;
@@ -430,17 +494,21 @@ TEST(ServoLoop, AFlippedFirstPoseIsNotConfirmedAndTheRobotDoesNotMove) {
   };
   std::vector<vpHomogeneousMatrix> estimates;
   hooks.on_frame = [&](const ServoFrame& frame) { estimates.push_back(frame.pose.cMo); };
+  std::vector<int> moved_at;
+  hooks.on_move = [&](int iteration) { moved_at.push_back(iteration); };
   std::ostringstream log;
   const ServoRunReport report = RunServo(config, log, hooks);
-  // Frame 0's estimate is the flipped pose (status ok), frame 1's the true one.
-  ASSERT_EQ(estimates.size(), 2u) << log.str() << report.message;
+  // Frame 0's estimate is the flipped pose (status ok), frame 1's the true one: not
+  // confirmed, nothing moves; frame 2 confirms frame 1 and moves the robot.
+  ASSERT_GE(estimates.size(), 3u) << log.str() << report.message;
   EXPECT_LT(vpMath::deg(Distance(estimates[0], flipped_cMo).rotation_rad), 2.0);
   EXPECT_LT(vpMath::deg(Distance(estimates[1], true_cMo).rotation_rad), 2.0);
-  EXPECT_EQ(report.status, ServoRunStatus::kPoseJump) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("pose not confirmed at iteration 1"));
-  EXPECT_EQ(report.moves, 0);
-  EXPECT_TRUE(report.robot_stopped);
-  EXPECT_TRUE(SamePose(report.final_wMc, config.robot.start_wMc));
+  EXPECT_EQ(report.iterations[1].status, "held");
+  EXPECT_THAT(report.iterations[1].held, HasSubstr("pose not confirmed"));
+  ASSERT_FALSE(moved_at.empty());
+  EXPECT_EQ(moved_at.front(), 2);
+  EXPECT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
 }
 
 // A position step above servo.max_step_m / max_step_deg stops the run before the robot moves.

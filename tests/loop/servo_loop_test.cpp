@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "io/image_source.h"
 #include "loop/frame_source.h"
@@ -94,7 +96,8 @@ TEST(RunServoLoop, EachPositionLawReachesTheGoalOnTheRenderedSheet) {
 }
 
 TEST(RunServoLoop, ATargetOutOfViewStopsTheRunAndTheRobotNeverMoves) {
-  const ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
+  ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
+  setup.loop.max_lost_frames = 2;
   // Looking away: the sheet 0.8 m to the side, out of the view.
   const SimulatedCameraOptions away =
       StartingAt(vpHomogeneousMatrix(0.8, 0.0, 0.6, 0.0, 0.0, 0.0), setup.wMo);
@@ -104,8 +107,10 @@ TEST(RunServoLoop, ATargetOutOfViewStopsTheRunAndTheRobotNeverMoves) {
   std::ostringstream log;
   const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
   EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
-  EXPECT_THAT(report.message, HasSubstr("target lost at iteration 0"));
+  EXPECT_THAT(report.message, HasSubstr("target lost: held 3 frames"));
   EXPECT_EQ(report.moves, 0);
+  ASSERT_EQ(report.iterations.size(), 3u);
+  EXPECT_THAT(report.iterations[0].held, HasSubstr("no pose: "));
   const vpHomogeneousMatrix end = robot.GetPosition(RobotFrame::kCamera).pose;
   EXPECT_LT((end.getTranslationVector() - start.getTranslationVector()).frobeniusNorm(), 1e-12);
 }
@@ -154,6 +159,58 @@ TEST(RecordedFrames, AnUnreadableFrameIsReportedWhereItIsTakenNotAsTheEnd) {
   EXPECT_EQ(gray.cols, 64);
   EXPECT_FALSE(frames.AtEnd()) << "an unreadable frame is not the end";
   EXPECT_THROW(frames.Grab(vpHomogeneousMatrix(), 1, &gray), std::runtime_error);
+}
+
+TEST(ServoLoopOptions, TheHoldsLimitsAreChecked) {
+  ServoLoopOptions loop;
+  loop.max_lost_s = -1.0;
+  EXPECT_THROW(loop.Check(), std::invalid_argument);
+  loop = ServoLoopOptions();
+  loop.max_lost_frames = -1;
+  try {
+    loop.Check();
+    FAIL() << "max_lost_frames -1 accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("ServoLoopOptions::max_lost_frames = -1"));
+  }
+}
+
+// A hand over the view for three frames in the middle of a velocity run: the loop holds (a
+// zero twist each frame: the camera stays where it was), finds the target again, confirms it
+// with the camera still, and carries on to the goal. The CSV says where it held and why.
+TEST(RunServoLoop, AVelocityRunHoldsStillUnderAHandAndCarriesOn) {
+  ServoSetup setup = SheetSetup(ServoMode::kVelocity);
+  setup.loop.law.gain = 2.0;
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  RenderedFrames frames(setup.target, RenderOptions());
+  ServoLoopHooks hooks;
+  constexpr int kFirstHidden = 5, kHidden = 3;
+  hooks.on_grab = [](int iteration, cv::Mat* gray) {
+    if (iteration >= kFirstHidden && iteration < kFirstHidden + kHidden) gray->setTo(40);
+  };
+  std::vector<int> moved_at;
+  hooks.on_move = [&](int iteration) { moved_at.push_back(iteration); };
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log, hooks);
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  // Held: the three hidden frames and the one found again; the next confirms and moves.
+  for (int i = kFirstHidden; i <= kFirstHidden + kHidden; ++i) {
+    const ServoIteration& row = report.iterations[static_cast<std::size_t>(i)];
+    EXPECT_EQ(row.status, "held") << "frame " << i;
+    EXPECT_EQ(row.x_mm, report.iterations[kFirstHidden].x_mm) << "frame " << i;
+    EXPECT_EQ(row.z_mm, report.iterations[kFirstHidden].z_mm) << "frame " << i;
+    EXPECT_EQ(std::count(moved_at.begin(), moved_at.end(), i), 0) << "frame " << i;
+  }
+  EXPECT_THAT(report.iterations[kFirstHidden].held, HasSubstr("no pose: "));
+  EXPECT_EQ(std::count(moved_at.begin(), moved_at.end(), kFirstHidden + kHidden + 1), 1);
+  EXPECT_EQ(report.holds, 1);
+  EXPECT_EQ(report.held_frames, kHidden + 1);
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
+  std::ostringstream csv;
+  WriteServoCsv(report, csv);
+  EXPECT_THAT(csv.str(), HasSubstr(",true_rotation_error_deg,held,status\n"));
+  EXPECT_THAT(csv.str(), HasSubstr(",\"no pose: "));
+  EXPECT_THAT(csv.str(), HasSubstr(",\"found again: the next frame"));
 }
 
 }  // namespace
