@@ -43,6 +43,7 @@ FaultCampaignReport RunFaultCampaign(const ServoAppConfig& config,
   setup.robot = FaultedRobotOf(config.robot.type);
   if (setup.robot == FaultedRobot::kScorbot) setup.controller = ControllerSimOptions(config);
   setup.outcome_prefix = "oalservo servo: ";  // RunServoWithOutputs' outcome line
+  setup.max_lost_frames = config.servo.max_lost_frames;
   setup.run = [&config](const FaultRunRequest& request, std::ostream& log) {
     ServoAppConfig run = config;
     run.output.directory = request.output_dir;

@@ -106,7 +106,7 @@ class TappedRobot final : public Robot {
     return fault ? MoveProgress{*fault, false} : inner_->PollMove();
   }
   RobotResult SetVelocity(RobotFrame frame, const vpColVector& v) override {
-    log_->Add(false);
+    if (v.frobeniusNorm() > 0.0) log_->Add(false);  // a zero twist holds the robot: no motion
     const std::optional<RobotResult> fault = Fault();
     return fault ? *fault : inner_->SetVelocity(frame, v);
   }
@@ -188,9 +188,16 @@ struct FaultPlan {
   std::string noise;                   ///< line noise
   cv::Point2d blob_centre, blob_axes;  ///< occlusion, fractions of the image
   double roll_deg = 0;                 ///< pose jump
+  int frames = 1;                      ///< frames spoiled (a long occlusion: all from then on)
 };
 
-FaultPlan PlanFault(FaultKind kind, double fault_free_s, std::uint64_t seed, int index) {
+// Frame faults the loop must hold past, and the one it must stop at.
+bool HeldPast(FaultKind kind) {
+  return kind == FaultKind::kShortOcclusion || kind == FaultKind::kPoseJump;
+}
+
+FaultPlan PlanFault(FaultKind kind, double fault_free_s, int max_lost_frames, std::uint64_t seed,
+                    int index) {
   std::mt19937_64 random(seed * 1000003ULL + static_cast<std::uint64_t>(index));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   FaultPlan plan;
@@ -200,8 +207,15 @@ FaultPlan PlanFault(FaultKind kind, double fault_free_s, std::uint64_t seed, int
   const int noise_bytes = 1 + static_cast<int>(random() % 16);
   for (int i = 0; i < noise_bytes; ++i) plan.noise.push_back(static_cast<char>(random() % 256));
   plan.blob_centre = {0.4 + 0.2 * unit(random), 0.4 + 0.2 * unit(random)};
-  plan.blob_axes = {0.2 + 0.15 * unit(random), 0.2 + 0.15 * unit(random)};
+  // A hand close to the lens, over the whole view: one the tracker might see past would not
+  // tell whether the loop holds.
+  plan.blob_axes = {0.9 + 0.2 * unit(random), 0.9 + 0.2 * unit(random)};
   plan.roll_deg = (6.0 + 19.0 * unit(random)) * (random() % 2 == 0 ? 1.0 : -1.0);
+  // A short hand: 1 to 10 frames, at most half the frames the loop holds for.
+  const int short_frames = std::clamp(max_lost_frames / 2, 1, 10);
+  plan.frames = 1 + static_cast<int>(random() % static_cast<unsigned>(short_frames));
+  if (kind == FaultKind::kLongOcclusion) plan.frames = std::numeric_limits<int>::max();
+  if (kind != FaultKind::kShortOcclusion && kind != FaultKind::kLongOcclusion) plan.frames = 1;
   return plan;
 }
 
@@ -211,7 +225,7 @@ void SpoilFrame(const FaultPlan& plan, cv::Mat* gray) {
   const cv::Size size = gray->size();
   if (plan.kind == FaultKind::kUnreadableFrame) {
     gray->release();
-  } else if (plan.kind == FaultKind::kOcclusion) {
+  } else if (plan.kind == FaultKind::kShortOcclusion || plan.kind == FaultKind::kLongOcclusion) {
     cv::Mat occluded = gray->clone();
     cv::ellipse(occluded,
                 cv::Point(static_cast<int>(plan.blob_centre.x * size.width),
@@ -239,6 +253,10 @@ struct Outcome {
   Clock::time_point started, ended;
   std::optional<Clock::time_point> fault_at;  ///< none: the run ended first
   std::optional<Clock::time_point> released;  ///< the loop let go of the robot (final stop)
+  /// When each frame was taken (the loop's thread writes it, read after the run), and the
+  /// iterations of the first and last frame spoiled.
+  std::vector<std::pair<int, Clock::time_point>> grabs;
+  int first_spoiled = -1, last_spoiled = -1;
 };
 
 // The Scorbot's commands as the controller received them: MOVE lines and Ctrl-A.
@@ -273,7 +291,7 @@ Outcome RunOnce(const FaultCampaignSetup& setup, const FaultCampaignOptions& opt
   auto commands = std::make_shared<CommandLog>();
   auto drive = std::make_shared<std::atomic<DriveFault>>(DriveFault::kNone);
   std::atomic<Clock::rep> fault_at{0};  // since the clock's epoch; 0: not yet
-  std::atomic<bool> frame_armed{false};
+  std::atomic<int> frames_armed{0};     // frames still to spoil
   const auto mark = [&fault_at] { fault_at.store(Clock::now().time_since_epoch().count()); };
   FaultTimer timer([&]() -> bool {
     switch (plan->kind) {
@@ -303,9 +321,10 @@ Outcome RunOnce(const FaultCampaignSetup& setup, const FaultCampaignOptions& opt
         drive->store(DriveFault::kSilent);
         break;
       case FaultKind::kUnreadableFrame:
-      case FaultKind::kOcclusion:
+      case FaultKind::kShortOcclusion:
+      case FaultKind::kLongOcclusion:
       case FaultKind::kPoseJump:
-        frame_armed = true;  // the next frame takes it
+        frames_armed = plan->frames;  // the next frames take it
         return true;
     }
     mark();
@@ -325,10 +344,18 @@ Outcome RunOnce(const FaultCampaignSetup& setup, const FaultCampaignOptions& opt
     timer.Cancel();
     outcome.released = Clock::now();
   };
-  hooks.on_grab = [&](int /*iteration*/, cv::Mat* gray) {
-    if (!frame_armed.exchange(false)) return;
+  hooks.on_grab = [&](int iteration, cv::Mat* gray) {
+    outcome.grabs.emplace_back(iteration, Clock::now());
+    int left = frames_armed.load();
+    while (left > 0 && !frames_armed.compare_exchange_weak(left, left - 1)) {
+    }
+    if (left <= 0) return;
     SpoilFrame(*plan, gray);
-    mark();
+    if (outcome.first_spoiled < 0) {
+      outcome.first_spoiled = iteration;
+      mark();
+    }
+    outcome.last_spoiled = iteration;
   };
   if (!scorbot) {
     request.wrap_driver = [&](std::unique_ptr<Robot> driver) -> std::unique_ptr<Robot> {
@@ -396,6 +423,38 @@ void FinalTrueError(const ServoRunReport& report, double* mm, double* deg) {
   *deg = report.iterations.back().true_rotation_error_deg;
 }
 
+// A frame fault the loop must hold past: no motion from its first spoiled frame until the
+// second frame after its last (found again, then confirmed), and the run converged; a long
+// occlusion: no motion from its first frame on, and the run stopped with target-lost.
+void JudgeHold(const Outcome& outcome, const FaultPlan& plan, FaultRun* run) {
+  const bool held_past = HeldPast(plan.kind),
+             long_occlusion = plan.kind == FaultKind::kLongOcclusion;
+  if ((!held_past && !long_occlusion) || outcome.first_spoiled < 0) return;
+  run->spoiled_frames = outcome.last_spoiled - outcome.first_spoiled + 1;
+  std::optional<Clock::time_point> from, until;
+  for (const auto& [iteration, at] : outcome.grabs) {
+    if (iteration == outcome.first_spoiled) from = at;
+    if (held_past && iteration == outcome.last_spoiled + 2) until = at;
+  }
+  for (const Command& command : outcome.commands) {
+    run->moves_while_held +=
+        !command.stop && from && command.at >= *from && (!until || command.at < *until);
+  }
+  std::vector<std::string>& problems = run->problems;
+  const std::string fault = ToString(plan.kind) + " of " + std::to_string(run->spoiled_frames) +
+                            (run->spoiled_frames == 1 ? " frame" : " frames");
+  if (run->moves_while_held > 0) {
+    problems.push_back(std::to_string(run->moves_while_held) +
+                       " motion command(s) while the loop " + "had to hold (" + fault + ")");
+  }
+  const ServoRunStatus expected =
+      held_past ? ServoRunStatus::kConverged : ServoRunStatus::kTargetLost;
+  if (outcome.report.status != expected) {
+    problems.push_back("a " + fault + " should end " + ToString(expected) + ", not " +
+                       ToString(outcome.report.status));
+  }
+}
+
 FaultRun Judge(const Outcome& outcome, const FaultPlan& plan, const fs::path& dir,
                const FaultCampaignReport& campaign, const std::string& outcome_prefix) {
   FaultRun run;
@@ -443,6 +502,7 @@ FaultRun Judge(const Outcome& outcome, const FaultPlan& plan, const fs::path& di
     problems.push_back(std::to_string(run.moves_after_stop) +
                        " motion command(s) after the stop command");
   }
+  JudgeHold(outcome, plan, &run);
   if (report.status == ServoRunStatus::kConverged &&
       (!(run.final_true_translation_mm <= campaign.fault_free_translation_mm + kToleratedExtraMm) ||
        !(run.final_true_rotation_deg <= campaign.fault_free_rotation_deg + kToleratedExtraDeg))) {
@@ -481,8 +541,10 @@ std::string ToString(FaultKind kind) {
       return "drive-timeout";
     case FaultKind::kUnreadableFrame:
       return "unreadable-frame";
-    case FaultKind::kOcclusion:
-      return "occlusion";
+    case FaultKind::kShortOcclusion:
+      return "short-occlusion";
+    case FaultKind::kLongOcclusion:
+      return "long-occlusion";
     case FaultKind::kPoseJump:
       return "pose-jump";
   }
@@ -494,8 +556,8 @@ std::string ToString(FaultedRobot robot) {
 }
 
 std::vector<FaultKind> FaultKindsFor(FaultedRobot robot) {
-  const std::vector<FaultKind> frames = {FaultKind::kUnreadableFrame, FaultKind::kOcclusion,
-                                         FaultKind::kPoseJump};
+  const std::vector<FaultKind> frames = {FaultKind::kUnreadableFrame, FaultKind::kShortOcclusion,
+                                         FaultKind::kLongOcclusion, FaultKind::kPoseJump};
   std::vector<FaultKind> kinds;
   if (robot == FaultedRobot::kScorbot) {
     kinds = {FaultKind::kImpact,    FaultKind::kControllerSilent, FaultKind::kReplyCut,
@@ -551,7 +613,7 @@ FaultCampaignReport RunFaultCampaign(const FaultCampaignSetup& setup,
   const std::vector<FaultKind> kinds = FaultKindsFor(setup.robot);
   const auto run_one = [&](int i) {
     FaultPlan plan = PlanFault(kinds[static_cast<std::size_t>(i) % kinds.size()],
-                               campaign.fault_free_s, options.seed, i);
+                               campaign.fault_free_s, setup.max_lost_frames, options.seed, i);
     std::ostringstream name;
     name << "run_" << std::setw(4) << std::setfill('0') << i;
     const fs::path dir = work / name.str();
@@ -604,11 +666,12 @@ FaultCampaignReport RunFaultCampaign(const FaultCampaignSetup& setup,
 std::string FaultCampaignTable(const FaultCampaignReport& report) {
   std::ostringstream out;
   out << "| fault | runs | reached | stopped, reason printed | stop not confirmed, said so | "
-         "converged on the goal | motion after the stop | fault to stop command median / max | "
-         "outputs whole | failed |\n"
-      << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+         "converged on the goal | motion while held | motion after the stop | fault to stop "
+         "command median / max | outputs whole | failed |\n"
+      << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const FaultKind kind : FaultKindsFor(report.robot)) {
     int runs = 0, reached = 0, stopped = 0, unconfirmed = 0, converged = 0, moved = 0, whole = 0;
+    int moved_held = 0;
     int failed = 0;
     std::vector<double> stop_ms;
     for (const FaultRun& run : report.runs) {
@@ -621,13 +684,14 @@ std::string FaultCampaignTable(const FaultCampaignReport& report) {
       unconfirmed += run.stop_unconfirmed;
       converged += run.status == ServoRunStatus::kConverged;
       moved += run.moves_after_stop > 0;
+      moved_held += run.moves_while_held > 0;
       whole += run.outputs_whole;
       if (std::isfinite(run.fault_to_stop_ms)) stop_ms.push_back(run.fault_to_stop_ms);
     }
     if (runs == 0) continue;
     out << "| " << ToString(kind) << " | " << runs << " | " << reached << " | " << stopped << " | "
-        << unconfirmed << " | " << converged << " | " << moved << " | " << std::fixed
-        << std::setprecision(0);
+        << unconfirmed << " | " << converged << " | " << moved_held << " | " << moved << " | "
+        << std::fixed << std::setprecision(0);
     if (stop_ms.empty()) {
       out << "-";
     } else {
@@ -660,6 +724,8 @@ std::string FaultCampaignJson(const FaultCampaignReport& report) {
                     {"stop_unconfirmed", run.stop_unconfirmed},
                     {"fault_to_stop_ms", number(run.fault_to_stop_ms)},
                     {"moves_after_stop", run.moves_after_stop},
+                    {"spoiled_frames", run.spoiled_frames},
+                    {"moves_while_held", run.moves_while_held},
                     {"outputs_whole", run.outputs_whole},
                     {"final_true_translation_error_mm", number(run.final_true_translation_mm)},
                     {"final_true_rotation_error_deg", number(run.final_true_rotation_deg)},

@@ -8,8 +8,12 @@
 //   - the time from the fault to that stop command;
 //   - the output folder holds whole files only: the CSV with every row, images that decode,
 //     no temporary file;
-//   - a run the fault did not stop (line noise the driver could ignore, an occlusion the
-//     detector saw past) ends at the goal as a fault-free run does (the simulation's truth).
+//   - a run the fault did not stop (line noise the driver could ignore, a short occlusion or
+//     a rolled frame the loop held past) ends at the goal as a fault-free run does (the
+//     simulation's truth); a frame fault the loop must hold past (short-occlusion, pose-jump)
+//     gets no motion command from its first spoiled frame until the second frame after its
+//     last (found again, then confirmed), and a long occlusion none after its first frame;
+//     a zero twist holds the robot and is no motion.
 // Where the commands are watched: for the Scorbot, on the wire: the Controller-A simulator, run
 // here rather than by the job, logs every line it receives with its arrival time (a "MOVE" is a
 // motion command, Ctrl-A the stop); for the simulated robot, a wrapper of its driver logs every
@@ -48,12 +52,19 @@ enum class FaultKind {
   kDriveFault,        ///< simulated robot: every motion and read call fails from now on
   kDriveTimeout,      ///< simulated robot: every call, the stop too, times out from now on
   kUnreadableFrame,   ///< the camera gives no frame
-  kOcclusion,         ///< a hand (a dark blob) over the middle of the view
-  kPoseJump,          ///< the frame rolled by 6-25 deg: the image disagrees with the motion
+  /// A hand (a dark blob) over the whole view for fewer frames than the loop holds for: the
+  /// run must hold, carry on and converge, no motion commanded while it holds.
+  kShortOcclusion,
+  /// ... for the rest of the run: it must stop (target-lost), nothing moving after the hand.
+  kLongOcclusion,
+  /// One frame rolled by 6-25 deg, the image disagreeing with the motion: held past, as a
+  /// short occlusion.
+  kPoseJump,
 };
 
 /// "impact", "controller-silent", "reply-cut", "line-noise", "port-closed", "xoff-held",
-/// "drive-fault", "drive-timeout", "unreadable-frame", "occlusion", "pose-jump".
+/// "drive-fault", "drive-timeout", "unreadable-frame", "short-occlusion", "long-occlusion",
+/// "pose-jump".
 std::string ToString(FaultKind kind);
 /// "simulated", "scorbot".
 std::string ToString(FaultedRobot robot);
@@ -101,6 +112,9 @@ struct FaultCampaignSetup {
   std::function<ServoRunReport(const FaultRunRequest& request, std::ostream& log)> run;
   /// What the job's console line with the outcome begins with (e.g. "oalservo servo: ").
   std::string outcome_prefix;
+  /// The job's servo.max_lost_frames: a short occlusion is well within it (the loop holds
+  /// one frame more than the hand covers, finding the target again), a long one lasts.
+  int max_lost_frames = 60;
 };
 
 struct FaultRun {
@@ -114,7 +128,11 @@ struct FaultRun {
   bool stop_unconfirmed = false;  ///< the run says "STOP COULD NOT BE SENT"
   /// From the fault to the first stop command the robot received after it; NaN: none.
   double fault_to_stop_ms = std::numeric_limits<double>::quiet_NaN();
-  int moves_after_stop = 0;   ///< motion commands the robot received after that stop
+  int moves_after_stop = 0;  ///< motion commands the robot received after that stop
+  /// Frame faults: the frames spoiled, and the motion commands the robot received while the
+  /// loop had to hold (see the file comment).
+  int spoiled_frames = 0;
+  int moves_while_held = 0;
   bool outputs_whole = true;  ///< no temporary file, images decode, one CSV row an iteration
   double final_true_translation_mm = std::numeric_limits<double>::quiet_NaN();
   double final_true_rotation_deg = std::numeric_limits<double>::quiet_NaN();
@@ -137,8 +155,9 @@ FaultCampaignReport RunFaultCampaign(
     const std::function<void(int done, int total)>& progress = nullptr);
 
 /// The campaign per fault as a Markdown table (runs, reached, stopped with the reason printed,
-/// stop not confirmed and said so, converged on the goal, motion after the stop, fault to
-/// stop command median / max, outputs whole, failed), then each failed run and its problems.
+/// stop not confirmed and said so, converged on the goal, motion while held, motion after the
+/// stop, fault to stop command median / max, outputs whole, failed), then each failed run and
+/// its problems.
 std::string FaultCampaignTable(const FaultCampaignReport& report);
 /// The campaign as JSON: the options, the fault-free run, every run.
 std::string FaultCampaignJson(const FaultCampaignReport& report);

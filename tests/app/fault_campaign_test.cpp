@@ -70,6 +70,19 @@ TEST(FaultCampaign, TheSimulatedRobotStopsOnEveryFault) {
     if (run.kind == FaultKind::kDriveTimeout) {
       EXPECT_THAT(run.message, HasSubstr("STOP COULD NOT BE SENT"));
     }
+    // The loop holds past a short hand and a rolled frame, and stops under a long hand.
+    if (run.kind == FaultKind::kShortOcclusion || run.kind == FaultKind::kPoseJump) {
+      EXPECT_EQ(run.status, ServoRunStatus::kConverged)
+          << ToString(run.kind) << ": " << run.message;
+      EXPECT_THAT(run.message, HasSubstr("held 1 time on the way"));
+      EXPECT_GE(run.spoiled_frames, 1);
+      EXPECT_EQ(run.moves_while_held, 0);
+    }
+    if (run.kind == FaultKind::kLongOcclusion) {
+      EXPECT_EQ(run.status, ServoRunStatus::kTargetLost) << run.message;
+      EXPECT_THAT(run.message, HasSubstr("target lost: held "));
+      EXPECT_EQ(run.moves_while_held, 0);
+    }
   }
 }
 

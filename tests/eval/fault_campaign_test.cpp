@@ -19,14 +19,16 @@ using ::testing::HasSubstr;
 TEST(FaultCampaign, EachRobotHasItsOwnFaultsAndTheFramesFaults) {
   const std::vector<FaultKind> arm = FaultKindsFor(FaultedRobot::kScorbot);
   const std::vector<FaultKind> drive = FaultKindsFor(FaultedRobot::kSimulated);
-  EXPECT_EQ(arm.size(), 9u);
-  EXPECT_EQ(drive.size(), 5u);
+  EXPECT_EQ(arm.size(), 10u);
+  EXPECT_EQ(drive.size(), 6u);
   EXPECT_EQ(arm.front(), FaultKind::kImpact);
   EXPECT_EQ(drive.front(), FaultKind::kDriveFault);
   for (const std::vector<FaultKind>* kinds : {&arm, &drive}) {
     EXPECT_EQ(kinds->back(), FaultKind::kPoseJump);
   }
   EXPECT_EQ(ToString(FaultKind::kXoffHeld), "xoff-held");
+  EXPECT_EQ(ToString(FaultKind::kShortOcclusion), "short-occlusion");
+  EXPECT_EQ(ToString(FaultKind::kLongOcclusion), "long-occlusion");
   EXPECT_EQ(ToString(FaultedRobot::kScorbot), "scorbot");
 }
 
@@ -62,16 +64,17 @@ TEST(FaultCampaign, TheTableCountsEachFaultAndListsTheFailedRuns) {
   report.runs = {stopped, failed};
   EXPECT_EQ(report.failed(), 1);
   const std::string table = FaultCampaignTable(report);
-  EXPECT_THAT(table, HasSubstr("| drive-fault | 2 | 2 | 2 | 0 | 0 | 1 | 12 / 12 ms | 2 | 1 |"));
+  EXPECT_THAT(table, HasSubstr("| drive-fault | 2 | 2 | 2 | 0 | 0 | 0 | 1 | 12 / 12 ms | 2 | 1 |"));
   EXPECT_THAT(table, HasSubstr("- run 1 (drive-fault at 0.5 s)"));
   EXPECT_THAT(table, HasSubstr("  - 2 motion command(s) after the stop command"));
-  EXPECT_THAT(table, ::testing::Not(HasSubstr("| occlusion |")));  // no run: no row
+  EXPECT_THAT(table, ::testing::Not(HasSubstr("| short-occlusion |")));  // no run: no row
 
   const nlohmann::json json = nlohmann::json::parse(FaultCampaignJson(report));
   EXPECT_EQ(json["robot"], "simulated");
   EXPECT_EQ(json["failed"], 1);
   ASSERT_EQ(json["runs"].size(), 2u);
   EXPECT_EQ(json["runs"][1]["moves_after_stop"], 2);
+  EXPECT_EQ(json["runs"][1]["moves_while_held"], 0);
   EXPECT_TRUE(json["runs"][0]["final_true_translation_error_mm"].is_null());  // NaN: unknown
 }
 
