@@ -546,6 +546,8 @@ const std::vector<Field<CameraConfig>>& CameraFields() {
       IntField("height", &O::height),
       DoubleField("noise", &O::noise),
       DoubleField("blur", &O::blur),
+      DoubleField("exposure_s", &O::exposure_s),
+      DoubleField("latency_s", &O::latency_s),
       PoseField("eMc", &O::eMc),
       {"true_eMc", [](const Value& value, O* camera) { camera->true_eMc = ReadPose(value); }},
       {"file", [](const Value& value, O* camera) { camera->file = PathNextTo(value.file, value); }},
@@ -1078,6 +1080,8 @@ const std::vector<Field<SceneOptions>>& SceneFields() {
       LivedInField("exposure", &LivedInOptions::exposure, &ExposureFields),
       LivedInField("motion_blur", &LivedInOptions::motion_blur, &MotionBlurFields),
       LivedInField("jpeg", &LivedInOptions::jpeg, &JpegFields),
+      RangeField("episode_s", &O::episode_s),
+      IntField("episode_seed", &O::episode_seed),
   };
   return fields;
 }
@@ -1096,6 +1100,12 @@ struct SceneCheck {
                   "0 <= background_gain <= 4");
     RequireOption(std::fabs(scene.background_offset) <= 255.0, "SceneOptions::background_offset",
                   scene.background_offset, "-255 <= background_offset <= 255");
+    RequireOption(scene.episode_seed >= 0, "SceneOptions::episode_seed", scene.episode_seed,
+                  "episode_seed >= 0");
+    RequireOption(scene.episode_s.lo > 0.0 && scene.episode_s.lo <= scene.episode_s.hi &&
+                      scene.episode_s.hi <= 3600.0,
+                  "SceneOptions::episode_s", scene.episode_s.lo,
+                  "0 < episode_s[0] <= episode_s[1] <= 3600");
     RenderOptions render;
     SceneOptions without_image = scene;
     without_image.background.clear();  // read when used, with its own message
@@ -1295,6 +1305,10 @@ void CameraConfig::Check() const {
   }
   if (!(blur >= 0.0 && blur <= 20.0))
     Violated("CameraConfig::blur", Number(blur), "0 <= blur <= 20");
+  if (!(exposure_s >= 0.0 && exposure_s <= 1.0))
+    Violated("CameraConfig::exposure_s", Number(exposure_s), "0 <= exposure_s <= 1");
+  if (!(latency_s >= 0.0 && latency_s <= 1.0))
+    Violated("CameraConfig::latency_s", Number(latency_s), "0 <= latency_s <= 1");
 }
 
 void RobotConfig::Check() const {

@@ -83,7 +83,11 @@ struct CameraConfig {
   int width = 640, height = 480;  ///< image size, pixels, [16, 8192]
   double noise = 0.0;             ///< Gaussian noise of the rendering, grey levels, [0, 100]
   double blur = 0.0;              ///< Gaussian blur of the rendering, pixels, [0, 20]
-  vpHomogeneousMatrix eMc;        ///< hand-eye: the camera in the end-effector frame
+  /// The simulated camera's exposure: its own motion blurs each frame over it, s, [0, 1].
+  double exposure_s = 0.0;
+  /// The simulated camera delivers a frame this long after it took it, s, [0, 1].
+  double latency_s = 0.0;
+  vpHomogeneousMatrix eMc;  ///< hand-eye: the camera in the end-effector frame
   /// Simulation (source: simulated): how the rendered camera is really mounted, when eMc is
   /// only what the loop believes (to try a hand-eye calibration); unset: eMc.
   std::optional<vpHomogeneousMatrix> true_eMc;

@@ -141,8 +141,10 @@ std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix
   const MeasureTarget measure = [&](std::string* why) -> std::optional<vpHomogeneousMatrix> {
     const RobotPose camera = TrueCameraPose(robot, config.camera.true_eMc);
     cv::Mat gray;
-    if (!camera.result.ok() ||
-        !frames->Grab(camera.pose.inverse() * config.target_wMo, frame_count++, &gray)) {
+    Capture capture;
+    capture.iteration = frame_count++;
+    if (camera.result.ok()) capture.true_cMo = camera.pose.inverse() * config.target_wMo;
+    if (!camera.result.ok() || !frames->Grab(capture, &gray)) {
       *why = camera.result.ok() ? frames->Name() + " has no frame left"
                                 : "the camera's pose cannot be read: " + camera.result.message;
       return std::nullopt;

@@ -25,8 +25,10 @@ ServoAccuracyReport EvaluateServoAccuracy(const ServoAppConfig& config,
                                           const ServoAccuracyOptions& options,
                                           const std::function<void(int, int)>& progress) {
   const ServoRunFrom run = [&config](const vpHomogeneousMatrix& start_wMc, ServoMode mode,
-                                     int max_iterations) {
+                                     int max_iterations, int start) {
     ServoAppConfig run_config = config;
+    // Each start its own episodes of the lived-in scene (the same for every law).
+    run_config.scene.episode_seed = config.scene.episode_seed + start;
     run_config.servo.law.mode = mode;
     if (max_iterations > 0) run_config.servo.max_iterations = max_iterations;
     run_config.robot.start_wMc = start_wMc;

@@ -116,7 +116,13 @@ std::unique_ptr<FrameSource> OpenFrames(const ServoAppConfig& config,
                                         std::vector<std::string>* warnings) {
   const SourceConfig& source = config.source;
   if (source.type == SourceType::kSimulated) {
-    return std::make_unique<RenderedFrames>(config.target, RenderOptionsOf(config));
+    SimulatedCameraScene scene;
+    scene.lived_in = config.scene.lived_in;
+    scene.episode_s = config.scene.episode_s;
+    scene.seed = static_cast<std::uint64_t>(config.scene.episode_seed);
+    scene.exposure_s = config.camera.exposure_s;
+    scene.latency_s = config.camera.latency_s;
+    return std::make_unique<RenderedFrames>(config.target, RenderOptionsOf(config), scene);
   }
   const bool v4l2 = source.type == SourceType::kV4l2;
   const std::string key = v4l2 ? "source.device" : "source.path";

@@ -67,7 +67,8 @@ ServoAccuracyReport EvaluateServoAccuracy(const ServoStartScene& scene,
     ServoAccuracyLaw law;
     law.mode = mode;
     for (std::size_t i = 0; i < starts.size(); ++i) {
-      const ServoRunReport result = run_from(starts[i], mode, options.max_iterations);
+      const ServoRunReport result =
+          run_from(starts[i], mode, options.max_iterations, static_cast<int>(i));
       ServoAccuracyRun run;
       run.start = static_cast<int>(i);
       run.start_wMc = starts[i];

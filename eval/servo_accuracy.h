@@ -70,11 +70,11 @@ struct ServoStartScene {
   int width = 640, height = 480;  ///< the camera's image, pixels
 };
 
-/// One servo run from the camera pose `start_wMc` with the law `mode`, at most
-/// `max_iterations` (0: the run's own limit), the image in the loop; its report, whose
-/// iterations carry the true errors (a simulated camera).
+/// One servo run from the camera pose `start_wMc` (the `start`-th, 0 first) with the law
+/// `mode`, at most `max_iterations` (0: the run's own limit), the image in the loop; its
+/// report, whose iterations carry the true errors (a simulated camera).
 using ServoRunFrom = std::function<ServoRunReport(const vpHomogeneousMatrix& start_wMc,
-                                                  ServoMode mode, int max_iterations)>;
+                                                  ServoMode mode, int max_iterations, int start)>;
 
 /// The start poses wMc of `options` in `scene` (deterministic in options.seed).
 std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoStartScene& scene,

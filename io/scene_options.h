@@ -46,6 +46,11 @@ struct SceneOptions {
   /// What happens from frame to frame in a lived-in scene (scene.occluders, glare, exposure,
   /// motion_blur, jpeg): drawn per frame by whoever renders the frames (scene/lived_in.h).
   LivedInOptions lived_in;
+  /// The servo's simulated camera draws them once for each episode of its run, of a length
+  /// drawn in this range (s, 0 < lo <= hi <= 3600), and holds them through it.
+  DrawRange episode_s{0.2, 1.0};
+  /// The episodes' draws, >= 0 (`oalservo servo-accuracy` adds each start's number).
+  int episode_seed = 1;
 
   /// Copies the effects into `render` and reads the background image. Throws
   /// std::runtime_error "FILE:LINE: scene.background ..." when it cannot be read, and

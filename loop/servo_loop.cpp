@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -166,12 +167,12 @@ std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int it
 
 // The frame of this iteration, of the camera's size; a stop when there is none.
 // `on_grab` (ServoLoopHooks) sees the frame before it is checked.
-std::optional<Stop> Grab(FrameSource& frames, int width, int height,
-                         const vpHomogeneousMatrix& true_cMo, int iteration,
+std::optional<Stop> Grab(FrameSource& frames, int width, int height, const Capture& capture,
                          const std::function<void(int, cv::Mat*)>& on_grab, cv::Mat* gray) {
+  const int iteration = capture.iteration;
   bool have_frame = false;
   try {
-    have_frame = frames.Grab(true_cMo, iteration, gray);
+    have_frame = frames.Grab(capture, gray);
   } catch (const std::exception& error) {
     return Stop{ServoRunStatus::kError, "cannot read the next frame at iteration " +
                                             std::to_string(iteration) + ": " + error.what()};
@@ -452,7 +453,10 @@ bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames,
       pose_error = "the camera's pose cannot be read: " + at.result.message;
       return false;
     }
-    if (!frames.Grab(at.pose.inverse() * setup.wMo, kLensFrameIndex + read++, &gray)) {
+    Capture capture;
+    capture.true_cMo = at.pose.inverse() * setup.wMo;
+    capture.iteration = kLensFrameIndex + read++;
+    if (!frames.Grab(capture, &gray)) {
       return false;
     }
     *view = ViewOf(gray);
@@ -475,6 +479,35 @@ bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames,
 }
 
 namespace {
+
+// Where the camera was at a time of the loop's clock: the poses read each frame and at the
+// end of each move, interpolated along the constant twist between two of them (as the
+// simulated robot moves: a velocity held for a period, a move along one twist).
+class PoseHistory {
+ public:
+  void Add(double time_s, const vpHomogeneousMatrix& wMc) {
+    if (!poses_.empty() && time_s <= poses_.back().first) poses_.pop_back();  // the same time
+    poses_.emplace_back(time_s, wMc);
+    if (poses_.size() > kKept) poses_.pop_front();
+  }
+  // The earliest kept when `time_s` is before it.
+  vpHomogeneousMatrix At(double time_s) const {
+    if (poses_.empty()) return vpHomogeneousMatrix();
+    if (time_s <= poses_.front().first) return poses_.front().second;
+    for (std::size_t i = 1; i < poses_.size(); ++i) {
+      const auto& [t1, M1] = poses_[i];
+      if (time_s > t1) continue;
+      const auto& [t0, M0] = poses_[i - 1];
+      const double s = (time_s - t0) / (t1 - t0);
+      return M0 * Se3Exp(s * Se3Log(M0.inverse() * M1));
+    }
+    return poses_.back().second;
+  }
+
+ private:
+  static constexpr std::size_t kKept = 256;
+  std::deque<std::pair<double, vpHomogeneousMatrix>> poses_;
+};
 
 // One run of the loop, in its steps: Prepare (before the robot is touched), Begin (connect,
 // enable, the lens), then one Iterate per frame until a Stop, and Finish (the stop sent, the
@@ -548,6 +581,8 @@ class ServoRun {
       return Stop{ServoRunStatus::kError, "cannot enable the robot: " + r.message};
     }
     WarnIfOutsideWorkspace(robot_, log_);
+    period_s_ = rig_.driver->Capabilities().sampling_time_s;
+    begun_ = std::chrono::steady_clock::now();
     report_.started = true;
     if (hooks_.on_started) hooks_.on_started();
     if (setup_.estimate_distortion) {
@@ -576,14 +611,24 @@ class ServoRun {
     if (!read.result.ok()) {
       return Stop{ServoRunStatus::kError, "cannot read the camera pose: " + read.result.message};
     }
-    const vpHomogeneousMatrix wMc = read.pose;
-    const vpHomogeneousMatrix true_cMo = wMc.inverse() * setup_.wMo;
-    if (std::optional<Stop> stop = Grab(frames_, setup_.width, setup_.height, true_cMo, iteration,
-                                        hooks_.on_grab, &gray_)) {
+    if (iteration > 0) simulated_s_ += period_s_;  // one frame of the simulated camera
+    const double now_s = Now();
+    history_.Add(now_s, read.pose);
+    // The frame was taken a latency ago: the scene then, and everything the loop predicts
+    // and commands from it, is where the camera was then.
+    Capture capture;
+    capture.iteration = iteration;
+    capture.time_s = now_s - frames_.LatencyS();
+    const vpHomogeneousMatrix wMc =
+        capture.time_s < now_s ? history_.At(capture.time_s) : read.pose;
+    capture.true_cMo = wMc.inverse() * setup_.wMo;
+    capture.velocity = velocity_;
+    if (std::optional<Stop> stop =
+            Grab(frames_, setup_.width, setup_.height, capture, hooks_.on_grab, &gray_)) {
       return stop;
     }
-    report_.iterations.push_back(
-        RowAt(rig_, columns_.truth, iteration, wMc, true_cMo, report_.cdMo));
+    report_.iterations.push_back(RowAt(rig_, columns_.truth, iteration, read.pose,
+                                       read.pose.inverse() * setup_.wMo, report_.cdMo));
     moved_since_row_ = false;
     ServoIteration& current = report_.iterations.back();
 
@@ -728,10 +773,17 @@ class ServoRun {
     return verdict;
   }
 
+  // The loop's clock, s: a simulated camera's time (nothing sleeps in a simulation: a frame
+  // takes one sampling period of the robot, a move its polls), else the wall clock.
+  double Now() const {
+    if (frames_.KnowsTruth()) return simulated_s_;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - begun_).count();
+  }
+
   // The loop holds at this frame: nothing commanded from it, the confirmation starts again.
   void Hold(int iteration, const HoldReason& reason, ServoIteration* row) {
     if (!hold_) {
-      hold_ = HoldState{iteration, std::chrono::steady_clock::now(), 0, reason};
+      hold_ = HoldState{iteration, Now(), 0, reason};
       ++report_.holds;
       log_ << "holding at frame " << iteration << ", nothing commanded: " << reason.why << '\n';
     }
@@ -746,8 +798,7 @@ class ServoRun {
   // A hold past servo.max_lost_frames or max_lost_s ends the run.
   std::optional<Stop> HeldTooLong() const {
     const ServoLoopOptions& loop = setup_.loop;
-    const double held_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - hold_->since).count();
+    const double held_s = Now() - hold_->since_s;
     if (hold_->frames <= loop.max_lost_frames && held_s <= loop.max_lost_s) return std::nullopt;
     const bool lost = hold_->reason.status == ServoRunStatus::kTargetLost;
     return Stop{hold_->reason.status,
@@ -762,7 +813,8 @@ class ServoRun {
   // While the loop holds, a velocity law commands zero (a position move has ended already).
   std::optional<Stop> HoldStill(int iteration) {
     if (setup_.open_loop || setup_.loop.law.mode != ServoMode::kVelocity) return std::nullopt;
-    const RobotResult held = robot_.SetVelocity(RobotFrame::kCamera, vpColVector(6, 0.0)).result;
+    velocity_ = vpColVector(6, 0.0);
+    const RobotResult held = robot_.SetVelocity(RobotFrame::kCamera, velocity_).result;
     if (!held.ok()) return RefusalStop(held, false, robot_, iteration, hooks_);
     return std::nullopt;
   }
@@ -807,12 +859,15 @@ class ServoRun {
     RobotResult moved;
     bool started = false;
     if (velocity_law) {
+      velocity_ = step.twist;
       moved = robot_.SetVelocity(RobotFrame::kCamera, step.twist).result;
       started = moved.ok();
     } else {
       const MoveReport move = robot_.MovePosition(RobotFrame::kCamera, wMc * step.c_T_cnew);
       moved = move.result;
       started = moved.ok() || move.polls > 0;
+      simulated_s_ += move.polls * period_s_;  // the move's time; it ends still
+      if (moved.ok()) history_.Add(Now(), move.reached);
     }
     if (started) ++report_.moves;
     if (!moved.ok()) return RefusalStop(moved, started, robot_, iteration, hooks_);
@@ -870,11 +925,17 @@ class ServoRun {
   std::optional<vpHomogeneousMatrix> candidate_cMo_;
   struct HoldState {
     int since_iteration = 0;
-    std::chrono::steady_clock::time_point since;
+    double since_s = 0.0;  ///< Now()
     int frames = 0;
     HoldReason reason;
   };
   std::optional<HoldState> hold_;  ///< holding: nothing commanded since since_iteration
+  /// The loop's clock (Now()): the simulated camera's, or the wall clock from begun_.
+  double period_s_ = 0.04;  ///< the robot's sampling period: a simulated frame's time
+  double simulated_s_ = 0.0;
+  std::chrono::steady_clock::time_point begun_ = std::chrono::steady_clock::now();
+  vpColVector velocity_;  ///< the twist commanded last (velocity law), for the exposure
+  PoseHistory history_;   ///< where the camera was, for a frame taken before it is delivered
   /// The last confirmed pose and where the camera was: the odometry's prediction starts here.
   std::optional<vpHomogeneousMatrix> previous_cMo_;
   vpHomogeneousMatrix previous_wMc_;

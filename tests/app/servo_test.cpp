@@ -73,6 +73,26 @@ TEST(ServoConfig, BuiltInDefaultIsConfigServoSimYaml) {
   EXPECT_NEAR(cMo.getTranslationVector().frobeniusNorm(), 0.6, 0.05);
 }
 
+// The lived-in bench for the servo: the default run with episodes of hands, tools, glares and
+// exposure changes, and the camera's own smear; every law converges on it.
+TEST(ServoConfig, ShippedLivedInConfigConvergesWithEveryLaw) {
+  const ServoAppConfig shipped = ShippedServoConfig("servo-lived-in.yaml");
+  EXPECT_DOUBLE_EQ(shipped.camera.exposure_s, 0.01);
+  EXPECT_DOUBLE_EQ(shipped.camera.latency_s, 0.06);
+  EXPECT_DOUBLE_EQ(shipped.scene.lived_in.occluders.fraction, 0.3);
+  EXPECT_DOUBLE_EQ(shipped.scene.episode_s.lo, 0.2);
+  EXPECT_DOUBLE_EQ(shipped.scene.episode_s.hi, 1.0);
+  for (const ServoMode mode : {ServoMode::kExponential, ServoMode::kVelocity}) {
+    ServoAppConfig config = Small(shipped);
+    config.servo.law.mode = mode;
+    std::ostringstream log;
+    const ServoRunReport report = RunServo(config, log);
+    EXPECT_EQ(report.status, ServoRunStatus::kConverged)
+        << ToString(mode) << ": " << report.message;
+    EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0) << ToString(mode);
+  }
+}
+
 TEST(ServoConfig, ShippedTable3UsesThePaperConvention) {
   const ServoAppConfig config = ShippedServoConfig("table3-sim.yaml");
   double x, y, z, pitch, roll, yaw;
@@ -132,6 +152,15 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
                         "<= 3600)"));
   EXPECT_THAT(ErrorOf("servo:\n  max_lost_frames: 1.5\n"),
               HasSubstr("servo.yaml:2: 'servo.max_lost_frames'"));
+  EXPECT_THAT(ErrorOf("camera:\n  latency_s: -0.1\n"),
+              HasSubstr("servo.yaml:2: 'camera.latency_s' is invalid: -0.1"));
+  EXPECT_THAT(ErrorOf("scene:\n  episode_s: [0.5, 0.2]\n"),
+              HasSubstr("servo.yaml:2: 'scene.episode_s' is invalid"));
+  EXPECT_THAT(ErrorOf("scene:\n  episode_seed: -3\n"),
+              HasSubstr("servo.yaml:2: 'scene.episode_seed' is invalid: -3"));
+  EXPECT_THAT(ErrorOf("camera:\n  px: 600\n  exposure_s: 2\n"),
+              HasSubstr("servo.yaml:3: 'camera.exposure_s' is invalid: 2 (needs 0 <= exposure_s "
+                        "<= 1)"));
   EXPECT_THAT(ErrorOf("servo:\n  mode: sideways\n"),
               HasSubstr("servo.yaml:2: 'servo.mode' must be one of point-and-go, exponential"));
   EXPECT_THAT(ErrorOf("camera:\n  px: 600\n  width: 8\n"),

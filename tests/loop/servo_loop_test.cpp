@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -155,10 +156,99 @@ TEST(RecordedFrames, AnUnreadableFrameIsReportedWhereItIsTakenNotAsTheEnd) {
   }
   RecordedFrames frames(OpenImageSource(dir.path().string()));
   cv::Mat gray;
-  ASSERT_TRUE(frames.Grab(vpHomogeneousMatrix(), 0, &gray));
+  ASSERT_TRUE(frames.Grab(Capture{}, &gray));
   EXPECT_EQ(gray.cols, 64);
   EXPECT_FALSE(frames.AtEnd()) << "an unreadable frame is not the end";
-  EXPECT_THROW(frames.Grab(vpHomogeneousMatrix(), 1, &gray), std::runtime_error);
+  Capture second;
+  second.iteration = 1;
+  EXPECT_THROW(frames.Grab(second, &gray), std::runtime_error);
+}
+
+// The simulated camera's lived-in episodes: drawn on its clock, the same for the same time
+// whatever was asked before, each held through its length; a hand in every episode changes
+// the frame; its own motion over the exposure smears it, more the faster it moves.
+TEST(RenderedFrames, EpisodesHoldTheirConditionsAndMotionSmearsTheFrame) {
+  const ServoSetup setup = SheetSetup(ServoMode::kVelocity);
+  SimulatedCameraScene scene;
+  scene.lived_in.occluders.fraction = 1.0;
+  scene.lived_in.occluders.kinds = {OccluderKind::kHand};
+  scene.episode_s = {0.5, 0.5};
+  scene.exposure_s = 0.02;
+  RenderedFrames hands(setup.target, RenderOptions(), scene);
+  RenderedFrames plain(setup.target, RenderOptions());
+  Capture capture;
+  capture.true_cMo = kStartcMo;
+  const auto frame = [&](RenderedFrames& frames, double time_s) {
+    capture.time_s = time_s;
+    cv::Mat gray;
+    EXPECT_TRUE(frames.Grab(capture, &gray));
+    return gray.clone();
+  };
+  const cv::Mat bare = frame(plain, 0.0);
+  const cv::Mat first = frame(hands, 0.1), later = frame(hands, 1.3);
+  EXPECT_GT(cv::norm(first, bare, cv::NORM_L1), 1e5) << "a hand over the sheet";
+  EXPECT_EQ(cv::norm(frame(hands, 0.4), first, cv::NORM_L1), 0.0) << "the same episode";
+  EXPECT_GT(cv::norm(later, first, cv::NORM_L1), 1e5) << "another episode, another hand";
+  EXPECT_EQ(cv::norm(frame(hands, 1.3), later, cv::NORM_L1), 0.0) << "asked again";
+  // Moving sideways at 0.1 m/s for 20 ms, 0.6 m away: about 2 px of smear.
+  capture.velocity = vpColVector(6, 0.0);
+  capture.velocity[0] = 0.1;
+  const cv::Mat slow = frame(plain, 0.0);
+  EXPECT_EQ(cv::norm(slow, bare, cv::NORM_L1), 0.0) << "no exposure set: no smear";
+  RenderedFrames exposed(setup.target, RenderOptions(),
+                         SimulatedCameraScene{{}, {1.0, 1.0}, 1, 0.02});
+  const cv::Mat smeared = frame(exposed, 0.0);
+  capture.velocity[0] = 0.5;
+  const cv::Mat faster = frame(exposed, 0.0);
+  const double slow_change = cv::norm(smeared, bare, cv::NORM_L1);
+  EXPECT_GT(slow_change, 0.0);
+  EXPECT_GT(cv::norm(faster, bare, cv::NORM_L1), 2.0 * slow_change);
+  SimulatedCameraScene bad = scene;
+  bad.episode_s = {0.0, 1.0};
+  EXPECT_THROW(RenderedFrames(setup.target, RenderOptions(), bad), std::invalid_argument);
+}
+
+// The simulated camera's frames recorded as the loop asks for them.
+class RecordingFrames : public FrameSource {
+ public:
+  RecordingFrames(const LineTarget& target, const SimulatedCameraScene& scene)
+      : frames_(target, RenderOptions(), scene) {}
+  bool Grab(const Capture& capture, cv::Mat* gray) override {
+    captures.push_back(capture);
+    return frames_.Grab(capture, gray);
+  }
+  std::string Name() const override { return frames_.Name(); }
+  bool KnowsTruth() const override { return true; }
+  double LatencyS() const override { return frames_.LatencyS(); }
+  std::vector<Capture> captures;
+
+ private:
+  RenderedFrames frames_;
+};
+
+// A frame delivered 60 ms after it was taken (1.5 periods of 40 ms) shows the camera where it
+// was then, halfway between the last two frames' poses; the velocity law still converges.
+TEST(RunServoLoop, ALateFrameShowsThePoseAtItsCaptureTime) {
+  ServoSetup setup = SheetSetup(ServoMode::kVelocity);
+  setup.loop.law.gain = 2.0;
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  SimulatedCameraScene scene;
+  scene.latency_s = 0.06;
+  RecordingFrames frames(setup.target, scene);
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  ASSERT_GT(frames.captures.size(), 10u);
+  for (std::size_t k = 3; k < 10; ++k) {
+    const Capture& capture = frames.captures[k];
+    EXPECT_NEAR(capture.time_s, 0.04 * static_cast<double>(k) - 0.06, 1e-9);
+    const vpTranslationVector at = (setup.wMo * capture.true_cMo.inverse()).getTranslationVector();
+    const ServoIteration& before = report.iterations[k - 2];
+    const ServoIteration& after = report.iterations[k - 1];
+    EXPECT_NEAR(at[0] * 1e3, 0.5 * (before.x_mm + after.x_mm), 0.05) << "frame " << k;
+    EXPECT_NEAR(at[2] * 1e3, 0.5 * (before.z_mm + after.z_mm), 0.05) << "frame " << k;
+  }
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
 }
 
 TEST(ServoLoopOptions, TheHoldsLimitsAreChecked) {
