@@ -540,8 +540,9 @@ class ServoRun {
     for (int iteration = 0;; ++iteration) {
       if (std::optional<Stop> stop = Interrupted(iteration)) return Finish(*stop);
       // Frames held count towards the hold's own limits, not the law's.
-      if (std::optional<Stop> stop = LimitReached(
-              setup_.loop, iteration_limit, iteration - report_.held_frames, start, frames_)) {
+      if (std::optional<Stop> stop =
+              LimitReached(setup_.loop, iteration_limit,
+                           iteration - report_.held_frames - skipped_frames_, start, frames_)) {
         return Finish(*stop);
       }
       if (std::optional<Stop> stop = Iterate(iteration)) return Finish(*stop);
@@ -631,6 +632,15 @@ class ServoRun {
                                        read.pose.inverse() * setup_.wMo, report_.cdMo));
     moved_since_row_ = false;
     ServoIteration& current = report_.iterations.back();
+    // A frame taken before the last move ended shows the arm on its way: the next one, taken
+    // with the arm still, is the one to act on.
+    if (capture.time_s < move_ended_s_) {
+      current.status = "skipped";
+      current.held = "taken before the move ended (camera latency)";
+      ++skipped_frames_;
+      LogRow(current, columns_, log_);
+      return std::nullopt;
+    }
 
     // Where the robot's motion since the last confirmed estimate puts the target.
     std::optional<vpHomogeneousMatrix> predicted_cMo;
@@ -868,6 +878,7 @@ class ServoRun {
       started = moved.ok() || move.polls > 0;
       simulated_s_ += move.polls * period_s_;  // the move's time; it ends still
       if (moved.ok()) history_.Add(Now(), move.reached);
+      move_ended_s_ = Now();
     }
     if (started) ++report_.moves;
     if (!moved.ok()) return RefusalStop(moved, started, robot_, iteration, hooks_);
@@ -934,8 +945,10 @@ class ServoRun {
   double period_s_ = 0.04;  ///< the robot's sampling period: a simulated frame's time
   double simulated_s_ = 0.0;
   std::chrono::steady_clock::time_point begun_ = std::chrono::steady_clock::now();
-  vpColVector velocity_;  ///< the twist commanded last (velocity law), for the exposure
-  PoseHistory history_;   ///< where the camera was, for a frame taken before it is delivered
+  vpColVector velocity_;        ///< the twist commanded last (velocity law), for the exposure
+  PoseHistory history_;         ///< where the camera was, for a frame taken before it is delivered
+  double move_ended_s_ = -1.0;  ///< Now() when the last position move ended
+  int skipped_frames_ = 0;      ///< taken before a move ended: not acted on, not counted
   /// The last confirmed pose and where the camera was: the odometry's prediction starts here.
   std::optional<vpHomogeneousMatrix> previous_cMo_;
   vpHomogeneousMatrix previous_wMc_;

@@ -32,8 +32,8 @@ namespace oal {
 /// The law and the loop's stop conditions (a configuration's `servo:` section).
 struct ServoLoopOptions {
   ServoOptions law;
-  /// Frames processed before iteration-limit, not counting those the loop held at, [0, 1e6];
-  /// 0: the law's own (IterationLimit).
+  /// Frames processed before iteration-limit, not counting those the loop held at or skipped,
+  /// [0, 1e6]; 0: the law's own (IterationLimit).
   int max_iterations = 0;
   double max_time_s = 60.0;        ///< wall time before time-limit, s, > 0
   double max_pose_jump_m = 0.05;   ///< estimate vs odometry prediction, m, > 0
@@ -156,10 +156,11 @@ struct ServoIteration {
   /// Error to the goal from the true pose (simulation ground truth).
   double true_translation_error_mm = 0, true_rotation_error_deg = 0;
   /// "running", "converged", "held" (nothing commanded: `held` says why), "found" (a pose
-  /// to be confirmed by the next frame, nothing commanded), the stop status, or "stopped" for
+  /// to be confirmed by the next frame, nothing commanded), "skipped" (a late frame taken
+  /// before the last position move ended: not looked at), the stop status, or "stopped" for
   /// the row after the stop (where the robot stopped; no frame).
   std::string status;
-  /// Why the loop held at this frame, in the user's words (empty unless status is "held").
+  /// Why the loop held at (or skipped) this frame, in the user's words (else empty).
   std::string held;
 };
 

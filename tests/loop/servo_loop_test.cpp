@@ -251,6 +251,24 @@ TEST(RunServoLoop, ALateFrameShowsThePoseAtItsCaptureTime) {
   EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
 }
 
+// A position law with a late camera: the first frame after a move was taken while the arm
+// was on its way; it is skipped, and the next one, taken with the arm still, is acted on.
+TEST(RunServoLoop, AFrameTakenBeforeAMoveEndedIsSkipped) {
+  const ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  SimulatedCameraScene scene;
+  scene.latency_s = 0.06;
+  RenderedFrames frames(setup.target, RenderOptions(), scene);
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  ASSERT_EQ(report.iterations.size(), 4u) << log.str();
+  EXPECT_EQ(report.iterations[2].status, "skipped");
+  EXPECT_THAT(report.iterations[2].held, HasSubstr("taken before the move ended"));
+  EXPECT_EQ(report.moves, 1);
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 1.0);
+}
+
 TEST(ServoLoopOptions, TheHoldsLimitsAreChecked) {
   ServoLoopOptions loop;
   loop.max_lost_s = -1.0;
