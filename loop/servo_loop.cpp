@@ -659,7 +659,10 @@ class ServoRun {
     CheckLensOnce(tracked);
     std::optional<ServoStep> step;
     if (tracked.status == TargetStatus::kOk) {
-      step = ComputeServoStep(pose.cMo, report_.cdMo, setup_.loop.law);
+      // The law acts now: the estimate, made where the camera was when the frame was taken,
+      // carried to where it is by the robot's own motion since (a late frame's delay is not
+      // the law's).
+      step = ComputeServoStep(read.pose.inverse() * wMc * pose.cMo, report_.cdMo, setup_.loop.law);
       current.translation_error_mm = step->translation_error_m * 1e3;
       current.rotation_error_deg = vpMath::deg(step->rotation_error_rad);
     }
@@ -696,7 +699,7 @@ class ServoRun {
                       Fixed(vpMath::deg(step->rotation_error_rad), 4) + " deg"};
     }
     if (setup_.open_loop) return std::nullopt;
-    return Move(iteration, wMc, *step);
+    return Move(iteration, read.pose, *step);
   }
 
   // What a frame's pose may do: command the robot, wait for the next frame's confirmation

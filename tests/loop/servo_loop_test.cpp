@@ -251,6 +251,27 @@ TEST(RunServoLoop, ALateFrameShowsThePoseAtItsCaptureTime) {
   EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
 }
 
+// Half a second of latency at a gain of 2/s would make a law acting on its frames' poses
+// overshoot and oscillate; the estimate carried to the present by the robot's own motion
+// converges as without it, the true error never growing.
+TEST(RunServoLoop, TheLawActsOnTheEstimateCarriedToThePresent) {
+  ServoSetup setup = SheetSetup(ServoMode::kVelocity);
+  setup.loop.law.gain = 2.0;
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  SimulatedCameraScene scene;
+  scene.latency_s = 0.5;
+  RenderedFrames frames(setup.target, RenderOptions(), scene);
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  for (std::size_t k = 1; k < report.iterations.size(); ++k) {
+    EXPECT_LE(report.iterations[k].true_translation_error_mm,
+              report.iterations[k - 1].true_translation_error_mm + 1e-3)
+        << "frame " << k;
+  }
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
+}
+
 // A position law with a late camera: the first frame after a move was taken while the arm
 // was on its way; it is skipped, and the next one, taken with the arm still, is acted on.
 TEST(RunServoLoop, AFrameTakenBeforeAMoveEndedIsSkipped) {
