@@ -116,6 +116,22 @@ TEST(RunServoLoop, ATargetOutOfViewStopsTheRunAndTheRobotNeverMoves) {
   EXPECT_LT((end.getTranslationVector() - start.getTranslationVector()).frobeniusNorm(), 1e-12);
 }
 
+// The hold's time limit runs on the simulated camera's clock (a frame a sampling period, 40 ms):
+// 0.1 s is passed at the fourth frame held, whatever the machine's speed.
+TEST(RunServoLoop, AHoldStopsAfterMaxLostSecondsOfTheCamerasClock) {
+  ServoSetup setup = SheetSetup(ServoMode::kExponential);
+  setup.loop.max_lost_s = 0.1;
+  const SimulatedCameraOptions away =
+      StartingAt(vpHomogeneousMatrix(0.8, 0.0, 0.6, 0.0, 0.0, 0.0), setup.wMo);
+  SimulatedCamera robot(away);
+  RenderedFrames frames(setup.target, RenderOptions());
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kTargetLost) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("target lost: held 4 frames (0.12 s)"));
+  EXPECT_EQ(report.moves, 0);
+}
+
 TEST(RunServoLoop, AnOpenLoopReplayComputesTheLawAndNeverMovesTheRobot) {
   const test::TestDir dir;
   const ServoSetup goal_setup = SheetSetup(ServoMode::kPointAndGo);
