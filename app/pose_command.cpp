@@ -166,7 +166,7 @@ class FrameFeed {
   bool ReadAhead(Frame* frame) {
     while (input_ < sources_.size()) {
       if (sources_[input_]->Next(frame)) {
-        held_.push_back({Frame{frame->gray.clone(), frame->source}, input_});
+        held_.push_back({Frame{frame->gray.clone(), frame->source, frame->taken_s}, input_});
         return true;
       }
       ++input_;

@@ -1,5 +1,6 @@
 #include "io/image_source.h"
 
+#include <sys/time.h>
 #include <visp3/core/vpConfig.h>
 #include <visp3/core/vpException.h>
 #include <visp3/core/vpImage.h>
@@ -131,6 +132,7 @@ class ImageListSource : public ImageSource {
     if (next_ >= paths_.size()) return false;
     const fs::path& path = paths_[next_++];  // past it even if it does not decode
     frame->source = path.string();           // also when it does not decode
+    frame->taken_s.reset();
     frame->gray = (next_ == 1 && !first_.empty()) ? first_ : DecodeGray(path);
     return true;
   }
@@ -251,6 +253,7 @@ class VideoSource : public ImageSource {
     pending_ = false;
     frame->gray = ToGray(buffer_);
     frame->source = path_ + "#" + std::to_string(index_++);
+    frame->taken_s.reset();
     return true;
   }
   std::string Name() const override { return "video " + Quoted(path_); }
@@ -289,7 +292,15 @@ class V4l2Source : public ImageSource {
   bool Next(Frame* frame) override {
     frame->source = device_ + "#" + std::to_string(index_++);
     try {
-      grabber_.acquire(image_);
+      timeval taken{};
+      grabber_.acquire(image_, taken);
+      // The driver's buffer timestamp (UVC cameras: the monotonic clock, when the frame's
+      // first byte arrived); 0 when it gives none.
+      frame->taken_s.reset();
+      if (taken.tv_sec != 0 || taken.tv_usec != 0) {
+        frame->taken_s =
+            static_cast<double>(taken.tv_sec) + 1e-6 * static_cast<double>(taken.tv_usec);
+      }
     } catch (const vpException& error) {
       throw std::runtime_error("cannot grab from V4L2 device '" + device_ +
                                "': " + error.getStringMessage());

@@ -18,6 +18,7 @@
 
 #include <memory>
 #include <opencv2/core/mat.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,9 @@ inline GrayImageView ViewOf(const cv::Mat& gray) {
 struct Frame {
   cv::Mat gray;        ///< CV_8UC1; may share memory with the source until its next Next()
   std::string source;  ///< image path, or "<video or device>#<index in that source>"
+  /// When the camera took it, s on the monotonic clock (std::chrono::steady_clock's, as the
+  /// V4L2 driver's buffer timestamps); unset when the source cannot tell (files, videos).
+  std::optional<double> taken_s;
 
   GrayImageView view() const { return ViewOf(gray); }
 };

@@ -97,6 +97,7 @@ bool RecordedFrames::Grab(const Capture& /*capture*/, cv::Mat* gray) {
   peeked_ = false;
   if (!have_frame) return false;
   *gray = frame_.gray;
+  taken_s_ = frame_.taken_s;
   return true;
 }
 

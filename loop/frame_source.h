@@ -9,6 +9,7 @@
 #include <exception>
 #include <memory>
 #include <opencv2/core/mat.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,10 @@ class FrameSource {
   /// How long before it is delivered a frame is taken, s: the loop asks for the scene at
   /// that earlier time and predicts from where the robot was then.
   virtual double LatencyS() const { return 0.0; }
+  /// When the last frame handed out was taken, s on the monotonic clock (steady_clock), when
+  /// the source says (a V4L2 camera's buffer timestamps); the loop then predicts from where the
+  /// robot was at that moment.
+  virtual std::optional<double> TakenAt() const { return std::nullopt; }
 };
 
 /// What the simulated camera sees besides the bench: a lived-in scene's conditions
@@ -94,9 +99,11 @@ class RecordedFrames : public FrameSource {
   /// and the next Grab() throws its error.
   bool AtEnd() override;
   std::string Name() const override { return source_->Name(); }
+  std::optional<double> TakenAt() const override { return taken_s_; }
 
  private:
   std::unique_ptr<ImageSource> source_;
+  std::optional<double> taken_s_;
   Frame frame_;
   bool peeked_ = false;              // frame_ holds the next frame already (AtEnd())
   bool peeked_frame_ = false;        // ... and there was one

@@ -620,13 +620,18 @@ class ServoRun {
     Capture capture;
     capture.iteration = iteration;
     capture.time_s = now_s - frames_.LatencyS();
-    const vpHomogeneousMatrix wMc =
-        capture.time_s < now_s ? history_.At(capture.time_s) : read.pose;
+    vpHomogeneousMatrix wMc = capture.time_s < now_s ? history_.At(capture.time_s) : read.pose;
     capture.true_cMo = wMc.inverse() * setup_.wMo;
     capture.velocity = velocity_;
     if (std::optional<Stop> stop =
             Grab(frames_, setup_.width, setup_.height, capture, hooks_.on_grab, &gray_)) {
       return stop;
+    }
+    // A camera that says when it took the frame (V4L2 timestamps, the monotonic clock).
+    if (const std::optional<double> taken = frames_.TakenAt(); taken && !frames_.KnowsTruth()) {
+      const double begun_s = std::chrono::duration<double>(begun_.time_since_epoch()).count();
+      capture.time_s = std::min(*taken - begun_s, now_s);
+      wMc = history_.At(capture.time_s);
     }
     report_.iterations.push_back(RowAt(rig_, columns_.truth, iteration, read.pose,
                                        read.pose.inverse() * setup_.wMo, report_.cdMo));
@@ -634,13 +639,26 @@ class ServoRun {
     ServoIteration& current = report_.iterations.back();
     // A frame taken before the last move ended shows the arm on its way: the next one, taken
     // with the arm still, is the one to act on.
-    if (capture.time_s < move_ended_s_) {
+    if (move_ended_s_ && capture.time_s < *move_ended_s_) {
       current.status = "skipped";
       current.held = "taken before the move ended (camera latency)";
       ++skipped_frames_;
+      // A camera whose frames stay older than the move (a wrong timestamp or latency) would
+      // be skipped for ever.
+      if (++skipped_in_a_row_ > setup_.loop.max_lost_frames) {
+        const Stop stop{ServoRunStatus::kError,
+                        std::to_string(skipped_in_a_row_) + " frames in a row were taken " +
+                            Fixed(*move_ended_s_ - capture.time_s, 3) +
+                            " s or more before the last move ended: the camera's timestamps (or "
+                            "camera.latency_s) say its frames are older than they can be"};
+        current.status = ToString(stop.status);
+        LogRow(current, columns_, log_);
+        return stop;
+      }
       LogRow(current, columns_, log_);
       return std::nullopt;
     }
+    skipped_in_a_row_ = 0;
 
     // Where the robot's motion since the last confirmed estimate puts the target.
     std::optional<vpHomogeneousMatrix> predicted_cMo;
@@ -948,10 +966,11 @@ class ServoRun {
   double period_s_ = 0.04;  ///< the robot's sampling period: a simulated frame's time
   double simulated_s_ = 0.0;
   std::chrono::steady_clock::time_point begun_ = std::chrono::steady_clock::now();
-  vpColVector velocity_;        ///< the twist commanded last (velocity law), for the exposure
-  PoseHistory history_;         ///< where the camera was, for a frame taken before it is delivered
-  double move_ended_s_ = -1.0;  ///< Now() when the last position move ended
-  int skipped_frames_ = 0;      ///< taken before a move ended: not acted on, not counted
+  vpColVector velocity_;  ///< the twist commanded last (velocity law), for the exposure
+  PoseHistory history_;   ///< where the camera was, for a frame taken before it is delivered
+  std::optional<double> move_ended_s_;  ///< Now() when the last position move ended
+  int skipped_frames_ = 0;              ///< taken before a move ended: not acted on, not counted
+  int skipped_in_a_row_ = 0;
   /// The last confirmed pose and where the camera was: the odometry's prediction starts here.
   std::optional<vpHomogeneousMatrix> previous_cMo_;
   vpHomogeneousMatrix previous_wMc_;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -304,6 +305,64 @@ TEST(RunServoLoop, AFrameTakenBeforeAMoveEndedIsSkipped) {
   EXPECT_THAT(report.iterations[2].held, HasSubstr("taken before the move ended"));
   EXPECT_EQ(report.moves, 1);
   EXPECT_LT(report.iterations.back().true_translation_error_mm, 1.0);
+}
+
+// A camera that says when it took its frames (as V4L2 timestamps do): the loop takes each
+// frame as seen from where the robot was then. This one's frames all claim to be ten seconds
+// old: the first ones, the robot still, are taken as they are; after the first move every
+// frame is older than the move, skipped, and the run stops on it rather than waiting for ever.
+class StaleFrames : public FrameSource {
+ public:
+  explicit StaleFrames(const LineTarget& target) : frames_(target, RenderOptions()) {}
+  bool Grab(const Capture& capture, cv::Mat* gray) override { return frames_.Grab(capture, gray); }
+  std::string Name() const override { return "a camera ten seconds late"; }
+  std::optional<double> TakenAt() const override {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+               .count() -
+           10.0;
+  }
+
+ private:
+  RenderedFrames frames_;
+};
+
+TEST(RunServoLoop, AFramesTimestampSaysWhereTheCameraWasWhenItWasTaken) {
+  ServoSetup setup = SheetSetup(ServoMode::kExponential);
+  setup.loop.max_lost_frames = 5;
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  StaleFrames frames(setup.target);
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kError) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("6 frames in a row were taken"));
+  EXPECT_THAT(report.message, HasSubstr("before the last move ended"));
+  EXPECT_EQ(report.moves, 1);
+  ASSERT_EQ(report.iterations.size(), 8u) << log.str();  // frames 2-7 skipped
+  EXPECT_EQ(report.iterations[2].status, "skipped");
+}
+
+TEST(RecordedFrames, ASourcesTimestampIsHandedOnWithItsFrame) {
+  class Stamped : public ImageSource {
+   public:
+    bool Next(Frame* frame) override {
+      frame->gray = cv::Mat(4, 4, CV_8UC1, cv::Scalar(1));
+      frame->taken_s = 12.5 + static_cast<double>(count_++);
+      return true;
+    }
+    std::string Name() const override { return "stamped"; }
+
+   private:
+    int count_ = 0;
+  };
+  RecordedFrames frames(std::make_unique<Stamped>());
+  EXPECT_FALSE(frames.TakenAt().has_value());
+  cv::Mat gray;
+  ASSERT_TRUE(frames.Grab(Capture{}, &gray));
+  EXPECT_EQ(frames.TakenAt(), 12.5);
+  EXPECT_FALSE(frames.AtEnd());  // reads the next ahead: the frame handed out keeps its time
+  EXPECT_EQ(frames.TakenAt(), 12.5);
+  ASSERT_TRUE(frames.Grab(Capture{}, &gray));
+  EXPECT_EQ(frames.TakenAt(), 13.5);
 }
 
 TEST(ServoLoopOptions, TheHoldsLimitsAreChecked) {
