@@ -1,8 +1,11 @@
 #include "app/servo_accuracy.h"
 
+#include <memory>
 #include <sstream>
+#include <utility>
 
 #include "app/servo_run.h"
+#include "eval/motion_audit.h"
 
 namespace oal {
 
@@ -33,7 +36,16 @@ ServoAccuracyReport EvaluateServoAccuracy(const ServoAppConfig& config,
     if (max_iterations > 0) run_config.servo.max_iterations = max_iterations;
     run_config.robot.start_wMc = start_wMc;
     std::ostringstream log;  // the per-iteration rows are not kept
-    return RunServo(run_config, log);
+    MotionAudit audit;
+    ServoRunHooks hooks;
+    hooks.wrap_driver = [&audit](std::unique_ptr<Robot> driver) {
+      return audit.Wrap(std::move(driver));
+    };
+    hooks.on_grab = [&audit](int iteration, cv::Mat*) { audit.FrameTaken(iteration); };
+    AuditedServoRun audited;
+    audited.report = RunServo(run_config, log, hooks);
+    audited.unconfirmed_motions = audit.Unconfirmed(audited.report);
+    return audited;
   };
   return EvaluateServoAccuracy(StartSceneOf(config), options, run, progress);
 }

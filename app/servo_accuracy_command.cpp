@@ -4,6 +4,7 @@
 #include <visp3/core/vpRxyzVector.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -23,11 +24,14 @@ namespace {
 
 std::string Table(const ServoAccuracyReport& report) {
   std::ostringstream out;
-  out << "| law | converged | moves median / p95 / max | true final error median / max |\n"
-      << "|---|---:|---:|---|\n";
+  out << "| law | converged | moves median / p95 / max | true final error median / max | "
+         "motion from an unconfirmed pose |\n"
+      << "|---|---:|---:|---|---:|\n";
   for (const ServoAccuracyLaw& law : report.laws) {
     std::vector<double> moves, mm, deg;
+    int unconfirmed = 0;
     for (const ServoAccuracyRun& run : law.runs) {
+      unconfirmed += std::max(run.unconfirmed_motions, 0);
       if (run.status != ServoRunStatus::kConverged) continue;
       moves.push_back(run.moves);
       mm.push_back(run.final_translation_error_mm);
@@ -39,7 +43,8 @@ std::string Table(const ServoAccuracyReport& report) {
         << std::setprecision(0) << Quantile(moves, 0.5) << " / " << Quantile(moves, 0.95) << " / "
         << Quantile(moves, 1.0) << " | " << std::setprecision(2) << Quantile(mm, 0.5) << " mm "
         << std::setprecision(3) << Quantile(deg, 0.5) << "° / " << std::setprecision(2)
-        << Quantile(mm, 1.0) << " mm " << std::setprecision(3) << Quantile(deg, 1.0) << "° |\n";
+        << Quantile(mm, 1.0) << " mm " << std::setprecision(3) << Quantile(deg, 1.0) << "° | "
+        << unconfirmed << " |\n";
   }
   for (const ServoAccuracyLaw& law : report.laws) {
     for (const ServoAccuracyRun& run : law.runs) {
@@ -69,6 +74,7 @@ nlohmann::json ToJson(const ServoAccuracyReport& report) {
                       {"status", ToString(run.status)},
                       {"message", run.message},
                       {"moves", run.moves},
+                      {"unconfirmed_motions", run.unconfirmed_motions},
                       {"start_distance_to_goal_m", run.start_distance_m},
                       {"start_rotation_to_goal_deg", run.start_off_deg},
                       {"final_true_translation_error_mm", run.final_translation_error_mm},

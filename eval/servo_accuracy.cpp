@@ -67,14 +67,16 @@ ServoAccuracyReport EvaluateServoAccuracy(const ServoStartScene& scene,
     ServoAccuracyLaw law;
     law.mode = mode;
     for (std::size_t i = 0; i < starts.size(); ++i) {
-      const ServoRunReport result =
+      const AuditedServoRun audited =
           run_from(starts[i], mode, options.max_iterations, static_cast<int>(i));
+      const ServoRunReport& result = audited.report;
       ServoAccuracyRun run;
       run.start = static_cast<int>(i);
       run.start_wMc = starts[i];
       run.status = result.status;
       run.message = result.message;
       run.moves = result.moves;
+      run.unconfirmed_motions = audited.unconfirmed_motions;
       if (!result.iterations.empty()) {
         const ServoIteration& first = result.iterations.front();
         const ServoIteration& last = result.iterations.back();

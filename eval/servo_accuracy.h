@@ -49,6 +49,9 @@ struct ServoAccuracyRun {
   double start_distance_m = 0, start_off_deg = 0;  ///< the start's distance to the goal
   double final_translation_error_mm = 0;           ///< true, at the last frame
   double final_rotation_error_deg = 0;
+  /// Motion commands the robot received after a frame the loop did not act on (-1: not
+  /// audited).
+  int unconfirmed_motions = -1;
 };
 
 struct ServoAccuracyLaw {
@@ -73,8 +76,14 @@ struct ServoStartScene {
 /// One servo run from the camera pose `start_wMc` (the `start`-th, 0 first) with the law
 /// `mode`, at most `max_iterations` (0: the run's own limit), the image in the loop; its
 /// report, whose iterations carry the true errors (a simulated camera).
-using ServoRunFrom = std::function<ServoRunReport(const vpHomogeneousMatrix& start_wMc,
-                                                  ServoMode mode, int max_iterations, int start)>;
+/// Its report, and the motion commands that reached the robot after a frame the loop did
+/// not act on (eval/motion_audit.h; -1: not audited).
+struct AuditedServoRun {
+  ServoRunReport report;
+  int unconfirmed_motions = -1;
+};
+using ServoRunFrom = std::function<AuditedServoRun(const vpHomogeneousMatrix& start_wMc,
+                                                   ServoMode mode, int max_iterations, int start)>;
 
 /// The start poses wMc of `options` in `scene` (deterministic in options.seed).
 std::vector<vpHomogeneousMatrix> SampleServoStarts(const ServoStartScene& scene,
