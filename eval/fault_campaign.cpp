@@ -26,6 +26,7 @@
 
 #include "base/check.h"
 #include "base/statistics.h"
+#include "robots/forwarding_robot.h"
 #include "robots/scorbot_controller_sim.h"
 
 namespace oal {
@@ -71,54 +72,42 @@ enum class DriveFault { kNone, kFails, kSilent };
 
 // The simulated robot's driver seen through a wrapper that logs its motion and stop calls and,
 // once the campaign switches a fault on, fails them as a broken drive would.
-class TappedRobot final : public Robot {
+class TappedRobot final : public ForwardingRobot {
  public:
   TappedRobot(std::unique_ptr<Robot> inner, std::shared_ptr<CommandLog> log,
               std::shared_ptr<std::atomic<DriveFault>> fault)
-      : inner_(std::move(inner)), log_(std::move(log)), fault_(std::move(fault)) {}
+      : ForwardingRobot(std::move(inner)), log_(std::move(log)), fault_(std::move(fault)) {}
 
-  std::string Name() const override { return inner_->Name(); }
-  RobotCapabilities Capabilities() const override { return inner_->Capabilities(); }
-  RobotResult Connect() override { return inner_->Connect(); }
   RobotResult Enable() override {
     const std::optional<RobotResult> fault = Fault();
-    return fault ? *fault : inner_->Enable();
+    return fault ? *fault : inner().Enable();
   }
   RobotResult Disable() noexcept override {
     log_->Add(true);
-    return fault_->load() == DriveFault::kSilent ? *Fault() : inner_->Disable();
+    return fault_->load() == DriveFault::kSilent ? *Fault() : inner().Disable();
   }
   RobotResult Stop() noexcept override {
     log_->Add(true);
-    return fault_->load() == DriveFault::kSilent ? *Fault() : inner_->Stop();
+    return fault_->load() == DriveFault::kSilent ? *Fault() : inner().Stop();
   }
   RobotPose GetPosition(RobotFrame frame) override {
     const std::optional<RobotResult> fault = Fault();
-    return fault ? RobotPose{*fault, vpHomogeneousMatrix()} : inner_->GetPosition(frame);
+    return fault ? RobotPose{*fault, vpHomogeneousMatrix()} : inner().GetPosition(frame);
   }
   RobotResult StartMove(RobotFrame frame, const vpHomogeneousMatrix& target) override {
     log_->Add(false);
     const std::optional<RobotResult> fault = Fault();
-    return fault ? *fault : inner_->StartMove(frame, target);
+    return fault ? *fault : inner().StartMove(frame, target);
   }
   MoveProgress PollMove() override {
     const std::optional<RobotResult> fault = Fault();
-    return fault ? MoveProgress{*fault, false} : inner_->PollMove();
+    return fault ? MoveProgress{*fault, false} : inner().PollMove();
   }
   RobotResult SetVelocity(RobotFrame frame, const vpColVector& v) override {
     if (v.frobeniusNorm() > 0.0) log_->Add(false);  // a zero twist holds the robot: no motion
     const std::optional<RobotResult> fault = Fault();
-    return fault ? *fault : inner_->SetVelocity(frame, v);
+    return fault ? *fault : inner().SetVelocity(frame, v);
   }
-  RobotPose NearestReachable(RobotFrame frame, const vpHomogeneousMatrix& target) override {
-    return inner_->NearestReachable(frame, target);  // computes only
-  }
-  RobotPose PoseAlongMove(RobotFrame frame, const vpHomogeneousMatrix& from,
-                          const vpHomogeneousMatrix& target, double fraction) const override {
-    return inner_->PoseAlongMove(frame, from, target, fraction);
-  }
-  vpHomogeneousMatrix eMc() const override { return inner_->eMc(); }
-  std::string LinkSummary(int moves) const override { return inner_->LinkSummary(moves); }
 
  private:
   std::optional<RobotResult> Fault() const {
@@ -133,7 +122,6 @@ class TappedRobot final : public Robot {
     return std::nullopt;
   }
 
-  std::unique_ptr<Robot> inner_;
   std::shared_ptr<CommandLog> log_;
   std::shared_ptr<std::atomic<DriveFault>> fault_;
 };

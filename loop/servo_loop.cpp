@@ -223,9 +223,7 @@ ServoIteration RowAt(const LoopRobot& robot, bool knows_truth, int iteration,
   return row;
 }
 
-// Why a frame's pose cannot command the robot: none (the tracker's reason), or it disagrees
-// with `reference` (the odometry's prediction, or the pose it should confirm) beyond
-// servo.max_pose_jump_m / max_pose_jump_deg. Empty when it can.
+// Why a frame has no pose, in the tracker's words: the pose's status and message.
 std::string NoPoseReason(const TargetFrame& tracked) {
   const PoseResult& pose = tracked.pose;
   // The pose's own status when it failed, else what the tracker refused it for.
@@ -235,6 +233,8 @@ std::string NoPoseReason(const TargetFrame& tracked) {
          (message.empty() ? "" : " (" + message + ")");
 }
 
+// How far cMo is from `reference` (the odometry's prediction, or the pose it should confirm)
+// when beyond servo.max_pose_jump_m or max_pose_jump_deg; nothing when it agrees.
 std::optional<PoseDistance> Disagreement(const vpHomogeneousMatrix& cMo,
                                          const vpHomogeneousMatrix& reference,
                                          const ServoLoopOptions& loop) {
@@ -762,11 +762,10 @@ class ServoRun {
       if (std::optional<PoseDistance> jump = Disagreement(cMo, candidate, setup_.loop)) {
         candidate_cMo_ = cMo;  // the next frame may confirm this one
         verdict.hold = HoldReason{
-            "pose not confirmed: estimated on its own, this frame puts the "
-            "target " +
+            "pose not confirmed: estimated on its own, this frame puts the target " +
                 Apart(*jump, setup_.loop) +
-                " from where the last frame did, the robot still (the "
-                "pose is ambiguous or wrong)",
+                " from where the last frame did, the robot still (the pose is ambiguous or "
+                "wrong)",
             ServoRunStatus::kPoseJump};
         return verdict;
       }
@@ -853,9 +852,9 @@ class ServoRun {
   // A pose that commands again after a hold: said once.
   void EndHold(int iteration) {
     if (!hold_) return;
-    log_ << "carrying on at frame " << iteration
-         << " after holding " + Counted(hold_->frames, "frame") + " since frame "
-         << hold_->since_iteration << ": the target found again and confirmed\n";
+    log_ << "carrying on at frame " << iteration << " after holding "
+         << Counted(hold_->frames, "frame") << " since frame " << hold_->since_iteration
+         << ": the target found again and confirmed\n";
     hold_.reset();
   }
 
