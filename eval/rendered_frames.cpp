@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "base/check.h"
+#include "base/random.h"
 #include "io/image_source.h"
 
 namespace oal {
@@ -15,14 +16,9 @@ constexpr const char* kVispImages = "/usr/share/visp-images-data/ViSP-images";
 }  // namespace
 
 double Uniform01(std::uint64_t seed, int frame, std::uint64_t stream) {
-  std::uint64_t x = seed * 0x9E3779B97F4A7C15ULL +
-                    static_cast<std::uint64_t>(frame) * 0xBF58476D1CE4E5B9ULL + stream;
-  x ^= x >> 30;
-  x *= 0xBF58476D1CE4E5B9ULL;
-  x ^= x >> 27;
-  x *= 0x94D049BB133111EBULL;
-  x ^= x >> 31;
-  return static_cast<double>(x >> 11) * 0x1.0p-53;
+  return UnitInterval(SplitMixFinal(seed * 0x9E3779B97F4A7C15ULL +
+                                    static_cast<std::uint64_t>(frame) * 0xBF58476D1CE4E5B9ULL +
+                                    stream));
 }
 
 void RenderedFrameOptions::Check() const {

@@ -6,19 +6,12 @@
 #include <utility>
 
 #include "base/check.h"
+#include "base/random.h"
 
 namespace oal {
 namespace {
 
 constexpr std::uint64_t kNoiseSeed = 20240605;
-
-// One step of SplitMix64: a well-mixed 64-bit value from a counter.
-std::uint64_t SplitMix64(std::uint64_t* state) {
-  std::uint64_t z = (*state += 0x9E3779B97F4A7C15ULL);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
 
 // The smear of the camera's twist over `exposure_s` where the target's origin is seen: its
 // image moves by (du, dv) = exposure * d(px X/Z, py Y/Z)/dt, the point moving by
@@ -62,8 +55,8 @@ int RenderedFrames::EpisodeAt(double time_s) {
   // Each episode's length from its own draw: the same episodes whatever the frames asked.
   while (episode_ends_.empty() || episode_ends_.back() <= time_s) {
     const auto index = static_cast<std::uint64_t>(episode_ends_.size());
-    std::uint64_t state = scene_.seed * 0x9E3779B97F4A7C15ULL + index * 0xBF58476D1CE4E5B9ULL + 1;
-    const double uniform = static_cast<double>(SplitMix64(&state) >> 11) * 0x1.0p-53;
+    const double uniform = UnitInterval(
+        SplitMix64(scene_.seed * 0x9E3779B97F4A7C15ULL + index * 0xBF58476D1CE4E5B9ULL + 1));
     const double length =
         scene_.episode_s.lo + uniform * (scene_.episode_s.hi - scene_.episode_s.lo);
     episode_ends_.push_back((episode_ends_.empty() ? 0.0 : episode_ends_.back()) + length);

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "base/check.h"
+#include "base/random.h"
 #include "detector/line.h"  // kPi
 
 namespace oal {
@@ -21,20 +22,13 @@ enum Stream : std::uint64_t {
   kJpegStream,
 };
 
-std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
 // Uniform draws in [0, 1) of one stream of one frame (std::mt19937_64 is specified exactly,
 // unlike the standard distributions, so the scenes are the same on every platform).
 class Draws {
  public:
   Draws(std::uint64_t seed, int frame, Stream stream)
-      : gen_(Mix(Mix(seed ^ 0x6c6976656420696eull) + static_cast<std::uint64_t>(frame) * 131u +
-                 stream)) {}
+      : gen_(SplitMix64(SplitMix64(seed ^ 0x6c6976656420696eull) +
+                        static_cast<std::uint64_t>(frame) * 131u + stream)) {}
   double operator()() { return static_cast<double>(gen_() >> 11) * 0x1.0p-53; }
   double In(const DrawRange& range) { return range.lo + (range.hi - range.lo) * (*this)(); }
 

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/random.h"
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "scene/geometry.h"
@@ -538,17 +539,9 @@ void ApplyGainOffset(double gain, double offset, cv::Mat1f* image) {
   image->convertTo(*image, CV_32F, gain, offset);
 }
 
-// SplitMix64, to spread nearby seeds over the generator's state space.
-std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
 void AddNoise(double sigma, std::uint64_t seed, cv::Mat1f* image) {
   if (sigma <= 0.0) return;
-  cv::RNG rng(Mix(seed));
+  cv::RNG rng(SplitMix64(seed));
   cv::Mat1f noise(image->size());
   rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
   *image += noise;
@@ -872,7 +865,7 @@ double ValueNoise(double X, double Y, double cell_m, std::uint64_t seed) {
   const auto lattice = [seed](double i, double j) {
     const auto key = static_cast<std::uint64_t>(static_cast<long long>(i)) * 0x9E3779B97F4A7C15ull ^
                      static_cast<std::uint64_t>(static_cast<long long>(j));
-    return static_cast<double>(Mix(seed ^ Mix(key)) >> 11) * 0x1.0p-52 - 1.0;
+    return static_cast<double>(SplitMix64(seed ^ SplitMix64(key)) >> 11) * 0x1.0p-52 - 1.0;
   };
   const double top = (1.0 - ax) * lattice(x0, y0) + ax * lattice(x0 + 1.0, y0);
   const double bottom = (1.0 - ax) * lattice(x0, y0 + 1.0) + ax * lattice(x0 + 1.0, y0 + 1.0);
@@ -1212,7 +1205,7 @@ Decal PrintedPictureDecal(const LineTarget& target, const RenderOptions& options
 
 // Other sheets and objects on the surface, drawn from options.scene_seed.
 void LayOutClutter(const LineTarget& target, const RenderOptions& options, SceneDressing* d) {
-  std::mt19937_64 gen(Mix(options.scene_seed ^ 0x636c7574746572ull));
+  std::mt19937_64 gen(SplitMix64(options.scene_seed ^ 0x636c7574746572ull));
   const double hw = 0.5 * target.board_width_m, hh = 0.5 * target.board_height_m;
   const double reach_x = hw + options.clutter_reach_m, reach_y = hh + options.clutter_reach_m;
   const Quad board_grown = RotatedRect(0.0, 0.0, 0.0, hw + kClutterGapM, hh + kClutterGapM);
@@ -1273,7 +1266,7 @@ std::shared_ptr<const SceneDressing> BuildDressing(const LineTarget& target,
   if (!NeedsDressing(options)) return nullptr;
   auto d = std::make_shared<SceneDressing>();
   d->paper_texture_grey = options.paper_texture_grey;
-  d->paper_seed = Mix(options.scene_seed ^ 0x7061706572ull);
+  d->paper_seed = SplitMix64(options.scene_seed ^ 0x7061706572ull);
   Quad picture_outline{};
   if (!options.printed_picture.empty()) {
     d->picture.push_back(PrintedPictureDecal(target, options, &picture_outline));
@@ -1347,8 +1340,9 @@ class PlaneEvents {
       if (cover <= 0.0) continue;
       double grey = occluder.grey;
       if (occluder.texture_grey > 0.0) {
-        grey += occluder.texture_grey *
-                ValueNoise(s.X, s.Y, kOccluderCellM, Mix(occluder.texture_seed ^ 0x68616e64ull));
+        grey +=
+            occluder.texture_grey *
+            ValueNoise(s.X, s.Y, kOccluderCellM, SplitMix64(occluder.texture_seed ^ 0x68616e64ull));
       }
       value += cover * (grey - value);
     }

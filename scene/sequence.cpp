@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/random.h"
 #include "scene/geometry.h"
 
 namespace oal {
@@ -44,10 +45,7 @@ double Uniform(std::mt19937_64& gen, double lo, double hi) {
 
 // SplitMix64 of (seed, frame): the noise seed of one frame.
 std::uint64_t FrameNoiseSeed(std::uint64_t seed, int frame) {
-  std::uint64_t x = seed + 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(frame + 1);
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
+  return SplitMix64(seed + 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(frame));
 }
 
 using scene_geometry::Cross;
