@@ -15,8 +15,26 @@ namespace {
 // A quadrilateral is kept only when its cells fill at least this much of it.
 constexpr double kMinFill = 0.6;
 // Refinement: points probed along each side, and how far along the normal, in cells.
-constexpr int kEdgePoints = 7;
-constexpr double kEdgeSearchCells = 1.5;
+constexpr int kEdgePoints = 9;
+constexpr std::size_t kMinEdgePoints = 4;
+constexpr double kEdgeSearchCells = 2.5;
+constexpr double kEdgeTolerancePx = 1.5;
+// The last pass: a cell is light only when it is at least this fraction of the brightest cell
+// within this many cells (a stripe under a glare stays darker than the paper beside it).
+constexpr int kLocalRadiusCells = 3;
+constexpr double kLocalLightRatio = 0.8;
+constexpr int kSaturatedGrey = 250;
+constexpr int kLocalSaturationMargin = 15;
+
+// The mean of the values of histogram[from, 256); 0 when there are none.
+double MeanFrom(const std::array<int, 256>& histogram, int from) {
+  double count = 0.0, sum = 0.0;
+  for (int g = from; g < 256; ++g) {
+    count += histogram[static_cast<std::size_t>(g)];
+    sum += static_cast<double>(g) * histogram[static_cast<std::size_t>(g)];
+  }
+  return count > 0.0 ? sum / count : 0.0;
+}
 
 // Otsu's threshold over the values of histogram[lo, 256): values >= the result are the
 // light class; *contrast gets the two classes' mean difference (0 when a class is empty).
@@ -102,7 +120,7 @@ struct Side {
 bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light, double search,
             int min_contrast, Point2d* edge) {
   const int n = static_cast<int>(2.0 * search) + 1;
-  std::array<double, 256> profile;
+  std::array<double, 512> profile;
   if (n > static_cast<int>(profile.size())) return false;
   double darkest = 255.0;
   for (int i = 0; i < n; ++i) {
@@ -133,18 +151,40 @@ bool RefineSide(const GrayImageView& image, const Side& side, double light, doub
                 int min_contrast, LineParams* line) {
   std::vector<Point2d> points;
   for (int k = 0; k < kEdgePoints; ++k) {
-    const double t = 0.15 + 0.7 * k / (kEdgePoints - 1.0);
+    const double t = 0.1 + 0.8 * k / (kEdgePoints - 1.0);
     Point2d edge;
     if (EdgeAt(image, side, t, light, search, min_contrast, &edge)) points.push_back(edge);
   }
-  if (points.size() < 4) return false;
-  LineParams fit = FitLine(points);
-  std::vector<Point2d> close;
-  for (const Point2d& p : points) {
-    if (std::fabs(fit.SignedDistance(p.u, p.v)) <= 1.5) close.push_back(p);
+  if (points.size() < kMinEdgePoints) return false;
+  // The line through two of the points that most of the others lie on: a hand or a pen over
+  // part of the side puts its own edge in a few of them.
+  // Distances to the line through points[i] and points[j] by its unit normal (no angles:
+  // this runs for every pair).
+  auto on_line = [&](std::size_t i, std::size_t j, const Point2d& p) {
+    const double du = points[j].u - points[i].u, dv = points[j].v - points[i].v;
+    const double length = std::hypot(du, dv);
+    return length > 0.0 && std::fabs((p.u - points[i].u) * dv - (p.v - points[i].v) * du) <=
+                               kEdgeTolerancePx * length;
+  };
+  std::size_t most = 0, best_i = 0, best_j = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (std::size_t j = i + 1; j < points.size(); ++j) {
+      const auto on = static_cast<std::size_t>(std::count_if(
+          points.begin(), points.end(), [&](const Point2d& p) { return on_line(i, j, p); }));
+      if (on > most) {
+        most = on;
+        best_i = i;
+        best_j = j;
+      }
+    }
   }
-  if (close.size() < 4) return false;
-  *line = FitLine(close);
+  if (most < kMinEdgePoints) return false;
+  std::vector<Point2d> kept;
+  for (const Point2d& p : points) {
+    if (on_line(best_i, best_j, p)) kept.push_back(p);
+  }
+  points.swap(kept);
+  *line = FitLine(points);
   return true;
 }
 
@@ -282,7 +322,7 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
   }
 }
 
-bool SheetFinder::Describe(const GrayImageView& image, int threshold,
+bool SheetFinder::Describe(const GrayImageView& image, const std::uint8_t* grid, int threshold,
                            const std::vector<CellRun>& runs, LightQuad* quad) const {
   const int c = options_.cell_px;
   // Cell edges in pixel coordinates (pixel centres at integers), clamped to the image.
@@ -349,7 +389,7 @@ bool SheetFinder::Describe(const GrayImageView& image, int threshold,
   for (int k = 0; k < 4 && open < 2; ++k) {
     const Side& side = sides[static_cast<std::size_t>(k)];
     auto closed_at = [&](double t) {
-      return ClosedInCells(side.At(t, 0.0), side.outward, threshold, reach);
+      return ClosedInCells(grid, side.At(t, 0.0), side.outward, threshold, reach);
     };
     const int first_two = closed_at(0.3) + closed_at(0.7);
     const bool closed = first_two == 2 || (first_two == 1 && closed_at(0.5));
@@ -370,11 +410,15 @@ bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
   const std::array<Point2d, 4>& q = quad->corners;
   const std::array<Side, 4> sides{Side(q[0], q[1]), Side(q[1], q[2]), Side(q[2], q[3]),
                                   Side(q[3], q[0])};
+  // A side whose edge is not found (a hand over it) stays where the cells put it: the other
+  // three still place the corners better than the cells do.
   std::array<LineParams, 4> lines;
-  for (int k = 0; k < 4; ++k) {
-    if (!RefineSide(image, sides[static_cast<std::size_t>(k)], quad->light, kEdgeSearchCells * c,
-                    options_.min_contrast, &lines[static_cast<std::size_t>(k)])) {
-      return false;
+  int unmoved = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (!RefineSide(image, sides[k], quad->light, kEdgeSearchCells * c, options_.min_contrast,
+                    &lines[k])) {
+      lines[k] = LineThrough(sides[k].a, sides[k].b);
+      if (++unmoved > 1) return false;
     }
   }
   std::array<Point2d, 4> refined{};
@@ -397,6 +441,37 @@ bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
   return quad->refined;
 }
 
+void SheetFinder::MarkLocallyDark() {
+  // A separable maximum over (2 kLocalRadiusCells + 1)^2 cells, then the cells darker than
+  // kLocalLightRatio of it set to 0.
+  const int w = grid_width_, h = grid_height_, r = kLocalRadiusCells;
+  // Where the paper itself is not saturated, a saturated cell is a glare's core, over ink and
+  // paper alike: it tells nothing, and taken as light it would join the cells around it.
+  const bool glare_saturates = first_light_ < kSaturatedGrey - kLocalSaturationMargin;
+  row_max_.resize(cells_.size());
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* in = cells_.data() + static_cast<std::size_t>(y) * w;
+    std::uint8_t* out = row_max_.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      out[x] = *std::max_element(in + std::max(0, x - r), in + std::min(w, x + r + 1));
+    }
+  }
+  local_.resize(cells_.size());
+  for (int y = 0; y < h; ++y) {
+    const int top = std::max(0, y - r), bottom = std::min(h - 1, y + r);
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t brightest = 0;
+      for (int k = top; k <= bottom; ++k) {
+        brightest = std::max(brightest, row_max_[static_cast<std::size_t>(k) * w + x]);
+      }
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const bool light = cells_[i] >= kLocalLightRatio * brightest &&
+                         !(glare_saturates && cells_[i] >= kSaturatedGrey);
+      local_[i] = light ? cells_[i] : 0;
+    }
+  }
+}
+
 int SheetFinder::Root(int run) {
   while (runs_[static_cast<std::size_t>(run)].parent != run) {
     CellRun& r = runs_[static_cast<std::size_t>(run)];
@@ -406,8 +481,8 @@ int SheetFinder::Root(int run) {
   return run;
 }
 
-bool SheetFinder::ClosedInCells(const Point2d& from, const Point2d& outward, int threshold,
-                                double reach) const {
+bool SheetFinder::ClosedInCells(const std::uint8_t* grid, const Point2d& from,
+                                const Point2d& outward, int threshold, double reach) const {
   const double c = options_.cell_px;
   const int steps = static_cast<int>(reach / c) + 1;
   int dark = 0;
@@ -416,7 +491,7 @@ bool SheetFinder::ClosedInCells(const Point2d& from, const Point2d& outward, int
     const int gx = static_cast<int>(std::floor((p.u + 0.5) / c));
     const int gy = static_cast<int>(std::floor((p.v + 0.5) / c));
     if (gx < 0 || gy < 0 || gx >= grid_width_ || gy >= grid_height_) return false;
-    const bool light = cells_[static_cast<std::size_t>(gy) * grid_width_ + gx] >= threshold;
+    const bool light = grid[static_cast<std::size_t>(gy) * grid_width_ + gx] >= threshold;
     if (!light) {
       ++dark;
     } else if (dark > 0) {
@@ -426,7 +501,8 @@ bool SheetFinder::ClosedInCells(const Point2d& from, const Point2d& outward, int
   return false;
 }
 
-void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
+void SheetFinder::AddComponents(const GrayImageView& image, const std::uint8_t* grid,
+                                int threshold) {
   // Runs of light cells row by row, each joined to the runs of the row above that it touches
   // (4-connectivity: overlapping columns). A row's light cells are found as a bit mask and its
   // runs by counting zeros: on a textured bench, a branch per cell mispredicts at every run.
@@ -435,7 +511,7 @@ void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
   light_bits_.resize(static_cast<std::size_t>(words));
   std::size_t above_begin = 0, above_end = 0;
   for (int gy = 0; gy < grid_height_; ++gy) {
-    LightMask(cells_.data() + static_cast<std::size_t>(gy) * grid_width_, grid_width_, threshold,
+    LightMask(grid + static_cast<std::size_t>(gy) * grid_width_, grid_width_, threshold,
               light_bits_.data());
     const std::size_t row_begin = runs_.size();
     std::size_t above = above_begin;  // the first run above that may touch this row's next run
@@ -509,7 +585,7 @@ void SheetFinder::AddComponents(const GrayImageView& image, int threshold) {
     });
     if (seen) continue;
     LightQuad quad;
-    if (!Describe(image, threshold, component_, &quad)) continue;
+    if (!Describe(image, grid, threshold, component_, &quad)) continue;
     boxes_.push_back(box);
     candidates_.push_back(quad);
   }
@@ -534,24 +610,52 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
   // Light against dark, then the light class split again (a light bench, a bright photo),
   // until a cell closed in on all four sides (a '#'s middle cell) is found: the splits are
   // for a sheet the first threshold merged with the bench, and cost a labelling each.
+  first_threshold_ = -1;
+  first_light_ = 0.0;
+  local_done_ = false;
   int lo = 0;
-  for (int level = 0; level < 3; ++level) {
+  bool closed = false;
+  for (int level = 0; level < 3 && !closed; ++level) {
     double contrast = 0.0;
     const int threshold = OtsuOfHistogram(histogram, lo, &contrast);
     if (threshold > 255 || contrast < options_.min_contrast) break;
-    AddComponents(image, threshold);
+    AddComponents(image, cells_.data(), threshold);
     lo = threshold;
-    if (std::any_of(candidates_.begin(), candidates_.end(),
-                    [](const LightQuad& quad) { return quad.ClosedSideCount() == 4; })) {
-      break;
+    if (first_threshold_ < 0) {
+      first_threshold_ = threshold;
+      first_light_ = MeanFrom(histogram, threshold);
     }
+    closed = std::any_of(candidates_.begin(), candidates_.end(),
+                         [](const LightQuad& quad) { return quad.ClosedSideCount() == 4; });
   }
+  if (!closed) AddLocallyLight(image);
+  KeepBest();
+  return candidates_;
+}
+
+const std::vector<LightQuad>& SheetFinder::FindLocallyLight(const GrayImageView& image) {
+  candidates_.clear();
+  if (!local_done_ && image.width / options_.cell_px == grid_width_ &&
+      image.height / options_.cell_px == grid_height_) {
+    AddLocallyLight(image);
+    KeepBest();
+  }
+  return candidates_;
+}
+
+void SheetFinder::AddLocallyLight(const GrayImageView& image) {
+  local_done_ = true;
+  if (first_threshold_ < 0) return;
+  MarkLocallyDark();
+  AddComponents(image, local_.data(), first_threshold_);
+}
+
+void SheetFinder::KeepBest() {
   std::stable_sort(candidates_.begin(), candidates_.end(),
                    [](const LightQuad& a, const LightQuad& b) { return a.score > b.score; });
   if (static_cast<int>(candidates_.size()) > options_.max_candidates) {
     candidates_.resize(static_cast<std::size_t>(options_.max_candidates));
   }
-  return candidates_;
 }
 
 }  // namespace oal

@@ -12,7 +12,12 @@
 //   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
 //      Otsu's over the light class again (a light bench, a bright photo), while the classes
 //      differ by at least min_contrast and no quadrilateral closed in on all four sides has
-//      been found at the thresholds before;
+//      been found at the thresholds before; when none is, a last pass at the first threshold
+//      with the cells darker than 0.8 times the brightest within three cells taken as dark,
+//      and saturated ones too where the paper is not (a stripe under a glare stays darker
+//      than the paper beside it, a glare's core is no paper, a grey hand is darker than the
+//      paper): this last pass is also FindLocallyLight's, for a caller none of whose
+//      candidates was the target;
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
@@ -22,8 +27,10 @@
 //      when dark pixels (a band of at least 2 px, min_contrast below the cell) and light ones
 //      again follow;
 //   4. a quadrilateral closed in on at least three sides is refined at pixel level: every
-//      side is moved onto the light/dark edge found along its normal at seven points
-//      (sub-pixel, a line fitted through them), and the corners are the sides' crossings;
+//      side is moved onto the light/dark edge found along its normal at nine points
+//      (sub-pixel; the line through two of them that most others lie within 1.5 px of, then
+//      fitted to those: a hand or a pen over part of a side), one side whose edge is not found
+//      left where the cells put it, and the corners are the sides' crossings;
 //   5. candidates are ranked by the sides closed in, how well the cells fill the
 //      quadrilateral, and its area; the same quadrilateral found at another threshold is
 //      kept once.
@@ -60,8 +67,9 @@ struct SheetFinderOptions {
 
 /// A light quadrilateral of the frame.
 struct LightQuad {
-  /// Corners in the image borders' turning sense (region.h), image pixels; on the light/dark
-  /// edges when `refined`.
+  /// Corners in the image borders' turning sense (region.h), image pixels; when `refined`,
+  /// the crossings of its sides moved onto the light/dark edges (three of them at least, a
+  /// side whose edge was not found left where the cells put it).
   std::array<Point2d, 4> corners;
   bool refined = false;
   /// Sides (0-3; side k runs from corner k to corner k+1) beyond which a dark band and light
@@ -85,6 +93,13 @@ class SheetFinder {
   /// The candidates of `image`, best first (may be none). The reference stays valid until
   /// the next call. Throws std::invalid_argument for an empty view.
   const std::vector<LightQuad>& Find(const GrayImageView& image);
+  /// More candidates of the image last given to Find, for when none of its own was the
+  /// target: the light cells again at its first threshold, those darker than 0.8 times the
+  /// brightest cell within three cells taken as dark (a stripe under a glare stays darker than
+  /// the paper beside it; a grey hand bridging the middle cell to the next is darker than the
+  /// paper), quadrilaterals Find returned left out. Empty when Find made this pass itself (it
+  /// does when it finds no quadrilateral closed in on four sides). Same validity as Find's.
+  const std::vector<LightQuad>& FindLocallyLight(const GrayImageView& image);
   /// Step 4 for one candidate of the same image (done on demand: a caller usually needs the
   /// first only): its sides moved onto the light/dark edges, sub-pixel. True when quad is
   /// (now) refined; its corners are unchanged otherwise.
@@ -107,20 +122,30 @@ class SheetFinder {
   void ComputeCells(const GrayImageView& image);
   /// Whether, stepping from `from` along `outward` (unit) through the grid's cells, dark
   /// cells and then light ones follow within `reach` px (at `threshold`).
-  bool ClosedInCells(const Point2d& from, const Point2d& outward, int threshold,
-                     double reach) const;
+  bool ClosedInCells(const std::uint8_t* grid, const Point2d& from, const Point2d& outward,
+                     int threshold, double reach) const;
   /// Adds the candidates of the light cells at `threshold` to candidates_.
-  void AddComponents(const GrayImageView& image, int threshold);
+  void AddComponents(const GrayImageView& image, const std::uint8_t* grid, int threshold);
+  /// local_: the cells, those much darker than the brightest near them set to 0.
+  void MarkLocallyDark();
+  /// Candidates of local_ at first_threshold_ (the last pass).
+  void AddLocallyLight(const GrayImageView& image);
+  /// candidates_ best first, at most max_candidates.
+  void KeepBest();
   int Root(int run);
   /// One component, given as its runs (sorted by row), into a candidate; false when it is no
   /// quadrilateral.
-  bool Describe(const GrayImageView& image, int threshold, const std::vector<CellRun>& runs,
-                LightQuad* quad) const;
+  bool Describe(const GrayImageView& image, const std::uint8_t* grid, int threshold,
+                const std::vector<CellRun>& runs, LightQuad* quad) const;
 
   SheetFinderOptions options_;
   int grid_width_ = 0, grid_height_ = 0;
   std::vector<std::uint8_t> cells_;
-  std::vector<std::uint32_t> row_sums_;    ///< per grid row, prefix sums of the cell means
+  std::vector<std::uint8_t> local_, row_max_;
+  int first_threshold_ = -1;             ///< the first pass's threshold of the last frame; -1: none
+  double first_light_ = 0.0;             ///< the mean of the cells at or above it
+  bool local_done_ = false;              ///< the last pass made for the last frame
+  std::vector<std::uint32_t> row_sums_;  ///< per grid row, prefix sums of the cell means
   std::vector<std::uint64_t> light_bits_;  ///< one grid row's light cells at a threshold
   std::vector<CellRun> runs_;
   std::vector<CellRun> component_;

@@ -47,8 +47,9 @@ struct StripeFitOptions {
   double min_scale_px = 0.1;
   /// A run is the stripe's only when its width across the stripe is within this factor of
   /// the stripe's width where the pose puts it (blur and the threshold change a width a
-  /// little; a run merged with a finger or a pen changes it a lot). Range [1, 100].
-  double max_width_ratio = 1.7;
+  /// little; a run merged with a finger, a pen or a cable lying against the stripe changes it
+  /// by their width, and its middle by half that). Range [1, 100].
+  double max_width_ratio = 1.35;
   /// A run one side of which is lighter than the other by more than this fraction of its
   /// depth (FramePoint::background_step: a glare's slope, a shadow's edge beside the stripe)
   /// is not centred on its stripe and is left out. Range (0, 1e9].

@@ -25,10 +25,10 @@ constexpr double kWaysRoundMargin = 0.1;
 // stripe's ends and middle), and this close in angle.
 constexpr double kGuideReach = 0.3;
 constexpr double kGuideMaxAngleRad = 8.0 * kPi / 180.0;
-// A pose fitted without four lines: each stripe's runs within this log ratio of its width
-// (0.22: 0.8 to 1.25 times; a stripe taken for its partner is 1.5 or 0.67 times), and its
-// points spanning this fraction of it at least (a stripe seen over less, its other stretches
-// under a hand or beyond the image, leaves the pose's tilt about it poorly told).
+// A pose fitted to the stripes: each stripe's runs within this log ratio of its width (0.22:
+// 0.8 to 1.25 times; a stripe taken for its partner is 1.5 or 0.67 times); without four lines
+// also its points spanning this fraction of it at least (a stripe seen over less, its other
+// stretches under a hand or beyond the image, leaves the pose's tilt about it poorly told).
 constexpr double kMaxFittedWidthLog = 0.22;
 constexpr double kMinFittedExtent = 0.12;
 // ... and its fits take points in corridors these many times the fit's, in turn.
@@ -232,6 +232,14 @@ std::array<std::vector<Point2d>, 4> TargetPoseTracker::StripePoints(double toler
 
 namespace {
 
+// The first stripe (0-3) whose kept runs are, at their median, not as wide as it; -1 when none.
+int MergedStripe(const StripeFit& fit) {
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (std::fabs(std::log(fit.width_ratio[k])) > kMaxFittedWidthLog) return static_cast<int>(k);
+  }
+  return -1;
+}
+
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -374,7 +382,17 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     frame_.fit = FitStripes(frame_.pose.cMo, layout_, detector_.feature_points(), camera_,
                             detector_.Undistorts(), options_.stripe_fit);
     if (frame_.fit.ok && !prior) frame_.fit = OtherTiltIfBetter(frame_.fit);
-    if (frame_.fit.ok) {
+    const int merged = frame_.fit.ok ? MergedStripe(frame_.fit) : -1;
+    if (merged >= 0 && source != ScanSource::kImage) {
+      // A stripe whose runs are not as wide as it: most of them merged with something beside
+      // it (a cable along it, a glare's slope), their middles off its centre line.
+      frame_.pose.status = PoseStatus::kDegenerate;
+      std::ostringstream message;
+      message << "the stripes' points do not hold the lines' pose: line " << merged + 1
+              << "'s runs are " << frame_.fit.width_ratio[static_cast<std::size_t>(merged)]
+              << " times its width";
+      frame_.pose.message = message.str();
+    } else if (frame_.fit.ok) {
       ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
     } else if (frame_.fit.starved_line >= 0 && source != ScanSource::kImage) {
       // The lines' pose puts a stripe where too few runs as wide as it lie (a line drawn
@@ -625,6 +643,29 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
   return false;
 }
 
+bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
+                                     const std::vector<LightQuad>& cells) {
+  int tried = 0;
+  for (LightQuad cell : cells) {
+    if (cell.ClosedSideCount() < 3 || tried >= options_.max_candidates) continue;
+    ++tried;
+    const auto refine_start = std::chrono::steady_clock::now();
+    finder_.Refine(image, &cell);
+    frame_.find_us += Microseconds(refine_start);
+    const std::optional<vpHomography> plane_to_image = PlaneToImageFromCell(layout_, cell, camera_);
+    if (plane_to_image && AttemptCandidate(image, *plane_to_image, ScanSource::kMiddleCell)) {
+      return true;
+    }
+    // Closed in on three sides: the middle cell broken open (a hand, a glare), or a cell
+    // beyond a stripe whose fourth side is the sheet's edge.
+    for (const TargetLayout::EdgeCell& edge : layout_.edge_cells) {
+      const std::optional<vpHomography> beyond = PlaneToImageFromEdgeCell(edge, cell, camera_);
+      if (beyond && AttemptCandidate(image, *beyond, ScanSource::kEdgeCell)) return true;
+    }
+  }
+  return false;
+}
+
 const TargetFrame& TargetPoseTracker::Track(
     const GrayImageView& image, const std::optional<vpHomogeneousMatrix>& predicted_cMo) {
   frame_ = TargetFrame{};
@@ -644,27 +685,17 @@ const TargetFrame& TargetPoseTracker::Track(
       }
     }
     if (!found) {
-      const auto start = std::chrono::steady_clock::now();
+      auto start = std::chrono::steady_clock::now();
       const std::vector<LightQuad>& cells = finder_.Find(image);
       frame_.find_us = Microseconds(start);
-      for (LightQuad cell : cells) {
-        if (cell.ClosedSideCount() < 3 || frame_.candidates >= options_.max_candidates) continue;
-        const auto refine_start = std::chrono::steady_clock::now();
-        finder_.Refine(image, &cell);
-        frame_.find_us += Microseconds(refine_start);
-        const std::optional<vpHomography> plane_to_image =
-            PlaneToImageFromCell(layout_, cell, camera_);
-        if (plane_to_image &&
-            (found = AttemptCandidate(image, *plane_to_image, ScanSource::kMiddleCell))) {
-          break;
-        }
-        // Closed in on three sides: the middle cell broken open (a hand, a glare), or a cell
-        // beyond a stripe whose fourth side is the sheet's edge.
-        for (const TargetLayout::EdgeCell& edge : layout_.edge_cells) {
-          const std::optional<vpHomography> beyond = PlaneToImageFromEdgeCell(edge, cell, camera_);
-          if (beyond && (found = AttemptCandidate(image, *beyond, ScanSource::kEdgeCell))) break;
-        }
-        if (found) break;
+      found = AttemptCells(image, cells);
+      if (!found) {
+        // None was the target's: the cells again, those much darker than the paper near them
+        // taken as dark (a hand or a glare joining the middle cell to its neighbour).
+        start = std::chrono::steady_clock::now();
+        const std::vector<LightQuad>& more = finder_.FindLocallyLight(image);
+        frame_.find_us += Microseconds(start);
+        found = AttemptCells(image, more);
       }
     }
     if (!found && options_.image_fallback) {

@@ -10,7 +10,9 @@
 //      (detector/sheet_finder.h); for each candidate closed in on three sides or more, best
 //      first (at most max_candidates), the borders its homography gives are scanned: as few
 //      as a tracked frame's first (its lines are seeded as a prior's are), all `borders` when
-//      those give no pose or lines whose widths barely identify them.
+//      those give no pose or lines whose widths barely identify them. When none gives a pose,
+//      the same for the finder's second look (SheetFinder::FindLocallyLight: a hand or a
+//      glare joining the middle cell to its neighbour).
 //   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
 //      with the paper's concentric image borders. A line of the bench can stand in for a
 //      stripe's edge there and tilt the pose by degrees yet pass the checks below, so the
@@ -108,7 +110,8 @@ struct TargetTrackerOptions {
   /// first frame's pose a third more accurate, its detection twice as long). Range [0, 1e9].
   double quick_max_identification_cost = 9.0;
   SheetFinderOptions finder;
-  /// Middle-cell candidates scanned per frame at most. Range [1, 16].
+  /// Middle-cell candidates scanned at most per pass of the sheet finder (two passes: its
+  /// candidates, then those with locally dark cells). Range [1, 16].
   int max_candidates = 3;
   /// When no candidate gives a pose, scan the whole image as the paper does.
   bool image_fallback = true;
@@ -246,6 +249,9 @@ class TargetPoseTracker {
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
   /// told from the lines.
   bool Verify(const GrayImageView& image);
+  /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,
+  /// at most max_candidates of them, best first; true when a pose is accepted.
+  bool AttemptCells(const GrayImageView& image, const std::vector<LightQuad>& cells);
   /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.

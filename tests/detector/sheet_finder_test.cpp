@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -33,6 +34,24 @@ Point2d Image(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera, 
   const double y = cMo[1][0] * p.u + cMo[1][1] * p.v + cMo[1][3];
   const double z = cMo[2][0] * p.u + cMo[2][1] * p.v + cMo[2][3];
   return DistortedPixel(camera, x / z, y / z);
+}
+
+// The largest distance of quad's corners from the middle cell's image, in the best cyclic
+// order.
+double CornerError(const LightQuad& quad, const LineTarget& target, const vpHomogeneousMatrix& cMo,
+                   const vpCameraParameters& camera) {
+  const std::array<Point2d, 4> cell = MiddleCell(target);
+  double best_error = HUGE_VAL;
+  for (int shift = 0; shift < 4; ++shift) {
+    double error = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const Point2d& a = quad.corners[static_cast<std::size_t>(k)];
+      const Point2d b = Image(cMo, camera, cell[static_cast<std::size_t>((k + shift) % 4)]);
+      error = std::max(error, std::hypot(a.u - b.u, a.v - b.v));
+    }
+    best_error = std::min(best_error, error);
+  }
+  return best_error;
 }
 
 struct SheetCase {
@@ -64,22 +83,8 @@ TEST_P(SheetFinderOnRenderedSheets, FindsTheMiddleCellClosedInAndRefinesItOntoTh
   EXPECT_EQ(best.ClosedSideCount(), 4);
   ASSERT_TRUE(finder.Refine(ViewOf(frame.image), &best));
   // Its corners are the middle cell's, in some cyclic order, within 2 px.
-  const std::array<Point2d, 4> cell = MiddleCell(target);
-  std::array<Point2d, 4> expected;
-  for (int k = 0; k < 4; ++k)
-    expected[static_cast<std::size_t>(k)] =
-        Image(cMo, render.camera, cell[static_cast<std::size_t>(k)]);
-  double best_error = HUGE_VAL;
-  for (int shift = 0; shift < 4; ++shift) {
-    double error = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      const Point2d& a = best.corners[static_cast<std::size_t>(k)];
-      const Point2d& b = expected[static_cast<std::size_t>((k + shift) % 4)];
-      error = std::max(error, std::hypot(a.u - b.u, a.v - b.v));
-    }
-    best_error = std::min(best_error, error);
-  }
-  EXPECT_LT(best_error, 2.0) << param.target << " at " << param.distance_m << " m";
+  EXPECT_LT(CornerError(best, target, cMo, render.camera), 2.0)
+      << param.target << " at " << param.distance_m << " m";
 }
 
 INSTANTIATE_TEST_SUITE_P(Sheets, SheetFinderOnRenderedSheets,
@@ -90,6 +95,99 @@ INSTANTIATE_TEST_SUITE_P(Sheets, SheetFinderOnRenderedSheets,
                                                      170},  // a light bench
                                            SheetCase{"four-line-a4", 0.55, 300.0, 28.0, 30},
                                            SheetCase{"four-line-letter", 0.45, 80.0, 10.0, 120}));
+
+// Whether the finder's candidates (its first pass, then FindLocallyLight's) hold the middle
+// cell closed in on three sides or more (what the target tracker scans), refined within 2 px
+// of it.
+bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target,
+                        const vpCameraParameters& camera) {
+  SheetFinder finder;
+  const GrayImageView view = ViewOf(frame.image);
+  std::vector<LightQuad> candidates = finder.Find(view);
+  const std::vector<LightQuad>& more = finder.FindLocallyLight(view);
+  candidates.insert(candidates.end(), more.begin(), more.end());
+  return std::any_of(candidates.begin(), candidates.end(), [&](LightQuad quad) {
+    return quad.ClosedSideCount() >= 3 && finder.Refine(view, &quad) &&
+           CornerError(quad, target, frame.cMo, camera) < 2.0;
+  });
+}
+
+class SheetFinderInALivedInScene : public ::testing::Test {
+ protected:
+  SheetFinderInALivedInScene() : target_(TargetByName("four-line-a3")) {
+    render_.camera = CameraWithKdu(600, 600, 319.5, 239.5, 0.15, 640, 480);
+    render_.noise_sigma = 4.0;
+    render_.blur_sigma_px = 1.0;
+    render_.background_grey = 70;
+  }
+  // The middle cell's corner where lines 1 and 2 cross, on the plane.
+  Point2d Crossing12() const { return Point2d{target_.lines[0].x1_m, target_.lines[1].y1_m}; }
+  RenderedFrame Render(const FrameEffects& effects) const {
+    const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
+    return SceneRenderer(target_, render_).Render(cMo, 5, effects);
+  }
+
+  LineTarget target_;
+  RenderOptions render_;
+};
+
+TEST_F(SheetFinderInALivedInScene, AGlareOverAStripeStillLeavesTheMiddleCellClosedIn) {
+  // A lamp's reflection on line 2 between its crossings, saturating ink and paper alike at its
+  // core, lighting the stripe around it above the first threshold: the middle cell joins the
+  // cell beyond line 2 there.
+  FrameEffects effects;
+  Glare glare;
+  glare.x_m = 0.5 * (target_.lines[0].x1_m + target_.lines[2].x1_m);
+  glare.y_m = target_.lines[1].y1_m;
+  glare.sigma_m = 0.02;
+  glare.peak_grey = 400.0;
+  effects.glares.push_back(glare);
+  EXPECT_TRUE(FindsTheMiddleCell(Render(effects), target_, render_.camera));
+}
+
+TEST_F(SheetFinderInALivedInScene, AGreyHandOverACrossingStillLeavesTheMiddleCellClosedIn) {
+  // A hand lighter than ink, darker than paper, over the crossing: it bridges the middle cell
+  // to the cells beyond; its own edge replaces a stretch of the cell's sides.
+  FrameEffects effects;
+  PlaneOccluder hand;
+  hand.label = "hand";
+  hand.grey = 150;
+  PlaneOccluder::Ellipse palm;
+  palm.x_m = Crossing12().u + 0.015;
+  palm.y_m = Crossing12().v + 0.01;
+  palm.semi_a_m = 0.03;
+  palm.semi_b_m = 0.02;
+  hand.ellipses.push_back(palm);
+  effects.plane_occluders.push_back(hand);
+  EXPECT_TRUE(FindsTheMiddleCell(Render(effects), target_, render_.camera));
+}
+
+TEST_F(SheetFinderInALivedInScene, APenAlongASideLeavesItWhereTheStripeIs) {
+  // A dark pen lying in the middle cell along line 2, a few millimetres from it, over a third
+  // of the cell's width: the side's edge points there lie on the pen; the side is the line
+  // most of them lie on.
+  FrameEffects effects;
+  PlaneOccluder pen;
+  pen.label = "pen";
+  pen.grey = 40;
+  const double x = target_.lines[0].x1_m + 0.5 * target_.lines[0].width_m;
+  const double y = target_.lines[1].y1_m + 0.5 * target_.lines[1].width_m + 0.007;
+  pen.capsules.push_back(PlaneOccluder::Capsule{x + 0.02, y, x + 0.075, y, 0.003});
+  effects.plane_occluders.push_back(pen);
+  EXPECT_TRUE(FindsTheMiddleCell(Render(effects), target_, render_.camera));
+}
+
+TEST(SheetFinder, FindLocallyLightAddsNothingAfterFindMadeThatPass) {
+  RenderOptions render;
+  render.noise_sigma = 3.0;
+  LineTarget blank = TargetByName("four-line-a3");
+  blank.lines.clear();  // the paper alone: no cell closed in, so Find makes the last pass
+  const RenderedFrame frame =
+      SceneRenderer(blank, render).Render(vpHomogeneousMatrix(0, 0, 0.6, 0.1, 0.1, 0.3), 3);
+  SheetFinder finder;
+  finder.Find(ViewOf(frame.image));
+  EXPECT_TRUE(finder.FindLocallyLight(ViewOf(frame.image)).empty());
+}
 
 TEST(SheetFinder, AFrameWithoutAGridHasNoCandidateClosedIn) {
   RenderOptions render;
