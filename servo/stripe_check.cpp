@@ -170,6 +170,13 @@ Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contr
       (std::fabs(low - p.low_edge) <= tolerance || std::fabs(high - p.high_edge) <= tolerance)) {
     return Verdict::kAgrees;
   }
+  // Narrower, inside the stripe, one edge the stripe's: something lighter than ink over the
+  // rest of it (a pen or a cable across it, a tool's rim); it hides that part and tells
+  // nothing.
+  if ((std::fabs(low - p.low_edge) <= tolerance && high < p.high_edge - tolerance) ||
+      (std::fabs(high - p.high_edge) <= tolerance && low > p.low_edge + tolerance)) {
+    return Verdict::kUnknown;
+  }
   return Verdict::kContradicts;
 }
 

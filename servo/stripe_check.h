@@ -14,7 +14,9 @@
 //     there is only paper where the ink should be (the profile light and flat, as light as the
 //     paper of the samples that agree);
 //   - tells nothing: something covers the place (a hand, a tool, a cable, a dark shadow: no
-//     paper on one side; a flat profile darker than the paper), a glare washes it out (the
+//     paper on one side; a flat profile darker than the paper; a dark run narrower than the
+//     stripe, inside it, one of its edges where the stripe's is: a pen or a cable lighter than
+//     ink across the rest of it), a glare washes it out (the
 //     profile saturates where the sheet's paper does not, or is lit well above that paper), or
 //     it is out of view.
 // Each edge of a dark run lies halfway between the darkest point and the paper on its own side

@@ -279,6 +279,27 @@ TEST(StripeCheck, AHandOrAGlareHidesWithoutContradicting) {
   EXPECT_EQ(agreement.Worst(), 1.0);
 }
 
+// A grey pen lying along line 1 over part of its width leaves a narrower dark run there, one
+// edge the stripe's: it hides that part of the stripe and contradicts nothing (samples between
+// agreeing ones are not excused as an occluder's rim).
+TEST(StripeCheck, APenOverPartOfAStripesWidthHidesWithoutContradicting) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  FrameEffects effects;
+  // Line 1: 24 mm wide at x = -0.09; the pen covers x from -0.086 to -0.074 between the
+  // crossings, with the stripe's ink in full on both sides of it.
+  PlaneOccluder pen;
+  pen.capsules.push_back({-0.08, -0.035, -0.08, 0.035, 0.006});
+  pen.grey = 170;
+  effects.plane_occluders.push_back(pen);
+  const RenderedFrame rendered = renderer.Render(Tilted(), 10, effects);
+  const StripeAgreement agreement =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera);
+  EXPECT_LT(agreement.dark[0], agreement.samples[0]);  // the pen hides some of line 1
+  EXPECT_EQ(agreement.contradict[0], 0);
+  EXPECT_EQ(agreement.Worst(), 1.0);
+}
+
 // A glare beside a stripe lights the paper on one side of it and the ink next to it: each of
 // the stripe's edges is read against the paper on its own side, and where the glare washes
 // the ink out its profile is brighter than the sheet's paper and tells nothing.
