@@ -325,6 +325,42 @@ std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, con
   return best;
 }
 
+std::vector<LightQuad> UncutCells(const TargetLayout& layout, const LightQuad& cell, int cut) {
+  constexpr double kMinLengthening = 1.1;
+  const auto length = [](const Point2d& a, const Point2d& b) {
+    return std::hypot(b.u - a.u, b.v - a.v);
+  };
+  const std::array<Point2d, 4>& plane = layout.middle_cell;
+  const double side_a = length(plane[0], plane[1]), side_b = length(plane[1], plane[2]);
+  const std::array<Point2d, 4>& c = cell.corners;
+  const auto at = [&](int k) { return c[static_cast<std::size_t>((k % 4 + 4) % 4)]; };
+  // The opposite side keeps both its corners; the sides beside the cut one run from them.
+  const Point2d from_1 = at(cut + 2), from_0 = at(cut + 3);
+  const Point2d to_1 = at(cut + 1), to_0 = at(cut);
+  const double opposite = length(from_1, from_0);
+  const double beside_1 = length(from_1, to_1), beside_0 = length(from_0, to_0);
+  std::vector<LightQuad> cells;
+  if (!(opposite > 0.0 && beside_1 > 0.0 && beside_0 > 0.0)) return cells;
+  for (const double aspect : {side_b / side_a, side_a / side_b}) {
+    const double wanted = aspect * opposite;
+    if (wanted < kMinLengthening * std::max(beside_1, beside_0)) continue;
+    LightQuad uncut = cell;
+    uncut.corners[static_cast<std::size_t>((cut + 1) % 4)] =
+        Point2d{from_1.u + (to_1.u - from_1.u) * wanted / beside_1,
+                from_1.v + (to_1.v - from_1.v) * wanted / beside_1};
+    uncut.corners[static_cast<std::size_t>(cut % 4)] =
+        Point2d{from_0.u + (to_0.u - from_0.u) * wanted / beside_0,
+                from_0.v + (to_0.v - from_0.v) * wanted / beside_0};
+    const std::vector<Point2d> polygon(uncut.corners.begin(), uncut.corners.end());
+    if (ConvexHull(polygon).size() == 4) cells.push_back(uncut);
+  }
+  std::sort(cells.begin(), cells.end(), [&](const LightQuad& a, const LightQuad& b) {
+    return length(a.corners[static_cast<std::size_t>(cut % 4)], from_0) >
+           length(b.corners[static_cast<std::size_t>(cut % 4)], from_0);
+  });
+  return cells;
+}
+
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
                                                      const LightQuad& cell,
                                                      const vpCameraParameters& camera) {

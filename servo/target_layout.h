@@ -127,6 +127,14 @@ std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCel
                                                      const LightQuad& cell,
                                                      const vpCameraParameters& camera);
 
+/// The middle cell `cell` would be if its side `cut` (from corner cut to cut + 1) were the edge
+/// of something lying across the cell (a hand, a tool, a cable) rather than a stripe's: the
+/// two sides beside it lengthened along their own lines, from the opposite side's corners, to
+/// the length the middle cell's shape gives them beside that side (its aspect either way round,
+/// as the image's foreshortening is not known). Only lengthenings by 10 % or more; none when
+/// the result is not convex.
+std::vector<LightQuad> UncutCells(const TargetLayout& layout, const LightQuad& cell, int cut);
+
 /// The image of a target point seen through `plane_to_image` and the lens: distorted pixels;
 /// false when it lies behind the camera or beyond the lens model's reach.
 bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,

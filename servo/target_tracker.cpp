@@ -646,6 +646,7 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
 bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
                                      const std::vector<LightQuad>& cells) {
   int tried = 0;
+  bool uncut_tried = false;
   for (LightQuad cell : cells) {
     if (cell.ClosedSideCount() < 3 || tried >= options_.max_candidates) continue;
     ++tried;
@@ -662,7 +663,33 @@ bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
       const std::optional<vpHomography> beyond = PlaneToImageFromEdgeCell(edge, cell, camera_);
       if (beyond && AttemptCandidate(image, *beyond, ScanSource::kEdgeCell)) return true;
     }
+    // Closed in on four sides, yet not the target's middle cell as it is: one side may be the
+    // edge of a hand, a tool or a cable lying across the cell (the first such cell only).
+    if (cell.ClosedSideCount() == 4 && !uncut_tried) {
+      uncut_tried = true;
+      if (AttemptUncut(image, cell)) return true;
+    }
   }
+  return false;
+}
+
+bool TargetPoseTracker::AttemptUncut(const GrayImageView& image, const LightQuad& cell) {
+  // These are guesses: when none gives a pose, the frame says what the cell as found gave.
+  const TargetFrame as_found = frame_;
+  const std::vector<DetectedLine> lines_as_found = lines_;
+  for (int cut = 0; cut < 4; ++cut) {
+    for (const LightQuad& uncut : UncutCells(layout_, cell, cut)) {
+      const std::optional<vpHomography> h = PlaneToImageFromCell(layout_, uncut, camera_);
+      if (h && AttemptCandidate(image, *h, ScanSource::kMiddleCell)) return true;
+    }
+  }
+  const double detect_us = frame_.detect_us, pose_us = frame_.pose_us;
+  const int candidates = frame_.candidates;
+  frame_ = as_found;
+  frame_.detect_us = detect_us;
+  frame_.pose_us = pose_us;
+  frame_.candidates = candidates;
+  lines_ = lines_as_found;
   return false;
 }
 

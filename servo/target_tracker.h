@@ -12,7 +12,9 @@
 //      as a tracked frame's first (its lines are seeded as a prior's are), all `borders` when
 //      those give no pose or lines whose widths barely identify them. When none gives a pose,
 //      the same for the finder's second look (SheetFinder::FindLocallyLight: a hand or a
-//      glare joining the middle cell to its neighbour).
+//      glare joining the middle cell to its neighbour). The first candidate closed in on four
+//      sides that gives no pose is also tried as the middle cell cut short by something lying
+//      across it (target_layout.h: UncutCells).
 //   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
 //      with the paper's concentric image borders. A line of the bench can stand in for a
 //      stripe's edge there and tilt the pose by degrees yet pass the checks below, so the
@@ -252,6 +254,11 @@ class TargetPoseTracker {
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,
   /// at most max_candidates of them, best first; true when a pose is accepted.
   bool AttemptCells(const GrayImageView& image, const std::vector<LightQuad>& cells);
+  /// A candidate closed in on four sides that gave no pose, taken as the middle cell cut by
+  /// something lying across it (UncutCells, each side in turn); when none gives a pose, the
+  /// frame is left as the candidate itself left it (its message, lines and region), with the
+  /// time spent added.
+  bool AttemptUncut(const GrayImageView& image, const LightQuad& cell);
   /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.

@@ -8,8 +8,10 @@
 #include <visp3/core/vpPixelMeterConversion.h>
 #include <visp3/core/vpRxyzVector.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "detector/lens.h"  // CameraWithKdu
 
@@ -101,6 +103,52 @@ TEST(TargetLayout, EdgeCellsReachTheSheetsEdgeAndMapBackThroughTheirOpenSide) {
   LightQuad closed;
   closed.closed_sides = 0xF;
   EXPECT_FALSE(PlaneToImageFromEdgeCell(above, closed, camera).has_value());
+}
+
+// The A3 sheet's middle cell seen face on (its image an exact scaling of it), a tool lying
+// across it parallel to one side: the cell the sheet finder sees ends at the tool's edge. Taken
+// as cut there, its two sides beside the cut are lengthened back to the whole cell.
+TEST(TargetLayout, AMiddleCellCutByAToolIsLengthenedBackToItsShape) {
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  constexpr double kPxPerMetre = 1000.0;
+  LightQuad whole;
+  for (std::size_t k = 0; k < 4; ++k) {
+    whole.corners[k] = Point2d{320.0 + kPxPerMetre * layout.middle_cell[k].u,
+                               240.0 + kPxPerMetre * layout.middle_cell[k].v};
+  }
+  for (int cut = 0; cut < 4; ++cut) {
+    // The corners cut and cut + 1 moved 40 % of the way towards the opposite side's.
+    LightQuad seen = whole;
+    const auto towards = [](const Point2d& a, const Point2d& b) {
+      return Point2d{a.u + 0.4 * (b.u - a.u), a.v + 0.4 * (b.v - a.v)};
+    };
+    seen.corners[static_cast<std::size_t>(cut)] =
+        towards(whole.corners[static_cast<std::size_t>(cut)],
+                whole.corners[static_cast<std::size_t>((cut + 3) % 4)]);
+    seen.corners[static_cast<std::size_t>((cut + 1) % 4)] =
+        towards(whole.corners[static_cast<std::size_t>((cut + 1) % 4)],
+                whole.corners[static_cast<std::size_t>((cut + 2) % 4)]);
+    const std::vector<LightQuad> uncut = UncutCells(layout, seen, cut);
+    ASSERT_FALSE(uncut.empty()) << "cut " << cut;
+    double best = HUGE_VAL;
+    for (const LightQuad& cell : uncut) {
+      double worst = 0.0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        worst = std::max(worst, std::hypot(cell.corners[k].u - whole.corners[k].u,
+                                           cell.corners[k].v - whole.corners[k].v));
+      }
+      best = std::min(best, worst);
+    }
+    EXPECT_LT(best, 1e-6) << "cut " << cut;
+    // The whole cell is not lengthened the right way round: only the other aspect, if at all.
+    for (const LightQuad& cell : UncutCells(layout, whole, cut)) {
+      EXPECT_GT(std::hypot(cell.corners[static_cast<std::size_t>(cut)].u -
+                               whole.corners[static_cast<std::size_t>(cut)].u,
+                           cell.corners[static_cast<std::size_t>(cut)].v -
+                               whole.corners[static_cast<std::size_t>(cut)].v),
+                1.0);
+    }
+  }
 }
 
 }  // namespace

@@ -345,6 +345,28 @@ TEST(TargetPoseTracker, ACableAgainstAStripeGivesNoWrongPose) {
   }
 }
 
+// A tool lying across the middle cell, parallel to line 4 and clear of it: the light cell the
+// sheet finder sees ends at the tool's edge, a quadrilateral closed in on four sides that is not
+// the middle cell's shape. Taken as cut by something lying across it, it is lengthened back.
+TEST(TargetPoseTracker, AToolAcrossTheMiddleCellIsSeenPast) {
+  const LineTarget target = FourLineA3Target();
+  const SceneRenderer renderer(target, BenchRender(11));
+  FrameEffects effects;
+  PlaneOccluder tool;
+  tool.capsules.push_back({-0.25, 0.028, 0.25, 0.028, 0.014});
+  tool.grey = 110;
+  tool.texture_grey = 6.0;
+  effects.plane_occluders.push_back(tool);
+  for (const double roll : {0.2, 2.0}) {
+    const vpHomogeneousMatrix cMo(0.0, 0.0, 0.5, 0.1, -0.12, roll);
+    TargetPoseTracker tracker = TrackerFor(renderer);
+    const TargetFrame& found = tracker.Track(ViewOf(renderer.Render(cMo, 12, effects).image));
+    ExpectRightPose(found, cMo, "a tool across the middle cell, roll " + std::to_string(roll));
+    // Read as the middle cell it is (not as a cell beyond a stripe, which it is not).
+    EXPECT_EQ(found.source, ScanSource::kMiddleCell);
+  }
+}
+
 // The settings in pixels follow the camera: a 1920x1080 webcam 70 degrees across (1371 px)
 // gets the detector's and the sheet finder's settings of a 600 px camera 2.285 times; with
 // reference_focal_px 0 they are used as given.
