@@ -26,25 +26,18 @@ constexpr double kLocalLightRatio = 0.8;
 constexpr int kSaturatedGrey = 250;
 constexpr int kLocalSaturationMargin = 15;
 
-// The mean of the values of histogram[from, 256); 0 when there are none.
-double MeanFrom(const std::array<int, 256>& histogram, int from) {
-  double count = 0.0, sum = 0.0;
-  for (int g = from; g < 256; ++g) {
-    count += histogram[static_cast<std::size_t>(g)];
-    sum += static_cast<double>(g) * histogram[static_cast<std::size_t>(g)];
-  }
-  return count > 0.0 ? sum / count : 0.0;
-}
-
 // Otsu's threshold over the values of histogram[lo, 256): values >= the result are the
-// light class; *contrast gets the two classes' mean difference (0 when a class is empty).
-int OtsuOfHistogram(const std::array<int, 256>& histogram, int lo, double* contrast) {
+// light class; *contrast gets the two classes' mean difference and *light the light class's
+// mean (both 0 when a class is empty).
+int OtsuOfHistogram(const std::array<int, 256>& histogram, int lo, double* contrast,
+                    double* light) {
   double total = 0.0, sum = 0.0;
   for (int g = lo; g < 256; ++g) {
     total += histogram[g];
     sum += static_cast<double>(g) * histogram[g];
   }
   *contrast = 0.0;
+  *light = 0.0;
   double weight_low = 0.0, sum_low = 0.0, best = -1.0;
   int threshold = 256;
   for (int g = lo; g < 255; ++g) {
@@ -58,6 +51,7 @@ int OtsuOfHistogram(const std::array<int, 256>& histogram, int lo, double* contr
       best = between;
       threshold = g + 1;
       *contrast = gap;
+      *light = (sum - sum_low) / weight_high;
     }
   }
   return threshold;
@@ -156,10 +150,9 @@ bool RefineSide(const GrayImageView& image, const Side& side, double light, doub
     if (EdgeAt(image, side, t, light, search, min_contrast, &edge)) points.push_back(edge);
   }
   if (points.size() < kMinEdgePoints) return false;
-  // The line through two of the points that most of the others lie on: a hand or a pen over
-  // part of the side puts its own edge in a few of them.
-  // Distances to the line through points[i] and points[j] by its unit normal (no angles:
-  // this runs for every pair).
+  // The line through two of the points that most of the others lie on (a hand or a pen over
+  // part of the side puts its own edge in a few of them); distances by the cross product, no
+  // angles, as this runs for every pair.
   auto on_line = [&](std::size_t i, std::size_t j, const Point2d& p) {
     const double du = points[j].u - points[i].u, dv = points[j].v - points[i].v;
     const double length = std::hypot(du, dv);
@@ -616,14 +609,14 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
   int lo = 0;
   bool closed = false;
   for (int level = 0; level < 3 && !closed; ++level) {
-    double contrast = 0.0;
-    const int threshold = OtsuOfHistogram(histogram, lo, &contrast);
+    double contrast = 0.0, light = 0.0;
+    const int threshold = OtsuOfHistogram(histogram, lo, &contrast, &light);
     if (threshold > 255 || contrast < options_.min_contrast) break;
     AddComponents(image, cells_.data(), threshold);
     lo = threshold;
     if (first_threshold_ < 0) {
       first_threshold_ = threshold;
-      first_light_ = MeanFrom(histogram, threshold);
+      first_light_ = light;
     }
     closed = std::any_of(candidates_.begin(), candidates_.end(),
                          [](const LightQuad& quad) { return quad.ClosedSideCount() == 4; });

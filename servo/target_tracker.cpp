@@ -232,10 +232,15 @@ std::array<std::vector<Point2d>, 4> TargetPoseTracker::StripePoints(double toler
 
 namespace {
 
-// The first stripe (0-3) whose kept runs are, at their median, not as wide as it; -1 when none.
+// Whether stripe k's kept runs are, at their median, as wide as it.
+bool RunsAsWideAsStripe(const StripeFit& fit, std::size_t k) {
+  return !(std::fabs(std::log(fit.width_ratio[k])) > kMaxFittedWidthLog);
+}
+
+// The first stripe (0-3) whose kept runs are not as wide as it; -1 when none.
 int MergedStripe(const StripeFit& fit) {
   for (std::size_t k = 0; k < 4; ++k) {
-    if (std::fabs(std::log(fit.width_ratio[k])) > kMaxFittedWidthLog) return static_cast<int>(k);
+    if (!RunsAsWideAsStripe(fit, k)) return static_cast<int>(k);
   }
   return -1;
 }
@@ -488,8 +493,7 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
   // each stripe seen over a good part of it: the lines' identification and support, for a pose
   // that has no four lines.
   for (std::size_t k = 0; k < 4; ++k) {
-    if (std::fabs(std::log(best->width_ratio[k])) > kMaxFittedWidthLog ||
-        best->extent[k] < kMinFittedExtent) {
+    if (!RunsAsWideAsStripe(*best, k) || best->extent[k] < kMinFittedExtent) {
       std::ostringstream message;
       message << why << "; fitted to the stripes' points, line " << k + 1 << "'s runs are "
               << best->width_ratio[k] << " times its width and span " << best->extent[k]
@@ -683,14 +687,20 @@ bool TargetPoseTracker::AttemptUncut(const GrayImageView& image, const LightQuad
       if (h && AttemptCandidate(image, *h, ScanSource::kMiddleCell)) return true;
     }
   }
+  RestoreFrame(as_found, lines_as_found);
+  return false;
+}
+
+void TargetPoseTracker::RestoreFrame(const TargetFrame& saved,
+                                     const std::vector<DetectedLine>& saved_lines) {
+  // The work done since stays counted: its time and the candidates it scanned.
   const double detect_us = frame_.detect_us, pose_us = frame_.pose_us;
   const int candidates = frame_.candidates;
-  frame_ = as_found;
+  frame_ = saved;
   frame_.detect_us = detect_us;
   frame_.pose_us = pose_us;
   frame_.candidates = candidates;
-  lines_ = lines_as_found;
-  return false;
+  lines_ = saved_lines;
 }
 
 const TargetFrame& TargetPoseTracker::Track(
@@ -743,11 +753,7 @@ bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
   const TargetFrame whole_image = frame_;
   const std::vector<DetectedLine> whole_image_lines = lines_;
   auto keep_whole_image = [&] {
-    const double detect_us = frame_.detect_us, pose_us = frame_.pose_us;  // both scans'
-    frame_ = whole_image;
-    frame_.detect_us = detect_us;
-    frame_.pose_us = pose_us;
-    lines_ = whole_image_lines;
+    RestoreFrame(whole_image, whole_image_lines);
     return true;
   };
   // The target's plane gave nothing (a board seen from near fills the view, its borders' lines

@@ -259,6 +259,9 @@ class TargetPoseTracker {
   /// frame is left as the candidate itself left it (its message, lines and region), with the
   /// time spent added.
   bool AttemptUncut(const GrayImageView& image, const LightQuad& cell);
+  /// frame_ and lines_ back to `saved` and `saved_lines`, an attempt since then undone but for
+  /// its time and the candidates it scanned.
+  void RestoreFrame(const TargetFrame& saved, const std::vector<DetectedLine>& saved_lines);
   /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.

@@ -122,9 +122,16 @@ class SheetFinderInALivedInScene : public ::testing::Test {
   }
   // The middle cell's corner where lines 1 and 2 cross, on the plane.
   Point2d Crossing12() const { return Point2d{target_.lines[0].x1_m, target_.lines[1].y1_m}; }
-  RenderedFrame Render(const FrameEffects& effects) const {
+  // The sheet seen with `effects`: does the finder find its middle cell?
+  bool FindsTheMiddleCellWith(const FrameEffects& effects) const {
     const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
-    return SceneRenderer(target_, render_).Render(cMo, 5, effects);
+    return FindsTheMiddleCell(SceneRenderer(target_, render_).Render(cMo, 5, effects), target_,
+                              render_.camera);
+  }
+  bool FindsTheMiddleCellPast(const PlaneOccluder& occluder) const {
+    FrameEffects effects;
+    effects.plane_occluders.push_back(occluder);
+    return FindsTheMiddleCellWith(effects);
   }
 
   LineTarget target_;
@@ -136,45 +143,30 @@ TEST_F(SheetFinderInALivedInScene, AGlareOverAStripeStillLeavesTheMiddleCellClos
   // core, lighting the stripe around it above the first threshold: the middle cell joins the
   // cell beyond line 2 there.
   FrameEffects effects;
-  Glare glare;
-  glare.x_m = 0.5 * (target_.lines[0].x1_m + target_.lines[2].x1_m);
-  glare.y_m = target_.lines[1].y1_m;
-  glare.sigma_m = 0.02;
-  glare.peak_grey = 400.0;
-  effects.glares.push_back(glare);
-  EXPECT_TRUE(FindsTheMiddleCell(Render(effects), target_, render_.camera));
+  effects.glares.push_back(
+      {0.5 * (target_.lines[0].x1_m + target_.lines[2].x1_m), target_.lines[1].y1_m, 0.02, 400.0});
+  EXPECT_TRUE(FindsTheMiddleCellWith(effects));
 }
 
 TEST_F(SheetFinderInALivedInScene, AGreyHandOverACrossingStillLeavesTheMiddleCellClosedIn) {
   // A hand lighter than ink, darker than paper, over the crossing: it bridges the middle cell
   // to the cells beyond; its own edge replaces a stretch of the cell's sides.
-  FrameEffects effects;
   PlaneOccluder hand;
-  hand.label = "hand";
   hand.grey = 150;
-  PlaneOccluder::Ellipse palm;
-  palm.x_m = Crossing12().u + 0.015;
-  palm.y_m = Crossing12().v + 0.01;
-  palm.semi_a_m = 0.03;
-  palm.semi_b_m = 0.02;
-  hand.ellipses.push_back(palm);
-  effects.plane_occluders.push_back(hand);
-  EXPECT_TRUE(FindsTheMiddleCell(Render(effects), target_, render_.camera));
+  hand.ellipses.push_back({Crossing12().u + 0.015, Crossing12().v + 0.01, 0.03, 0.02, 0.0});
+  EXPECT_TRUE(FindsTheMiddleCellPast(hand));
 }
 
 TEST_F(SheetFinderInALivedInScene, APenAlongASideLeavesItWhereTheStripeIs) {
   // A dark pen lying in the middle cell along line 2, a few millimetres from it, over a third
   // of the cell's width: the side's edge points there lie on the pen; the side is the line
   // most of them lie on.
-  FrameEffects effects;
   PlaneOccluder pen;
-  pen.label = "pen";
   pen.grey = 40;
   const double x = target_.lines[0].x1_m + 0.5 * target_.lines[0].width_m;
   const double y = target_.lines[1].y1_m + 0.5 * target_.lines[1].width_m + 0.007;
-  pen.capsules.push_back(PlaneOccluder::Capsule{x + 0.02, y, x + 0.075, y, 0.003});
-  effects.plane_occluders.push_back(pen);
-  EXPECT_TRUE(FindsTheMiddleCell(Render(effects), target_, render_.camera));
+  pen.capsules.push_back({x + 0.02, y, x + 0.075, y, 0.003});
+  EXPECT_TRUE(FindsTheMiddleCellPast(pen));
 }
 
 TEST(SheetFinder, FindLocallyLightAddsNothingAfterFindMadeThatPass) {

@@ -53,6 +53,11 @@ SimulatedCameraOptions StartingAt(const vpHomogeneousMatrix& cMo, const vpHomoge
   return options;
 }
 
+// Looking away: the sheet 0.8 m to the side, out of the view.
+SimulatedCameraOptions LookingAway(const vpHomogeneousMatrix& wMo) {
+  return StartingAt(vpHomogeneousMatrix(0.8, 0.0, 0.6, 0.0, 0.0, 0.0), wMo);
+}
+
 TEST(ServoLoopOptions, EachLawHasItsOwnIterationLimit) {
   ServoLoopOptions loop;
   loop.law.mode = ServoMode::kExponential;
@@ -112,9 +117,7 @@ TEST(RunServoLoop, EachPositionLawReachesTheGoalOnTheRenderedSheet) {
 TEST(RunServoLoop, ATargetOutOfViewStopsTheRunAndTheRobotNeverMoves) {
   ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
   setup.loop.max_lost_frames = 2;
-  // Looking away: the sheet 0.8 m to the side, out of the view.
-  const SimulatedCameraOptions away =
-      StartingAt(vpHomogeneousMatrix(0.8, 0.0, 0.6, 0.0, 0.0, 0.0), setup.wMo);
+  const SimulatedCameraOptions away = LookingAway(setup.wMo);
   SimulatedCamera robot(away);
   const vpHomogeneousMatrix start = away.wMc;
   RenderedFrames frames(setup.target, RenderOptions());
@@ -134,8 +137,7 @@ TEST(RunServoLoop, ATargetOutOfViewStopsTheRunAndTheRobotNeverMoves) {
 TEST(RunServoLoop, AHoldStopsAfterMaxLostSecondsOfTheCamerasClock) {
   ServoSetup setup = SheetSetup(ServoMode::kExponential);
   setup.loop.max_lost_s = 0.1;
-  const SimulatedCameraOptions away =
-      StartingAt(vpHomogeneousMatrix(0.8, 0.0, 0.6, 0.0, 0.0, 0.0), setup.wMo);
+  const SimulatedCameraOptions away = LookingAway(setup.wMo);
   SimulatedCamera robot(away);
   RenderedFrames frames(setup.target, RenderOptions());
   std::ostringstream log;
