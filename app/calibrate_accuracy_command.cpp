@@ -8,14 +8,15 @@
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
 #include "base/format.h"
+#include "detector/lens.h"
 #include "eval/calibrate_accuracy.h"
 
 namespace oal {
 namespace {
 
-nlohmann::json CameraJson(const vpCameraParameters& camera) {
-  return {{"px", camera.get_px()}, {"py", camera.get_py()},   {"u0", camera.get_u0()},
-          {"v0", camera.get_v0()}, {"kdu", camera.get_kdu()}, {"kud", camera.get_kud()}};
+nlohmann::json CameraJson(const Lens& camera) {
+  return {{"px", camera.px()}, {"py", camera.py()},   {"u0", camera.u0()},
+          {"v0", camera.v0()}, {"kdu", camera.kdu()}, {"kud", camera.kud()}};
 }
 
 struct Worst {
@@ -49,17 +50,17 @@ std::string Table(const CalibrateAccuracyOptions& o,
     const CameraCalibrationTrial& t = trials[c];
     out << "| " << c << " | ";
     if (!t.failed.empty()) {
-      out << Fixed(t.truth.get_px(), 1) << " / — | — | — | — | " << Fixed(t.truth.get_kdu(), 4)
+      out << Fixed(t.truth.px(), 1) << " / — | — | — | — | " << Fixed(t.truth.kdu(), 4)
           << " / — | — | " << t.failed << " |\n";
       continue;
     }
-    out << Fixed(t.truth.get_px(), 1) << " / " << Fixed(t.found.get_px(), 1) << " ("
-        << Fixed(t.px_error_pct(), 3) << " %) | " << Fixed(t.truth.get_py(), 1) << " / "
-        << Fixed(t.found.get_py(), 1) << " (" << Fixed(t.py_error_pct(), 3) << " %) | "
-        << Fixed(t.truth.get_u0(), 1) << " / " << Fixed(t.found.get_u0(), 1) << " | "
-        << Fixed(t.truth.get_v0(), 1) << " / " << Fixed(t.found.get_v0(), 1) << " | "
-        << Fixed(t.truth.get_kdu(), 4) << " / " << Fixed(t.found.get_kdu(), 4) << " | " << t.used
-        << " / " << t.views << " | " << Fixed(t.rms_px, 3) << " |\n";
+    out << Fixed(t.truth.px(), 1) << " / " << Fixed(t.found.px(), 1) << " ("
+        << Fixed(t.px_error_pct(), 3) << " %) | " << Fixed(t.truth.py(), 1) << " / "
+        << Fixed(t.found.py(), 1) << " (" << Fixed(t.py_error_pct(), 3) << " %) | "
+        << Fixed(t.truth.u0(), 1) << " / " << Fixed(t.found.u0(), 1) << " | "
+        << Fixed(t.truth.v0(), 1) << " / " << Fixed(t.found.v0(), 1) << " | "
+        << Fixed(t.truth.kdu(), 4) << " / " << Fixed(t.found.kdu(), 4) << " | " << t.used << " / "
+        << t.views << " | " << Fixed(t.rms_px, 3) << " |\n";
   }
   const Worst w = WorstOf(trials);
   out << "\n"

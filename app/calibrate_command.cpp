@@ -17,6 +17,7 @@
 #include "calibration/chessboard.h"
 #include "calibration/sheet_view_finder.h"
 #include "calibration/view_selector.h"
+#include "detector/lens.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
@@ -47,13 +48,13 @@ void PrintReport(const CalibrationResult& result, const std::string& points) {
       std::cout << view.name << ": not used: " << view.rejected << '\n';
     }
   }
-  const vpCameraParameters& camera = result.camera;
-  std::cout << "px " << Fixed(camera.get_px(), 2) << " +- " << Fixed(result.px_sd, 2) << ", py "
-            << Fixed(camera.get_py(), 2) << " +- " << Fixed(result.py_sd, 2) << ", u0 "
-            << Fixed(camera.get_u0(), 2) << " +- " << Fixed(result.u0_sd, 2) << ", v0 "
-            << Fixed(camera.get_v0(), 2) << " +- " << Fixed(result.v0_sd, 2) << " px\n";
-  if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
-    std::cout << "kud " << Fixed(camera.get_kud(), 5) << ", kdu " << Fixed(camera.get_kdu(), 5)
+  const Lens& camera = result.camera;
+  std::cout << "px " << Fixed(camera.px(), 2) << " +- " << Fixed(result.px_sd, 2) << ", py "
+            << Fixed(camera.py(), 2) << " +- " << Fixed(result.py_sd, 2) << ", u0 "
+            << Fixed(camera.u0(), 2) << " +- " << Fixed(result.u0_sd, 2) << ", v0 "
+            << Fixed(camera.v0(), 2) << " +- " << Fixed(result.v0_sd, 2) << " px\n";
+  if (camera.distorted()) {
+    std::cout << "kud " << Fixed(camera.kud(), 5) << ", kdu " << Fixed(camera.kdu(), 5)
               << " (OpenCV's k1 " << Fixed(result.lens.k1, 5) << " +- " << Fixed(result.k1_sd, 5)
               << ", k2 " << Fixed(result.lens.k2, 5) << ")\n";
   }

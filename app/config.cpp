@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "base/format.h"
+#include "detector/lens.h"
 #include "io/camera_file.h"
 #include "io/image_source.h"
 
@@ -484,6 +485,24 @@ std::array<double, 3> ReadVector3(const Value& value, const char* unit) {
   return v;
 }
 
+// OpenCV's distortion coefficients in calib3d's order: [k1, k2, p1, p2], [k1, k2, p1, p2, k3]
+// or [k1, k2, p1, p2, k3, k4, k5, k6], finite.
+Distortion ReadDistortion(const Value& value) {
+  const YAML::Node& node = value.node;
+  const std::size_t n = node.IsSequence() ? node.size() : 0;
+  if (n != 4 && n != 5 && n != 8) {
+    value.Fail("'" + value.key +
+               "' must be OpenCV's distortion coefficients [k1, k2, p1, p2, k3] (4, 5 or 8 "
+               "numbers), got '" +
+               (node.IsSequence() ? "a sequence of " + std::to_string(n) : value.Text()) + "'");
+  }
+  std::array<double, 8> c{};
+  for (std::size_t i = 0; i < n; ++i) {
+    c[i] = Value{node[i], value.file, value.key + "[" + std::to_string(i) + "]"}.FiniteDouble();
+  }
+  return Distortion::FromArray(c);
+}
+
 // {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]}, R = Rx·Ry·Rz; both keys required (one
 // missing, silently read as zeros, would put the robot or the goal somewhere else).
 vpHomogeneousMatrix ReadPose(const Value& value) {
@@ -540,6 +559,8 @@ const std::vector<Field<CameraConfig>>& CameraFields() {
       DoubleField("u0", &O::u0),
       DoubleField("v0", &O::v0),
       DoubleField("kdu", &O::kdu),
+      {"distortion",
+       [](const Value& value, O* camera) { camera->distortion = ReadDistortion(value); }},
       BoolField("correct_distortion", &O::correct_distortion),
       BoolField("estimate_distortion", &O::estimate_distortion),
       IntField("width", &O::width),
@@ -563,7 +584,7 @@ void ApplyCameraFile(const std::string& yaml, const Lines& lines, CameraConfig* 
   const auto at = [&yaml, &lines](const char* key) {
     return yaml + ":" + std::to_string(lines.at(key));
   };
-  for (const char* key : {"px", "py", "u0", "v0", "kdu"}) {
+  for (const char* key : {"px", "py", "u0", "v0", "kdu", "distortion"}) {
     if (lines.count(key) == 0) continue;
     throw std::runtime_error(at(key) + ": 'camera." + key + "' and 'camera.file' (line " +
                              std::to_string(lines.at("file")) +
@@ -576,14 +597,13 @@ void ApplyCameraFile(const std::string& yaml, const Lines& lines, CameraConfig* 
   } catch (const std::runtime_error& error) {
     throw std::runtime_error(at("file") + ": camera.file: " + error.what());
   }
-  const vpCameraParameters& read = loaded.camera;
-  camera->px = read.get_px();
-  camera->py = read.get_py();
-  camera->u0 = read.get_u0();
-  camera->v0 = read.get_v0();
-  camera->kdu = read.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
-                    ? read.get_kdu()
-                    : 0.0;
+  const Lens& read = loaded.camera;
+  camera->px = read.px();
+  camera->py = read.py();
+  camera->u0 = read.u0();
+  camera->v0 = read.v0();
+  camera->kdu = read.kdu();
+  camera->distortion = read.distortion();
   if (loaded.width == 0 || loaded.height == 0) return;
   const int width = static_cast<int>(loaded.width), height = static_cast<int>(loaded.height);
   for (const char* key : {"width", "height"}) {
@@ -1276,14 +1296,10 @@ std::string AppConfig::Origin(const std::string& key) const {
   return origin == origins.end() ? "" : origin->second;
 }
 
-vpCameraParameters CameraConfig::Camera() const {
-  vpCameraParameters camera;
-  if (kdu != 0.0) {
-    camera = CameraWithKdu(px, py, u0, v0, kdu, width, height);
-  } else {
-    camera.initPersProjWithoutDistortion(px, py, u0, v0);
-  }
-  return camera;
+Lens CameraConfig::Camera() const {
+  if (!distortion.IsZero()) return Lens::WithDistortion(px, py, u0, v0, distortion);
+  if (kdu != 0.0) return Lens::WithKdu(px, py, u0, v0, kdu, width, height);
+  return Lens::Pinhole(px, py, u0, v0);
 }
 
 void CameraConfig::Check() const {
@@ -1294,6 +1310,10 @@ void CameraConfig::Check() const {
   // The same range as every command line's --kdu.
   if (!(kdu > -1.0 && kdu < 1.0)) {
     Violated("CameraConfig::kdu", Number(kdu), "-1 < kdu < 1");
+  }
+  if (kdu != 0.0 && !distortion.IsZero()) {
+    Violated("CameraConfig::kdu", Number(kdu),
+             "kdu = 0 when distortion (OpenCV's coefficients) is given: one lens model");
   }
   if (width < 16 || width > 8192)
     Violated("CameraConfig::width", Number(width), "16 <= width <= 8192");

@@ -47,13 +47,13 @@
 // rather than silently ignored.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <map>
 #include <optional>
 #include <string>
 
+#include "detector/lens.h"
 #include "detector/options.h"
 #include "io/scene_options.h"
 #include "loop/servo_loop.h"
@@ -73,7 +73,10 @@ struct CameraConfig {
   double px = 600.0, py = 600.0;  ///< focal lengths, pixels, > 0
   double u0 = 319.5, v0 = 239.5;  ///< principal point, pixels, finite
   double kdu = 0.0;               ///< ViSP's distorted -> undistorted coefficient; 0: none
-  /// Undistort the feature points with kdu (detector) and use it in the pose; false ignores
+  /// `camera.distortion`: OpenCV's coefficients [k1, k2, p1, p2, k3(, k4, k5, k6)] (the
+  /// other lens model; all zero: none). Not together with kdu.
+  Distortion distortion;
+  /// Undistort the feature points with the lens (detector) and use it in the pose; false ignores
   /// the lens in both (the paper's condition: its lines stay curved).
   bool correct_distortion = true;
   /// Tell the lens from the target's stripes over the first frames, the robot still, instead
@@ -91,14 +94,15 @@ struct CameraConfig {
   /// Simulation (source: simulated): how the rendered camera is really mounted, when eMc is
   /// only what the loop believes (to try a hand-eye calibration); unset: eMc.
   std::optional<vpHomogeneousMatrix> true_eMc;
-  /// `camera.file`: a ViSP camera XML (the canonical form) that gives px, py, u0, v0, kdu and,
-  /// when it has them, width and height; empty: the inline keys. Relative to the config file.
+  /// `camera.file`: a camera file (ViSP's XML, OpenCV's calibration YAML or ROS's camera_info,
+  /// io/camera_file.h) that gives px, py, u0, v0, the lens's distortion and, when it has
+  /// them, width and height; empty: the inline keys. Relative to the config file.
   std::string file;
   /// `camera.name`: the camera to read from `file` (empty: its first).
   std::string file_camera;
 
-  /// The vpCameraParameters (with distortion when kdu != 0).
-  vpCameraParameters Camera() const;
+  /// The lens: OpenCV's model when `distortion` is set, ViSP's when kdu != 0, else the pinhole.
+  Lens Camera() const;
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
 };

@@ -54,8 +54,7 @@ RenderOptions CheapCamera() {
 // MatchLines), in undistorted pixels: a detected line more than kMaxMatchAngleDeg from a true
 // one is not its match; the offset is bounded only by the image. Missed lines get a row too.
 std::vector<DemoMatch> MatchTruth(const std::vector<TruthLine>& truth,
-                                  const std::vector<DetectedLine>& detected,
-                                  const vpCameraParameters& camera) {
+                                  const std::vector<DetectedLine>& detected, const Lens& camera) {
   const PointUndistorter undistorter(camera);
   std::vector<ReferenceLine> references;
   std::vector<int> reference_truth;  // the truth index of each reference

@@ -12,6 +12,7 @@
 #include "app/config.h"
 #include "app/frame_command.h"
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "detector/line_fit.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
@@ -36,7 +37,7 @@ struct DetectRun {
   OalDetector detector;
   std::optional<CameraFile> camera;
   std::vector<std::unique_ptr<ImageSource>> sources;
-  std::optional<vpCameraParameters> undistorted_by;  ///< set when lines are undistorted
+  std::optional<Lens> undistorted_by;  ///< set when lines are undistorted
 };
 
 OalDetector MakeDetector(const DetectorOptions& options, const std::optional<CameraFile>& camera) {
@@ -60,9 +61,9 @@ std::optional<double> Straightness(const std::vector<DetectedLine>& lines, const
   Point2d principal_point{0.5 * (frame.gray.cols - 1), 0.5 * (frame.gray.rows - 1)};
   double focal_px = frame.gray.cols;
   if (run.camera) {
-    const vpCameraParameters& camera = run.camera->camera;
-    principal_point = Point2d{camera.get_u0(), camera.get_v0()};
-    focal_px = std::sqrt(camera.get_px() * camera.get_py());
+    const Lens& camera = run.camera->camera;
+    principal_point = Point2d{camera.u0(), camera.v0()};
+    focal_px = std::sqrt(camera.px() * camera.py());
   }
   return RadialBendOfFour({lines[0].line, lines[1].line, lines[2].line, lines[3].line},
                           run.detector.feature_points(),

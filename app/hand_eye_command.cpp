@@ -21,6 +21,7 @@
 #include "base/format.h"
 #include "base/parse.h"
 #include "calibration/hand_eye_routine.h"
+#include "detector/lens.h"
 #include "io/atomic_file.h"
 #include "io/image_source.h"
 #include "robots/safe_robot.h"
@@ -69,8 +70,7 @@ class SignalRegistration {
 
 // The target is seen well when its four crossings land inside the image, a tenth of its size
 // in from the edges: the stripes then cross the scanned borders on every side.
-TargetInView CrossingsInView(const LineTarget& target, const vpCameraParameters& camera, int width,
-                             int height) {
+TargetInView CrossingsInView(const LineTarget& target, const Lens& camera, int width, int height) {
   const TargetLayout layout = TargetLayout::Of(target);
   return [layout, camera, width, height](const vpHomogeneousMatrix& cMo) -> std::string {
     const vpHomography plane_to_image = PlaneToImage(cMo);
@@ -110,7 +110,7 @@ std::vector<HandEyePair> TakePairs(const Settings& settings, vpHomogeneousMatrix
   CheckServoConfig(config);
   *configured_eMc = config.camera.eMc;
   const ServoSetup setup = ServoSetupOf(config);
-  vpCameraParameters model_camera = setup.camera;  // with the lens, once told
+  Lens model_camera = setup.camera;  // with the lens, once told
   TargetPoseTracker tracker = MakeTracker(setup);
   std::vector<std::string> warnings;
   const std::unique_ptr<FrameSource> frames = OpenFrames(config, &warnings);

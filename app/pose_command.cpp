@@ -18,6 +18,7 @@
 #include "app/config.h"
 #include "app/frame_command.h"
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
@@ -54,7 +55,7 @@ struct PoseRun {
   CameraFile camera;
   TargetPoseTracker tracker;
   std::vector<std::unique_ptr<ImageSource>> sources;
-  std::optional<vpCameraParameters> undistorted_by;  ///< set when lines are undistorted
+  std::optional<Lens> undistorted_by;  ///< set when lines are undistorted
 };
 
 // The configuration: --config, else the target.yaml `oalservo render` writes next to its
@@ -189,7 +190,7 @@ class FrameFeed {
 // and, when it succeeds, gives the tracker the camera with it. Says what it did in `summary`.
 void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* run,
                   PoseSummary* summary) {
-  const vpCameraParameters pinhole = run->camera.camera;
+  const Lens pinhole = run->camera.camera;
   Frame frame;
   int read = 0;
   const ToldLens told = TellLensFromStripes(
@@ -277,12 +278,10 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   AppConfig config = LoadPoseConfig(options, &summary);
   summary.camera_path = FindCameraPath(options, &summary);
   CameraFile camera = LoadCameraFile(summary.camera_path, options.camera_name);
-  if (options.estimate_distortion &&
-      camera.camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
+  if (options.estimate_distortion && camera.camera.distorted()) {
     throw std::invalid_argument("--estimate-distortion is for a camera file without distortion; '" +
-                                summary.camera_path + "' has kdu " +
-                                std::to_string(camera.camera.get_kdu()) +
-                                ": remove the flag, or give the camera without it");
+                                summary.camera_path + "' has a " + LensModelName(camera.camera) +
+                                " lens: remove the flag, or give the camera without it");
   }
   // The target and the options with the camera, before any frame: a bad one fails here.
   TargetPoseTracker tracker(config.target, camera.camera, config.detector, config.pose,

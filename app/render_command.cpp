@@ -12,6 +12,7 @@
 #include "app/config.h"
 #include "app/evaluation_config.h"  // AddSeedOption
 #include "base/check.h"
+#include "detector/lens.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/rendered_dataset.h"
@@ -156,8 +157,8 @@ void RenderCommandOptions::Check() const {
   }
 }
 
-vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu) {
-  return CameraWithKdu(fx_px, fx_px, 0.5 * (width - 1), 0.5 * (height - 1), kdu, width, height);
+Lens RenderCamera(int width, int height, double fx_px, double kdu) {
+  return Lens::WithKdu(fx_px, fx_px, 0.5 * (width - 1), 0.5 * (height - 1), kdu, width, height);
 }
 
 int RenderDataset(const RenderCommandOptions& options) {

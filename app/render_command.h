@@ -7,10 +7,10 @@
 // and keeps any other file in DIR.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
-
 #include <cstdint>
 #include <string>
+
+#include "detector/lens.h"
 
 namespace oal {
 
@@ -61,7 +61,7 @@ struct RenderCommandOptions {
 
 /// The camera of a rendered data set: fx = fy = `fx_px`, principal point at the image centre
 /// ((w-1)/2, (h-1)/2), model perspectiveProjWithDistortion with `kdu` and kud = FitKud().
-vpCameraParameters RenderCamera(int width, int height, double fx_px, double kdu);
+Lens RenderCamera(int width, int height, double fx_px, double kdu);
 
 /// Frames of a sequence when `--sequence` is given without `--count`.
 constexpr int kDefaultSequenceFrames = 60;

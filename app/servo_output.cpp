@@ -6,6 +6,8 @@
 #include <visp3/core/vpImage.h>
 #include <visp3/core/vpImageConvert.h>
 #include <visp3/core/vpRGBa.h>
+
+#include "detector/lens.h"
 #ifdef VISP_HAVE_X11
 #include <visp3/gui/vpDisplayX.h>
 #endif
@@ -144,8 +146,8 @@ void WriteServoPlot(const ServoRunReport& report, const ServoOptions& law,
 }
 
 cv::Mat AnnotateServoFrame(const ServoFrame& frame) {
-  const std::optional<vpCameraParameters> undistorted_by =
-      frame.lines_undistorted ? std::optional<vpCameraParameters>(frame.camera) : std::nullopt;
+  const std::optional<Lens> undistorted_by =
+      frame.lines_undistorted ? std::optional<Lens>(frame.camera) : std::nullopt;
   cv::Mat image = AnnotatePose(frame.gray, frame.lines, frame.pose, frame.camera, undistorted_by,
                                frame.tracked.region);
   DrawGoalLines(&image, frame.target, frame.cdMo, frame.camera);

@@ -23,7 +23,7 @@ RenderOptions CheapCamera(int width, int height) {
   options.width = width;
   options.height = height;
   const double f = 600.0 * width / 640.0;
-  options.camera.initPersProjWithDistortion(f, f, 0.5 * (width - 1), 0.5 * (height - 1), 0.0, 0.33);
+  options.camera = Lens::WithKudKdu(f, f, 0.5 * (width - 1), 0.5 * (height - 1), 0.0, 0.33);
   options.noise_sigma = 8.0;
   options.blur_sigma_px = 1.0;
   return options;

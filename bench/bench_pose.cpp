@@ -21,7 +21,7 @@ struct PoseInputs {
 const PoseInputs& Inputs() {
   static const PoseInputs inputs = [] {
     PoseInputs built;
-    built.render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.33, 640, 480);
+    built.render.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.33, 640, 480);
     built.render.noise_sigma = 8.0;
     built.render.blur_sigma_px = 1.0;
     const SceneRenderer renderer(FourLineTarget(), built.render);

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "scene/bench_scene.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
@@ -46,9 +47,9 @@ std::vector<std::shared_ptr<const vpImage<unsigned char>>> BenchPhotos() {
 }
 
 // The camera of a benchmark's image width: 640x480 at 56 degrees across, or 1920x1080 at 70.
-vpCameraParameters CameraOfWidth(int width) {
-  if (width == 1920) return CameraWithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
-  return CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+Lens CameraOfWidth(int width) {
+  if (width == 1920) return Lens::WithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
+  return Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
 }
 
 RenderOptions BenchRender(std::shared_ptr<const vpImage<unsigned char>> photo, int index,
@@ -70,7 +71,7 @@ FrameEffects EffectsOf(int frame) {
 }
 
 struct TargetInputs {
-  vpCameraParameters camera;
+  Lens camera;
   std::vector<RenderedFrame> still;   ///< random poses, each frame on its own
   std::vector<RenderedFrame> moving;  ///< a smooth sweep between two random poses
 };

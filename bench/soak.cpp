@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "robots/scorbot_controller_sim.h"
 #include "robots/serial_port.h"
 #include "scene/bench_scene.h"
@@ -54,7 +55,7 @@ int OpenDescriptors() {
 
 RenderOptions SoakRender() {
   RenderOptions render;
-  render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  render.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
   DressAsBench(&render, 7);
   return render;
 }
@@ -91,7 +92,7 @@ const RenderedFrame& PingPong(const std::vector<RenderedFrame>& frames, long i) 
 
 int SoakTracker(long frames) {
   const std::vector<RenderedFrame> sweep = Sweep();
-  const vpCameraParameters camera = SoakRender().camera;
+  const Lens camera = SoakRender().camera;
   PoseOptions pose;
   pose.camera = camera;
   pose.image_width = 640;
@@ -163,9 +164,10 @@ int WriteVideo(const std::string& dir, long frames) {
   }
   writer.release();
   vpXmlParserCamera xml;
-  const vpCameraParameters camera = SoakRender().camera;
+  const Lens camera = SoakRender().camera;
   std::filesystem::remove(dir + "/camera.xml");  // save() refuses a camera already there
-  if (xml.save(camera, dir + "/camera.xml", "Camera", 640, 480) != vpXmlParserCamera::SEQUENCE_OK) {
+  if (xml.save(camera.ViSPCamera(640, 480), dir + "/camera.xml", "Camera", 640, 480) !=
+      vpXmlParserCamera::SEQUENCE_OK) {
     std::cerr << "oal_soak video: cannot write " << dir << "/camera.xml\n";
     return 1;
   }

@@ -379,9 +379,9 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     }
     const RadialFit visp =
         FitViSPDistortion(result.lens, px, py, u0, v0, options.width, options.height, max_radius);
-    result.camera.initPersProjWithDistortion(px, py, u0, v0, visp.kud, visp.kdu);
+    result.camera = Lens::WithKudKdu(px, py, u0, v0, visp.kud, visp.kdu);
   } else {
-    result.camera.initPersProjWithoutDistortion(px, py, u0, v0);
+    result.camera = Lens::Pinhole(px, py, u0, v0);
   }
   result.px_sd = sd_intrinsics.at<double>(0);
   result.py_sd = sd_intrinsics.at<double>(1);

@@ -11,11 +11,10 @@
 // image the views cover.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
-
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "detector/line.h"
 
 namespace oal {
@@ -76,7 +75,7 @@ struct RadialDistortion {
 struct CalibrationResult {
   /// perspectiveProjWithDistortion (px, py, u0, v0, kud, kdu), or without distortion when
   /// estimate_distortion is false.
-  vpCameraParameters camera;
+  Lens camera;
   double rms_px = 0.0;  ///< reprojection RMS over every point of the views used
   /// The solver's lens: OpenCV's radial coefficients.
   RadialDistortion lens;

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "detector/lens.h"
 #include "detector/simd.h"
 
 namespace oal {
@@ -105,7 +106,7 @@ OalDetector::OalDetector(const DetectorOptions& options)
       oal_(options.angle_change_deg * kDegToRad, options.r_change_px, options.max_lines,
            options.max_lines + MaxPairs(options.max_points_per_border)) {}
 
-OalDetector::OalDetector(const DetectorOptions& options, const vpCameraParameters& camera)
+OalDetector::OalDetector(const DetectorOptions& options, const Lens& camera)
     : OalDetector(options) {
   PointUndistorter undistorter(camera);
   if (undistorter.active()) undistorter_ = undistorter;

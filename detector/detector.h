@@ -36,8 +36,6 @@
 // coordinates (the pixels an ideal pinhole camera with the same intrinsics would see).
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
-
 #include <array>
 #include <optional>
 #include <vector>
@@ -82,7 +80,7 @@ class OalDetector {
   explicit OalDetector(const DetectorOptions& options = DetectorOptions());
   /// As above; feature points are undistorted with `camera`'s kdu when its model has
   /// distortion.
-  OalDetector(const DetectorOptions& options, const vpCameraParameters& camera);
+  OalDetector(const DetectorOptions& options, const Lens& camera);
 
   /// Detects the lines of `image`, best first. The returned reference stays valid until the
   /// next call. An image smaller than the first border gives no line; an empty view throws

@@ -1,7 +1,6 @@
 #include "detector/lens.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
-
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -13,22 +12,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
-
-double Kdu(const vpCameraParameters& camera) {
-  return camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion
-             ? camera.get_kdu()
-             : 0.0;
-}
-
-// Undistort() is vpPixelMeterConversion::convertPoint (distorted pixel -> metre, with kdu)
-// followed by x -> u0 + px * x, folded into one expression; tests/detector/lens_test.cpp
-// checks it against ViSP's own conversion.
-PointUndistorter::PointUndistorter(const vpCameraParameters& camera)
-    : u0_(camera.get_u0()),
-      v0_(camera.get_v0()),
-      inv_px2_(1.0 / (camera.get_px() * camera.get_px())),
-      inv_py2_(1.0 / (camera.get_py() * camera.get_py())),
-      kdu_(Kdu(camera)) {}
 
 double DistortedOverIdeal(double kdu, double rho2) {
   // rho = r (1 + kdu r^2) reads e s^3 + s = 1 in the ratio s = r / rho, with e = kdu rho^2:
@@ -57,16 +40,242 @@ double DistortedOverIdeal(double kdu, double rho2) {
   return s;
 }
 
-Point2d DistortedPixel(const vpCameraParameters& camera, double x, double y) {
-  const double k = Kdu(camera);
-  const double scale = k != 0.0 ? DistortedOverIdeal(k, x * x + y * y) : 1.0;
-  if (std::isnan(scale)) return Point2d{kNaN, kNaN};
-  return Point2d{camera.get_u0() + camera.get_px() * x * scale,
-                 camera.get_v0() + camera.get_py() * y * scale};
+Distortion Distortion::FromArray(const std::array<double, 8>& c) {
+  return Distortion{c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
 }
 
-double FitKud(const vpCameraParameters& camera, int width, int height) {
-  if (Kdu(camera) == 0.0) return 0.0;
+bool Distortion::IsZero() const {
+  for (double c : ToArray()) {
+    if (c != 0.0) return false;
+  }
+  return true;
+}
+
+Lens::Lens() : Lens(vpCameraParameters()) {}
+
+Lens::Lens(const vpCameraParameters& camera)
+    : px_(camera.get_px()), py_(camera.get_py()), u0_(camera.get_u0()), v0_(camera.get_v0()) {
+  if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion &&
+      (camera.get_kdu() != 0.0 || camera.get_kud() != 0.0)) {
+    model_ = Model::kViSP;
+    kud_ = camera.get_kud();
+    kdu_ = camera.get_kdu();
+  }
+}
+
+Lens Lens::Pinhole(double px, double py, double u0, double v0) {
+  return Lens(vpCameraParameters(px, py, u0, v0));
+}
+
+Lens Lens::WithKudKdu(double px, double py, double u0, double v0, double kud, double kdu) {
+  Lens lens = Pinhole(px, py, u0, v0);
+  if (kud != 0.0 || kdu != 0.0) {
+    lens.model_ = Model::kViSP;
+    lens.kud_ = kud;
+    lens.kdu_ = kdu;
+  }
+  return lens;
+}
+
+Lens Lens::WithKdu(double px, double py, double u0, double v0, double kdu, int width, int height) {
+  const Lens without_kud = WithKudKdu(px, py, u0, v0, 0.0, kdu);
+  return WithKudKdu(px, py, u0, v0, FitKud(without_kud, width, height), kdu);
+}
+
+Lens Lens::WithDistortion(double px, double py, double u0, double v0,
+                          const Distortion& distortion) {
+  Lens lens = Pinhole(px, py, u0, v0);
+  if (!distortion.IsZero()) {
+    lens.model_ = Model::kOpenCV;
+    lens.distortion_ = distortion;
+    lens.max_ideal_r2_ = FoldRadius2(distortion);
+  }
+  return lens;
+}
+
+namespace {
+
+// OpenCV's radial factor and its derivative in r^2.
+struct Radial {
+  double factor, slope;
+};
+
+Radial RadialOf(const Distortion& d, double r2) {
+  const double a = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  const double b = 1.0 + r2 * (d.k4 + r2 * (d.k5 + r2 * d.k6));
+  const double da = d.k1 + r2 * (2.0 * d.k2 + 3.0 * r2 * d.k3);
+  const double db = d.k4 + r2 * (2.0 * d.k5 + 3.0 * r2 * d.k6);
+  return Radial{a / b, (da * b - a * db) / (b * b)};
+}
+
+// d(r factor(r^2)) / dr: the radial map's slope, positive while it has not folded over.
+double RadialMapSlope(const Distortion& d, double r2) {
+  const Radial radial = RadialOf(d, r2);
+  return radial.factor + 2.0 * r2 * radial.slope;
+}
+
+// OpenCV's forward map at the ideal point (x, y): the distorted point and its Jacobian.
+struct Forward {
+  double xd, yd, jxx, jxy, jyy;  // d xd / dy = d yd / dx = jxy
+};
+
+Forward ForwardOf(const Distortion& d, double x, double y) {
+  const double r2 = x * x + y * y;
+  const Radial radial = RadialOf(d, r2);
+  Forward f;
+  f.xd = x * radial.factor + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
+  f.yd = y * radial.factor + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
+  f.jxx = radial.factor + 2.0 * x * x * radial.slope + 2.0 * d.p1 * y + 6.0 * d.p2 * x;
+  f.jyy = radial.factor + 2.0 * y * y * radial.slope + 6.0 * d.p1 * y + 2.0 * d.p2 * x;
+  f.jxy = 2.0 * x * y * radial.slope + 2.0 * d.p1 * x + 2.0 * d.p2 * y;
+  return f;
+}
+
+}  // namespace
+
+double Lens::FoldRadius2(const Distortion& d) {
+  // The first ideal radius where the radial map turns back, searched out to r = 20 (87
+  // degrees off axis) in steps of 1/500; beyond, no lens users have is modelled.
+  constexpr double kStep = 0.002, kFar = 20.0;
+  for (double r = kStep; r <= kFar; r += kStep) {
+    if (!(RadialMapSlope(d, r * r) > 0.0)) return (r - kStep) * (r - kStep);
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+Point2d Lens::Normalised(double u, double v) const {
+  const double xd = (u - u0_) / px_, yd = (v - v0_) / py_;
+  switch (model_) {
+    case Model::kPinhole:
+      return Point2d{xd, yd};
+    case Model::kViSP: {
+      const double factor = 1.0 + kdu_ * (xd * xd + yd * yd);
+      return Point2d{xd * factor, yd * factor};
+    }
+    case Model::kOpenCV:
+      break;
+  }
+  // Newton's method on the forward map from the distorted point itself; the Jacobian's
+  // determinant stays positive inside the fold radius, and a step that leaves it is halved.
+  double x = xd, y = yd;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const Forward f = ForwardOf(distortion_, x, y);
+    const double fx = f.xd - xd, fy = f.yd - yd;
+    const double det = f.jxx * f.jyy - f.jxy * f.jxy;
+    if (!(det > 0.0)) return Point2d{kNaN, kNaN};
+    double sx = (f.jyy * fx - f.jxy * fy) / det, sy = (f.jxx * fy - f.jxy * fx) / det;
+    for (int halving = 0; halving < 60 && (x - sx) * (x - sx) + (y - sy) * (y - sy) > max_ideal_r2_;
+         ++halving) {
+      sx *= 0.5;
+      sy *= 0.5;
+    }
+    x -= sx;
+    y -= sy;
+    if (std::fabs(sx) + std::fabs(sy) <= 1e-15 * (1.0 + std::fabs(x) + std::fabs(y))) {
+      return Point2d{x, y};
+    }
+  }
+  // Converged to rounding without meeting the tolerance: accept a residual under 1e-12.
+  const Point2d back = Pixel(x, y);
+  if (std::fabs(back.u - u) + std::fabs(back.v - v) < 1e-9) return Point2d{x, y};
+  return Point2d{kNaN, kNaN};
+}
+
+Point2d Lens::Pixel(double x, double y) const {
+  switch (model_) {
+    case Model::kPinhole:
+      return Point2d{u0_ + px_ * x, v0_ + py_ * y};
+    case Model::kViSP: {
+      const double scale = DistortedOverIdeal(kdu_, x * x + y * y);
+      if (std::isnan(scale)) return Point2d{kNaN, kNaN};
+      return Point2d{u0_ + px_ * x * scale, v0_ + py_ * y * scale};
+    }
+    case Model::kOpenCV:
+      break;
+  }
+  if (!(x * x + y * y <= max_ideal_r2_)) return Point2d{kNaN, kNaN};
+  const Forward f = ForwardOf(distortion_, x, y);
+  return Point2d{u0_ + px_ * f.xd, v0_ + py_ * f.yd};
+}
+
+std::array<double, 4> Lens::NormalisedDerivative(double u, double v, const Point2d& ideal) const {
+  const double inv_px = 1.0 / px_, inv_py = 1.0 / py_;
+  switch (model_) {
+    case Model::kPinhole:
+      return {inv_px, 0.0, 0.0, inv_py};
+    case Model::kViSP: {
+      // x = du (1 + k r^2), du = (u - u0) / px, likewise y.
+      const double du = (u - u0_) * inv_px, dv = (v - v0_) * inv_py;
+      const double f = 1.0 + kdu_ * (du * du + dv * dv), cross = 2.0 * kdu_ * du * dv;
+      return {(f + 2.0 * kdu_ * du * du) * inv_px, cross * inv_py, cross * inv_px,
+              (f + 2.0 * kdu_ * dv * dv) * inv_py};
+    }
+    case Model::kOpenCV:
+      break;
+  }
+  // The inverse of the forward map's Jacobian at the ideal point.
+  const Forward f = ForwardOf(distortion_, ideal.u, ideal.v);
+  const double inv_det = 1.0 / (f.jxx * f.jyy - f.jxy * f.jxy);
+  return {f.jyy * inv_det * inv_px, -f.jxy * inv_det * inv_py, -f.jxy * inv_det * inv_px,
+          f.jxx * inv_det * inv_py};
+}
+
+vpCameraParameters Lens::PinholeCamera() const {
+  return vpCameraParameters(px_, py_, u0_, v0_);
+}
+
+vpCameraParameters Lens::ViSPCamera(int width, int height) const {
+  vpCameraParameters camera = PinholeCamera();
+  if (model_ == Model::kViSP) {
+    camera.initPersProjWithDistortion(px_, py_, u0_, v0_, kud_, kdu_);
+  } else if (model_ == Model::kOpenCV) {
+    // Least squares over a grid of the image's pixels of the ideal pixel error of
+    // x = xd (1 + kdu rd^2): linear in kdu.
+    constexpr int kSteps = 40;
+    double saa = 0.0, sab = 0.0;
+    for (int j = 0; j <= kSteps; ++j) {
+      for (int i = 0; i <= kSteps; ++i) {
+        const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
+        const Point2d ideal = Normalised(u, v);
+        if (!std::isfinite(ideal.u)) continue;
+        const double xd = (u - u0_) / px_, yd = (v - v0_) / py_, rd2 = xd * xd + yd * yd;
+        const double au = px_ * xd * rd2, av = py_ * yd * rd2;
+        saa += au * au + av * av;
+        sab += au * px_ * (ideal.u - xd) + av * py_ * (ideal.v - yd);
+      }
+    }
+    const double kdu = saa > 0.0 ? sab / saa : 0.0;
+    const Lens one_term = WithKdu(px_, py_, u0_, v0_, kdu, width, height);
+    camera.initPersProjWithDistortion(px_, py_, u0_, v0_, one_term.kud(), one_term.kdu());
+  }
+  return camera;
+}
+
+bool Lens::operator==(const Lens& other) const {
+  return model_ == other.model_ && px_ == other.px_ && py_ == other.py_ && u0_ == other.u0_ &&
+         v0_ == other.v0_ && kud_ == other.kud_ && kdu_ == other.kdu_ &&
+         distortion_ == other.distortion_;
+}
+
+std::string LensModelName(const Lens& lens) {
+  switch (lens.model()) {
+    case Lens::Model::kPinhole:
+      return "perspectiveProjWithoutDistortion";
+    case Lens::Model::kViSP:
+      return "perspectiveProjWithDistortion";
+    case Lens::Model::kOpenCV:
+      break;
+  }
+  return lens.distortion().IsRational() ? "rational_polynomial" : "plumb_bob";
+}
+
+PointUndistorter::PointUndistorter(const Lens& lens)
+    : lens_(lens),
+      inv_px2_(1.0 / (lens.px() * lens.px())),
+      inv_py2_(1.0 / (lens.py() * lens.py())) {}
+
+double FitKud(const Lens& lens, int width, int height) {
+  if (lens.kdu() == 0.0) return 0.0;
   // Minimise sum over a grid of distorted pixels of |u0 + px x (1 + kud r^2) - u|^2 (and v),
   // (x, y) the ideal point of (u, v): linear in kud.
   constexpr int kSteps = 40;
@@ -74,12 +283,11 @@ double FitKud(const vpCameraParameters& camera, int width, int height) {
   for (int j = 0; j <= kSteps; ++j) {
     for (int i = 0; i <= kSteps; ++i) {
       const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(camera, u, v, x, y);
-      const double r2 = x * x + y * y;
-      const double au = camera.get_px() * x * r2, av = camera.get_py() * y * r2;
-      const double bu = u - camera.get_u0() - camera.get_px() * x;
-      const double bv = v - camera.get_v0() - camera.get_py() * y;
+      const Point2d ideal = lens.Normalised(u, v);
+      const double x = ideal.u, y = ideal.v, r2 = x * x + y * y;
+      const double au = lens.px() * x * r2, av = lens.py() * y * r2;
+      const double bu = u - lens.u0() - lens.px() * x;
+      const double bv = v - lens.v0() - lens.py() * y;
       saa += au * au + av * av;
       sab += au * bu + av * bv;
     }
@@ -87,26 +295,50 @@ double FitKud(const vpCameraParameters& camera, int width, int height) {
   return saa > 0.0 ? sab / saa : 0.0;
 }
 
-vpCameraParameters CameraWithKdu(double px, double py, double u0, double v0, double kdu, int width,
-                                 int height) {
-  vpCameraParameters camera;
-  camera.initPersProjWithDistortion(px, py, u0, v0, 0.0, kdu);
-  camera.initPersProjWithDistortion(px, py, u0, v0, FitKud(camera, width, height), kdu);
-  return camera;
+double CornerRadius2(const Lens& lens, int width, int height) {
+  const double du = std::max(std::fabs(lens.u0()), std::fabs(width - 1 - lens.u0()));
+  const double dv = std::max(std::fabs(lens.v0()), std::fabs(height - 1 - lens.v0()));
+  return du * du / (lens.px() * lens.px()) + dv * dv / (lens.py() * lens.py());
 }
 
-void CheckPerspectiveCamera(const vpCameraParameters& camera, const std::string& field) {
-  const auto model = camera.get_projModel();
-  RequireOption(model == vpCameraParameters::perspectiveProjWithoutDistortion ||
-                    model == vpCameraParameters::perspectiveProjWithDistortion,
-                field + ".projModel", static_cast<int>(model),
-                "perspective projection with or without (kdu) distortion");
-  RequireOption(camera.get_px() > 0.0 && std::isfinite(camera.get_px()), field + ".px",
-                camera.get_px(), "px > 0");
-  RequireOption(camera.get_py() > 0.0 && std::isfinite(camera.get_py()), field + ".py",
-                camera.get_py(), "py > 0");
-  RequireOption(std::isfinite(camera.get_u0()), field + ".u0", camera.get_u0(), "u0 is finite");
-  RequireOption(std::isfinite(camera.get_v0()), field + ".v0", camera.get_v0(), "v0 is finite");
+void CheckPerspectiveCamera(const Lens& lens, const std::string& field) {
+  RequireOption(lens.px() > 0.0 && std::isfinite(lens.px()), field + ".px", lens.px(), "px > 0");
+  RequireOption(lens.py() > 0.0 && std::isfinite(lens.py()), field + ".py", lens.py(), "py > 0");
+  RequireOption(std::isfinite(lens.u0()), field + ".u0", lens.u0(), "u0 is finite");
+  RequireOption(std::isfinite(lens.v0()), field + ".v0", lens.v0(), "v0 is finite");
+  RequireOption(std::isfinite(lens.kdu()), field + ".kdu", lens.kdu(), "kdu is finite");
+  RequireOption(std::isfinite(lens.kud()), field + ".kud", lens.kud(), "kud is finite");
+  const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
+  const auto coefficients = lens.distortion().ToArray();
+  for (std::size_t i = 0; i < coefficients.size(); ++i) {
+    RequireOption(std::isfinite(coefficients[i]), field + "." + names[i], coefficients[i],
+                  std::string(names[i]) + " is finite");
+  }
+}
+
+void CheckInvertibleOver(const Lens& lens, int width, int height, const std::string& field) {
+  if (lens.model() == Lens::Model::kViSP) {
+    // The pixel -> ray map must not fold over inside the image: 1 + 3 kdu r^2 > 0 at the
+    // farthest corner (the radial derivative of r (1 + kdu r^2)).
+    const double r2 = CornerRadius2(lens, width, height);
+    RequireOption(1.0 + 3.0 * lens.kdu() * r2 > 0.0, field + ".kdu", lens.kdu(),
+                  "1 + 3 kdu r^2 > 0 at the image corners (the lens model is invertible)");
+  } else if (lens.model() == Lens::Model::kOpenCV) {
+    // Every pixel of the image's rim has an ideal point inside the fold radius (the radial
+    // map is monotonic there, so the inside has too).
+    bool invertible = true;
+    const int steps = 64;
+    for (int i = 0; i <= steps && invertible; ++i) {
+      const double u = (width - 1.0) * i / steps, v = (height - 1.0) * i / steps;
+      for (const Point2d& p :
+           {Point2d{u, 0.0}, Point2d{u, height - 1.0}, Point2d{0.0, v}, Point2d{width - 1.0, v}}) {
+        invertible = invertible && std::isfinite(lens.Normalised(p.u, p.v).u);
+      }
+    }
+    RequireOption(invertible, field + ".k1", lens.distortion().k1,
+                  "the distortion model maps every pixel of the image to a ray (it folds over "
+                  "inside the image)");
+  }
 }
 
 }  // namespace oal

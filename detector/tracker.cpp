@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "detector/lens.h"
+
 namespace oal {
 namespace {
 
@@ -74,7 +76,7 @@ void TrackedLine::getExtremities(vpImagePoint& ip1, vpImagePoint& ip2) const {
 OalLineTracker::OalLineTracker(const TrackerOptions& options)
     : options_((options.Check(), options)), detector_(options.detector) {}
 
-OalLineTracker::OalLineTracker(const TrackerOptions& options, const vpCameraParameters& camera)
+OalLineTracker::OalLineTracker(const TrackerOptions& options, const Lens& camera)
     : options_((options.Check(), options)), detector_(options.detector, camera) {}
 
 void OalLineTracker::initTracking(const vpImage<unsigned char>& I) {

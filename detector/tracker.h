@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 
 namespace oal {
 
@@ -82,7 +83,7 @@ class OalLineTracker : public vpTracker {
   /// Throws std::invalid_argument for options failing Check().
   explicit OalLineTracker(const TrackerOptions& options = TrackerOptions());
   /// With `camera`, feature points are undistorted and lines are in undistorted pixels.
-  OalLineTracker(const TrackerOptions& options, const vpCameraParameters& camera);
+  OalLineTracker(const TrackerOptions& options, const Lens& camera);
 
   /// Forgets every track and detects the lines of `I` (all of them `new`).
   void initTracking(const vpImage<unsigned char>& I);

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "detector/lens.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 
@@ -98,29 +99,22 @@ struct PixelScale {
     return LineParams{(line.rho_px + 0.5 * (c + s) - 0.5 * (a + b)) / n, std::atan2(b, a)};
   }
   // The distortion coefficients are in normalised coordinates: unchanged.
-  vpCameraParameters Camera(const vpCameraParameters& camera) const {
-    vpCameraParameters scaled = camera;
-    const double u0 = sx * (camera.get_u0() + 0.5) - 0.5, v0 = sy * (camera.get_v0() + 0.5) - 0.5;
-    if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
-      scaled.initPersProjWithDistortion(sx * camera.get_px(), sy * camera.get_py(), u0, v0,
-                                        camera.get_kud(), camera.get_kdu());
-    } else {
-      scaled.initPersProjWithoutDistortion(sx * camera.get_px(), sy * camera.get_py(), u0, v0);
-    }
-    return scaled;
+  Lens Camera(const Lens& camera) const {
+    const double u0 = sx * (camera.u0() + 0.5) - 0.5, v0 = sy * (camera.v0() + 0.5) - 0.5;
+    return camera.WithIntrinsics(sx * camera.px(), sy * camera.py(), u0, v0);
   }
 };
 
 // The frame at `size` with every held track (thin, labelled #id), lines 1-4 and the target
 // frame's axes (AnnotatePose), and the frame number, drawn at that size.
 cv::Mat Annotate(const TrackedFrame& frame, const std::optional<CameraFile>& camera,
-                 const std::optional<vpCameraParameters>& undistorted_by, const cv::Size& size) {
+                 const std::optional<Lens>& undistorted_by, const cv::Size& size) {
   const bool scaled = size != frame.gray.size();
   const PixelScale scale{static_cast<double>(size.width) / frame.gray.cols,
                          static_cast<double>(size.height) / frame.gray.rows};
   cv::Mat gray = frame.gray;
   std::vector<DetectedLine> held = frame.held;
-  std::optional<vpCameraParameters> undistorted = undistorted_by;
+  std::optional<Lens> undistorted = undistorted_by;
   if (scaled) {
     cv::resize(frame.gray, gray, size, 0.0, 0.0, cv::INTER_AREA);
     for (DetectedLine& line : held) line.line = scale.Line(line.line);
@@ -232,8 +226,8 @@ void AnnotatedVideo::Commit() {
 }
 
 void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::size_t thumbnails,
-                 const std::optional<CameraFile>& camera,
-                 const std::optional<vpCameraParameters>& undistorted_by, WriterResult* result) {
+                 const std::optional<CameraFile>& camera, const std::optional<Lens>& undistorted_by,
+                 WriterResult* result) {
   WorstFrames worst(thumbnails);
   try {
     while (std::optional<TrackedFrame> frame = queue->Pop()) {

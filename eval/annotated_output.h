@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "eval/pipeline.h"
 #include "eval/report.h"
 #include "io/camera_file.h"
@@ -73,7 +74,7 @@ struct WriterResult {
 /// `undistorted_by`: the camera whose undistortion the tracked lines are in. An error is kept
 /// in result->error and closes the queue.
 void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::size_t thumbnails,
-                 const std::optional<CameraFile>& camera,
-                 const std::optional<vpCameraParameters>& undistorted_by, WriterResult* result);
+                 const std::optional<CameraFile>& camera, const std::optional<Lens>& undistorted_by,
+                 WriterResult* result);
 
 }  // namespace oal

@@ -1,6 +1,5 @@
 #include "eval/apriltag_method.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
 #include <visp3/detection/vpDetectorAprilTag.h>
 
 #include <algorithm>
@@ -46,17 +45,10 @@ vpHomogeneousMatrix SheetFromTag() {
 // pixels): the principal point moved by half a pixel right and down. ViSP 3.5's getPose hands
 // the library's corners to a camera in ViSP's pixels, half a pixel off in u and v; in the
 // library's pixels u - u0 is the same as in ours, so the pose (homography, then the corners
-// undistorted with kdu) is that of the corners where they are.
-vpCameraParameters InLibraryPixels(const vpCameraParameters& camera) {
-  vpCameraParameters shifted = camera;
-  if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion) {
-    shifted.initPersProjWithDistortion(camera.get_px(), camera.get_py(), camera.get_u0() + 0.5,
-                                       camera.get_v0() + 0.5, camera.get_kud(), camera.get_kdu());
-  } else {
-    shifted.initPersProjWithoutDistortion(camera.get_px(), camera.get_py(), camera.get_u0() + 0.5,
-                                          camera.get_v0() + 0.5);
-  }
-  return shifted;
+// undistorted with kdu) is that of the corners where they are. A distorted lens's frames are
+// resampled to a pinhole camera first (LensUndistortion), so the pinhole's is all it needs.
+vpCameraParameters InLibraryPixels(const Lens& pinhole) {
+  return vpCameraParameters(pinhole.px(), pinhole.py(), pinhole.u0() + 0.5, pinhole.v0() + 0.5);
 }
 
 double PolygonArea(const std::vector<vpImagePoint>& polygon) {
@@ -76,16 +68,16 @@ double PolygonArea(const std::vector<vpImagePoint>& polygon) {
 // frame has none.
 class LensUndistortion {
  public:
-  LensUndistortion(const vpCameraParameters& camera, int width, int height) {
-    const double px = camera.get_px(), py = camera.get_py();
+  LensUndistortion(const Lens& camera, int width, int height) {
+    const double px = camera.px(), py = camera.py();
     double min_u = 1e300, min_v = 1e300, max_u = -1e300, max_v = -1e300;
     const auto grow = [&](double u, double v) {
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(camera, u, v, x, y);
-      min_u = std::min(min_u, camera.get_u0() + px * x);
-      max_u = std::max(max_u, camera.get_u0() + px * x);
-      min_v = std::min(min_v, camera.get_v0() + py * y);
-      max_v = std::max(max_v, camera.get_v0() + py * y);
+      const Point2d ideal = camera.Normalised(u, v);
+      const double x = ideal.u, y = ideal.v;
+      min_u = std::min(min_u, camera.u0() + px * x);
+      max_u = std::max(max_u, camera.u0() + px * x);
+      min_v = std::min(min_v, camera.v0() + py * y);
+      max_v = std::max(max_v, camera.v0() + py * y);
     };
     for (int u = 0; u < width; ++u) {
       grow(u, 0.0);
@@ -98,12 +90,11 @@ class LensUndistortion {
     const double left = std::floor(min_u), top = std::floor(min_v);
     const int cols = static_cast<int>(std::ceil(max_u) - left) + 1;
     const int rows = static_cast<int>(std::ceil(max_v) - top) + 1;
-    pinhole_.initPersProjWithoutDistortion(px, py, camera.get_u0() - left, camera.get_v0() - top);
+    pinhole_ = Lens::Pinhole(px, py, camera.u0() - left, camera.v0() - top);
     cv::Mat1f map_u(rows, cols), map_v(rows, cols);
     for (int j = 0; j < rows; ++j) {
       for (int i = 0; i < cols; ++i) {
-        const Point2d p =
-            DistortedPixel(camera, (i - pinhole_.get_u0()) / px, (j - pinhole_.get_v0()) / py);
+        const Point2d p = camera.Pixel((i - pinhole_.u0()) / px, (j - pinhole_.v0()) / py);
         const bool seen = std::isfinite(p.u) && std::isfinite(p.v);
         map_u(j, i) = seen ? static_cast<float>(p.u) : -10.0f;
         map_v(j, i) = seen ? static_cast<float>(p.v) : -10.0f;
@@ -114,7 +105,7 @@ class LensUndistortion {
   }
 
   /// The pinhole camera of the canvas (ViSP's pixels).
-  const vpCameraParameters& pinhole() const { return pinhole_; }
+  const Lens& pinhole() const { return pinhole_; }
 
   const vpImage<unsigned char>& Undistort(const vpImage<unsigned char>& frame) {
     const cv::Mat in(static_cast<int>(frame.getHeight()), static_cast<int>(frame.getWidth()), CV_8U,
@@ -127,17 +118,17 @@ class LensUndistortion {
   }
 
  private:
-  vpCameraParameters pinhole_;
+  Lens pinhole_;
   cv::Mat map_fixed_, map_fraction_;
   vpImage<unsigned char> canvas_;
 };
 
 class AprilTagMethod : public MarkerMethod {
  public:
-  AprilTagMethod(const LineTarget& sheet, const vpCameraParameters& camera, int width, int height)
+  AprilTagMethod(const LineTarget& sheet, const Lens& camera, int width, int height)
       : tag_size_m_(AprilTagBlackSide(sheet)),
         detector_(vpDetectorAprilTag::TAG_36h11, vpDetectorAprilTag::HOMOGRAPHY_VIRTUAL_VS) {
-    if (Kdu(camera) != 0.0) {
+    if (camera.distorted()) {
       undistortion_ = std::make_unique<LensUndistortion>(camera, width, height);
       camera_ = InLibraryPixels(undistortion_->pinhole());
     } else {
@@ -217,9 +208,8 @@ double AprilTagBlackSide(const LineTarget& sheet) {
   return std::min(sheet.board_width_m, sheet.board_height_m) * kBlackModules / kPictureModules;
 }
 
-std::unique_ptr<MarkerMethod> MakeAprilTagMethod(const LineTarget& sheet,
-                                                 const vpCameraParameters& camera, int width,
-                                                 int height) {
+std::unique_ptr<MarkerMethod> MakeAprilTagMethod(const LineTarget& sheet, const Lens& camera,
+                                                 int width, int height) {
   return std::make_unique<AprilTagMethod>(sheet, camera, width, height);
 }
 

@@ -33,6 +33,7 @@
 
 #include <memory>
 
+#include "detector/lens.h"
 #include "eval/marker_method.h"
 
 namespace oal {
@@ -41,8 +42,7 @@ namespace oal {
 double AprilTagBlackSide(const LineTarget& sheet);
 
 /// The method for frames of width x height pixels from `camera`.
-std::unique_ptr<MarkerMethod> MakeAprilTagMethod(const LineTarget& sheet,
-                                                 const vpCameraParameters& camera, int width,
-                                                 int height);
+std::unique_ptr<MarkerMethod> MakeAprilTagMethod(const LineTarget& sheet, const Lens& camera,
+                                                 int width, int height);
 
 }  // namespace oal

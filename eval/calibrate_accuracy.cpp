@@ -14,7 +14,7 @@ namespace {
 // Streams of Uniform01 for the camera's draws.
 enum Draw : std::uint64_t { kFocal = 11, kAspect, kCentreU, kCentreV, kLens };
 
-vpCameraParameters DrawCamera(const CalibrateAccuracyOptions& o, int camera) {
+Lens DrawCamera(const CalibrateAccuracyOptions& o, int camera) {
   const auto draw = [&](double lo, double hi, Draw stream) {
     return lo + (hi - lo) * Uniform01(o.seed, camera, stream);
   };
@@ -24,7 +24,7 @@ vpCameraParameters DrawCamera(const CalibrateAccuracyOptions& o, int camera) {
       0.5 * (o.width - 1) + draw(-o.max_centre_offset_px, o.max_centre_offset_px, kCentreU);
   const double v0 =
       0.5 * (o.height - 1) + draw(-o.max_centre_offset_px, o.max_centre_offset_px, kCentreV);
-  return CameraWithKdu(px, py, u0, v0, draw(o.min_kdu, o.max_kdu, kLens), o.width, o.height);
+  return Lens::WithKdu(px, py, u0, v0, draw(o.min_kdu, o.max_kdu, kLens), o.width, o.height);
 }
 
 double TiltDeg(const vpHomogeneousMatrix& cMo) {
@@ -51,22 +51,22 @@ void CalibrateAccuracyOptions::Check() const {
 }
 
 double CameraCalibrationTrial::px_error_pct() const {
-  return 100.0 * std::fabs(found.get_px() - truth.get_px()) / truth.get_px();
+  return 100.0 * std::fabs(found.px() - truth.px()) / truth.px();
 }
 double CameraCalibrationTrial::py_error_pct() const {
-  return 100.0 * std::fabs(found.get_py() - truth.get_py()) / truth.get_py();
+  return 100.0 * std::fabs(found.py() - truth.py()) / truth.py();
 }
 double CameraCalibrationTrial::u0_error_px() const {
-  return std::fabs(found.get_u0() - truth.get_u0());
+  return std::fabs(found.u0() - truth.u0());
 }
 double CameraCalibrationTrial::v0_error_px() const {
-  return std::fabs(found.get_v0() - truth.get_v0());
+  return std::fabs(found.v0() - truth.v0());
 }
 double CameraCalibrationTrial::kdu_error_abs() const {
-  return std::fabs(found.get_kdu() - truth.get_kdu());
+  return std::fabs(found.kdu() - truth.kdu());
 }
 double CameraCalibrationTrial::kdu_error() const {
-  return kdu_error_abs() / std::max(0.005, 0.03 * std::fabs(truth.get_kdu()));
+  return kdu_error_abs() / std::max(0.005, 0.03 * std::fabs(truth.kdu()));
 }
 
 std::vector<CameraCalibrationTrial> EvaluateCalibration(

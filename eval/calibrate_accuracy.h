@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "calibration/calibrate.h"
+#include "detector/lens.h"
 #include "eval/rendered_frames.h"
 #include "scene/bench_scene.h"
 #include "servo/target_tracker.h"
@@ -37,7 +38,7 @@ struct CalibrateAccuracyOptions : RenderedFrameOptions {
 
 /// One camera's calibration against its truth.
 struct CameraCalibrationTrial {
-  vpCameraParameters truth, found;
+  Lens truth, found;
   int views = 0, used = 0;
   double rms_px = 0.0;
   std::string failed;  ///< why the calibration refused (then `found` is unset)

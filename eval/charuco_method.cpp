@@ -1,6 +1,5 @@
 #include "eval/charuco_method.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
 #include <visp3/core/vpRotationMatrix.h>
 #include <visp3/core/vpThetaUVector.h>
 #include <visp3/core/vpTranslationVector.h>
@@ -41,7 +40,7 @@ cv::Matx33d InArucoPixels(cv::Matx33d camera_matrix) {
 
 class CharucoMethod : public MarkerMethod {
  public:
-  CharucoMethod(const LineTarget& sheet, const vpCameraParameters& camera, int width, int height)
+  CharucoMethod(const LineTarget& sheet, const Lens& camera, int width, int height)
       : square_m_(CharucoSquareSide(sheet)),
         camera_matrix_(InArucoPixels(OpenCvCameraMatrix(camera))),
         distortion_(KduAsOpenCvDistortion(camera, width, height)),
@@ -132,20 +131,20 @@ double CharucoSquareSide(const LineTarget& sheet) {
   return kA3SquareM * std::min(sheet.board_width_m / 0.42, sheet.board_height_m / 0.297);
 }
 
-cv::Matx33d OpenCvCameraMatrix(const vpCameraParameters& camera) {
-  return cv::Matx33d(camera.get_px(), 0.0, camera.get_u0(), 0.0, camera.get_py(), camera.get_v0(),
-                     0.0, 0.0, 1.0);
+cv::Matx33d OpenCvCameraMatrix(const Lens& camera) {
+  return cv::Matx33d(camera.px(), 0.0, camera.u0(), 0.0, camera.py(), camera.v0(), 0.0, 0.0, 1.0);
 }
 
-cv::Matx<double, 1, 5> KudAsOpenCvDistortion(const vpCameraParameters& camera) {
-  const bool distorted =
-      camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion;
-  return cv::Matx<double, 1, 5>(distorted ? camera.get_kud() : 0.0, 0.0, 0.0, 0.0, 0.0);
+cv::Matx<double, 1, 5> KudAsOpenCvDistortion(const Lens& camera) {
+  return cv::Matx<double, 1, 5>(camera.kud(), 0.0, 0.0, 0.0, 0.0);
 }
 
-cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const vpCameraParameters& camera, int width,
-                                             int height) {
-  if (Kdu(camera) == 0.0) return cv::Matx<double, 1, 5>::zeros();
+cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const Lens& camera, int width, int height) {
+  if (!camera.distorted()) return cv::Matx<double, 1, 5>::zeros();
+  if (camera.model() == Lens::Model::kOpenCV && !camera.distortion().IsRational()) {
+    const Distortion& d = camera.distortion();
+    return cv::Matx<double, 1, 5>(d.k1, d.k2, d.p1, d.p2, d.k3);
+  }
   // Minimise over a grid of distorted pixels (u, v) the distance from (u, v) to
   // u0 + px x (1 + k1 r^2 + k2 r^4 + k3 r^6) (and v), (x, y) the ideal point of (u, v) and
   // r^2 = x^2 + y^2: linear in (k1, k2, k3).
@@ -155,13 +154,13 @@ cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const vpCameraParameters& camera, i
   for (int j = 0; j <= kSteps; ++j) {
     for (int i = 0; i <= kSteps; ++i) {
       const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(camera, u, v, x, y);
+      const Point2d ideal = camera.Normalised(u, v);
+      const double x = ideal.u, y = ideal.v;
       const double r2 = x * x + y * y;
       const cv::Vec3d powers(r2, r2 * r2, r2 * r2 * r2);
-      const cv::Vec3d au = camera.get_px() * x * powers, av = camera.get_py() * y * powers;
-      const double bu = u - camera.get_u0() - camera.get_px() * x;
-      const double bv = v - camera.get_v0() - camera.get_py() * y;
+      const cv::Vec3d au = camera.px() * x * powers, av = camera.py() * y * powers;
+      const double bu = u - camera.u0() - camera.px() * x;
+      const double bv = v - camera.v0() - camera.py() * y;
       normal += au * au.t() + av * av.t();
       right += bu * au + bv * av;
     }
@@ -170,9 +169,8 @@ cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const vpCameraParameters& camera, i
   return cv::Matx<double, 1, 5>(k[0], k[1], 0.0, 0.0, k[2]);
 }
 
-std::unique_ptr<MarkerMethod> MakeCharucoMethod(const LineTarget& sheet,
-                                                const vpCameraParameters& camera, int width,
-                                                int height) {
+std::unique_ptr<MarkerMethod> MakeCharucoMethod(const LineTarget& sheet, const Lens& camera,
+                                                int width, int height) {
   return std::make_unique<CharucoMethod>(sheet, camera, width, height);
 }
 

@@ -35,6 +35,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 
+#include "detector/lens.h"
 #include "eval/marker_method.h"
 
 namespace oal {
@@ -44,18 +45,16 @@ namespace oal {
 double CharucoSquareSide(const LineTarget& sheet);
 
 /// OpenCV's camera matrix (3 x 3) of a ViSP camera.
-cv::Matx33d OpenCvCameraMatrix(const vpCameraParameters& camera);
+cv::Matx33d OpenCvCameraMatrix(const Lens& camera);
 /// ViSP's metre -> pixel direction (kud) as OpenCV's distortion coefficients: (kud, 0, 0, 0,
 /// 0), exactly; none for a camera without distortion.
-cv::Matx<double, 1, 5> KudAsOpenCvDistortion(const vpCameraParameters& camera);
+cv::Matx<double, 1, 5> KudAsOpenCvDistortion(const Lens& camera);
 /// ViSP's kdu lens (pixel -> metre, the one the renderer forms images with) as OpenCV's
 /// coefficients (k1, k2, 0, 0, k3): least squares over a grid of the width x height image's
 /// distorted pixels, as FitKud fits kud; none for a camera without distortion.
-cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const vpCameraParameters& camera, int width,
-                                             int height);
+cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const Lens& camera, int width, int height);
 
-std::unique_ptr<MarkerMethod> MakeCharucoMethod(const LineTarget& sheet,
-                                                const vpCameraParameters& camera, int width,
-                                                int height);
+std::unique_ptr<MarkerMethod> MakeCharucoMethod(const LineTarget& sheet, const Lens& camera,
+                                                int width, int height);
 
 }  // namespace oal

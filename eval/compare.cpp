@@ -47,10 +47,9 @@ std::vector<TargetLineTruth> TargetsFromDetections(const std::vector<DetectedLin
     target.width_px = detected[i].width_px;
     target.image_line = target.ideal_line = detected[i].line;
     if (undistorted && camera) {  // back to image pixels: two points through the lens
-      const vpCameraParameters& cam = camera->camera;
+      const Lens& cam = camera->camera;
       auto distort = [&](const Point2d& p) {
-        return DistortedPixel(cam, (p.u - cam.get_u0()) / cam.get_px(),
-                              (p.v - cam.get_v0()) / cam.get_py());
+        return cam.Pixel((p.u - cam.u0()) / cam.px(), (p.v - cam.v0()) / cam.py());
       };
       const Point2d a = distort(detected[i].end_a), b = distort(detected[i].end_b);
       if (!std::isfinite(a.u) || !std::isfinite(b.u)) continue;
@@ -114,7 +113,7 @@ cv::Mat Figure(const cv::Mat& gray, int frame, const CompareReport& report,
   cv::cvtColor(gray, figure, cv::COLOR_GRAY2BGR);
   const int w = gray.cols, h = gray.rows;
   auto draw = [&](const LineParams& line, bool ideal, const cv::Scalar& colour, int thickness) {
-    std::optional<vpCameraParameters> by;
+    std::optional<Lens> by;
     if (ideal && camera) by = camera->camera;
     for (const auto& polyline : LineInFrame(line, w, h, by)) {
       for (std::size_t i = 1; i < polyline.size(); ++i) {

@@ -664,7 +664,7 @@ class InputEvaluation {
   std::optional<CameraFile> camera_;
   std::string camera_path_;
   bool undistorts_ = false;
-  std::optional<vpCameraParameters> undistorted_by_;
+  std::optional<Lens> undistorted_by_;
   std::optional<PointUndistorter> undistorter_;
   std::vector<std::string> warnings_;
   RadialBend lens_;  // the target tracker's last frame

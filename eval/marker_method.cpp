@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "detector/lens.h"
 #include "eval/apriltag_method.h"
 #include "eval/charuco_method.h"
 
@@ -52,8 +53,7 @@ std::string ToString(MarkerStatus status) {
 }
 
 std::unique_ptr<MarkerMethod> MakeMarkerMethod(SheetMarker marker, const LineTarget& sheet,
-                                               const vpCameraParameters& camera, int width,
-                                               int height) {
+                                               const Lens& camera, int width, int height) {
   switch (marker) {
     case SheetMarker::kAprilTag:
       return MakeAprilTagMethod(sheet, camera, width, height);

@@ -5,7 +5,6 @@
 // in charuco_method.h.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpImage.h>
 
@@ -13,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "detector/lens.h"
 #include "scene/scene.h"  // PrintedPicture
 #include "target/line_target.h"
 
@@ -78,8 +78,7 @@ class MarkerMethod {
 /// or without distortion) in width x height frames. Throws std::invalid_argument for
 /// SheetMarker::kOal (ours is the target tracker, not a printed marker).
 std::unique_ptr<MarkerMethod> MakeMarkerMethod(SheetMarker marker, const LineTarget& sheet,
-                                               const vpCameraParameters& camera, int width,
-                                               int height);
+                                               const Lens& camera, int width, int height);
 
 /// `sheet`'s board, paper and ink without its stripes, named after `method`: the board a
 /// marker is printed on (LineTarget::Check allows a target without lines).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "detector/lens.h"
 #include "detector/tracker.h"
 
 namespace oal {
@@ -12,8 +13,7 @@ namespace {
 // refused, not scored). Its failures are the frames without a pose.
 class OalTargetMethod : public LineMethod {
  public:
-  OalTargetMethod(const TrackerSetup& setup, const LineTarget& target,
-                  const vpCameraParameters& camera)
+  OalTargetMethod(const TrackerSetup& setup, const LineTarget& target, const Lens& camera)
       : tracker_(target, camera, setup.detector, PoseOf(setup), setup.tracking) {}
   std::string Name() const override { return "oal-target"; }
   bool Undistorted() const override { return tracker_.detector().Undistorts(); }
@@ -93,7 +93,7 @@ std::unique_ptr<LineMethod> MakeOalTrackerMethod(const DetectorOptions& options,
 }
 
 std::unique_ptr<LineMethod> MakeOalTargetMethod(const TrackerSetup& setup, const LineTarget& target,
-                                                const vpCameraParameters& camera) {
+                                                const Lens& camera) {
   return std::make_unique<OalTargetMethod>(setup, target, camera);
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "detector/options.h"
 #include "eval/line_method.h"
 #include "io/camera_file.h"
@@ -58,6 +59,6 @@ std::unique_ptr<LineMethod> MakeOalTrackerMethod(const DetectorOptions& options,
 /// The target tracker ("oal-target") of a four-line `target`: the lines of the poses it
 /// accepts, in the target's order; nothing in a frame without one.
 std::unique_ptr<LineMethod> MakeOalTargetMethod(const TrackerSetup& setup, const LineTarget& target,
-                                                const vpCameraParameters& camera);
+                                                const Lens& camera);
 
 }  // namespace oal

@@ -94,11 +94,11 @@ constexpr std::uint64_t kLensSeedOffset = 0x9e3779b97f4a7c15ULL;
 
 // The camera with the lens the stripes tell, from frames tracked by a pinhole camera; the
 // pinhole camera itself, with report->estimate_failed saying why, when they cannot tell it.
-vpCameraParameters EstimatedCamera(const EvaluationScenes& scenes,
-                                   const PoseAccuracyOptions& options, PoseAccuracyReport* report) {
-  const vpCameraParameters lens = scenes.For(0).options().camera;
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(lens.get_px(), lens.get_py(), lens.get_u0(), lens.get_v0());
+Lens EstimatedCamera(const EvaluationScenes& scenes, const PoseAccuracyOptions& options,
+                     PoseAccuracyReport* report) {
+  const Lens lens = scenes.For(0).options().camera;
+  Lens pinhole;
+  pinhole = Lens::Pinhole(lens.px(), lens.py(), lens.u0(), lens.v0());
   TargetPoseTracker tracker(options.target, pinhole, options.detector, options.pose,
                             options.tracking);
   std::uint64_t state = options.seed + kLensSeedOffset;
@@ -160,7 +160,7 @@ bool OutlineInView(const RenderOptions& render, const vpHomogeneousMatrix& cMo,
     if (!(z > 0.0)) return false;
     const double x = (cMo[0][0] * corner[0] + cMo[0][1] * corner[1] + cMo[0][3]) / z;
     const double y = (cMo[1][0] * corner[0] + cMo[1][1] * corner[1] + cMo[1][3]) / z;
-    const Point2d pixel = DistortedPixel(render.camera, x, y);
+    const Point2d pixel = render.camera.Pixel(x, y);
     if (!(pixel.u >= 0.0 && pixel.u <= render.width - 1 && pixel.v >= 0.0 &&
           pixel.v <= render.height - 1)) {
       return false;
@@ -225,9 +225,8 @@ PoseAccuracyReport EvaluatePoseAccuracy(
   if (options.marker != SheetMarker::kOal) return EvaluateMarkerPoseAccuracy(options, progress);
   const EvaluationScenes scenes(options.target, options);
   PoseAccuracyReport report;
-  const vpCameraParameters camera = options.estimate_distortion
-                                        ? EstimatedCamera(scenes, options, &report)
-                                        : scenes.For(0).options().camera;
+  const Lens camera = options.estimate_distortion ? EstimatedCamera(scenes, options, &report)
+                                                  : scenes.For(0).options().camera;
   TargetPoseTracker tracker(options.target, camera, options.detector, options.pose,
                             options.tracking);
   const PointUndistorter undistorter(camera);

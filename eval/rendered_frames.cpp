@@ -6,6 +6,7 @@
 
 #include "base/check.h"
 #include "base/random.h"
+#include "detector/lens.h"
 #include "io/image_source.h"
 
 namespace oal {
@@ -46,7 +47,7 @@ RenderOptions MakeRenderOptions(const RenderedFrameOptions& options) {
   render.width = options.width;
   render.height = options.height;
   render.camera =
-      CameraWithKdu(options.focal_px, options.focal_px, 0.5 * (options.width - 1),
+      Lens::WithKdu(options.focal_px, options.focal_px, 0.5 * (options.width - 1),
                     0.5 * (options.height - 1), options.kdu, options.width, options.height);
   if (options.camera) render.camera = *options.camera;
   SceneOptions scene = options.scene;
@@ -142,14 +143,9 @@ nlohmann::json RenderedFrameJson(const RenderedFrameOptions& options) {
                       {"illumination_gradient", options.illumination_gradient},
                       {"backgrounds", options.backgrounds}};
   if (options.camera) {
-    const vpCameraParameters& c = *options.camera;
+    const Lens& c = *options.camera;
     json["camera"] = {
-        {"px", c.get_px()},
-        {"py", c.get_py()},
-        {"u0", c.get_u0()},
-        {"v0", c.get_v0()},
-        {"kdu", c.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion ? c.get_kdu()
-                                                                                       : 0.0}};
+        {"px", c.px()}, {"py", c.py()}, {"u0", c.u0()}, {"v0", c.v0()}, {"kdu", c.kdu()}};
   }
   if (options.scene.lived_in.Any()) {
     const LivedInOptions& l = options.scene.lived_in;

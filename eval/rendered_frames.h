@@ -3,14 +3,13 @@
 // lies on, and each frame's effects, reproducible from the seed.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
-
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "io/scene_options.h"
 #include "scene/scene.h"
 #include "target/line_target.h"
@@ -26,7 +25,7 @@ struct RenderedFrameOptions {
   double kdu = 0.33;  ///< cheap wide lens (barrel, k1 ≈ -0.25)
   /// A camera to render through instead (its own px, py, u0, v0 and kdu; `oalservo
   /// calibrate-accuracy`'s off-centre cameras); focal_px and kdu are then unused.
-  std::optional<vpCameraParameters> camera;
+  std::optional<Lens> camera;
   double noise_sigma = 8.0;  ///< grey levels
   /// Each frame's noise drawn uniformly in [noise_sigma, noise_max] (from the seed); below
   /// noise_sigma: every frame noise_sigma.

@@ -10,7 +10,6 @@
 // and everything else are the caller's run's.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <cstdint>
@@ -18,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "loop/servo_loop.h"
 #include "servo/pbvs.h"
 #include "target/line_target.h"
@@ -69,7 +69,7 @@ struct ServoAccuracyReport {
 struct ServoStartScene {
   LineTarget target;
   vpHomogeneousMatrix wMo;  ///< the target in the world frame
-  vpCameraParameters camera;
+  Lens camera;
   int width = 640, height = 480;  ///< the camera's image, pixels
 };
 

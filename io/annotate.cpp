@@ -21,7 +21,7 @@ constexpr double kSampleStepPx = 3.0;
 
 // The box that holds the undistorted image of the frame (larger than the frame for barrel
 // distortion), from its outline sampled every few pixels.
-cv::Rect2d UndistortedBounds(int width, int height, const vpCameraParameters& camera) {
+cv::Rect2d UndistortedBounds(int width, int height, const Lens& camera) {
   const PointUndistorter undistorter(camera);
   double u0 = 0, v0 = 0, u1 = width - 1, v1 = height - 1;
   auto extend = [&](double u, double v) {
@@ -39,7 +39,7 @@ bool Inside(const cv::Point2d& p, int width, int height) {
 }
 
 std::vector<std::vector<cv::Point2d>> CurvedLine(const LineParams& line, int width, int height,
-                                                 const vpCameraParameters& camera) {
+                                                 const Lens& camera) {
   const cv::Rect2d box = UndistortedBounds(width, height, camera);
   Point2d a, b;
   if (!ClipToRect(line, box.x, box.y, box.x + box.width, box.y + box.height, &a, &b)) return {};
@@ -49,8 +49,8 @@ std::vector<std::vector<cv::Point2d>> CurvedLine(const LineParams& line, int wid
   for (int i = 0; i < samples; ++i) {
     const double t = static_cast<double>(i) / (samples - 1);
     const double u = a.u + t * (b.u - a.u), v = a.v + t * (b.v - a.v);
-    const Point2d d = DistortedPixel(camera, (u - camera.get_u0()) / camera.get_px(),
-                                     (v - camera.get_v0()) / camera.get_py());
+    const Point2d d =
+        camera.Pixel((u - camera.u0()) / camera.px(), (v - camera.v0()) / camera.py());
     const cv::Point2d p(d.u, d.v);
     if (Inside(p, width, height)) {
       runs.back().push_back(p);
@@ -92,15 +92,9 @@ void DrawLabel(cv::Mat& image, const std::string& text, const cv::Point2d& at,
 // Pixel of the normalised point (x, y) in the frame: through the kdu model (the exact inverse
 // of the detector's undistortion, as LineInFrame draws lines) when the camera has
 // distortion, else vpMeterPixelConversion.
-cv::Point2d FramePixel(const vpCameraParameters& camera, double x, double y) {
-  if (camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion &&
-      camera.get_kdu() != 0.0) {
-    const Point2d p = DistortedPixel(camera, x, y);
-    return cv::Point2d(p.u, p.v);
-  }
-  double u = 0.0, v = 0.0;
-  vpMeterPixelConversion::convertPoint(camera, x, y, u, v);
-  return cv::Point2d(u, v);
+cv::Point2d FramePixel(const Lens& camera, double x, double y) {
+  const Point2d p = camera.Pixel(x, y);
+  return cv::Point2d(p.u, p.v);
 }
 
 void DrawText(cv::Mat& image, const std::string& text, const cv::Point& origin,
@@ -117,8 +111,7 @@ struct LabelAnchor {
   double radius_px = 0.0;
 };
 
-LabelAnchor AnchorOf(const PoseResult& pose, const vpCameraParameters& camera, int width,
-                     int height) {
+LabelAnchor AnchorOf(const PoseResult& pose, const Lens& camera, int width, int height) {
   std::vector<cv::Point2d> corners;
   for (const vpColVector& corner : pose.corners_m) {
     if (corner.size() < 2) continue;
@@ -179,9 +172,8 @@ cv::Point2d LabelPoint(const std::vector<cv::Point2d>& drawn, const LabelAnchor&
 
 }  // namespace
 
-std::vector<std::vector<cv::Point2d>> LineInFrame(
-    const LineParams& line, int width, int height,
-    const std::optional<vpCameraParameters>& undistorted_by) {
+std::vector<std::vector<cv::Point2d>> LineInFrame(const LineParams& line, int width, int height,
+                                                  const std::optional<Lens>& undistorted_by) {
   if (undistorted_by) return CurvedLine(line, width, height, *undistorted_by);
   Point2d a, b;
   if (!ClipToRect(line, 0.0, 0.0, width - 1.0, height - 1.0, &a, &b)) return {};
@@ -189,7 +181,7 @@ std::vector<std::vector<cv::Point2d>> LineInFrame(
 }
 
 cv::Mat AnnotateLines(const cv::Mat& frame, const std::vector<DetectedLine>& lines,
-                      const std::optional<vpCameraParameters>& undistorted_by) {
+                      const std::optional<Lens>& undistorted_by) {
   cv::Mat image;
   if (frame.channels() == 1) {
     cv::cvtColor(frame, image, cv::COLOR_GRAY2BGR);
@@ -215,8 +207,8 @@ const cv::Scalar kLineColours[4] = {{0, 200, 255}, {255, 0, 200}, {255, 255, 0},
 // The frame with the identified lines labelled 1-4, the corners, the target frame's axes
 // (x red, y green, z blue, kAxisLengthM long) when the pose is ok, and the status.
 cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines,
-                     const PoseResult& pose, const vpCameraParameters& camera,
-                     const std::optional<vpCameraParameters>& undistorted_by,
+                     const PoseResult& pose, const Lens& camera,
+                     const std::optional<Lens>& undistorted_by,
                      const std::vector<Point2d>& region) {
   cv::Mat image;
   cv::cvtColor(gray, image, cv::COLOR_GRAY2BGR);
@@ -273,7 +265,7 @@ cv::Mat AnnotatePose(const cv::Mat& gray, const std::vector<DetectedLine>& lines
 }
 
 void DrawGoalLines(cv::Mat* image, const LineTarget& target, const vpHomogeneousMatrix& cdMo,
-                   const vpCameraParameters& camera) {
+                   const Lens& camera) {
   constexpr double kDashPx = 8.0;
   for (std::size_t k = 0; k < target.lines.size() && k < 4; ++k) {
     const TargetLine& line = target.lines[k];

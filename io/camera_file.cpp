@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "detector/lens.h"
 #include "io/atomic_file.h"
 
 namespace oal {
@@ -186,10 +187,11 @@ CameraFile LoadCameraFile(const std::string& path, const std::string& camera_nam
                    entry.name, entry.with_distortion ? kWithDistortion : kWithoutDistortion);
   CameraFile result;
   int status = vpXmlParserCamera::SEQUENCE_ERROR;
+  vpCameraParameters parsed;
   try {
     MuteStandardStreams mute;
     vpXmlParserCamera parser;
-    status = parser.parse(result.camera, path, entry.name, model, entry.width, entry.height);
+    status = parser.parse(parsed, path, entry.name, model, entry.width, entry.height);
   } catch (const vpException& error) {
     throw std::runtime_error("vpXmlParserCamera cannot read " + label + ": " + error.getMessage());
   }
@@ -198,7 +200,8 @@ CameraFile LoadCameraFile(const std::string& path, const std::string& camera_nam
                              " (a model with missing parameters, or several cameras of that "
                              "name and image size)");
   }
-  if (!(result.camera.get_px() > 0.0 && result.camera.get_py() > 0.0)) {
+  result.camera = parsed;
+  if (!(result.camera.px() > 0.0 && result.camera.py() > 0.0)) {
     throw std::runtime_error(label + " has px or py <= 0");
   }
   result.name = entry.name;
@@ -207,8 +210,8 @@ CameraFile LoadCameraFile(const std::string& path, const std::string& camera_nam
   return result;
 }
 
-void SaveCameraFile(const std::string& path, const vpCameraParameters& camera,
-                    const std::string& name, unsigned int width, unsigned int height) {
+void SaveCameraFile(const std::string& path, const Lens& camera, const std::string& name,
+                    unsigned int width, unsigned int height) {
   // vpXmlParserCamera::save adds to an existing file, so it writes a fresh temporary file
   // that then replaces `path`.
   const std::filesystem::path temp = TempPathFor(path);
@@ -217,7 +220,8 @@ void SaveCameraFile(const std::string& path, const vpCameraParameters& camera,
   {
     MuteStandardStreams mute;
     vpXmlParserCamera parser;
-    status = parser.save(camera, temp.string(), name, width, height);
+    status = parser.save(camera.ViSPCamera(static_cast<int>(width), static_cast<int>(height)),
+                         temp.string(), name, width, height);
   }
   std::error_code error;
   if (status == vpXmlParserCamera::SEQUENCE_OK && std::filesystem::is_regular_file(temp)) {

@@ -8,16 +8,16 @@
 // own name and size.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
-
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
+
 namespace oal {
 
 struct CameraFile {
-  vpCameraParameters camera;
+  Lens camera;
   std::string name;         ///< <name>, may be empty
   unsigned int width = 0;   ///< <image_width>, 0 if absent
   unsigned int height = 0;  ///< <image_height>, 0 if absent
@@ -35,7 +35,7 @@ std::optional<std::string> CameraSizeMismatch(const CameraFile& camera, int widt
 CameraFile LoadCameraFile(const std::string& path, const std::string& camera_name = "");
 
 /// Writes `camera` with vpXmlParserCamera::save to `path`, atomically (replacing `path`).
-void SaveCameraFile(const std::string& path, const vpCameraParameters& camera,
-                    const std::string& name, unsigned int width, unsigned int height);
+void SaveCameraFile(const std::string& path, const Lens& camera, const std::string& name,
+                    unsigned int width, unsigned int height);
 
 }  // namespace oal

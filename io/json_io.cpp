@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include "detector/lens.h"
+
 namespace oal {
 
 Json PointJson(const Point2d& point) {
@@ -46,19 +48,23 @@ Json PoseJson(const vpHomogeneousMatrix& cMo) {
               {"thetau_rad", Json::array({tu[0], tu[1], tu[2]})}};
 }
 
-Json CameraJson(const vpCameraParameters& camera, int width, int height) {
-  const bool distortion =
-      camera.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion;
-  return Json{
-      {"model", distortion ? "perspectiveProjWithDistortion" : "perspectiveProjWithoutDistortion"},
-      {"px", camera.get_px()},
-      {"py", camera.get_py()},
-      {"u0", camera.get_u0()},
-      {"v0", camera.get_v0()},
-      {"kud", distortion ? camera.get_kud() : 0.0},
-      {"kdu", distortion ? camera.get_kdu() : 0.0},
-      {"width", width},
-      {"height", height}};
+Json CameraJson(const Lens& camera, int width, int height) {
+  Json json{{"model", LensModelName(camera)},
+            {"px", camera.px()},
+            {"py", camera.py()},
+            {"u0", camera.u0()},
+            {"v0", camera.v0()},
+            {"kud", camera.kud()},
+            {"kdu", camera.kdu()},
+            {"width", width},
+            {"height", height}};
+  if (camera.model() == Lens::Model::kOpenCV) {
+    const auto c = camera.distortion().ToArray();
+    json["distortion_coefficients"] = camera.distortion().IsRational()
+                                          ? Json(c)
+                                          : Json(std::vector<double>(c.begin(), c.begin() + 5));
+  }
+  return json;
 }
 
 void WriteJsonLine(std::ostream& sink, const Json& record, bool flush) {

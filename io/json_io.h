@@ -2,7 +2,6 @@
 // line, a pose or a camera reads the same in every file oalservo writes.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <nlohmann/json.hpp>
@@ -10,6 +9,7 @@
 #include <string>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "scene/scene.h"
 #include "servo/target_tracker.h"
 
@@ -30,7 +30,7 @@ Json TruthLineJson(const TruthLine& line);
 /// {matrix: 4x4 rows, t_m: [x,y,z] metres, thetau_rad: [tux,tuy,tuz] (theta-u, radians)}
 Json PoseJson(const vpHomogeneousMatrix& cMo);
 /// {model, px, py, u0, v0, kud, kdu, width, height}
-Json CameraJson(const vpCameraParameters& camera, int width, int height);
+Json CameraJson(const Lens& camera, int width, int height);
 /// Where the target tracker looked for the frame's target: {mode, source, borders,
 /// candidates, region (the outermost border scanned, image pixels; empty: the whole image)}.
 Json ScanJson(const TargetFrame& result, ScanMode mode);

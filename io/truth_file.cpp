@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "base/parse.h"
+#include "detector/lens.h"
 
 namespace oal {
 namespace {
@@ -171,7 +172,7 @@ std::vector<TargetLineTruth> LoadTruthJson(const std::string& path) {
 
 Json FrameTruthJson(const RenderedFrame& frame, int index, const std::string& image,
                     const std::string& target, std::uint64_t seed, std::uint64_t noise_seed,
-                    const vpCameraParameters& camera, int width, int height) {
+                    const Lens& camera, int width, int height) {
   Json lines = Json::array();
   for (const TruthLine& line : frame.truth) lines.push_back(TruthLineJson(line));
   return Json{{"frame", index},

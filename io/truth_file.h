@@ -21,7 +21,6 @@
 // A header row starting with "frame", blank lines and lines starting with '#' are skipped.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <cstdint>
@@ -30,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "detector/line.h"
 #include "io/json_io.h"
 #include "scene/scene.h"  // RenderedFrame
@@ -79,6 +79,6 @@ std::optional<vpHomogeneousMatrix> LoadTruthPoseJson(const std::string& path);
 /// `image`: the frame's file name; `seed`: the data set's; `noise_seed`: the frame's.
 Json FrameTruthJson(const RenderedFrame& frame, int index, const std::string& image,
                     const std::string& target, std::uint64_t seed, std::uint64_t noise_seed,
-                    const vpCameraParameters& camera, int width, int height);
+                    const Lens& camera, int width, int height);
 
 }  // namespace oal

@@ -7,6 +7,7 @@
 
 #include "base/check.h"
 #include "base/random.h"
+#include "detector/lens.h"
 
 namespace oal {
 namespace {
@@ -16,7 +17,7 @@ constexpr std::uint64_t kNoiseSeed = 20240605;
 // The smear of the camera's twist over `exposure_s` where the target's origin is seen: its
 // image moves by (du, dv) = exposure * d(px X/Z, py Y/Z)/dt, the point moving by
 // -v - w x P in the camera frame.
-void MotionBlurOf(const Capture& capture, const vpCameraParameters& camera, double exposure_s,
+void MotionBlurOf(const Capture& capture, const Lens& camera, double exposure_s,
                   FrameEffects* effects) {
   if (exposure_s <= 0.0 || capture.velocity.size() != 6) return;
   const vpColVector& twist = capture.velocity;
@@ -25,8 +26,8 @@ void MotionBlurOf(const Capture& capture, const vpCameraParameters& camera, doub
   const double dX = -twist[0] - (twist[4] * Z - twist[5] * Y);
   const double dY = -twist[1] - (twist[5] * X - twist[3] * Z);
   const double dZ = -twist[2] - (twist[3] * Y - twist[4] * X);
-  const double du = exposure_s * camera.get_px() * (dX / Z - X * dZ / (Z * Z));
-  const double dv = exposure_s * camera.get_py() * (dY / Z - Y * dZ / (Z * Z));
+  const double du = exposure_s * camera.px() * (dX / Z - X * dZ / (Z * Z));
+  const double dv = exposure_s * camera.py() * (dY / Z - Y * dZ / (Z * Z));
   const double length = std::min(std::hypot(du, dv), 200.0);
   if (length > effects->motion_blur_px) {
     effects->motion_blur_px = length;

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "base/format.h"
+#include "detector/lens.h"
 
 namespace oal {
 namespace {
@@ -21,17 +22,16 @@ void StripeCollector::Add(const TargetPoseTracker& tracker) {
   ++frames_;
 }
 
-PlumbLineResult StripeCollector::Estimate(const vpCameraParameters& pinhole, int width,
-                                          int height) const {
+PlumbLineResult StripeCollector::Estimate(const Lens& pinhole, int width, int height) const {
   PlumbLineOptions options;
   options.width = width;
   options.height = height;
-  return EstimateRadialDistortion(stripes_, pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
-                                  pinhole.get_v0(), options);
+  return EstimateRadialDistortion(stripes_, pinhole.px(), pinhole.py(), pinhole.u0(), pinhole.v0(),
+                                  options);
 }
 
-ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameters& pinhole,
-                             const NextFrame& next, int frames, int max_read) {
+ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const Lens& pinhole, const NextFrame& next,
+                             int frames, int max_read) {
   // Every view on all its borders: the plumb line wants every point along the stripes (on 8
   // borders instead of 16, the lens told was off by 3 % instead of 1-2 %).
   struct FullScans {
@@ -83,11 +83,9 @@ std::string LensMismatchWarning(const LensCheck& lens, const std::string& correc
          remedy;
 }
 
-vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens) {
-  vpCameraParameters camera;
-  camera.initPersProjWithDistortion(pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(),
-                                    pinhole.get_v0(), lens.kud, lens.kdu);
-  return camera;
+Lens WithLens(const Lens& pinhole, const PlumbLineResult& lens) {
+  return Lens::WithKudKdu(pinhole.px(), pinhole.py(), pinhole.u0(), pinhole.v0(), lens.kud,
+                          lens.kdu);
 }
 
 }  // namespace oal

@@ -4,8 +4,6 @@
 // commands say when the lens check finds a camera file that misses the lens.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
-
 #include <functional>
 #include <optional>
 #include <string>
@@ -13,6 +11,7 @@
 
 #include "calibration/plumb_line.h"
 #include "detector/image_view.h"
+#include "detector/lens.h"
 #include "detector/line.h"
 #include "servo/target_tracker.h"
 
@@ -26,7 +25,7 @@ class StripeCollector {
   int frames() const { return frames_; }
   /// kud and kdu from the stripes collected, through `pinhole`'s px, py, u0, v0, in a width x
   /// height image. Throws std::runtime_error saying why when they cannot tell the lens.
-  PlumbLineResult Estimate(const vpCameraParameters& pinhole, int width, int height) const;
+  PlumbLineResult Estimate(const Lens& pinhole, int width, int height) const;
 
  private:
   std::vector<std::vector<Point2d>> stripes_;
@@ -53,9 +52,8 @@ struct ToldLens {
 /// `frames` show the target or `max_read` have been read, and tells the lens from their stripes
 /// through `pinhole`. Every view is scanned on all its borders (TargetPoseTracker::
 /// set_quick_scan); the tracker is reset after. What `next` throws goes through.
-ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const vpCameraParameters& pinhole,
-                             const NextFrame& next, int frames = kLensFrames,
-                             int max_read = kMaxLensFramesRead);
+ToldLens TellLensFromStripes(TargetPoseTracker& tracker, const Lens& pinhole, const NextFrame& next,
+                             int frames = kLensFrames, int max_read = kMaxLensFramesRead);
 
 /// The lens check's warning: "lines 1-4 still bend after `corrected_by` corrects them, as if
 /// the lens's kdu were the camera's +0.10 ... `remedy`".
@@ -63,6 +61,6 @@ std::string LensMismatchWarning(const LensCheck& lens, const std::string& correc
                                 const std::string& remedy);
 
 /// `pinhole` with the estimated lens (kud and kdu).
-vpCameraParameters WithLens(const vpCameraParameters& pinhole, const PlumbLineResult& lens);
+Lens WithLens(const Lens& pinhole, const PlumbLineResult& lens);
 
 }  // namespace oal

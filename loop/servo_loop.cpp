@@ -24,6 +24,7 @@
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
+#include "detector/lens.h"
 #include "loop/lens_estimate.h"  // LensMismatchWarning
 #include "scene/scene.h"
 #include "servo/pbvs.h"
@@ -439,9 +440,8 @@ RobotPose TrueCameraPose(SafeRobot& robot, const std::optional<vpHomogeneousMatr
   return wMe;
 }
 
-bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames,
-                 vpCameraParameters* camera, TargetPoseTracker* tracker, std::ostream& log,
-                 std::string* why) {
+bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames, Lens* camera,
+                 TargetPoseTracker* tracker, std::ostream& log, std::string* why) {
   // The frames read, the robot still: their noise seeds apart from the loop's.
   constexpr int kLensFrameIndex = 1000000;
   cv::Mat gray;
@@ -944,7 +944,7 @@ class ServoRun {
   const LoopRobot& rig_;
   std::ostream& log_;
   const ServoLoopHooks& hooks_;
-  vpCameraParameters camera_;  ///< the setup's, with the lens once told
+  Lens camera_;  ///< the setup's, with the lens once told
   TargetPoseTracker tracker_;
   SafeRobot robot_;
   const TableColumns columns_;

@@ -7,7 +7,6 @@
 // frame sources and every stop: docs/SERVO_LOOP.md.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <atomic>
@@ -19,6 +18,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "loop/frame_source.h"
 #include "robots/robot.h"
 #include "robots/safe_robot.h"
@@ -67,7 +67,7 @@ struct ServoSetup {
   /// The camera model the detector and the pose use (a pinhole camera, px, py, u0, v0 only,
   /// when estimate_distortion is set or the lens is not to be corrected), and the size its
   /// frames must have.
-  vpCameraParameters camera;
+  Lens camera;
   int width = 640, height = 480;
   /// Tell the lens from the target's stripes over the first frames, the robot still, and use
   /// it from then on (loop/lens_estimate.h); `camera` must then be a pinhole camera.
@@ -196,10 +196,10 @@ struct ServoFrame {
   const PoseResult& pose;      ///< the last pose estimated (tracked.pose)
   const TargetFrame& tracked;  ///< what the tracker did: status, region scanned
   const ServoIteration& row;
-  const vpCameraParameters& camera;  ///< the camera model the detector and pose used
-  const LineTarget& target;          ///< the target the loop servos on
-  const vpHomogeneousMatrix& cdMo;   ///< the goal: where the lines should end up
-  bool lines_undistorted = false;    ///< the lines are in undistorted pixels
+  const Lens& camera;               ///< the camera model the detector and pose used
+  const LineTarget& target;         ///< the target the loop servos on
+  const vpHomogeneousMatrix& cdMo;  ///< the goal: where the lines should end up
+  bool lines_undistorted = false;   ///< the lines are in undistorted pixels
 };
 
 /// Hooks for the caller: `interrupt` is polled every iteration (and on set, the robot's
@@ -241,9 +241,8 @@ RobotPose TrueCameraPose(SafeRobot& robot, const std::optional<vpHomogeneousMatr
 /// (loop/lens_estimate.h): `*camera` (a pinhole camera) gains it and `*tracker` is rebuilt
 /// from the setup with it; `log` gets one line saying what it is. False with `why` when the
 /// frames cannot tell it.
-bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames,
-                 vpCameraParameters* camera, TargetPoseTracker* tracker, std::ostream& log,
-                 std::string* why);
+bool TellTheLens(const ServoSetup& setup, SafeRobot& robot, FrameSource& frames, Lens* camera,
+                 TargetPoseTracker* tracker, std::ostream& log, std::string* why);
 
 /// The Table 3 columns of a camera pose wMc: X, Y, Z (mm), pitch, roll and yaw (deg) with
 /// wRc = Rx(π)·Rx(pitch)·Ry(yaw)·Rz(roll) (ServoIteration).

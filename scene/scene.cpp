@@ -3,8 +3,6 @@
 // calls inline across them.
 #include "scene/scene.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -54,19 +52,18 @@ Vec3 ToCamera(const vpHomogeneousMatrix& cMo, double X, double Y) {
 // The image of the 3D line through the camera-frame points a and b, in ideal pixels: the
 // plane through the centre of projection and the line has normal a x b. False when the line
 // passes through the centre of projection.
-bool IdealLineOf(const vpCameraParameters& camera, const Vec3& a, const Vec3& b, LineParams* out) {
+bool IdealLineOf(const Lens& camera, const Vec3& a, const Vec3& b, LineParams* out) {
   const Vec3 n = Cross(a, b);
-  const double A = n.x / camera.get_px(), B = n.y / camera.get_py();
-  const double C = n.z - A * camera.get_u0() - B * camera.get_v0();
+  const double A = n.x / camera.px(), B = n.y / camera.py();
+  const double C = n.z - A * camera.u0() - B * camera.v0();
   const double norm = std::hypot(A, B);
   if (!(norm > 1e-15 * std::fabs(C))) return false;
   *out = Normalized(-C / norm, std::atan2(B, A));
   return true;
 }
 
-Point2d IdealPixel(const vpCameraParameters& camera, const Vec3& p) {
-  return {camera.get_u0() + camera.get_px() * p.x / p.z,
-          camera.get_v0() + camera.get_py() * p.y / p.z};
+Point2d IdealPixel(const Lens& camera, const Vec3& p) {
+  return {camera.u0() + camera.px() * p.x / p.z, camera.v0() + camera.py() * p.y / p.z};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -86,7 +83,7 @@ class SegmentView {
   bool Inside(double t, Point2d* pixel) const {
     const Vec3 p = At(t);
     if (p.z <= kMinDepthM) return false;
-    *pixel = DistortedPixel(options_.camera, p.x / p.z, p.y / p.z);
+    *pixel = options_.camera.Pixel(p.x / p.z, p.y / p.z);
     return pixel->u >= 0.0 && pixel->u <= options_.width - 1 && pixel->v >= 0.0 &&
            pixel->v <= options_.height - 1;
   }
@@ -124,8 +121,8 @@ bool VisibleRange(const SegmentView& view, double* t_a, double* t_b) {
 }
 
 // Apparent width of `line` at the centre-line parameter t, in ideal pixels.
-double ApparentWidth(const TargetLine& line, const vpHomogeneousMatrix& cMo,
-                     const vpCameraParameters& camera, double t) {
+double ApparentWidth(const TargetLine& line, const vpHomogeneousMatrix& cMo, const Lens& camera,
+                     double t) {
   const double dx = line.x2_m - line.x1_m, dy = line.y2_m - line.y1_m;
   const double length = std::hypot(dx, dy);
   const double nx = -dy / length * 0.5 * line.width_m, ny = dx / length * 0.5 * line.width_m;
@@ -232,12 +229,7 @@ struct PlaneSample {
 // q = G^-1 (x, y, 1) gives X = q0 / q2, Y = q1 / q2 at depth 1 / q2.
 class PlaneProjector {
  public:
-  PlaneProjector(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera)
-      : u0_(camera.get_u0()),
-        v0_(camera.get_v0()),
-        inv_px_(1.0 / camera.get_px()),
-        inv_py_(1.0 / camera.get_py()),
-        k_(Kdu(camera)) {
+  PlaneProjector(const vpHomogeneousMatrix& cMo, const Lens& camera) : camera_(camera) {
     const double g[3][3] = {{cMo[0][0], cMo[0][1], cMo[0][3]},
                             {cMo[1][0], cMo[1][1], cMo[1][3]},
                             {cMo[2][0], cMo[2][1], cMo[2][3]}};
@@ -269,12 +261,7 @@ class PlaneProjector {
     const double Xy = (inv_[0][1] - s->X * inv_[2][1]) * w;
     const double Yx = (inv_[1][0] - s->Y * inv_[2][0]) * w;
     const double Yy = (inv_[1][1] - s->Y * inv_[2][1]) * w;
-    // d(x, y)/d(u, v) of x = du (1 + k r^2), du = (u - u0) / px, likewise y.
-    const double du = (u - u0_) * inv_px_, dv = (v - v0_) * inv_py_;
-    const double f = 1.0 + k_ * (du * du + dv * dv);
-    const double cross = 2.0 * k_ * du * dv;
-    const double xu = (f + 2.0 * k_ * du * du) * inv_px_, xv = cross * inv_py_;
-    const double yu = cross * inv_px_, yv = (f + 2.0 * k_ * dv * dv) * inv_py_;
+    const auto [xu, xv, yu, yv] = camera_.NormalisedDerivative(u, v, Point2d{x, y});
     s->Xu = Xx * xu + Xy * yu;
     s->Xv = Xx * xv + Xy * yv;
     s->Yu = Yx * xu + Yy * yu;
@@ -283,7 +270,7 @@ class PlaneProjector {
   }
 
  private:
-  double u0_, v0_, inv_px_, inv_py_, k_;
+  Lens camera_;
   double inv_[3][3] = {};
   bool valid_ = false;
 };
@@ -467,7 +454,7 @@ void ApplyIllumination(double gradient, double angle_rad, cv::Mat1f* image) {
 // per row.
 void ApplyLightFalloff(const RenderOptions& options, cv::Mat1f* image) {
   if (options.vignetting <= 0.0 && options.hot_spot_gain <= 0.0) return;
-  const double u0 = options.camera.get_u0(), v0 = options.camera.get_v0();
+  const double u0 = options.camera.u0(), v0 = options.camera.v0();
   const double w = image->cols - 1.0, h = image->rows - 1.0;
   double corner2 = 0.0;
   for (const double cu : {0.0, w}) {
@@ -1430,15 +1417,7 @@ void RenderOptions::Check() const {
   RequireOption(InRange(width, 16, 8192), "RenderOptions::width", width, "16 <= width <= 8192");
   RequireOption(InRange(height, 16, 8192), "RenderOptions::height", height, "16 <= height <= 8192");
   CheckPerspectiveCamera(camera, "RenderOptions::camera");
-  // The pixel -> ray map must not fold over inside the image: 1 + 3 kdu r^2 > 0 at the
-  // farthest corner (the radial derivative of r (1 + kdu r^2)).
-  const double du = std::max(std::fabs(camera.get_u0()), std::fabs(width - 1 - camera.get_u0()));
-  const double dv = std::max(std::fabs(camera.get_v0()), std::fabs(height - 1 - camera.get_v0()));
-  const double r2 =
-      du * du / (camera.get_px() * camera.get_px()) + dv * dv / (camera.get_py() * camera.get_py());
-  RequireOption(std::isfinite(Kdu(camera)) && 1.0 + 3.0 * Kdu(camera) * r2 > 0.0,
-                "RenderOptions::camera.kdu", Kdu(camera),
-                "1 + 3 kdu r^2 > 0 at the image corners (the lens model is invertible)");
+  CheckInvertibleOver(camera, width, height, "RenderOptions::camera");
   RequireOption(InRange(noise_sigma, 0.0, 100.0), "RenderOptions::noise_sigma", noise_sigma,
                 "0 <= noise_sigma <= 100");
   RequireOption(InRange(blur_sigma_px, 0.0, 20.0), "RenderOptions::blur_sigma_px", blur_sigma_px,
@@ -1626,8 +1605,8 @@ SceneRenderer::SceneRenderer(LineTarget target, RenderOptions options)
   ray_y_.resize(n);
   for (int v = 0; v < options_.height; ++v) {
     for (int u = 0; u < options_.width; ++u) {
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(options_.camera, u, v, x, y);
+      const Point2d ideal = options_.camera.Normalised(u, v);
+      const double x = ideal.u, y = ideal.v;
       const std::size_t i = static_cast<std::size_t>(v) * options_.width + u;
       ray_x_[i] = static_cast<float>(x);
       ray_y_[i] = static_cast<float>(y);
@@ -1755,7 +1734,7 @@ bool CornersInView(const RenderOptions& options, const vpHomogeneousMatrix& cMo,
     for (const auto& corner : crossing.corners_m) {
       const Vec3 p = ToCamera(cMo, corner[0], corner[1]);
       if (!(p.z > kMinDepthM)) return false;
-      const Point2d pixel = DistortedPixel(options.camera, p.x / p.z, p.y / p.z);
+      const Point2d pixel = options.camera.Pixel(p.x / p.z, p.y / p.z);
       if (!(pixel.u >= margin_px && pixel.u <= options.width - 1 - margin_px &&
             pixel.v >= margin_px && pixel.v <= options.height - 1 - margin_px)) {
         return false;

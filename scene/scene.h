@@ -25,7 +25,6 @@
 // board's edges stay exact, and the ground truth never depends on the dressing.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpImage.h>
 
@@ -61,11 +60,11 @@ struct PrintedPicture {
 };
 
 struct RenderOptions {
-  int width = 640;                                        ///< pixels, [16, 8192]
-  int height = 480;                                       ///< pixels, [16, 8192]
-  vpCameraParameters camera{600.0, 600.0, 319.5, 239.5};  ///< with or without distortion
-  double noise_sigma = 0.0;                               ///< Gaussian noise, grey levels, [0, 100]
-  double blur_sigma_px = 0.0;                             ///< Gaussian blur, pixels, [0, 20]
+  int width = 640;                                          ///< pixels, [16, 8192]
+  int height = 480;                                         ///< pixels, [16, 8192]
+  Lens camera = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);  ///< with or without distortion
+  double noise_sigma = 0.0;    ///< Gaussian noise, grey levels, [0, 100]
+  double blur_sigma_px = 0.0;  ///< Gaussian blur, pixels, [0, 20]
   /// Illumination falls linearly by this fraction across the image along gradient_angle_rad.
   double illumination_gradient = 0.0;  ///< [0, 0.9]
   double gradient_angle_rad = 0.0;

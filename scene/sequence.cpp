@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "base/random.h"
+#include "detector/lens.h"
 #include "scene/geometry.h"
 
 namespace oal {
@@ -131,8 +132,7 @@ std::pair<double, double> CrossingOfFirstLines(const LineTarget& target) {
 }
 
 // Distorted pixel of the board point (X, Y) seen from cMo (NaN behind the camera).
-Point2d ProjectBoardPoint(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
-                          double X, double Y) {
+Point2d ProjectBoardPoint(const vpHomogeneousMatrix& cMo, const Lens& camera, double X, double Y) {
   const double x = cMo[0][0] * X + cMo[0][1] * Y + cMo[0][3];
   const double y = cMo[1][0] * X + cMo[1][1] * Y + cMo[1][3];
   const double z = cMo[2][0] * X + cMo[2][1] * Y + cMo[2][3];
@@ -140,7 +140,7 @@ Point2d ProjectBoardPoint(const vpHomogeneousMatrix& cMo, const vpCameraParamete
     return Point2d{std::numeric_limits<double>::quiet_NaN(),
                    std::numeric_limits<double>::quiet_NaN()};
   }
-  return DistortedPixel(camera, x / z, y / z);
+  return camera.Pixel(x / z, y / z);
 }
 
 // Distance from p along `dir` to leave the image rectangle, p inside or outside it.
@@ -161,7 +161,7 @@ RenderOptions BaseOptions(double kdu) {
   RenderOptions options;
   options.width = kWidth;
   options.height = kHeight;
-  options.camera = CameraWithKdu(kFocalPx, kFocalPx, 0.5 * (kWidth - 1), 0.5 * (kHeight - 1), kdu,
+  options.camera = Lens::WithKdu(kFocalPx, kFocalPx, 0.5 * (kWidth - 1), 0.5 * (kHeight - 1), kdu,
                                  kWidth, kHeight);
   options.noise_sigma = kNoiseSigma;
   options.blur_sigma_px = kBlurSigmaPx;
@@ -290,7 +290,7 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
       const auto [cx, cy] = CrossingOfFirstLines(target);
       Point2d through = ProjectBoardPoint(m.At(mid), s.options.camera, cx, cy);
       if (!std::isfinite(through.u) || !std::isfinite(through.v)) {
-        through = {s.options.camera.get_u0(), s.options.camera.get_v0()};
+        through = {s.options.camera.u0(), s.options.camera.v0()};
       }
       const double reach =
           std::max(DistanceToLeave(through, du, dv), DistanceToLeave(through, -du, -dv)) +
@@ -344,7 +344,7 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
     case SequenceKind::kDistortion: {
       const Motion m = Follow(DistortionMotion(), kPi, gen, &s);
       text << "Heavy barrel distortion, kdu = " << kDistortionKdu
-           << " (kud = " << s.options.camera.get_kud()
+           << " (kud = " << s.options.camera.kud()
            << "), moderate motion (lines move about 3-5 px per frame): " << MotionText(m) << ".";
       break;
     }

@@ -1,22 +1,21 @@
 #include "servo/feature_line.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
+
 namespace oal {
 
-MetricLine MetricLineFromUndistorted(const LineParams& undistorted,
-                                     const vpCameraParameters& camera) {
+MetricLine MetricLineFromUndistorted(const LineParams& undistorted, const Lens& camera) {
   // u' = u0 + px·x, v' = v0 + py·y in u'·c + v'·s = rho gives
   //   (px·c)·x + (py·s)·y = rho - u0·c - v0·s,  then normalise the normal (px·c, py·s).
   const double c = std::cos(undistorted.theta_rad), s = std::sin(undistorted.theta_rad);
-  const double nx = camera.get_px() * c, ny = camera.get_py() * s;
+  const double nx = camera.px() * c, ny = camera.py() * s;
   const double norm = std::hypot(nx, ny);
-  const double rhs = undistorted.rho_px - camera.get_u0() * c - camera.get_v0() * s;
+  const double rhs = undistorted.rho_px - camera.u0() * c - camera.v0() * s;
   MetricLine line{rhs / norm, std::atan2(ny, nx)};
   // s >= 0 for theta in [0, pi), so theta_m is in [0, pi]; pi only for an input outside
   // line.h's range: fold it back.
@@ -30,18 +29,17 @@ MetricLine MetricLineFromUndistorted(const LineParams& undistorted,
   return line;
 }
 
-LineParams UndistortedFromMetricLine(const MetricLine& line, const vpCameraParameters& camera) {
+LineParams UndistortedFromMetricLine(const MetricLine& line, const Lens& camera) {
   // x = (u' - u0)/px, y = (v' - v0)/py in x·c + y·s = rho.
   const double c = std::cos(line.theta_rad), s = std::sin(line.theta_rad);
-  const double nu = c / camera.get_px(), nv = s / camera.get_py();
+  const double nu = c / camera.px(), nv = s / camera.py();
   const double norm = std::hypot(nu, nv);
-  const double rhs = line.rho_m + camera.get_u0() * nu + camera.get_v0() * nv;
+  const double rhs = line.rho_m + camera.u0() * nu + camera.v0() * nv;
   return Normalized(rhs / norm, std::atan2(nv, nu));
 }
 
 LineParams UndistortedLineFromDistortedSegment(const Point2d& a, const Point2d& b,
-                                               const vpCameraParameters& camera, int samples,
-                                               double* rms_px) {
+                                               const Lens& camera, int samples, double* rms_px) {
   if (samples < 2) {
     throw std::invalid_argument("UndistortedLineFromDistortedSegment: samples = " +
                                 std::to_string(samples) + ". Violated constraint: samples >= 2");
@@ -56,12 +54,11 @@ LineParams UndistortedLineFromDistortedSegment(const Point2d& a, const Point2d& 
   double mean_u = 0.0, mean_v = 0.0;
   for (int k = 0; k < samples; ++k) {
     const double t = static_cast<double>(k) / (samples - 1);
-    double x = 0.0, y = 0.0;
-    vpPixelMeterConversion::convertPoint(camera, a.u + t * (b.u - a.u), a.v + t * (b.v - a.v), x,
-                                         y);
+    const Point2d ideal = camera.Normalised(a.u + t * (b.u - a.u), a.v + t * (b.v - a.v));
+    const double x = ideal.u, y = ideal.v;
     Point2d& p = points[static_cast<std::size_t>(k)];
-    p.u = camera.get_u0() + camera.get_px() * x;
-    p.v = camera.get_v0() + camera.get_py() * y;
+    p.u = camera.u0() + camera.px() * x;
+    p.v = camera.v0() + camera.py() * y;
     mean_u += p.u;
     mean_v += p.v;
   }
@@ -107,20 +104,19 @@ void BuildFeatureLine(const MetricLine& line, vpFeatureLine* feature) {
   feature->buildFrom(line.rho_m, line.theta_rad);
 }
 
-void BuildFeatureLineFromUndistorted(const LineParams& undistorted,
-                                     const vpCameraParameters& camera, vpFeatureLine* feature) {
+void BuildFeatureLineFromUndistorted(const LineParams& undistorted, const Lens& camera,
+                                     vpFeatureLine* feature) {
   BuildFeatureLine(MetricLineFromUndistorted(undistorted, camera), feature);
 }
 
-void BuildFeatureLineFromDistorted(const Point2d& a, const Point2d& b,
-                                   const vpCameraParameters& camera, vpFeatureLine* feature,
-                                   int samples) {
+void BuildFeatureLineFromDistorted(const Point2d& a, const Point2d& b, const Lens& camera,
+                                   vpFeatureLine* feature, int samples) {
   const LineParams undistorted = UndistortedLineFromDistortedSegment(a, b, camera, samples);
   BuildFeatureLine(MetricLineFromUndistorted(undistorted, camera), feature);
 }
 
-void BuildFeatureLine(const DetectedLine& line, bool detector_undistorts,
-                      const vpCameraParameters& camera, vpFeatureLine* feature) {
+void BuildFeatureLine(const DetectedLine& line, bool detector_undistorts, const Lens& camera,
+                      vpFeatureLine* feature) {
   if (detector_undistorts) {
     BuildFeatureLineFromUndistorted(line.line, camera, feature);
   } else {

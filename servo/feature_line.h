@@ -34,10 +34,10 @@
 // pose, e.g. the pose evaluation's). They never touch A, B, C, D.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/visual_features/vpFeatureLine.h>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "detector/line.h"
 
 namespace oal {
@@ -50,11 +50,10 @@ struct MetricLine {
 
 /// Exact conversion of a line in undistorted pixels (u' = u0 + px·x, v' = v0 + py·y) to
 /// metres; any kdu/kud of `camera` is irrelevant here. Result theta in [0, pi).
-MetricLine MetricLineFromUndistorted(const LineParams& undistorted,
-                                     const vpCameraParameters& camera);
+MetricLine MetricLineFromUndistorted(const LineParams& undistorted, const Lens& camera);
 
 /// The inverse: a metric line to undistorted pixels (theta in [0, pi), line.h).
-LineParams UndistortedFromMetricLine(const MetricLine& line, const vpCameraParameters& camera);
+LineParams UndistortedFromMetricLine(const MetricLine& line, const Lens& camera);
 
 /// APPROXIMATE undistorted-pixel line for the segment a-b of a line fitted in the distorted
 /// image (e.g. its visible part): `samples` points spread evenly from a to b (>= 2; the ends
@@ -64,7 +63,7 @@ LineParams UndistortedFromMetricLine(const MetricLine& line, const vpCameraParam
 /// distortion in `camera` the result is the line through a and b. Throws
 /// std::invalid_argument if a == b or samples < 2.
 LineParams UndistortedLineFromDistortedSegment(const Point2d& a, const Point2d& b,
-                                               const vpCameraParameters& camera, int samples = 16,
+                                               const Lens& camera, int samples = 16,
                                                double* rms_px = nullptr);
 
 /// The same line with the orientation whose theta is closest to `reference_theta_rad`
@@ -75,19 +74,18 @@ MetricLine AlignedTo(const MetricLine& line, double reference_theta_rad);
 void BuildFeatureLine(const MetricLine& line, vpFeatureLine* feature);
 
 /// Exact: a line in undistorted pixels (OalDetector with the camera) to `*feature`.
-void BuildFeatureLineFromUndistorted(const LineParams& undistorted,
-                                     const vpCameraParameters& camera, vpFeatureLine* feature);
+void BuildFeatureLineFromUndistorted(const LineParams& undistorted, const Lens& camera,
+                                     vpFeatureLine* feature);
 
 /// Approximate: the segment a-b of a line fitted in the distorted image to `*feature`, via
 /// UndistortedLineFromDistortedSegment(). Exact when `camera` has no distortion.
-void BuildFeatureLineFromDistorted(const Point2d& a, const Point2d& b,
-                                   const vpCameraParameters& camera, vpFeatureLine* feature,
-                                   int samples = 16);
+void BuildFeatureLineFromDistorted(const Point2d& a, const Point2d& b, const Lens& camera,
+                                   vpFeatureLine* feature, int samples = 16);
 
 /// A detector line to `*feature`: the exact path when the detector undistorted its points
 /// (`detector_undistorts`, OalDetector::Undistorts()), otherwise the approximate path on the
 /// line's end points (image pixels).
-void BuildFeatureLine(const DetectedLine& line, bool detector_undistorts,
-                      const vpCameraParameters& camera, vpFeatureLine* feature);
+void BuildFeatureLine(const DetectedLine& line, bool detector_undistorts, const Lens& camera,
+                      vpFeatureLine* feature);
 
 }  // namespace oal

@@ -1,6 +1,5 @@
 // Step 1 of the pose (pose.h): identification of the detected lines as target lines 1-4, and
 // the options' check.
-#include <visp3/core/vpPixelMeterConversion.h>
 
 #include <algorithm>
 #include <cmath>
@@ -92,13 +91,13 @@ class Identifier {
   Identifier(const std::vector<DetectedLine>& lines, const HashTarget& target,
              const PoseOptions& options, const vpRotationMatrix* previous_cRo)
       : lines_(lines), target_(target), options_(options), previous_cRo_(previous_cRo) {
-    const vpCameraParameters& camera = options.camera;
-    k_inv_ = {1.0 / camera.get_px(),
+    const Lens& camera = options.camera;
+    k_inv_ = {1.0 / camera.px(),
               0.0,
-              -camera.get_u0() / camera.get_px(),
+              -camera.u0() / camera.px(),
               0.0,
-              1.0 / camera.get_py(),
-              -camera.get_v0() / camera.get_py(),
+              1.0 / camera.py(),
+              -camera.v0() / camera.py(),
               0.0,
               0.0,
               1.0};
@@ -249,7 +248,7 @@ bool Identifier::SplitIntoGroups(const std::array<int, 4>& idx, Groups* groups,
 // Step 2: the corners q[i][j] = G_i ∩ H_j, near the image, a convex quadrilateral; its
 // orientation (the sign of its turns).
 bool Identifier::FindCorners(const Groups& groups, Quad* quad, std::string* message) const {
-  const vpCameraParameters& camera = options_.camera;
+  const Lens& camera = options_.camera;
   for (int i = 0; i < 2; ++i) {
     for (int j = 0; j < 2; ++j) {
       Point2d p;
@@ -462,13 +461,14 @@ HashTarget HashTargetFrom(const LineTarget& target) {
   return hash;
 }
 
-void PixelToMetre(const vpCameraParameters& camera, bool undistorted, const Point2d& p, double* x,
-                  double* y) {
+void PixelToMetre(const Lens& camera, bool undistorted, const Point2d& p, double* x, double* y) {
   if (undistorted) {
-    *x = (p.u - camera.get_u0()) / camera.get_px();
-    *y = (p.v - camera.get_v0()) / camera.get_py();
+    *x = (p.u - camera.u0()) / camera.px();
+    *y = (p.v - camera.v0()) / camera.py();
   } else {
-    vpPixelMeterConversion::convertPoint(camera, p.u, p.v, *x, *y);
+    const Point2d ideal = camera.Normalised(p.u, p.v);
+    *x = ideal.u;
+    *y = ideal.v;
   }
 }
 

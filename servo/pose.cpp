@@ -14,6 +14,7 @@
 #include <sstream>
 #include <utility>
 
+#include "detector/lens.h"
 #include "servo/pose_internal.h"
 #include "servo/target_layout.h"
 
@@ -37,7 +38,7 @@ double Wrap180(double deg) {
 
 // Reprojection RMS of the corners in undistorted pixels, +inf if a corner is not in front.
 double ResidualPx(const vpHomogeneousMatrix& cMo, const HashTarget& target,
-                  const std::array<vpColVector, 4>& corners_m, const vpCameraParameters& camera) {
+                  const std::array<vpColVector, 4>& corners_m, const Lens& camera) {
   double sum = 0.0;
   for (int k = 0; k < 4; ++k) {
     const double ox = target.corner[k].x, oy = target.corner[k].y;
@@ -45,8 +46,8 @@ double ResidualPx(const vpHomogeneousMatrix& cMo, const HashTarget& target,
     const double yc = cMo[1][0] * ox + cMo[1][1] * oy + cMo[1][3];
     const double zc = cMo[2][0] * ox + cMo[2][1] * oy + cMo[2][3];
     if (!(zc > 0.0)) return std::numeric_limits<double>::infinity();
-    const double du = camera.get_px() * (xc / zc - corners_m[k][0]);
-    const double dv = camera.get_py() * (yc / zc - corners_m[k][1]);
+    const double du = camera.px() * (xc / zc - corners_m[k][0]);
+    const double dv = camera.py() * (yc / zc - corners_m[k][1]);
     sum += du * du + dv * dv;
   }
   const double rms = std::sqrt(sum / 4.0);
@@ -72,14 +73,13 @@ bool Compute(vpPose* pose, vpPose::vpPoseMethodType method, vpHomogeneousMatrix*
 }
 
 // Undistorted pixel of a board point seen from cMo (false when not in front of the camera).
-bool Project(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera, double x, double y,
-             Point2d* out) {
+bool Project(const vpHomogeneousMatrix& cMo, const Lens& camera, double x, double y, Point2d* out) {
   const double xc = cMo[0][0] * x + cMo[0][1] * y + cMo[0][3];
   const double yc = cMo[1][0] * x + cMo[1][1] * y + cMo[1][3];
   const double zc = cMo[2][0] * x + cMo[2][1] * y + cMo[2][3];
   if (!(zc > 0.0)) return false;
-  out->u = camera.get_u0() + camera.get_px() * xc / zc;
-  out->v = camera.get_v0() + camera.get_py() * yc / zc;
+  out->u = camera.u0() + camera.px() * xc / zc;
+  out->v = camera.v0() + camera.py() * yc / zc;
   return true;
 }
 
@@ -100,7 +100,7 @@ LineParams Middle(const LineParams& a, const LineParams& b) {
 // cMo: corner image (centre lines) minus intersection of the stripe middles (pose.h,
 // correct_stripe_centres). False if some image cannot be formed.
 bool StripeCentreShifts(const vpHomogeneousMatrix& cMo, const HashTarget& target,
-                        const vpCameraParameters& camera, const std::array<bool, 4>& is_stripe,
+                        const Lens& camera, const std::array<bool, 4>& is_stripe,
                         std::array<Point2d, 4>* shift) {
   std::array<LineParams, 4> centre, seen;
   for (int k = 0; k < 4; ++k) {
@@ -307,7 +307,7 @@ std::optional<std::string> LinearPoseRefined(const vpHomogeneousMatrix* previous
                                              const PoseOptions& options, vpPose* pose,
                                              PoseResult* result, vpHomogeneousMatrix* cMo,
                                              double* residual_px) {
-  const vpCameraParameters& camera = options.camera;
+  const Lens& camera = options.camera;
   corners.Set(nullptr, result, pose);
   vpHomogeneousMatrix by_dementhon, by_lagrange;
   const bool lagrange_ok = Compute(pose, vpPose::LAGRANGE, &by_lagrange);
@@ -345,9 +345,9 @@ std::optional<std::string> LinearPoseRefined(const vpHomogeneousMatrix* previous
 
 // Step 2: the roll of line 1, from its corner with line 2 (corner 0) to its corner with line 4
 // (corner 3), in (undistorted) pixels, after the stripe-centre correction.
-double Line1RollDeg(const PoseResult& result, const vpCameraParameters& camera) {
-  const double du = camera.get_px() * (result.corners_m[3][0] - result.corners_m[0][0]);
-  const double dv = camera.get_py() * (result.corners_m[3][1] - result.corners_m[0][1]);
+double Line1RollDeg(const PoseResult& result, const Lens& camera) {
+  const double du = camera.px() * (result.corners_m[3][0] - result.corners_m[0][0]);
+  const double dv = camera.py() * (result.corners_m[3][1] - result.corners_m[0][1]);
   return Wrap360(std::atan2(-du, dv) * kDegPerRad);
 }
 

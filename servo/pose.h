@@ -51,7 +51,6 @@
 // (px times the normalised reprojection error).
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpMatrix.h>
 
@@ -61,6 +60,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "detector/line.h"
 #include "target/line_target.h"
 
@@ -89,7 +89,7 @@ std::string ToString(PoseMethod method);
 
 struct PoseOptions {
   /// Intrinsics (and kdu when the model has distortion) of the camera that took the frame.
-  vpCameraParameters camera{600.0, 600.0, 319.5, 239.5};
+  Lens camera = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   /// true: the lines are in undistorted pixels (OalDetector::Undistorts()), converted to
   /// metres by x = (u - u0)/px; false: in image pixels, converted with kdu
   /// (vpPixelMeterConversion).

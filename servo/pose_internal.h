@@ -2,13 +2,13 @@
 // it, the pixel -> metre conversion, and step 1 on a checked target.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpRotationMatrix.h>
 
 #include <array>
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "servo/pose.h"
 #include "target/line_target.h"
 
@@ -32,8 +32,7 @@ struct HashTarget {
 HashTarget HashTargetFrom(const LineTarget& target);
 
 /// A point in the lines' pixels to normalised metres (PoseOptions::lines_undistorted).
-void PixelToMetre(const vpCameraParameters& camera, bool undistorted, const Point2d& p, double* x,
-                  double* y);
+void PixelToMetre(const Lens& camera, bool undistorted, const Point2d& p, double* x, double* y);
 
 /// Step 1 (IdentifyTargetLines) without the checks; `previous_cRo` (may be null) keeps the
 /// identity of lines 1-4 consistent with the previous pose (PoseOptions::previous_max_deg).

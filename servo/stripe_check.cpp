@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "base/check.h"
+#include "detector/lens.h"
 
 namespace oal {
 namespace {
@@ -218,7 +219,7 @@ double StripeAgreement::Seen() const {
 }
 
 StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
-                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
+                             const vpHomogeneousMatrix& cMo, const Lens& camera,
                              const StripeCheckOptions& options) {
   StripeAgreement agreement;
   const PlaneProjector projector(PlaneToImage(cMo), camera);

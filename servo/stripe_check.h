@@ -34,12 +34,12 @@
 // contradict along whole stripes.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <array>
 
 #include "detector/image_view.h"
+#include "detector/lens.h"
 #include "servo/target_layout.h"
 
 namespace oal {
@@ -84,7 +84,7 @@ struct StripeAgreement {
 
 /// The model check of `layout` at cMo in `image` (`camera`'s lens: distorted pixels).
 StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& layout,
-                             const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera,
+                             const vpHomogeneousMatrix& cMo, const Lens& camera,
                              const StripeCheckOptions& options = {});
 
 }  // namespace oal

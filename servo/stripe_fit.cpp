@@ -1,13 +1,12 @@
 #include "servo/stripe_fit.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "base/check.h"
+#include "detector/lens.h"
 
 namespace oal {
 namespace {
@@ -193,15 +192,14 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
 
 class Fitter {
  public:
-  Fitter(const TargetLayout& layout, const vpCameraParameters& camera,
-         const StripeFitOptions& options)
+  Fitter(const TargetLayout& layout, const Lens& camera, const StripeFitOptions& options)
       : layout_(layout), camera_(camera), options_(options) {
     const double det = layout.axis_a.u * layout.axis_b.v - layout.axis_a.v * layout.axis_b.u;
     inverse_ = {layout.axis_b.v / det, -layout.axis_b.u / det, -layout.axis_a.v / det,
                 layout.axis_a.u / det};
-    inv_px2_ = 1.0 / (camera.get_px() * camera.get_px());
-    inv_py2_ = 1.0 / (camera.get_py() * camera.get_py());
-    focal_ = std::sqrt(camera.get_px() * camera.get_py());
+    inv_px2_ = 1.0 / (camera.px() * camera.px());
+    inv_py2_ = 1.0 / (camera.py() * camera.py());
+    focal_ = std::sqrt(camera.px() * camera.py());
   }
 
   // Sorts `points` onto the stripes where `pose` puts them.
@@ -228,10 +226,12 @@ class Fitter {
       }
       Vec3 p(0.0, 0.0, 1.0);
       if (undistorted) {
-        p(0) = (source.p.u - camera_.get_u0()) / camera_.get_px();
-        p(1) = (source.p.v - camera_.get_v0()) / camera_.get_py();
+        p(0) = (source.p.u - camera_.u0()) / camera_.px();
+        p(1) = (source.p.v - camera_.v0()) / camera_.py();
       } else {
-        vpPixelMeterConversion::convertPoint(camera_, source.p.u, source.p.v, p(0), p(1));
+        const Point2d ideal = camera_.Normalised(source.p.u, source.p.v);
+        p(0) = ideal.u;
+        p(1) = ideal.v;
       }
       const Vec3 q = image_to_plane * p;
       if (!(q(2) > 0.0)) continue;
@@ -321,7 +321,7 @@ class Fitter {
     sight.centre = line(0.0);
     sight.low = line(-span.half);
     sight.high = line(span.half);
-    const double nu = sight.centre(0) / camera_.get_px(), nv = sight.centre(1) / camera_.get_py();
+    const double nu = sight.centre(0) / camera_.px(), nv = sight.centre(1) / camera_.py();
     const double norm = std::sqrt(nu * nu + nv * nv);
     sight.nu = nu / norm;
     sight.nv = nv / norm;
@@ -334,8 +334,8 @@ class Fitter {
       // Behind the camera: no width (a run there is never the stripe's).
       sight.width[static_cast<std::size_t>(i)] =
           lo(2) > 0.0 && hi(2) > 0.0
-              ? std::fabs(camera_.get_px() * (hi(0) / hi(2) - lo(0) / lo(2)) * sight.nu +
-                          camera_.get_py() * (hi(1) / hi(2) - lo(1) / lo(2)) * sight.nv)
+              ? std::fabs(camera_.px() * (hi(0) / hi(2) - lo(0) / lo(2)) * sight.nu +
+                          camera_.py() * (hi(1) / hi(2) - lo(1) / lo(2)) * sight.nv)
               : 0.0;
     }
     return sight;
@@ -357,8 +357,8 @@ class Fitter {
                Vec3* shifted) const {
     const double length = std::sqrt(static_cast<double>(source.across_u) * source.across_u +
                                     static_cast<double>(source.across_v) * source.across_v);
-    const double du = source.across_u / length / camera_.get_px();
-    const double dv = source.across_v / length / camera_.get_py();
+    const double du = source.across_u / length / camera_.px();
+    const double dv = source.across_v / length / camera_.py();
     const auto along = [&](const Vec3& line) {
       const double towards = line(0) * du + line(1) * dv;
       return std::fabs(towards) > 1e-15 ? -line.dot(p) / towards : 0.0;
@@ -389,7 +389,7 @@ class Fitter {
   }
 
   const TargetLayout& layout_;
-  const vpCameraParameters& camera_;
+  const Lens& camera_;
   const StripeFitOptions& options_;
   std::array<double, 4> inverse_{};
   double inv_px2_ = 1.0, inv_py2_ = 1.0, focal_ = 1.0;
@@ -435,7 +435,7 @@ vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo) {
 }
 
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
-                     const std::vector<FramePoint>& points, const vpCameraParameters& camera,
+                     const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options,
                      const StripeGuides* guides) {
   options.Check();
@@ -447,7 +447,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   // fraction of the corridor at most, and points must not hop between stripes as it goes.
   std::array<StripePoints, 4> stripes;
   fitter.Assign(pose, points, points_undistorted, guides, &stripes);
-  for (StripePoints& stripe : stripes) KeepCollinear(camera.get_px(), camera.get_py(), &stripe);
+  for (StripePoints& stripe : stripes) KeepCollinear(camera.px(), camera.py(), &stripe);
 
   std::vector<double> magnitudes;
   double scale = options.min_scale_px;

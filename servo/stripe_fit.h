@@ -24,7 +24,6 @@
 // median of distances), before the fit weighs them.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <array>
@@ -32,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "detector/lens.h"
 #include "detector/line_fit.h"
 #include "servo/target_layout.h"
 
@@ -106,7 +106,7 @@ vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo);
 /// between its printed ends as `start` puts them, wide enough) however far `start` puts the
 /// stripe: a start tens of pixels off still converges when the stripes' lines were told.
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
-                     const std::vector<FramePoint>& points, const vpCameraParameters& camera,
+                     const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options = {},
                      const StripeGuides* guides = nullptr);
 

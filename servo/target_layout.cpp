@@ -1,7 +1,5 @@
 #include "servo/target_layout.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -226,17 +224,13 @@ vpHomography PlaneToImage(const vpHomogeneousMatrix& cMo) {
   return h;
 }
 
-bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,
-                       const Point2d& plane, Point2d* pixel) {
+bool ProjectPlanePoint(const vpHomography& plane_to_image, const Lens& camera, const Point2d& plane,
+                       Point2d* pixel) {
   return PlaneProjector(plane_to_image, camera).Project(plane, pixel);
 }
 
-PlaneProjector::PlaneProjector(const vpHomography& plane_to_image, const vpCameraParameters& camera)
-    : px_(camera.get_px()),
-      py_(camera.get_py()),
-      u0_(camera.get_u0()),
-      v0_(camera.get_v0()),
-      kdu_(Kdu(camera)) {
+PlaneProjector::PlaneProjector(const vpHomography& plane_to_image, const Lens& camera)
+    : camera_(camera) {
   for (unsigned int r = 0; r < 3; ++r) {
     for (unsigned int c = 0; c < 3; ++c) h_[r][c] = plane_to_image[r][c];
   }
@@ -248,22 +242,20 @@ bool PlaneProjector::Project(const Point2d& plane, Point2d* pixel) const {
   const double inverse_w = 1.0 / w;
   const double x = (h_[0][0] * plane.u + h_[0][1] * plane.v + h_[0][2]) * inverse_w;
   const double y = (h_[1][0] * plane.u + h_[1][1] * plane.v + h_[1][2]) * inverse_w;
-  const double scale = kdu_ != 0.0 ? DistortedOverIdeal(kdu_, x * x + y * y) : 1.0;
-  pixel->u = u0_ + px_ * x * scale;
-  pixel->v = v0_ + py_ * y * scale;
+  *pixel = camera_.Pixel(x, y);
   return std::isfinite(pixel->u) && std::isfinite(pixel->v) && std::fabs(pixel->u) < kFarPx &&
          std::fabs(pixel->v) < kFarPx;
 }
 
 ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
-                          const vpCameraParameters& camera, int count) {
+                          const Lens& camera, int count) {
   ScanBorders borders;
   TargetBorders(layout, plane_to_image, camera, count, &borders);
   return borders;
 }
 
 void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
-                   const vpCameraParameters& camera, int count, ScanBorders* out) {
+                   const Lens& camera, int count, ScanBorders* out) {
   std::vector<std::vector<Point2d>>& polygons = out->polygons;
   const PlaneProjector projector(plane_to_image, camera);
   std::size_t used = 0;
@@ -291,12 +283,12 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
 }
 
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
-                                                 const vpCameraParameters& camera) {
+                                                 const Lens& camera) {
   std::array<Point2d, 4> image;
   for (int k = 0; k < 4; ++k) {
     const Point2d& corner = cell.corners[static_cast<std::size_t>(k)];
     Point2d& normalised = image[static_cast<std::size_t>(k)];
-    vpPixelMeterConversion::convertPoint(camera, corner.u, corner.v, normalised.u, normalised.v);
+    normalised = camera.Normalised(corner.u, corner.v);
     if (!std::isfinite(normalised.u) || !std::isfinite(normalised.v)) return std::nullopt;
   }
   std::optional<vpHomography> best;
@@ -362,8 +354,7 @@ std::vector<LightQuad> UncutCells(const TargetLayout& layout, const LightQuad& c
 }
 
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
-                                                     const LightQuad& cell,
-                                                     const vpCameraParameters& camera) {
+                                                     const LightQuad& cell, const Lens& camera) {
   if (cell.ClosedSideCount() != 3) return std::nullopt;
   int open = 0;
   while ((cell.closed_sides >> open) & 1) ++open;
@@ -374,7 +365,7 @@ std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCel
     const std::size_t i = static_cast<std::size_t>((k + open - edge.outer + 4) % 4);
     const Point2d& corner = cell.corners[i];
     Point2d& normalised = image[static_cast<std::size_t>(k)];
-    vpPixelMeterConversion::convertPoint(camera, corner.u, corner.v, normalised.u, normalised.v);
+    normalised = camera.Normalised(corner.u, corner.v);
     if (!std::isfinite(normalised.u) || !std::isfinite(normalised.v)) return std::nullopt;
     plane[static_cast<std::size_t>(k)] = edge.corners[static_cast<std::size_t>(k)];
     centre = Point2d{centre.u + 0.25 * plane[static_cast<std::size_t>(k)].u,

@@ -17,7 +17,6 @@
 // light cell the four stripes close in, whose corners are the stripes' inner edges.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/vision/vpHomography.h>
 
@@ -25,6 +24,7 @@
 #include <optional>
 #include <vector>
 
+#include "detector/lens.h"
 #include "detector/line.h"
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
@@ -106,10 +106,10 @@ std::optional<vpHomography> FourPointHomography(const std::array<Point2d, 4>& pl
 /// rectangle with a corner behind the camera, too far out, or whose image is not convex is
 /// left out (the borders may then be fewer; none when the target is not in front).
 ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
-                          const vpCameraParameters& camera, int count);
+                          const Lens& camera, int count);
 /// The same into *borders, reusing the memory it holds (for a loop).
 void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
-                   const vpCameraParameters& camera, int count, ScanBorders* borders);
+                   const Lens& camera, int count, ScanBorders* borders);
 
 /// The plane-to-image homography (normalised coordinates) that maps the layout's middle cell
 /// onto `cell`, a light quadrilateral of the frame: of the two ways to lay the cell's sides
@@ -117,15 +117,14 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
 /// changes no border), the one whose homography is nearer a rotation's first two columns.
 /// Nothing when the corners cannot be undistorted or the homography is degenerate.
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
-                                                 const vpCameraParameters& camera);
+                                                 const Lens& camera);
 
 /// The plane-to-image homography (normalised coordinates) that maps `edge`, an edge cell of
 /// the layout, onto `cell`, a light quadrilateral closed in on three sides: its open side on
 /// the cell's outer side (the board's edge). Nothing unless exactly one side is open, or when
 /// the corners cannot be undistorted or the homography is degenerate.
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
-                                                     const LightQuad& cell,
-                                                     const vpCameraParameters& camera);
+                                                     const LightQuad& cell, const Lens& camera);
 
 /// The middle cell `cell` would be if its side `cut` (from corner cut to cut + 1) were the edge
 /// of something lying across the cell (a hand, a tool, a cable) rather than a stripe's: the
@@ -137,20 +136,20 @@ std::vector<LightQuad> UncutCells(const TargetLayout& layout, const LightQuad& c
 
 /// The image of a target point seen through `plane_to_image` and the lens: distorted pixels;
 /// false when it lies behind the camera or beyond the lens model's reach.
-bool ProjectPlanePoint(const vpHomography& plane_to_image, const vpCameraParameters& camera,
-                       const Point2d& plane, Point2d* pixel);
+bool ProjectPlanePoint(const vpHomography& plane_to_image, const Lens& camera, const Point2d& plane,
+                       Point2d* pixel);
 
 /// ProjectPlanePoint for many points of one view: the homography and the lens are read once
 /// (the model check projects a few hundred points a frame), and the lens is inverted to
 /// 1e-12 of the radius, far below a pixel, rather than to the renderer's last bit.
 class PlaneProjector {
  public:
-  PlaneProjector(const vpHomography& plane_to_image, const vpCameraParameters& camera);
+  PlaneProjector(const vpHomography& plane_to_image, const Lens& camera);
   bool Project(const Point2d& plane, Point2d* pixel) const;
 
  private:
   double h_[3][3];
-  double px_, py_, u0_, v0_, kdu_;
+  Lens camera_;
 };
 
 }  // namespace oal

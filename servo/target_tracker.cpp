@@ -1,6 +1,5 @@
 #include "servo/target_tracker.h"
 
-#include <visp3/core/vpPixelMeterConversion.h>
 #include <visp3/core/vpThetaUVector.h>
 
 #include <algorithm>
@@ -125,9 +124,9 @@ void TargetTrackerOptions::Check() const {
   stripe_fit.Check();
 }
 
-double TargetTrackerOptions::PixelScale(const vpCameraParameters& camera) const {
+double TargetTrackerOptions::PixelScale(const Lens& camera) const {
   if (reference_focal_px == 0.0) return 1.0;
-  return std::clamp(std::sqrt(camera.get_px() * camera.get_py()) / reference_focal_px, 0.01, 100.0);
+  return std::clamp(std::sqrt(camera.px() * camera.py()) / reference_focal_px, 0.01, 100.0);
 }
 
 TargetTrackerOptions TargetTrackerOptions::ScaledBy(double scale) const {
@@ -171,12 +170,11 @@ struct StripeOutline {
   // `plane_to_image` maps the target plane to normalised coordinates; `camera`'s px, py, u0,
   // v0 take them to pixels (the detector's undistorted pixels, or those of a pinhole camera).
   static StripeOutline Of(const TargetLayout& layout, int k, const vpHomography& plane_to_image,
-                          const vpCameraParameters& camera) {
+                          const Lens& camera) {
     const StripeSpan& span = layout.stripes[static_cast<std::size_t>(k)];
     const auto to_pixel = [&](const Point2d& plane) {
       const PlaneImage image = ThroughHomography(plane_to_image, plane);
-      return Point2d{camera.get_u0() + camera.get_px() * image.x,
-                     camera.get_v0() + camera.get_py() * image.y};
+      return Point2d{camera.u0() + camera.px() * image.x, camera.v0() + camera.py() * image.y};
     };
     StripeOutline view;
     const double across[3] = {-span.half, 0.0, span.half};
@@ -269,7 +267,7 @@ LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames) {
   return check;
 }
 
-TargetPoseTracker::TargetPoseTracker(const LineTarget& target, const vpCameraParameters& camera,
+TargetPoseTracker::TargetPoseTracker(const LineTarget& target, const Lens& camera,
                                      const DetectorOptions& detector, const PoseOptions& pose,
                                      const TargetTrackerOptions& options)
     : target_(target),
@@ -304,9 +302,9 @@ std::array<std::optional<LineExtent>, 4> TargetPoseTracker::StripeEnds(
       ok = image.w > 1e-9;
       if (!ok) break;
       // The detector's coordinates: undistorted pixels when it undistorts.
-      ends[e] = detector_.Undistorts() ? Point2d{camera_.get_u0() + camera_.get_px() * image.x,
-                                                 camera_.get_v0() + camera_.get_py() * image.y}
-                                       : DistortedPixel(camera_, image.x, image.y);
+      ends[e] = detector_.Undistorts() ? Point2d{camera_.u0() + camera_.px() * image.x,
+                                                 camera_.v0() + camera_.py() * image.y}
+                                       : camera_.Pixel(image.x, image.y);
       ok = std::isfinite(ends[e].u) && std::isfinite(ends[e].v);
     }
     if (ok) extents[static_cast<std::size_t>(k)] = LineExtent{ends[0], ends[1]};
@@ -537,10 +535,12 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
     Intersect(lines_[k].line, lines_[(k + 1) % 4].line, &corner);
     double x = 0.0, y = 0.0;
     if (detector_.Undistorts()) {
-      x = (corner.u - camera_.get_u0()) / camera_.get_px();
-      y = (corner.v - camera_.get_v0()) / camera_.get_py();
+      x = (corner.u - camera_.u0()) / camera_.px();
+      y = (corner.v - camera_.v0()) / camera_.py();
     } else {
-      vpPixelMeterConversion::convertPoint(camera_, corner.u, corner.v, x, y);
+      const Point2d ideal = camera_.Normalised(corner.u, corner.v);
+      x = ideal.u;
+      y = ideal.v;
     }
     pose.corners_m[k] = vpColVector(2);
     pose.corners_m[k][0] = x;
@@ -564,8 +564,8 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
   // Only the points on the printed stripes: beyond their ends the lines run over the bench.
   frame_.lens = RadialBendOfFour(
       identified, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px,
-      StripeEnds(PlaneToImage(frame_.pose.cMo)), Point2d{camera_.get_u0(), camera_.get_v0()},
-      std::sqrt(camera_.get_px() * camera_.get_py()));
+      StripeEnds(PlaneToImage(frame_.pose.cMo)), Point2d{camera_.u0(), camera_.v0()},
+      std::sqrt(camera_.px() * camera_.py()));
   if (frame_.pose.method == PoseMethod::kStripes) {
     // The four stripes held together: their points in all (each stripe has its fit's minimum).
     const int points = frame_.fit.TotalPoints();

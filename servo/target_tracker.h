@@ -38,7 +38,6 @@
 // distortion (the detector undistorts the feature points), as pose.h states.
 #pragma once
 
-#include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <array>
@@ -48,6 +47,7 @@
 #include <vector>
 
 #include "detector/detector.h"
+#include "detector/lens.h"
 #include "detector/line_fit.h"
 #include "detector/region.h"
 #include "detector/sheet_finder.h"
@@ -155,7 +155,7 @@ struct TargetTrackerOptions {
   /// The model check's options from the fields above.
   StripeCheckOptions StripeCheck() const;
   /// The factor the settings in pixels take for `camera` (reference_focal_px).
-  double PixelScale(const vpCameraParameters& camera) const;
+  double PixelScale(const Lens& camera) const;
   /// These options with their settings in pixels (stripe_tolerance_px, the finder's, the
   /// stripe fit's corridor and guide tolerance) times `scale`. `scale` in (0, 100].
   TargetTrackerOptions ScaledBy(double scale) const;
@@ -193,8 +193,8 @@ class TargetPoseTracker {
 
   /// Throws std::invalid_argument for options failing Check(), detector or pose options
   /// failing theirs, or a target that is not a '#' whose stripes reach past the crossings.
-  TargetPoseTracker(const LineTarget& target, const vpCameraParameters& camera,
-                    const DetectorOptions& detector, const PoseOptions& pose,
+  TargetPoseTracker(const LineTarget& target, const Lens& camera, const DetectorOptions& detector,
+                    const PoseOptions& pose,
                     const TargetTrackerOptions& options = TargetTrackerOptions());
 
   /// Forgets the previous frames (the next one is found from scratch).
@@ -287,7 +287,7 @@ class TargetPoseTracker {
   void Accept(bool predicted);
 
   LineTarget target_;
-  vpCameraParameters camera_;
+  Lens camera_;
   TargetLayout layout_;
   double pixel_scale_ = 1.0;  ///< TargetTrackerOptions::PixelScale for the camera
   PoseOptions pose_options_;

@@ -25,7 +25,7 @@ using test::RunOalservo;
 using test::TestDir;
 
 // Twelve chessboard views through `camera` as PGM files in dir/shots.
-std::string WriteShots(const TestDir& dir, const vpCameraParameters& camera) {
+std::string WriteShots(const TestDir& dir, const Lens& camera) {
   const std::string shots = dir / "shots";
   std::filesystem::create_directories(shots);
   const std::vector<vpHomogeneousMatrix> poses = test::VariedPoses();
@@ -38,7 +38,7 @@ std::string WriteShots(const TestDir& dir, const vpCameraParameters& camera) {
 
 TEST(CalibrateCommand, WritesACameraFileThatTheOtherCommandsRead) {
   const TestDir dir;
-  const vpCameraParameters truth = CameraWithKdu(700.0, 702.0, 326.0, 235.0, 0.25, 640, 480);
+  const Lens truth = Lens::WithKdu(700.0, 702.0, 326.0, 235.0, 0.25, 640, 480);
   const std::string shots = WriteShots(dir, truth);
   const OalservoRun run =
       RunOalservo(dir, "calibrate '" + shots + "' --chessboard 9x6 --square 0.02 --out '" +
@@ -47,16 +47,16 @@ TEST(CalibrateCommand, WritesACameraFileThatTheOtherCommandsRead) {
   EXPECT_NE(run.out.find("view00.pgm: 54 corners, RMS"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("reprojection RMS"), std::string::npos) << run.out;
   const CameraFile file = LoadCameraFile(dir / "cam/camera.xml", "Bench");
-  EXPECT_NEAR(file.camera.get_px(), 700.0, 0.003 * 700.0);
-  EXPECT_NEAR(file.camera.get_u0(), 326.0, 1.5);
-  EXPECT_NEAR(file.camera.get_kdu(), 0.25, 0.03 * 0.25);
+  EXPECT_NEAR(file.camera.px(), 700.0, 0.003 * 700.0);
+  EXPECT_NEAR(file.camera.u0(), 326.0, 1.5);
+  EXPECT_NEAR(file.camera.kdu(), 0.25, 0.03 * 0.25);
   EXPECT_EQ(file.width, 640u);
   EXPECT_EQ(file.height, 480u);
 }
 
 // `views` views of the A3 sheet lying on the bench photographs, through `camera`, tilted
 // 15-45 deg, as PGM files in dir/sheet.
-std::string WriteSheetShots(const TestDir& dir, const vpCameraParameters& camera, int views) {
+std::string WriteSheetShots(const TestDir& dir, const Lens& camera, int views) {
   const std::string shots = dir / "sheet";
   std::filesystem::create_directories(shots);
   const LineTarget target = FourLineA3Target();
@@ -88,7 +88,7 @@ TEST(CalibrateCommand, CalibratesFromThePrintedSheetOnABench) {
     GTEST_SKIP() << "Debian's visp-images-data (the bench photographs) is not installed";
   }
   const TestDir dir;
-  const vpCameraParameters truth = CameraWithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
+  const Lens truth = Lens::WithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
   const std::string shots = WriteSheetShots(dir, truth, 14);
   // A blank frame among them: listed as not used, the others calibrate.
   vpImageIo::write(vpImage<unsigned char>(480, 640, 128), shots + "/zz-blank.pgm");
@@ -101,11 +101,11 @@ TEST(CalibrateCommand, CalibratesFromThePrintedSheetOnABench) {
   EXPECT_NE(run.out.find("stripe points, RMS"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("of 15 views"), std::string::npos) << run.out;
   const CameraFile file = LoadCameraFile(dir / "camera.xml", "Camera");
-  EXPECT_NEAR(file.camera.get_px(), truth.get_px(), 0.005 * truth.get_px());
-  EXPECT_NEAR(file.camera.get_py(), truth.get_py(), 0.005 * truth.get_py());
-  EXPECT_NEAR(file.camera.get_u0(), truth.get_u0(), 3.0);
-  EXPECT_NEAR(file.camera.get_v0(), truth.get_v0(), 3.0);
-  EXPECT_NEAR(file.camera.get_kdu(), 0.2, 0.02);
+  EXPECT_NEAR(file.camera.px(), truth.px(), 0.005 * truth.px());
+  EXPECT_NEAR(file.camera.py(), truth.py(), 0.005 * truth.py());
+  EXPECT_NEAR(file.camera.u0(), truth.u0(), 3.0);
+  EXPECT_NEAR(file.camera.v0(), truth.v0(), 3.0);
+  EXPECT_NEAR(file.camera.kdu(), 0.2, 0.02);
 }
 
 // A video of the sheet moved from pose to pose and held still at each: --live takes one view
@@ -116,7 +116,7 @@ TEST(CalibrateCommand, LiveTakesAViewWhereTheSheetIsHeldStill) {
   }
   const TestDir dir;
   const std::string video = dir / "moving.avi";
-  const vpCameraParameters truth = CameraWithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
+  const Lens truth = Lens::WithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
   {
     cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, {640, 480});
     if (!writer.isOpened()) GTEST_SKIP() << "OpenCV cannot write MJPG AVI files here";
@@ -152,7 +152,7 @@ TEST(CalibrateCommand, LiveTakesAViewWhereTheSheetIsHeldStill) {
   EXPECT_NE(run.out.find("hold the target still"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("(camera 'Camera', 640x480, 5 of 5 views)"), std::string::npos) << run.out;
   const CameraFile file = LoadCameraFile(dir / "camera.xml", "Camera");
-  EXPECT_NEAR(file.camera.get_px(), truth.get_px(), 0.03 * truth.get_px());
+  EXPECT_NEAR(file.camera.px(), truth.px(), 0.03 * truth.px());
 }
 
 TEST(CalibrateCommand, TargetOptionsThatDoNotGoTogetherAreUsageErrors) {

@@ -170,9 +170,9 @@ TEST(Pose, ACameraFileThatMissesTheLensIsToldOnce) {
   EXPECT_EQ(lens_warnings(summary), 0);
 
   const CameraFile right = LoadCameraFile(options.camera_path);
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(right.camera.get_px(), right.camera.get_py(),
-                                        right.camera.get_u0(), right.camera.get_v0());
+  Lens pinhole;
+  pinhole =
+      Lens::Pinhole(right.camera.px(), right.camera.py(), right.camera.u0(), right.camera.v0());
   options.camera_path = dir / "pinhole.xml";
   SaveCameraFile(options.camera_path, pinhole, "Camera", right.width, right.height);
   out.str("");
@@ -352,8 +352,8 @@ TEST(PoseCommand, EstimatesTheLensFromTheStripesAndUsesIt) {
   render.target = "four-line-a3";
   render.kdu = 0.15;
   test::RenderChecked(render);
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole;
+  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   SaveCameraFile(dir / "pinhole.xml", pinhole, "Camera", 640, 480);
   PoseCommandOptions options;
   options.inputs = {dir / "data"};

@@ -64,10 +64,10 @@ TEST(Render, WritesFramesTruthAndCamera) {
   EXPECT_EQ(camera.name, "oal-render");
   EXPECT_EQ(camera.width, 160u);
   EXPECT_EQ(camera.height, 120u);
-  EXPECT_EQ(camera.camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
-  EXPECT_DOUBLE_EQ(camera.camera.get_kdu(), 0.2);
-  EXPECT_NEAR(camera.camera.get_kud(), FitKud(camera.camera, 160, 120), 1e-9);
-  EXPECT_LT(camera.camera.get_kud(), 0.0);  // barrel: the inverse of a positive kdu
+  EXPECT_EQ(camera.camera.model(), Lens::Model::kViSP);
+  EXPECT_DOUBLE_EQ(camera.camera.kdu(), 0.2);
+  EXPECT_NEAR(camera.camera.kud(), FitKud(camera.camera, 160, 120), 1e-9);
+  EXPECT_LT(camera.camera.kud(), 0.0);  // barrel: the inverse of a positive kdu
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
 
@@ -81,7 +81,7 @@ TEST(Render, ThroughACameraFile) {
   const CameraFile camera = LoadCameraFile(dir / "again/camera.xml");
   EXPECT_EQ(camera.width, 160u);
   EXPECT_EQ(camera.height, 120u);
-  EXPECT_DOUBLE_EQ(camera.camera.get_kdu(), 0.2);
+  EXPECT_DOUBLE_EQ(camera.camera.kdu(), 0.2);
   EXPECT_EQ(cv::imread(dir / "again/frame_0000.png", cv::IMREAD_UNCHANGED).cols, 160);
   const test::OalservoRun both =
       test::RunOalservo(dir, "render --count 1 --camera '" + dir / "small/camera.xml" +
@@ -134,13 +134,13 @@ TEST(Render, SameSeedSameFiles) {
 }
 
 TEST(Render, CameraHasThePrincipalPointAtTheCentre) {
-  const vpCameraParameters camera = RenderCamera(640, 480, 600.0, 0.0);
-  EXPECT_EQ(camera.get_u0(), 319.5);
-  EXPECT_EQ(camera.get_v0(), 239.5);
-  EXPECT_EQ(camera.get_px(), 600.0);
-  EXPECT_EQ(camera.get_py(), 600.0);
-  EXPECT_EQ(camera.get_kdu(), 0.0);
-  EXPECT_EQ(camera.get_kud(), 0.0);
+  const Lens camera = RenderCamera(640, 480, 600.0, 0.0);
+  EXPECT_EQ(camera.u0(), 319.5);
+  EXPECT_EQ(camera.v0(), 239.5);
+  EXPECT_EQ(camera.px(), 600.0);
+  EXPECT_EQ(camera.py(), 600.0);
+  EXPECT_EQ(camera.kdu(), 0.0);
+  EXPECT_EQ(camera.kud(), 0.0);
 }
 
 TEST(Render, BadOptionsNameTheField) {
@@ -257,7 +257,7 @@ TEST(Render, OverwriteReplacesTheWholeDataSetAndKeepsOtherFiles) {
   for (const char* stale : {"frame_0002.png", "frame_0002.json", "frame_0003.png"}) {
     EXPECT_FALSE(fs::exists(dir / (std::string("reuse/") + stale))) << stale;
   }
-  EXPECT_EQ(LoadCameraFile(dir / "reuse/camera.xml").camera.get_kdu(), 0.0);
+  EXPECT_EQ(LoadCameraFile(dir / "reuse/camera.xml").camera.kdu(), 0.0);
   EXPECT_EQ(json::parse(test::ReadText(dir / "reuse/frame_0001.json")).at("camera").at("kdu"), 0.0);
   EXPECT_EQ(test::ReadText(dir / "reuse/notes.txt"), "mine");
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
@@ -349,7 +349,7 @@ TEST(RenderSequence, WritesFramesTruthAndSequenceJson) {
   const CameraFile camera = LoadCameraFile(options.out_dir + "/camera.xml");
   EXPECT_EQ(camera.width, 640u);
   EXPECT_EQ(camera.height, 480u);
-  EXPECT_EQ(camera.camera.get_px(), 600.0);
+  EXPECT_EQ(camera.camera.px(), 600.0);
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
 
@@ -366,8 +366,8 @@ TEST(RenderSequence, SameSeedSameFilesAndDistortionCamera) {
         << name;
   }
   const CameraFile camera = LoadCameraFile(a.out_dir + "/camera.xml");
-  EXPECT_EQ(camera.camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
-  EXPECT_NEAR(camera.camera.get_kdu(), 0.47, 1e-12);
+  EXPECT_EQ(camera.camera.model(), Lens::Model::kViSP);
+  EXPECT_NEAR(camera.camera.kdu(), 0.47, 1e-12);
 }
 
 // A sequence lies on the surface it is given (--background): the frames change only where the

@@ -35,7 +35,7 @@ CalibrationOptions OptionsFor(int width, int height) {
 TEST(Calibrate, RecoversTheIntrinsicsAndViSPsDistortionFromChessboardViews) {
   for (const double kdu : {0.0, 0.2, 0.35}) {
     SCOPED_TRACE("kdu " + std::to_string(kdu));
-    const vpCameraParameters truth = CameraWithKdu(760.0, 755.0, 331.0, 228.0, kdu, 640, 480);
+    const Lens truth = Lens::WithKdu(760.0, 755.0, 331.0, 228.0, kdu, 640, 480);
     const std::vector<CalibrationView> views = RenderedViews(truth, VariedPoses());
     int found = 0;
     for (const CalibrationView& view : views) {
@@ -44,31 +44,30 @@ TEST(Calibrate, RecoversTheIntrinsicsAndViSPsDistortionFromChessboardViews) {
     }
     ASSERT_GE(found, 10) << "the chessboard is found in most views";
     const CalibrationResult result = Calibrate(views, OptionsFor(640, 480));
-    EXPECT_NEAR(result.camera.get_px(), truth.get_px(), 0.003 * truth.get_px());
-    EXPECT_NEAR(result.camera.get_py(), truth.get_py(), 0.003 * truth.get_py());
-    EXPECT_NEAR(result.camera.get_u0(), truth.get_u0(), 1.5);
-    EXPECT_NEAR(result.camera.get_v0(), truth.get_v0(), 1.5);
-    EXPECT_NEAR(result.camera.get_kdu(), kdu, std::max(0.03 * kdu, 0.005));
+    EXPECT_NEAR(result.camera.px(), truth.px(), 0.003 * truth.px());
+    EXPECT_NEAR(result.camera.py(), truth.py(), 0.003 * truth.py());
+    EXPECT_NEAR(result.camera.u0(), truth.u0(), 1.5);
+    EXPECT_NEAR(result.camera.v0(), truth.v0(), 1.5);
+    EXPECT_NEAR(result.camera.kdu(), kdu, std::max(0.03 * kdu, 0.005));
     // kud is the best single-term inverse over the part of the image the views cover (the
     // truth's over the whole image differs by a few %): the two directions agree there, to
     // what two single terms can (under a pixel at kdu 0.35).
-    const vpCameraParameters& camera = result.camera;
+    const Lens& camera = result.camera;
     for (double u = 120.0; u <= 520.0; u += 50.0) {
       for (double v = 60.0; v <= 420.0; v += 45.0) {
-        const double xd = (u - camera.get_u0()) / camera.get_px();
-        const double yd = (v - camera.get_v0()) / camera.get_py();
-        const double grow = 1.0 + camera.get_kdu() * (xd * xd + yd * yd);
+        const double xd = (u - camera.u0()) / camera.px();
+        const double yd = (v - camera.v0()) / camera.py();
+        const double grow = 1.0 + camera.kdu() * (xd * xd + yd * yd);
         const double xu = xd * grow, yu = yd * grow;
-        const double shrink = 1.0 + camera.get_kud() * (xu * xu + yu * yu);
-        EXPECT_NEAR(camera.get_u0() + camera.get_px() * xu * shrink, u, 1.0) << u << ", " << v;
-        EXPECT_NEAR(camera.get_v0() + camera.get_py() * yu * shrink, v, 1.0) << u << ", " << v;
+        const double shrink = 1.0 + camera.kud() * (xu * xu + yu * yu);
+        EXPECT_NEAR(camera.u0() + camera.px() * xu * shrink, u, 1.0) << u << ", " << v;
+        EXPECT_NEAR(camera.v0() + camera.py() * yu * shrink, v, 1.0) << u << ", " << v;
       }
     }
     EXPECT_LT(result.rms_px, 0.2);
-    std::cout << "kdu " << kdu << ": px " << result.camera.get_px() << " py "
-              << result.camera.get_py() << " u0 " << result.camera.get_u0() << " v0 "
-              << result.camera.get_v0() << " kdu " << result.camera.get_kdu() << " RMS "
-              << result.rms_px << " px\n";
+    std::cout << "kdu " << kdu << ": px " << result.camera.px() << " py " << result.camera.py()
+              << " u0 " << result.camera.u0() << " v0 " << result.camera.v0() << " kdu "
+              << result.camera.kdu() << " RMS " << result.rms_px << " px\n";
     for (const std::string& advice : result.advice) ADD_FAILURE() << advice;
     for (const CalibrationViewReport& view : result.views) {
       if (view.used) {
@@ -79,7 +78,7 @@ TEST(Calibrate, RecoversTheIntrinsicsAndViSPsDistortionFromChessboardViews) {
 }
 
 TEST(Calibrate, ViewsThatFaceTheCameraAreRefusedWithWhatToDo) {
-  const vpCameraParameters truth = CameraWithKdu(760.0, 755.0, 331.0, 228.0, 0.1, 640, 480);
+  const Lens truth = Lens::WithKdu(760.0, 755.0, 331.0, 228.0, 0.1, 640, 480);
   std::vector<vpHomogeneousMatrix> facing;
   for (int k = 0; k < 6; ++k)
     facing.push_back(LookingAtTheBoard(0.4 + 0.03 * k, 1.0, -2.0, 15.0 * k));

@@ -56,8 +56,8 @@ inline vpHomogeneousMatrix LookingAtTheBoard(double distance_m, double tilt_x_de
 }
 
 // The chessboard seen through `camera` from `cMo` (noise 4 grey levels, blur 1 px).
-inline vpImage<unsigned char> RenderChessboard(const vpCameraParameters& camera,
-                                               const vpHomogeneousMatrix& cMo, std::uint64_t seed) {
+inline vpImage<unsigned char> RenderChessboard(const Lens& camera, const vpHomogeneousMatrix& cMo,
+                                               std::uint64_t seed) {
   LineTarget blank;  // the renderer's board: a speck of paper far from the chessboard
   blank.name = "blank";
   blank.board_width_m = blank.board_height_m = 0.001;
@@ -80,7 +80,7 @@ inline ChessboardOptions TestChessboard() {
 }
 
 // Renders the chessboard through `camera` from each pose and finds it in every view.
-inline std::vector<CalibrationView> RenderedViews(const vpCameraParameters& camera,
+inline std::vector<CalibrationView> RenderedViews(const Lens& camera,
                                                   const std::vector<vpHomogeneousMatrix>& poses) {
   std::vector<CalibrationView> views;
   for (std::size_t k = 0; k < poses.size(); ++k) {

@@ -60,7 +60,7 @@ TEST(PlumbLine, RecoversViSPsLensFromLinesItBent) {
     const PlumbLineResult result = EstimateRadialDistortion(Hash(kdu, 0.0, 1), kPx, kPx, kU0, kV0);
     EXPECT_NEAR(result.kdu, kdu, 1e-6) << "kdu " << kdu;
     // kud undoes it, as the camera files pair them.
-    EXPECT_NEAR(result.kud, CameraWithKdu(kPx, kPx, kU0, kV0, kdu, 640, 480).get_kud(), 1e-3);
+    EXPECT_NEAR(result.kud, Lens::WithKdu(kPx, kPx, kU0, kV0, kdu, 640, 480).kud(), 1e-3);
     EXPECT_LT(result.rms_after_px, 1e-4);
     if (kdu != 0.0) {
       EXPECT_GT(result.rms_before_px, 0.1);
@@ -134,14 +134,14 @@ TEST(PlumbLine, TheSheetsStripesTellTheLensInTenFrames) {
   for (const auto& [scene, kdu] : cases) {
     SCOPED_TRACE("scene " + std::to_string(scene) + ", kdu " + std::to_string(kdu));
     RenderOptions render;
-    render.camera = CameraWithKdu(kPx, kPx, kU0, kV0, kdu, 640, 480);
+    render.camera = Lens::WithKdu(kPx, kPx, kU0, kV0, kdu, 640, 480);
     render.noise_sigma = 4.0;
     render.blur_sigma_px = 1.0;
     DressAsBench(&render, scene);
     const SceneRenderer renderer(FourLineA3Target(), render);
     const PoseSampling sampling = SheetSampling(renderer.target());
-    vpCameraParameters pinhole;
-    pinhole.initPersProjWithoutDistortion(kPx, kPx, kU0, kV0);
+    Lens pinhole;
+    pinhole = Lens::Pinhole(kPx, kPx, kU0, kV0);
     PoseOptions pose;
     pose.camera = pinhole;
     pose.image_width = 640;
@@ -167,8 +167,7 @@ TEST(PlumbLine, TheSheetsStripesTellTheLensInTenFrames) {
     // borders the frames were scanned on moves it by that much).
     const double tolerance = std::max(0.05 * kdu, 3.0 * result.kdu_sd);
     EXPECT_NEAR(result.kdu, kdu, tolerance) << "kud " << result.kud << ", sd " << result.kdu_sd;
-    EXPECT_NEAR(result.kud, render.camera.get_kud(),
-                tolerance / kdu * std::fabs(render.camera.get_kud()));
+    EXPECT_NEAR(result.kud, render.camera.kud(), tolerance / kdu * std::fabs(render.camera.kud()));
     EXPECT_LT(result.rms_after_px, result.rms_before_px);
   }
 }

@@ -35,7 +35,7 @@ CalibrationOptions Options640x480() {
 
 TEST(SheetView, KeepsEachStripesOwnPointsAndLeavesOutTheCrossingsAndSpecks) {
   const LineTarget target = FourLineA3Target();
-  const vpCameraParameters camera = CameraWithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
+  const Lens camera = Lens::WithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
   std::mt19937 random(1);
   std::vector<std::vector<Point2d>> seen =
       SeenAlongStripes(target, camera, LookingAtTheSheet(0.5, 15.0, -10.0, 20.0), 0.0, &random);
@@ -61,7 +61,7 @@ TEST(SheetView, KeepsEachStripesOwnPointsAndLeavesOutTheCrossingsAndSpecks) {
 
 TEST(SheetView, FewerThanFourCrossingsGiveAViewWithoutLines) {
   const LineTarget target = FourLineA3Target();
-  const vpCameraParameters camera = CameraWithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
+  const Lens camera = Lens::WithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
   std::mt19937 random(2);
   std::vector<std::vector<Point2d>> seen =
       SeenAlongStripes(target, camera, LookingAtTheSheet(0.5, 20.0, 0.0, 0.0), 0.1, &random);
@@ -77,7 +77,7 @@ TEST(CalibrateFromTheSheet, RecoversTheIntrinsicsAndViSPsDistortionFromTheStripe
                                                             {FourLineA4Target(), 0.0}};
   for (const auto& [target, kdu] : cases) {
     SCOPED_TRACE(target.name + ", kdu " + std::to_string(kdu));
-    const vpCameraParameters truth = CameraWithKdu(720.0, 716.0, 333.0, 229.0, kdu, 640, 480);
+    const Lens truth = Lens::WithKdu(720.0, 716.0, 333.0, 229.0, kdu, 640, 480);
     const double scale = target.board_width_m / 0.42;  // the A4 sheet is seen from nearer
     std::mt19937 random(7);
     std::vector<CalibrationView> views;
@@ -88,11 +88,11 @@ TEST(CalibrateFromTheSheet, RecoversTheIntrinsicsAndViSPsDistortionFromTheStripe
                                 "view" + std::to_string(views.size())));
     }
     const CalibrationResult result = Calibrate(views, Options640x480());
-    EXPECT_NEAR(result.camera.get_px(), truth.get_px(), 0.003 * truth.get_px());
-    EXPECT_NEAR(result.camera.get_py(), truth.get_py(), 0.003 * truth.get_py());
-    EXPECT_NEAR(result.camera.get_u0(), truth.get_u0(), 1.5);
-    EXPECT_NEAR(result.camera.get_v0(), truth.get_v0(), 1.5);
-    EXPECT_NEAR(result.camera.get_kdu(), kdu, std::max(0.03 * kdu, 0.005));
+    EXPECT_NEAR(result.camera.px(), truth.px(), 0.003 * truth.px());
+    EXPECT_NEAR(result.camera.py(), truth.py(), 0.003 * truth.py());
+    EXPECT_NEAR(result.camera.u0(), truth.u0(), 1.5);
+    EXPECT_NEAR(result.camera.v0(), truth.v0(), 1.5);
+    EXPECT_NEAR(result.camera.kdu(), kdu, std::max(0.03 * kdu, 0.005));
     EXPECT_LT(result.rms_px, 0.3);
     for (const CalibrationViewReport& view : result.views) {
       EXPECT_TRUE(view.used) << view.name << ": " << view.rejected;
@@ -102,7 +102,7 @@ TEST(CalibrateFromTheSheet, RecoversTheIntrinsicsAndViSPsDistortionFromTheStripe
 
 TEST(CalibrateFromTheSheet, AViewWhosePointsDisagreeWithTheOthersIsLeftOut) {
   const LineTarget target = FourLineA3Target();
-  const vpCameraParameters truth = CameraWithKdu(720.0, 716.0, 333.0, 229.0, 0.15, 640, 480);
+  const Lens truth = Lens::WithKdu(720.0, 716.0, 333.0, 229.0, 0.15, 640, 480);
   std::mt19937 random(9);
   std::vector<CalibrationView> views;
   for (const vpHomogeneousMatrix& pose : VariedSheetPoses()) {
@@ -123,8 +123,8 @@ TEST(CalibrateFromTheSheet, AViewWhosePointsDisagreeWithTheOthersIsLeftOut) {
   EXPECT_NE(result.views.back().rejected.find("its points disagree with the other views'"),
             std::string::npos)
       << result.views.back().rejected;
-  EXPECT_NEAR(result.camera.get_px(), truth.get_px(), 0.003 * truth.get_px());
-  EXPECT_NEAR(result.camera.get_kdu(), 0.15, 0.03 * 0.15);
+  EXPECT_NEAR(result.camera.px(), truth.px(), 0.003 * truth.px());
+  EXPECT_NEAR(result.camera.kdu(), 0.15, 0.03 * 0.15);
 }
 
 TEST(CalibrateFromTheSheet, AViewWhoseLinesCannotBePlacedIsRefusedWithTheReason) {

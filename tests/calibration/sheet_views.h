@@ -38,7 +38,7 @@ inline std::vector<vpHomogeneousMatrix> VariedSheetPoses() {
 // Points every 6 mm along each stripe's centre line, through `camera` from `cMo`, with pixel
 // noise of `sigma_px`; those outside the image are not seen.
 inline std::vector<std::vector<Point2d>> SeenAlongStripes(const LineTarget& target,
-                                                          const vpCameraParameters& camera,
+                                                          const Lens& camera,
                                                           const vpHomogeneousMatrix& cMo,
                                                           double sigma_px, std::mt19937* random) {
   std::normal_distribution<double> noise(0.0, sigma_px);
@@ -52,7 +52,7 @@ inline std::vector<std::vector<Point2d>> SeenAlongStripes(const LineTarget& targ
                           stripe.y1_m + t * (stripe.y2_m - stripe.y1_m), 0.0, 1.0};
       const vpColVector c = cMo * o;
       // Through ViSP's kdu model exactly, as the renderer draws and the detector undistorts.
-      const Point2d pixel = DistortedPixel(camera, c[0] / c[2], c[1] / c[2]);
+      const Point2d pixel = camera.Pixel(c[0] / c[2], c[1] / c[2]);
       const double u = pixel.u + noise(*random), v = pixel.v + noise(*random);
       if (u >= 0.0 && u < 640.0 && v >= 0.0 && v < 480.0) seen[k].push_back(Point2d{u, v});
     }

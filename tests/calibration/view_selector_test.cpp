@@ -26,7 +26,7 @@ class ViewSelectorTest : public ::testing::Test {
   }
 
   const LineTarget target_ = FourLineA3Target();
-  const vpCameraParameters camera_ = CameraWithKdu(700.0, 700.0, 320.0, 240.0, 0.1, 640, 480);
+  const Lens camera_ = Lens::WithKdu(700.0, 700.0, 320.0, 240.0, 0.1, 640, 480);
   std::mt19937 random_{3};
 };
 
@@ -77,7 +77,7 @@ TEST_F(ViewSelectorTest, ANewPoseIsTakenAndALostTargetStartsOver) {
 
 TEST(TargetOutline, IsTheSheetsInkSeenThroughTheView) {
   const LineTarget target = FourLineA3Target();
-  const vpCameraParameters pinhole = CameraWithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
+  const Lens pinhole = Lens::WithKdu(700.0, 700.0, 320.0, 240.0, 0.0, 640, 480);
   std::mt19937 random(1);
   const CalibrationView view = SheetView(
       target,

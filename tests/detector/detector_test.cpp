@@ -212,7 +212,7 @@ class RenderedFrames : public ::testing::TestWithParam<RenderedCase> {};
 TEST_P(RenderedFrames, EveryTargetLineWithinHalfDegreeAndOnePixel) {
   const RenderedCase& param = GetParam();
   RenderOptions render;
-  render.camera.initPersProjWithDistortion(600.0, 600.0, 319.5, 239.5, 0.0, param.kdu);
+  render.camera = Lens::WithKudKdu(600.0, 600.0, 319.5, 239.5, 0.0, param.kdu);
   render.noise_sigma = 4.0;
   render.blur_sigma_px = 0.8;
   const SceneRenderer renderer(TargetByName(param.target), render);

@@ -29,17 +29,17 @@ std::array<Point2d, 4> MiddleCell(const LineTarget& target) {
   return {Point2d{x0, y0}, Point2d{x1, y0}, Point2d{x1, y1}, Point2d{x0, y1}};
 }
 
-Point2d Image(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera, const Point2d& p) {
+Point2d Image(const vpHomogeneousMatrix& cMo, const Lens& camera, const Point2d& p) {
   const double x = cMo[0][0] * p.u + cMo[0][1] * p.v + cMo[0][3];
   const double y = cMo[1][0] * p.u + cMo[1][1] * p.v + cMo[1][3];
   const double z = cMo[2][0] * p.u + cMo[2][1] * p.v + cMo[2][3];
-  return DistortedPixel(camera, x / z, y / z);
+  return camera.Pixel(x / z, y / z);
 }
 
 // The largest distance of quad's corners from the middle cell's image, in the best cyclic
 // order.
 double CornerError(const LightQuad& quad, const LineTarget& target, const vpHomogeneousMatrix& cMo,
-                   const vpCameraParameters& camera) {
+                   const Lens& camera) {
   const std::array<Point2d, 4> cell = MiddleCell(target);
   double best_error = HUGE_VAL;
   for (int shift = 0; shift < 4; ++shift) {
@@ -65,7 +65,7 @@ class SheetFinderOnRenderedSheets : public ::testing::TestWithParam<SheetCase> {
 TEST_P(SheetFinderOnRenderedSheets, FindsTheMiddleCellClosedInAndRefinesItOntoTheStripes) {
   const SheetCase param = GetParam();
   RenderOptions render;
-  render.camera = CameraWithKdu(600, 600, 319.5, 239.5, 0.15, 640, 480);
+  render.camera = Lens::WithKdu(600, 600, 319.5, 239.5, 0.15, 640, 480);
   render.noise_sigma = 5.0;
   render.blur_sigma_px = 1.0;
   render.illumination_gradient = 0.2;
@@ -99,8 +99,7 @@ INSTANTIATE_TEST_SUITE_P(Sheets, SheetFinderOnRenderedSheets,
 // Whether the finder's candidates (its first pass, then FindLocallyLight's) hold the middle
 // cell closed in on three sides or more (what the target tracker scans), refined within 2 px
 // of it.
-bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target,
-                        const vpCameraParameters& camera) {
+bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target, const Lens& camera) {
   SheetFinder finder;
   const GrayImageView view = ViewOf(frame.image);
   std::vector<LightQuad> candidates = finder.Find(view);
@@ -115,7 +114,7 @@ bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target,
 class SheetFinderInALivedInScene : public ::testing::Test {
  protected:
   SheetFinderInALivedInScene() : target_(TargetByName("four-line-a3")) {
-    render_.camera = CameraWithKdu(600, 600, 319.5, 239.5, 0.15, 640, 480);
+    render_.camera = Lens::WithKdu(600, 600, 319.5, 239.5, 0.15, 640, 480);
     render_.noise_sigma = 4.0;
     render_.blur_sigma_px = 1.0;
     render_.background_grey = 70;

@@ -33,8 +33,8 @@ namespace {
 using ::testing::HasSubstr;
 
 // The evaluations' sheet lens at 640 x 480 (kdu 0.15: barrel).
-vpCameraParameters SheetCamera() {
-  return CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+Lens SheetCamera() {
+  return Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
 }
 
 // A camera `distance_m` from the sheet's point (x_m, y_m), tilted by tilt_rad about an axis
@@ -54,7 +54,7 @@ vpHomogeneousMatrix ViewOfSheet(double distance_m, double x_m, double y_m, doubl
 // `method`'s marker printed on the A3 sheet's board, rendered from cMo through `camera`: a
 // little noise and blur, the paper's texture and the sheet's shadow on a grey bench.
 RenderedFrame RenderMarker(const MarkerMethod& method, const vpHomogeneousMatrix& cMo,
-                           const vpCameraParameters& camera = SheetCamera()) {
+                           const Lens& camera = SheetCamera()) {
   RenderOptions options;
   options.camera = camera;
   options.noise_sigma = 2.0;
@@ -104,8 +104,8 @@ TEST(CharucoMethod, PosesARenderedA3SheetWithinOnePercentAndOneDegree) {
 // checked in scene_tests).
 TEST(AprilTagMethod, TheTagsCornersAreFoundAtTheirProjectedPlanePoints) {
   const LineTarget sheet = FourLineA3Target();
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole;
+  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   const std::unique_ptr<MarkerMethod> method = MakeAprilTagMethod(sheet, pinhole, 640, 480);
   const double h = 0.5 * AprilTagBlackSide(sheet);
   EXPECT_NEAR(2.0 * h, 0.25, 0.001) << "A3: the largest tag with a white border";
@@ -131,8 +131,8 @@ TEST(AprilTagMethod, TheTagsCornersAreFoundAtTheirProjectedPlanePoints) {
 // camera matrix whose principal point is moved by as much).
 TEST(CharucoMethod, TheBoardsCornersAreFoundAtTheirProjectedPlanePoints) {
   const LineTarget sheet = FourLineA3Target();
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole;
+  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   const std::unique_ptr<MarkerMethod> method = MakeCharucoMethod(sheet, pinhole, 640, 480);
   const double square = CharucoSquareSide(sheet);
   const auto dictionary = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100);
@@ -169,10 +169,10 @@ TEST(CharucoMethod, TheBoardsCornersAreFoundAtTheirProjectedPlanePoints) {
 // r^2 = x^2 + y^2 of the undistorted point: OpenCV's projection with k1 = kud and nothing else
 // gives the same pixels.
 TEST(OpenCvDistortion, OpenCvsK1IsViSPsKud) {
-  const vpCameraParameters camera = SheetCamera();
-  ASSERT_NE(camera.get_kud(), 0.0);
+  const Lens camera = SheetCamera();
+  ASSERT_NE(camera.kud(), 0.0);
   const cv::Matx<double, 1, 5> distortion = KudAsOpenCvDistortion(camera);
-  EXPECT_EQ(distortion(0), camera.get_kud());
+  EXPECT_EQ(distortion(0), camera.kud());
   for (int i = 1; i < 5; ++i) EXPECT_EQ(distortion(i), 0.0);
   std::vector<cv::Point3d> points;
   for (double x = -0.6; x <= 0.6; x += 0.1) {
@@ -183,26 +183,26 @@ TEST(OpenCvDistortion, OpenCvsK1IsViSPsKud) {
                     distortion, projected);
   for (std::size_t i = 0; i < points.size(); ++i) {
     double u = 0.0, v = 0.0;
-    vpMeterPixelConversion::convertPoint(camera, points[i].x, points[i].y, u, v);
+    vpMeterPixelConversion::convertPoint(camera.ViSPCamera(640, 480), points[i].x, points[i].y, u,
+                                         v);
     EXPECT_NEAR(projected[i].x, u, 1e-9);
     EXPECT_NEAR(projected[i].y, v, 1e-9);
   }
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole;
+  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   EXPECT_EQ(KudAsOpenCvDistortion(pinhole)(0), 0.0);
 }
 
 // The worst distance over the image between where the rendered (kdu) lens puts the ideal point
 // of each pixel and where OpenCV's model with `distortion` puts it.
-double WorstPixelMiss(const vpCameraParameters& camera, int width, int height,
+double WorstPixelMiss(const Lens& camera, int width, int height,
                       const cv::Matx<double, 1, 5>& distortion) {
   std::vector<cv::Point3d> rays;
   std::vector<cv::Point2d> pixels;
   for (int v = 0; v < height; v += 8) {
     for (int u = 0; u < width; u += 8) {
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(camera, u, v, x, y);
-      rays.emplace_back(x, y, 1.0);
+      const Point2d ray = camera.Normalised(u, v);
+      rays.emplace_back(ray.u, ray.v, 1.0);
       pixels.emplace_back(u, v);
     }
   }
@@ -225,8 +225,8 @@ TEST(OpenCvDistortion, TheFittedCoefficientsFollowTheRenderedLens) {
   } cases[] = {
       {640, 480, 600.0, 0.02, 1.5}, {1280, 720, 914.0, 0.07, 5.0}, {1920, 1080, 1371.0, 0.1, 8.0}};
   for (const auto& c : cases) {
-    const vpCameraParameters camera = CameraWithKdu(c.focal_px, c.focal_px, 0.5 * (c.width - 1),
-                                                    0.5 * (c.height - 1), 0.15, c.width, c.height);
+    const Lens camera = Lens::WithKdu(c.focal_px, c.focal_px, 0.5 * (c.width - 1),
+                                      0.5 * (c.height - 1), 0.15, c.width, c.height);
     const cv::Matx<double, 1, 5> fitted = KduAsOpenCvDistortion(camera, c.width, c.height);
     EXPECT_EQ(fitted(2), 0.0);
     EXPECT_EQ(fitted(3), 0.0);
@@ -234,8 +234,8 @@ TEST(OpenCvDistortion, TheFittedCoefficientsFollowTheRenderedLens) {
     EXPECT_GT(WorstPixelMiss(camera, c.width, c.height, KudAsOpenCvDistortion(camera)), c.kud_px)
         << c.width;
   }
-  vpCameraParameters pinhole;
-  pinhole.initPersProjWithoutDistortion(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole;
+  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   EXPECT_EQ(KduAsOpenCvDistortion(pinhole, 640, 480), (cv::Matx<double, 1, 5>::zeros()));
 }
 

@@ -17,8 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = data[2 + i % (size - 2)];
   const oal::GrayImageView image{pixels.data(), width, height, width};
 
-  const vpCameraParameters camera = oal::CameraWithKdu(0.9 * width, 0.9 * width, 0.5 * (width - 1),
-                                                       0.5 * (height - 1), 0.15, width, height);
+  const oal::Lens camera = oal::Lens::WithKdu(0.9 * width, 0.9 * width, 0.5 * (width - 1),
+                                              0.5 * (height - 1), 0.15, width, height);
   oal::OalDetector detector(oal::DetectorOptions(), camera);
   for (const oal::DetectedLine& line : detector.Detect(image)) {
     if (!std::isfinite(line.line.rho_px) || !std::isfinite(line.line.theta_rad)) __builtin_trap();

@@ -56,10 +56,10 @@ TEST(CameraFile, FirstCameraWithItsDistortionModelWhenNoNameIsGiven) {
   const CameraFile camera = LoadCameraFile(dir / "cams.xml");
   EXPECT_EQ(camera.name, "left");
   EXPECT_EQ(camera.width, 320u);
-  EXPECT_EQ(camera.camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
-  EXPECT_EQ(camera.camera.get_px(), 310.0);
-  EXPECT_EQ(camera.camera.get_kdu(), 0.11);
-  EXPECT_EQ(camera.camera.get_kud(), -0.1);
+  EXPECT_EQ(camera.camera.model(), Lens::Model::kViSP);
+  EXPECT_EQ(camera.camera.px(), 310.0);
+  EXPECT_EQ(camera.camera.kdu(), 0.11);
+  EXPECT_EQ(camera.camera.kud(), -0.1);
 }
 
 TEST(CameraFile, CameraByNameWithoutDistortion) {
@@ -68,20 +68,20 @@ TEST(CameraFile, CameraByNameWithoutDistortion) {
   const CameraFile camera = LoadCameraFile(dir / "cams.xml", "right");
   EXPECT_EQ(camera.name, "right");
   EXPECT_EQ(camera.height, 480u);
-  EXPECT_EQ(camera.camera.get_projModel(), vpCameraParameters::perspectiveProjWithoutDistortion);
-  EXPECT_EQ(camera.camera.get_u0(), 319.5);
+  EXPECT_EQ(camera.camera.model(), Lens::Model::kPinhole);
+  EXPECT_EQ(camera.camera.u0(), 319.5);
 }
 
 TEST(CameraFile, SaveThenLoad) {
   test::TestDir dir;
-  vpCameraParameters camera;
-  camera.initPersProjWithDistortion(500.0, 501.0, 159.5, 119.5, -0.2, 0.25);
+  Lens camera;
+  camera = Lens::WithKudKdu(500.0, 501.0, 159.5, 119.5, -0.2, 0.25);
   SaveCameraFile(dir / "camera.xml", camera, "mine", 320, 240);
   SaveCameraFile(dir / "camera.xml", camera, "mine", 320, 240);  // replaces, never appends
   const CameraFile loaded = LoadCameraFile(dir / "camera.xml");
   EXPECT_EQ(loaded.name, "mine");
-  EXPECT_EQ(loaded.camera.get_py(), 501.0);
-  EXPECT_EQ(loaded.camera.get_kdu(), 0.25);
+  EXPECT_EQ(loaded.camera.py(), 501.0);
+  EXPECT_EQ(loaded.camera.kdu(), 0.25);
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
 
@@ -129,7 +129,7 @@ TEST(CameraFile, BadParametersNameTheFileAndTheField) {
   EXPECT_THAT(LoadError(path), HasSubstr(":9: camera 'c', model perspectiveProjWithDistortion: "
                                          "<kdu> is '0.1x', not a number"));
   test::WriteText(path, camera(" 600 ", "0.1"));  // whitespace around a number is fine
-  EXPECT_EQ(LoadCameraFile(path).camera.get_px(), 600.0);
+  EXPECT_EQ(LoadCameraFile(path).camera.px(), 600.0);
 }
 
 }  // namespace

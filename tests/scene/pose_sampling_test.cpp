@@ -233,7 +233,7 @@ TEST(SamplePose, CrossingsInViewPutsEveryCrossingSquareInTheImage) {
 TEST(SamplePose, CrossingsInViewHoldsThroughTheLensAndInTheImage) {
   const LineTarget target = FourLineA3Target();
   RenderOptions options;
-  options.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  options.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
   const SceneRenderer renderer(target, options);
   const PoseSampling sampling = SheetSampling();
   std::uint64_t state = 5;
@@ -245,7 +245,7 @@ TEST(SamplePose, CrossingsInViewHoldsThroughTheLensAndInTheImage) {
         Point2d ideal;
         ASSERT_TRUE(Project(cMo, options.camera, corner[0], corner[1], &ideal));
         const Point2d p =
-            DistortedPixel(options.camera, (ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
+            options.camera.Pixel((ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
         EXPECT_TRUE(InImage(p, sampling.crossings_margin_px)) << "pose " << i;
       }
     }
@@ -257,8 +257,7 @@ TEST(SamplePose, CrossingsInViewHoldsThroughTheLensAndInTheImage) {
       ASSERT_TRUE(Project(cMo, options.camera,
                           0.5 * (crossing.corners_m[0][0] + crossing.corners_m[2][0]),
                           0.5 * (crossing.corners_m[0][1] + crossing.corners_m[2][1]), &ideal));
-      const Point2d p =
-          DistortedPixel(options.camera, (ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
+      const Point2d p = options.camera.Pixel((ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
       EXPECT_EQ(frame.image[static_cast<int>(std::lround(p.v))][static_cast<int>(std::lround(p.u))],
                 target.line_grey)
           << "pose " << i;

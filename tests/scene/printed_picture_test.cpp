@@ -96,7 +96,7 @@ double CrossingOffset(const vpImage<unsigned char>& image, const LineTarget& she
 TEST(RenderPicture, EdgesLieOnTheProjectedSidesThroughATiltedDistortedLens) {
   const LineTarget sheet = BlankA3();
   RenderOptions options;
-  options.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  options.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
   std::vector<std::pair<unsigned, unsigned>> black;
   for (unsigned j = 1; j <= 8; ++j) {
     for (unsigned i = 1; i <= 8; ++i) black.push_back({i, j});
@@ -115,7 +115,7 @@ TEST(RenderPicture, EdgesLieOnTheProjectedSidesThroughATiltedDistortedLens) {
   const auto pixel = [&](double X, double Y) {
     Point2d ideal;
     EXPECT_TRUE(testing::Project(cMo, options.camera, X, Y, &ideal));
-    return DistortedPixel(options.camera, (ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
+    return options.camera.Pixel((ideal.u - 319.5) / 600.0, (ideal.v - 239.5) / 600.0);
   };
   double worst = 0.0;
   // Each side's points and its inward normal on the plane.

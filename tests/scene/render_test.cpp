@@ -102,7 +102,7 @@ TEST(Render, RolledStripeRowCentroidsLieOnTheIdealLine) {
 
 TEST(Render, DistortedStripeCentresUndistortOntoTheIdealLine) {
   RenderOptions options;
-  options.camera.initPersProjWithDistortion(600.0, 600.0, 319.5, 239.5, 0.0, 0.33);
+  options.camera = Lens::WithKudKdu(600.0, 600.0, 319.5, 239.5, 0.0, 0.33);
   const LineTarget target = TwoLineTarget();
   const SceneRenderer renderer(target, options);
   // The left stripe lies far right of the centre, where the distortion bends it most.
@@ -115,9 +115,9 @@ TEST(Render, DistortedStripeCentresUndistortOntoTheIdealLine) {
     const int guess =
         static_cast<int>((fit.rho_px - v * std::sin(fit.theta_rad)) / std::cos(fit.theta_rad));
     const double centroid = RowCentroid(frame, target, v, guess - 25, guess + 25);
-    double x = 0.0, y = 0.0;
-    vpPixelMeterConversion::convertPoint(options.camera, centroid, v, x, y);
-    const double distance = truth.ideal.SignedDistance(319.5 + 600.0 * x, 239.5 + 600.0 * y);
+    const Point2d ray = options.camera.Normalised(centroid, v);
+    const double distance =
+        truth.ideal.SignedDistance(319.5 + 600.0 * ray.u, 239.5 + 600.0 * ray.v);
     EXPECT_NEAR(distance, 0.0, kCentreTolerancePx) << "row " << v;
   }
 }
@@ -132,7 +132,7 @@ TEST_P(PixelsMatchDenseSampling, UnderPerspective) {
   RenderOptions options;
   options.width = 320;
   options.height = 240;
-  options.camera.initPersProjWithDistortion(300.0, 300.0, 159.5, 119.5, 0.0, GetParam());
+  options.camera = Lens::WithKudKdu(300.0, 300.0, 159.5, 119.5, 0.0, GetParam());
   const SceneRenderer renderer(target, options);
   vpHomogeneousMatrix tilt;
   tilt.buildFrom(0.0, 0.0, 0.0, 0.45, -0.3, 0.0);
@@ -295,7 +295,7 @@ vpHomogeneousMatrix TiltedView(double distance_m, double x_m, double y_m, double
 
 RenderOptions OldEffects() {
   RenderOptions options;
-  options.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  options.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
   options.noise_sigma = 4.0;
   options.blur_sigma_px = 1.0;
   options.illumination_gradient = 0.3;

@@ -31,8 +31,8 @@ inline vpHomogeneousMatrix FrontoParallel(double distance_m, double x_m = 0.0, d
 }
 
 /// Ideal pixel of the object point (X, Y, 0); false when it is behind the camera.
-inline bool Project(const vpHomogeneousMatrix& cMo, const vpCameraParameters& camera, double X,
-                    double Y, Point2d* pixel) {
+inline bool Project(const vpHomogeneousMatrix& cMo, const Lens& camera, double X, double Y,
+                    Point2d* pixel) {
   vpColVector p(4);
   p[0] = X;
   p[1] = Y;
@@ -40,8 +40,7 @@ inline bool Project(const vpHomogeneousMatrix& cMo, const vpCameraParameters& ca
   p[3] = 1.0;
   const vpColVector c = cMo * p;
   if (c[2] <= 0.0) return false;
-  *pixel = {camera.get_u0() + camera.get_px() * c[0] / c[2],
-            camera.get_v0() + camera.get_py() * c[1] / c[2]};
+  *pixel = {camera.u0() + camera.px() * c[0] / c[2], camera.v0() + camera.py() * c[1] / c[2]};
   return true;
 }
 
@@ -91,10 +90,9 @@ inline double ReferenceGrey(const LineTarget& target, const RenderOptions& optio
   double sum = 0.0;
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
-      double x = 0.0, y = 0.0;
-      vpPixelMeterConversion::convertPoint(options.camera, u - 0.5 + (i + 0.5) / n,
-                                           v - 0.5 + (j + 0.5) / n, x, y);
-      sum += SampleGrey(target, options, oMc, x, y);
+      const Point2d ray =
+          options.camera.Normalised(u - 0.5 + (i + 0.5) / n, v - 0.5 + (j + 0.5) / n);
+      sum += SampleGrey(target, options, oMc, ray.u, ray.v);
     }
   }
   return sum / (n * n);

@@ -93,7 +93,7 @@ TEST(Sequence, CommonSettings) {
     EXPECT_EQ(s.frames.size(), static_cast<std::size_t>(kFrames));
     EXPECT_EQ(s.options.width, 640);
     EXPECT_EQ(s.options.height, 480);
-    EXPECT_EQ(s.options.camera.get_px(), 600.0);
+    EXPECT_EQ(s.options.camera.px(), 600.0);
     EXPECT_GE(s.options.noise_sigma, 4.0);
     EXPECT_LE(s.options.noise_sigma, 6.0);
     EXPECT_EQ(s.options.blur_sigma_px, 1.0);
@@ -166,16 +166,16 @@ TEST(Sequence, FastLinesMoveTensOfPixelsPerFrame) {
 
 TEST(Sequence, DistortionIsHeavyAndMotionModerate) {
   const Sequence s = MakeSequence(SequenceKind::kDistortion, 30, kSeed);
-  ASSERT_EQ(s.options.camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
-  EXPECT_GE(s.options.camera.get_kdu(), 0.45);
-  EXPECT_LE(s.options.camera.get_kdu(), 0.5);
-  EXPECT_NEAR(s.options.camera.get_kud(), FitKud(s.options.camera, 640, 480), 1e-12);
+  ASSERT_EQ(s.options.camera.model(), Lens::Model::kViSP);
+  EXPECT_GE(s.options.camera.kdu(), 0.45);
+  EXPECT_LE(s.options.camera.kdu(), 0.5);
+  EXPECT_NEAR(s.options.camera.kud(), FitKud(s.options.camera, 640, 480), 1e-12);
   const double median = MedianDisplacementPx(TruthOf(s));
   EXPECT_GT(median, 2.0);
   EXPECT_LT(median, 10.0);
   for (const SequenceKind kind : AllSequenceKinds()) {
     if (kind == SequenceKind::kDistortion) continue;
-    EXPECT_EQ(MakeSequence(kind, 2, kSeed).options.camera.get_kdu(), 0.0) << ToString(kind);
+    EXPECT_EQ(MakeSequence(kind, 2, kSeed).options.camera.kdu(), 0.0) << ToString(kind);
   }
 }
 

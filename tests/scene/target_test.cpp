@@ -157,7 +157,7 @@ TEST(RenderOptionsCheck, RejectsEachBadField) {
             std::string::npos);
   // A kdu so negative that the pixel -> ray map folds over inside the image.
   EXPECT_NE(message_for([](RenderOptions& o) {
-              o.camera.initPersProjWithDistortion(600, 600, 319.5, 239.5, 0.0, -1.0);
+              o.camera = Lens::WithKudKdu(600, 600, 319.5, 239.5, 0.0, -1.0);
             }).find("RenderOptions::camera.kdu"),
             std::string::npos);
 }

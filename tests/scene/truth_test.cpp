@@ -15,25 +15,23 @@ namespace {
 using testing::FrontoParallel;
 using testing::Project;
 
-vpCameraParameters WideLens(double kdu = 0.33) {
-  vpCameraParameters camera;
-  camera.initPersProjWithDistortion(600.0, 590.0, 322.0, 241.0, 0.0, kdu);
-  return camera;
+Lens WideLens(double kdu = 0.33) {
+  return Lens::WithKudKdu(600.0, 590.0, 322.0, 241.0, 0.0, kdu);
 }
 
 // The normalised point a distorted pixel sees (ViSP's conversion).
-void Ray(const vpCameraParameters& camera, const Point2d& pixel, double* x, double* y) {
-  vpPixelMeterConversion::convertPoint(camera, pixel.u, pixel.v, *x, *y);
+void Ray(const Lens& camera, const Point2d& pixel, double* x, double* y) {
+  vpPixelMeterConversion::convertPoint(camera.ViSPCamera(640, 480), pixel.u, pixel.v, *x, *y);
 }
 
 TEST(DistortedPixel, RoundTripsThroughVispPixelToMetre) {
   std::mt19937_64 gen(1);
   for (const double kdu : {0.33, 0.05, -0.1}) {
-    const vpCameraParameters camera = WideLens(kdu);
+    const Lens camera = WideLens(kdu);
     std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
     for (int trial = 0; trial < 10000; ++trial) {
       const double x = coordinate(gen), y = coordinate(gen);
-      const Point2d pixel = DistortedPixel(camera, x, y);
+      const Point2d pixel = camera.Pixel(x, y);
       ASSERT_TRUE(std::isfinite(pixel.u)) << kdu << " " << x << " " << y;
       double xr = 0.0, yr = 0.0;
       Ray(camera, pixel, &xr, &yr);
@@ -44,23 +42,23 @@ TEST(DistortedPixel, RoundTripsThroughVispPixelToMetre) {
 }
 
 TEST(DistortedPixel, IsThePinholeWithoutDistortion) {
-  const vpCameraParameters camera(600.0, 590.0, 322.0, 241.0);
-  const Point2d p = DistortedPixel(camera, 0.3, -0.2);
+  const Lens camera = Lens::Pinhole(600.0, 590.0, 322.0, 241.0);
+  const Point2d p = camera.Pixel(0.3, -0.2);
   EXPECT_DOUBLE_EQ(p.u, 322.0 + 600.0 * 0.3);
   EXPECT_DOUBLE_EQ(p.v, 241.0 - 590.0 * 0.2);
 }
 
 TEST(DistortedPixel, BarrelLensPullsPointsInwardAndUnreachablePointsAreNaN) {
-  const Point2d barrel = DistortedPixel(WideLens(0.33), 0.5, 0.0);
+  const Point2d barrel = WideLens(0.33).Pixel(0.5, 0.0);
   EXPECT_LT(barrel.u, 322.0 + 600.0 * 0.5 - 10.0);
   EXPECT_GT(barrel.u, 322.0);
   // kdu = -0.5: r (1 - 0.5 r^2) never exceeds 0.544.
-  const Point2d unreachable = DistortedPixel(WideLens(-0.5), 0.6, 0.0);
+  const Point2d unreachable = WideLens(-0.5).Pixel(0.6, 0.0);
   EXPECT_TRUE(std::isnan(unreachable.u));
 }
 
 // Mean squared error of the metre -> pixel model u = u0 + px x (1 + kud r^2) over the image.
-double KudError(const vpCameraParameters& camera, double kud) {
+double KudError(const Lens& camera, double kud) {
   double sum = 0.0;
   int n = 0;
   for (int v = 0; v < 480; v += 12) {
@@ -68,8 +66,8 @@ double KudError(const vpCameraParameters& camera, double kud) {
       double x = 0.0, y = 0.0;
       Ray(camera, {static_cast<double>(u), static_cast<double>(v)}, &x, &y);
       const double r2 = x * x + y * y;
-      const double du = camera.get_u0() + camera.get_px() * x * (1.0 + kud * r2) - u;
-      const double dv = camera.get_v0() + camera.get_py() * y * (1.0 + kud * r2) - v;
+      const double du = camera.u0() + camera.px() * x * (1.0 + kud * r2) - u;
+      const double dv = camera.v0() + camera.py() * y * (1.0 + kud * r2) - v;
       sum += du * du + dv * dv;
       ++n;
     }
@@ -78,7 +76,7 @@ double KudError(const vpCameraParameters& camera, double kud) {
 }
 
 TEST(FitKud, MinimisesTheMetreToPixelError) {
-  const vpCameraParameters camera = WideLens(0.33);
+  const Lens camera = WideLens(0.33);
   const double kud = FitKud(camera, 640, 480);
   EXPECT_LT(kud, -0.15);
   EXPECT_GT(kud, -0.33);
@@ -162,8 +160,7 @@ TEST(Truth, DistortedFitFollowsTheDistortedImageOfTheCentreLine) {
       Point2d ideal;
       ASSERT_TRUE(Project(cMo, vpCameraParameters(600.0, 590.0, 322.0, 241.0), t.x1_m,
                           t.y1_m + s * (t.y2_m - t.y1_m), &ideal));
-      const Point2d p =
-          DistortedPixel(options.camera, (ideal.u - 322.0) / 600.0, (ideal.v - 241.0) / 590.0);
+      const Point2d p = options.camera.Pixel((ideal.u - 322.0) / 600.0, (ideal.v - 241.0) / 590.0);
       if (p.u >= 0 && p.u <= 639 && p.v >= 0 && p.v <= 479) curve.push_back(p);
     }
     ASSERT_GT(curve.size(), 500u);

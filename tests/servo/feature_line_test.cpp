@@ -33,12 +33,10 @@ vpCameraParameters PinholeCamera() {
 
 // The same intrinsics with a cheap wide lens (scene.h: kdu ≈ +0.33 at 640x480, px = 600).
 vpCameraParameters DistortedCamera() {
-  const vpCameraParameters pinhole = PinholeCamera();
-  vpCameraParameters camera(pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(), pinhole.get_v0(),
-                            0.0, 0.33);
+  const Lens pinhole = PinholeCamera();
+  vpCameraParameters camera(pinhole.px(), pinhole.py(), pinhole.u0(), pinhole.v0(), 0.0, 0.33);
   const double kud = FitKud(camera, kWidth, kHeight);
-  return vpCameraParameters(pinhole.get_px(), pinhole.get_py(), pinhole.get_u0(), pinhole.get_v0(),
-                            kud, 0.33);
+  return vpCameraParameters(pinhole.px(), pinhole.py(), pinhole.u0(), pinhole.v0(), kud, 0.33);
 }
 
 vpHomogeneousMatrix TestPose() {
@@ -91,9 +89,8 @@ ProjectedLine ProjectWithVisp(const Point3& a, const Point3& b, const vpHomogene
 
 // Ideal (undistorted) pixel of a normalised point, written out here rather than taken from
 // the code under test.
-Point2d IdealPixel(const vpCameraParameters& camera, const std::array<double, 2>& xy) {
-  return Point2d{camera.get_u0() + camera.get_px() * xy[0],
-                 camera.get_v0() + camera.get_py() * xy[1]};
+Point2d IdealPixel(const Lens& camera, const std::array<double, 2>& xy) {
+  return Point2d{camera.u0() + camera.px() * xy[0], camera.v0() + camera.py() * xy[1]};
 }
 
 bool InImage(const Point2d& p) {
@@ -105,14 +102,14 @@ bool InImage(const Point2d& p) {
 std::vector<ProjectedLine> RandomLines(int count, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> xy(-0.35, 0.35), z(-0.15, 0.15);
-  const vpCameraParameters camera = DistortedCamera();
+  const Lens camera = DistortedCamera();
   std::vector<ProjectedLine> lines;
   while (static_cast<int>(lines.size()) < count) {
     const Point3 a{xy(rng), xy(rng), z(rng)}, b{xy(rng), xy(rng), z(rng)};
     const ProjectedLine line = ProjectWithVisp(a, b, TestPose());
     const Point2d ia = IdealPixel(camera, line.xa), ib = IdealPixel(camera, line.xb);
-    const Point2d da = DistortedPixel(camera, line.xa[0], line.xa[1]);
-    const Point2d db = DistortedPixel(camera, line.xb[0], line.xb[1]);
+    const Point2d da = camera.Pixel(line.xa[0], line.xa[1]);
+    const Point2d db = camera.Pixel(line.xb[0], line.xb[1]);
     if (!InImage(ia) || !InImage(ib) || !InImage(da) || !InImage(db)) continue;
     if (std::hypot(ia.u - ib.u, ia.v - ib.v) < 150.0) continue;
     lines.push_back(line);
@@ -157,7 +154,7 @@ double EndErrorPx(const ProjectedLine& truth, double rho, double theta, double p
 }
 
 TEST(FeatureLine, MatchesVispProjectionWithoutDistortion) {
-  const vpCameraParameters camera = PinholeCamera();
+  const Lens camera = PinholeCamera();
   for (const ProjectedLine& truth : RandomLines(200, 11)) {
     const LineParams pixel_line =
         LineThrough(IdealPixel(camera, truth.xa), IdealPixel(camera, truth.xb));
@@ -175,14 +172,14 @@ TEST(FeatureLine, MatchesVispProjectionWithoutDistortion) {
 
 TEST(FeatureLine, VispMeLinePathAgreesWithoutDistortion) {
   // Checks ToMeLineConvention against ViSP's own vpMeLine -> vpFeatureLine conversion.
-  const vpCameraParameters camera = PinholeCamera();
+  const Lens camera = PinholeCamera();
   for (const ProjectedLine& truth : RandomLines(200, 12)) {
     const LineParams pixel_line =
         LineThrough(IdealPixel(camera, truth.xa), IdealPixel(camera, truth.xb));
     MeLineWithParams me_line;
     me_line.Set(ToMeLineConvention(pixel_line));
     vpFeatureLine visp;
-    vpFeatureBuilder::create(visp, camera, me_line);
+    vpFeatureBuilder::create(visp, camera.ViSPCamera(640, 480), me_line);
     ExpectSameLine(truth.visp_rho, truth.visp_theta, visp.getRho(), visp.getTheta(), kExactTol);
   }
 }
@@ -190,8 +187,8 @@ TEST(FeatureLine, VispMeLinePathAgreesWithoutDistortion) {
 TEST(FeatureLine, ExactWithDistortionFromUndistortedPixels) {
   // OalDetector with the camera reports lines in undistorted pixels: the conversion is exact
   // whatever kdu is.
-  const vpCameraParameters camera = DistortedCamera();
-  ASSERT_EQ(camera.get_projModel(), vpCameraParameters::perspectiveProjWithDistortion);
+  const Lens camera = DistortedCamera();
+  ASSERT_EQ(camera.model(), Lens::Model::kViSP);
   for (const ProjectedLine& truth : RandomLines(200, 13)) {
     const LineParams undistorted =
         LineThrough(IdealPixel(camera, truth.xa), IdealPixel(camera, truth.xb));
@@ -211,8 +208,8 @@ TEST(FeatureLine, DistortedImageLineApproximationBeatsVispWhichIgnoresKdu) {
   constexpr double kVispMinMeanErrorPx = 3.0;  // what ignoring a cheap wide lens costs
   constexpr double kOursMaxErrorPx = 1.0;      // the curve's sag left by the approximation
   constexpr double kMinGain = 5.0;             // ours is better, line by line, by this factor
-  const vpCameraParameters camera = DistortedCamera();
-  const Point2d centre{camera.get_u0(), camera.get_v0()};
+  const Lens camera = DistortedCamera();
+  const Point2d centre{camera.u0(), camera.v0()};
   double visp_sum = 0.0, ours_max = 0.0;
   int lines = 0;
   for (const ProjectedLine& truth : RandomLines(300, 14)) {
@@ -223,8 +220,8 @@ TEST(FeatureLine, DistortedImageLineApproximationBeatsVispWhichIgnoresKdu) {
     std::vector<Point2d> curve;
     for (int k = 0; k <= 200; ++k) {
       const double t = k / 200.0;
-      curve.push_back(DistortedPixel(camera, truth.xa[0] + t * (truth.xb[0] - truth.xa[0]),
-                                     truth.xa[1] + t * (truth.xb[1] - truth.xa[1])));
+      curve.push_back(camera.Pixel(truth.xa[0] + t * (truth.xb[0] - truth.xa[0]),
+                                   truth.xa[1] + t * (truth.xb[1] - truth.xa[1])));
     }
     const LineParams fitted = FitLine(curve);
     const Point2d end_a = ProjectOnto(fitted, curve.front()),
@@ -233,12 +230,12 @@ TEST(FeatureLine, DistortedImageLineApproximationBeatsVispWhichIgnoresKdu) {
     MeLineWithParams me_line;
     me_line.Set(ToMeLineConvention(fitted));
     vpFeatureLine visp;
-    vpFeatureBuilder::create(visp, camera, me_line);
-    const double visp_error = EndErrorPx(truth, visp.getRho(), visp.getTheta(), camera.get_px());
+    vpFeatureBuilder::create(visp, camera.ViSPCamera(640, 480), me_line);
+    const double visp_error = EndErrorPx(truth, visp.getRho(), visp.getTheta(), camera.px());
 
     vpFeatureLine ours;
     BuildFeatureLineFromDistorted(end_a, end_b, camera, &ours);
-    const double ours_error = EndErrorPx(truth, ours.getRho(), ours.getTheta(), camera.get_px());
+    const double ours_error = EndErrorPx(truth, ours.getRho(), ours.getTheta(), camera.px());
 
     EXPECT_LT(ours_error, kOursMaxErrorPx);
     EXPECT_LT(ours_error * kMinGain, visp_error);
@@ -253,7 +250,7 @@ TEST(FeatureLine, DistortedImageLineApproximationBeatsVispWhichIgnoresKdu) {
 }
 
 TEST(FeatureLine, SegmentApproximationReportsTheSag) {
-  const vpCameraParameters camera = DistortedCamera();
+  const Lens camera = DistortedCamera();
   double rms = -1.0;
   // A horizontal segment near the top of the image bows under barrel distortion.
   UndistortedLineFromDistortedSegment({20.0, 20.0}, {620.0, 20.0}, camera, 16, &rms);
@@ -267,7 +264,7 @@ TEST(FeatureLine, SegmentApproximationReportsTheSag) {
 }
 
 TEST(FeatureLine, DetectedLineChoosesThePath) {
-  const vpCameraParameters camera = DistortedCamera();
+  const Lens camera = DistortedCamera();
   DetectedLine line;
   line.line = LineThrough({100.0, 50.0}, {500.0, 400.0});
   line.end_a = {100.0, 50.0};
@@ -285,7 +282,7 @@ TEST(FeatureLine, DetectedLineChoosesThePath) {
 }
 
 TEST(FeatureLine, MetricAndUndistortedRoundTrip) {
-  const vpCameraParameters camera = PinholeCamera();
+  const Lens camera = PinholeCamera();
   std::mt19937 rng(21);
   std::uniform_real_distribution<double> rho(-900.0, 900.0), theta(0.0, kPi);
   for (int trial = 0; trial < 10000; ++trial) {

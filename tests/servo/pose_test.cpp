@@ -36,14 +36,9 @@ constexpr double kMaxRollErrorDeg = 1.0;  // line 1's roll, any roll
 
 // Small frames keep the tests fast: 320x240, px = 300 (the same field of view as 640x480 at
 // px = 600); kdu = 0.33 is the scene.h cheap wide lens.
-vpCameraParameters SmallCamera(bool distorted) {
-  vpCameraParameters camera;
-  if (distorted) {
-    camera.initPersProjWithDistortion(300.0, 300.0, 159.5, 119.5, 0.0, 0.33);
-  } else {
-    camera.initPersProjWithoutDistortion(300.0, 300.0, 159.5, 119.5);
-  }
-  return camera;
+Lens SmallCamera(bool distorted) {
+  return distorted ? Lens::WithKudKdu(300.0, 300.0, 159.5, 119.5, 0.0, 0.33)
+                   : Lens::Pinhole(300.0, 300.0, 159.5, 119.5);
 }
 
 RenderOptions SmallRender(bool distorted) {
@@ -128,9 +123,9 @@ vpHomogeneousMatrix PoseAt(double distance_m, double roll_deg, double tilt_deg,
 // lines in the order `order` (order[i] = target line shown as detected line i), with the
 // line and width perturbations of a real detector.
 std::vector<DetectedLine> SyntheticLines(const std::vector<TruthLine>& truth,
-                                         const std::vector<int>& order,
-                                         const vpCameraParameters& camera, std::mt19937* rng,
-                                         double rho_sigma_px = 0.1, double width_sigma = 0.08) {
+                                         const std::vector<int>& order, const Lens& camera,
+                                         std::mt19937* rng, double rho_sigma_px = 0.1,
+                                         double width_sigma = 0.08) {
   std::normal_distribution<double> normal(0.0, 1.0);
   const PointUndistorter undistorter(camera);
   std::vector<DetectedLine> lines;

@@ -41,7 +41,7 @@ const Resolution kResolutions[] = {{"640x480", 640, 480, 600.0}, {"1920x1080", 1
 RenderOptions BenchRender(const Resolution& resolution, std::uint64_t scene_seed) {
   RenderOptions render;
   render.camera =
-      CameraWithKdu(resolution.focal_px, resolution.focal_px, 0.5 * (resolution.width - 1),
+      Lens::WithKdu(resolution.focal_px, resolution.focal_px, 0.5 * (resolution.width - 1),
                     0.5 * (resolution.height - 1), 0.15, resolution.width, resolution.height);
   render.width = resolution.width;
   render.height = resolution.height;
@@ -87,7 +87,7 @@ vpHomogeneousMatrix Sheet(const SceneRenderer& renderer, std::uint64_t* state) {
 // Whether a corner of the sheet lies outside the image (ideal pixels).
 bool SheetPartlyOut(const SceneRenderer& renderer, const vpHomogeneousMatrix& cMo) {
   const LineTarget& target = renderer.target();
-  const vpCameraParameters& camera = renderer.options().camera;
+  const Lens& camera = renderer.options().camera;
   for (const double x : {-0.5, 0.5}) {
     for (const double y : {-0.5, 0.5}) {
       vpColVector corner(4);
@@ -97,8 +97,8 @@ bool SheetPartlyOut(const SceneRenderer& renderer, const vpHomogeneousMatrix& cM
       corner[3] = 1.0;
       const vpColVector c = cMo * corner;
       if (!(c[2] > 0.0)) return true;
-      double u = 0.0, v = 0.0;
-      vpMeterPixelConversion::convertPoint(camera, c[0] / c[2], c[1] / c[2], u, v);
+      const Point2d pixel = camera.Pixel(c[0] / c[2], c[1] / c[2]);
+      const double u = pixel.u, v = pixel.v;
       if (u < 0.0 || v < 0.0 || u > renderer.options().width - 1.0 ||
           v > renderer.options().height - 1.0) {
         return true;

@@ -19,7 +19,7 @@ namespace {
 
 using testing::FrontoParallel;
 
-const vpCameraParameters kCamera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+const Lens kCamera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
 
 RenderOptions Render() {
   RenderOptions render;

@@ -24,7 +24,7 @@ TEST(PlaneProjector, ItsPixelsAreViSPsDistortedProjection) {
                                 vpRotationMatrix(vpRxyzVector(0.44, -0.26, 0.7)));
   const vpHomography plane_to_image = PlaneToImage(cMo);
   for (const double kdu : {-0.3, -0.12, 0.0, 0.05, 0.15, 0.4, 1.2}) {
-    const vpCameraParameters camera = CameraWithKdu(600.0, 610.0, 319.5, 239.5, kdu, 640, 480);
+    const Lens camera = Lens::WithKdu(600.0, 610.0, 319.5, 239.5, kdu, 640, 480);
     const PlaneProjector projector(plane_to_image, camera);
     int projected = 0;
     for (double X = -0.3; X <= 0.3; X += 0.025) {
@@ -41,7 +41,8 @@ TEST(PlaneProjector, ItsPixelsAreViSPsDistortedProjection) {
         }
         ++projected;
         double x_back = 0.0, y_back = 0.0;
-        vpPixelMeterConversion::convertPoint(camera, pixel.u, pixel.v, x_back, y_back);
+        vpPixelMeterConversion::convertPoint(camera.ViSPCamera(640, 480), pixel.u, pixel.v, x_back,
+                                             y_back);
         EXPECT_NEAR(x_back, x, 1e-9) << "kdu " << kdu << " X " << X << " Y " << Y;
         EXPECT_NEAR(y_back, y, 1e-9) << "kdu " << kdu << " X " << X << " Y " << Y;
       }

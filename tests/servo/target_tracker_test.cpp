@@ -36,7 +36,7 @@ std::shared_ptr<const vpImage<unsigned char>> Bench() {
 // sheet's shadow and printed marks, other sheets and tools around it.
 RenderOptions BenchRender(std::uint64_t scene_seed) {
   RenderOptions render;
-  render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  render.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
   render.noise_sigma = 4.0;
   render.blur_sigma_px = 1.0;
   render.background = Bench();
@@ -197,7 +197,7 @@ TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
   }
   for (const double kdu : {0.15, 0.05, 0.25, 0.0}) {
     const bool right = kdu == 0.15;
-    const vpCameraParameters camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, kdu, 640, 480);
+    const Lens camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, kdu, 640, 480);
     PoseOptions pose;
     pose.camera = camera;
     pose.image_width = 640;
@@ -245,7 +245,7 @@ TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
 // along the run, the points stay on it.
 TEST(TargetPoseTracker, TheStripesPointsLieOnTheirCentreLines) {
   RenderOptions render;
-  render.camera = CameraWithKdu(600.0, 600.0, 319.5, 239.5, 0.0, 640, 480);
+  render.camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.0, 640, 480);
   render.blur_sigma_px = 1.0;
   const SceneRenderer renderer(FourLineA3Target(), render);
   TargetPoseTracker tracker = TrackerFor(renderer);
@@ -371,7 +371,7 @@ TEST(TargetPoseTracker, AToolAcrossTheMiddleCellIsSeenPast) {
 // gets the detector's and the sheet finder's settings of a 600 px camera 2.285 times; with
 // reference_focal_px 0 they are used as given.
 TEST(TargetPoseTracker, ItsSettingsInPixelsFollowTheCamerasFocalLength) {
-  const vpCameraParameters camera = CameraWithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
+  const Lens camera = Lens::WithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
   PoseOptions pose;
   pose.camera = camera;
   const TargetPoseTracker scaled(FourLineA3Target(), camera, DetectorOptions(), pose);
