@@ -31,8 +31,8 @@ int RunCompare(int argc, char** argv) {
   cli.add_option("--config", config_path, "YAML configuration of our detector")
       ->check(CLI::ExistingFile);
   cli.add_option("--camera", options.camera_path,
-                 "ViSP camera XML: our detector undistorts its points and is scored against the "
-                 "truth's ideal lines");
+                 "camera file (ViSP's .xml, OpenCV's or ROS's .yaml): our detector undistorts its "
+                 "points and is scored against the truth's ideal lines");
   cli.add_option("--out", options.out_dir,
                  "directory for compare.md, compare.json and compare_frame_NNNN.png (created)");
   cli.add_option("--lines", options.lines,

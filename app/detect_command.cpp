@@ -160,9 +160,10 @@ int RunDetect(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   cli.add_flag("--paper", options.paper,
                "start from the paper's algorithm (every remedy off); --config still overrides");
-  CLI::Option* camera =
-      cli.add_option("--camera", options.camera_path,
-                     "ViSP camera XML; with distortion (kdu), lines are in undistorted pixels");
+  CLI::Option* camera = cli.add_option(
+      "--camera", options.camera_path,
+      "camera file (ViSP's .xml, OpenCV's or ROS's .yaml); with distortion, lines are "
+      "in undistorted pixels");
   cli.add_option("--camera-name", options.camera_name,
                  "camera to read from --camera (default: the first in the file)")
       ->needs(camera);

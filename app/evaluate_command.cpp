@@ -30,9 +30,10 @@ int RunEvaluate(int argc, char** argv) {
                  "YAML configuration: detector, target and pose sections (default: the "
                  "target.yaml `oalservo render` writes next to its frames, else the A3 sheet)")
       ->check(CLI::ExistingFile);
-  cli.add_option("--camera", options.camera_path,
-                 "ViSP camera XML for every input (default: camera.xml next to each input; "
-                 "without a camera there is no pose)");
+  cli.add_option(
+      "--camera", options.camera_path,
+      "camera file for every input: ViSP's .xml, OpenCV's or ROS's .yaml (default: "
+      "camera.xml or camera.yaml next to each input; without a camera there is no pose)");
   cli.add_option("--truth", options.truth_path,
                  "truth of the single input: a CSV of lines and poses, or a directory of the "
                  "renderer's frame JSON (default: JSON next to the images, <video>.truth.csv)");

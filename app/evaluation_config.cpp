@@ -65,8 +65,8 @@ void AddRenderedCameraOptions(CLI::App& cli, RenderedFrameOptions* options,
                  "focal length, pixels (default: 600 at 640 px wide, in proportion to --width: "
                  "56 deg across; a 70 deg webcam is 914 at 1280, 1371 at 1920)");
   cli.add_option("--camera", *camera_path,
-                 "render through this ViSP camera file's camera (px, py, u0, v0, kdu) at its "
-                 "image size, instead of --focal and --kdu")
+                 "render through this camera file's lens (ViSP's .xml, OpenCV's or ROS's .yaml) "
+                 "at its image size, instead of --focal and --kdu")
       ->check(CLI::ExistingFile);
 }
 

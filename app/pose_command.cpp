@@ -24,6 +24,7 @@
 #include "io/camera_file.h"
 #include "io/image_source.h"
 #include "io/json_io.h"
+#include "io/rendered_dataset.h"
 #include "loop/lens_estimate.h"
 #include "scene/scene.h"
 #include "servo/pose.h"
@@ -34,18 +35,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The camera file: --camera, or the camera.xml `oalservo render` writes next to its frames
-// (in the first input if it is a directory, else in the first input's directory).
+// The camera file: --camera, or the camera.xml or camera.yaml `oalservo render` writes next
+// to its frames (in the first input if it is a directory, else in the first input's directory).
 std::string FindCameraPath(const PoseCommandOptions& options, PoseSummary* summary) {
   if (!options.camera_path.empty()) return options.camera_path;
-  const std::optional<std::string> found = CompanionFile(options.inputs, "camera.xml");
+  const std::optional<std::filesystem::path> found =
+      options.inputs.empty() ? std::nullopt : FindDatasetCamera(CompanionDirectory(options.inputs));
   if (!found) {
     throw std::runtime_error(
-        "pose needs the camera intrinsics: give --camera FILE (no camera.xml in '" +
+        "pose needs the camera intrinsics: give --camera FILE (no camera.xml or camera.yaml in '" +
         CompanionDirectory(options.inputs) + "')");
   }
-  summary->warnings.push_back("no --camera: using the camera in '" + *found + "'");
-  return *found;
+  summary->warnings.push_back("no --camera: using the camera in '" + found->string() + "'");
+  return found->string();
 }
 
 // Everything one run needs, opened before any output is started so that a bad input or
@@ -318,8 +320,9 @@ int RunPose(int argc, char** argv) {
                  "A3 sheet")
       ->check(CLI::ExistingFile);
   cli.add_option("--camera", options.camera_path,
-                 "ViSP camera XML (required unless the first input's directory has a "
-                 "camera.xml, as `oalservo render` writes)");
+                 "camera file: ViSP's .xml, OpenCV's calibration .yaml or ROS's camera_info .yaml "
+                 "(required unless the first input's directory has the camera.xml or camera.yaml "
+                 "`oalservo render` writes)");
   cli.add_option("--camera-name", options.camera_name,
                  "camera to read from the camera file (default: the first in the file)");
   cli.add_flag("--independent", options.independent,

@@ -218,9 +218,11 @@ int RunRender(int argc, char** argv) {
           ->capture_default_str(),
       cli.add_option("--kdu", options.kdu, "lens distortion (ViSP kdu; 0.33 is a cheap wide lens)")
           ->capture_default_str(),
-      cli.add_option("--camera", options.camera_path,
-                     "render through this ViSP camera file's camera (px, py, u0, v0, kdu) at its "
-                     "image size, instead of --fx, --kdu (and --width, --height when it has one)")
+      cli.add_option(
+             "--camera", options.camera_path,
+             "render through this camera file's lens (ViSP's .xml, OpenCV's or ROS's .yaml) "
+             "at its image size, instead of --fx, --kdu (and --width, --height when it "
+             "has one)")
           ->check(CLI::ExistingFile),
       cli.add_option("--noise", options.noise_sigma, "Gaussian noise sigma, grey levels")
           ->capture_default_str(),

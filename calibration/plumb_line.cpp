@@ -205,8 +205,7 @@ PlumbLineResult EstimateRadialDistortion(const std::vector<std::vector<Point2d>>
   result.kdu = step.kdu;
   result.points = step.used;
   result.rms_after_px = RmsPx(lines, step.kdu, scale_px);
-  Lens camera;
-  camera = Lens::WithKudKdu(px, py, u0, v0, 0.0, step.kdu);
+  Lens camera = Lens::WithKudKdu(px, py, u0, v0, 0.0, step.kdu);
   result.kud = FitKud(camera, options.width, options.height);
   return result;
 }

@@ -251,6 +251,52 @@ vpCameraParameters Lens::ViSPCamera(int width, int height) const {
   return camera;
 }
 
+Lens Lens::OpenCvCamera(int width, int height) const {
+  if (model_ != Model::kViSP) return *this;
+  // Minimise over a grid of distorted pixels (u, v) the distance from (u, v) to
+  // u0 + px x (1 + k1 r^2 + k2 r^4 + k3 r^6) (and v), (x, y) the ideal point of (u, v): linear
+  // in (k1, k2, k3), solved by its 3 x 3 normal equations.
+  constexpr int kSteps = 40;
+  double a[3][3] = {}, b[3] = {};
+  for (int j = 0; j <= kSteps; ++j) {
+    for (int i = 0; i <= kSteps; ++i) {
+      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
+      const Point2d ideal = Normalised(u, v);
+      if (!std::isfinite(ideal.u)) continue;
+      const double r2 = ideal.u * ideal.u + ideal.v * ideal.v;
+      const double powers[3] = {r2, r2 * r2, r2 * r2 * r2};
+      const double bu = u - u0_ - px_ * ideal.u, bv = v - v0_ - py_ * ideal.v;
+      for (int r = 0; r < 3; ++r) {
+        const double ur = px_ * ideal.u * powers[r], vr = py_ * ideal.v * powers[r];
+        b[r] += ur * bu + vr * bv;
+        for (int c = 0; c < 3; ++c) {
+          a[r][c] += ur * px_ * ideal.u * powers[c] + vr * py_ * ideal.v * powers[c];
+        }
+      }
+    }
+  }
+  const auto det3 = [](const double m[3][3]) {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  };
+  const double det = det3(a);
+  if (!(std::fabs(det) > 0.0)) return Pinhole(px_, py_, u0_, v0_);
+  double k[3];
+  for (int c = 0; c < 3; ++c) {  // Cramer's rule
+    double m[3][3];
+    for (int r = 0; r < 3; ++r) {
+      for (int cc = 0; cc < 3; ++cc) m[r][cc] = cc == c ? b[r] : a[r][cc];
+    }
+    k[c] = det3(m) / det;
+  }
+  Distortion fitted;
+  fitted.k1 = k[0];
+  fitted.k2 = k[1];
+  fitted.k3 = k[2];
+  return WithDistortion(px_, py_, u0_, v0_, fitted);
+}
+
 bool Lens::operator==(const Lens& other) const {
   return model_ == other.model_ && px_ == other.px_ && py_ == other.py_ && u0_ == other.u0_ &&
          v0_ == other.v0_ && kud_ == other.kud_ && kdu_ == other.kdu_ &&
@@ -293,6 +339,21 @@ double FitKud(const Lens& lens, int width, int height) {
     }
   }
   return saa > 0.0 ? sab / saa : 0.0;
+}
+
+double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height) {
+  constexpr int kSteps = 40;
+  double worst = 0.0;
+  for (int j = 0; j <= kSteps; ++j) {
+    for (int i = 0; i <= kSteps; ++i) {
+      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
+      const Point2d p = a.Normalised(u, v), q = b.Normalised(u, v);
+      const double d = std::hypot(a.px() * p.u - b.px() * q.u + a.u0() - b.u0(),
+                                  a.py() * p.v - b.py() * q.v + a.v0() - b.v0());
+      worst = std::isfinite(d) ? std::max(worst, d) : std::numeric_limits<double>::infinity();
+    }
+  }
+  return worst;
 }
 
 double CornerRadius2(const Lens& lens, int width, int height) {

@@ -109,6 +109,12 @@ class Lens {
   vpCameraParameters ViSPCamera(int width, int height) const;
   /// True when ViSPCamera() is only an approximation of this lens.
   bool IsViSPApproximation() const { return model_ == Model::kOpenCV; }
+  /// OpenCV's model of this lens: itself for the pinhole and OpenCV's model; for ViSP's, the
+  /// coefficients (k1, k2, 0, 0, k3) that best map the width x height image's pixels to their
+  /// ideal points (least squares), what calibrating it with OpenCV's default model gives.
+  Lens OpenCvCamera(int width, int height) const;
+  /// True when OpenCvCamera() is only an approximation of this lens.
+  bool IsOpenCvApproximation() const { return model_ == Model::kViSP; }
 
   /// OpenCV's model: the largest ideal normalised radius squared the model maps outwards
   /// (where its radial map turns back), infinity if none within 87 degrees off axis.
@@ -164,6 +170,11 @@ double DistortedOverIdeal(double kdu, double rho2);
 /// The kud that best inverts the lens's kdu over a width x height image (least squares), so a
 /// camera file written with both is consistent in ViSP's two directions.
 double FitKud(const Lens& lens, int width, int height);
+
+/// The largest distance between the ideal pixels (u0 + px x, v0 + py y) two lenses give the
+/// same distorted pixel, over a grid of a width x height image (how far an approximation
+/// misses); infinity where one has no ideal point.
+double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height);
 
 /// The largest distorted normalised radius squared of a width x height image's corners.
 double CornerRadius2(const Lens& lens, int width, int height);

@@ -43,7 +43,7 @@ class CharucoMethod : public MarkerMethod {
   CharucoMethod(const LineTarget& sheet, const Lens& camera, int width, int height)
       : square_m_(CharucoSquareSide(sheet)),
         camera_matrix_(InArucoPixels(OpenCvCameraMatrix(camera))),
-        distortion_(KduAsOpenCvDistortion(camera, width, height)),
+        distortion_(OpenCvDistortion(camera, width, height)),
         dictionary_(cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100)),
         board_(cv::aruco::CharucoBoard::create(kSquaresX, kSquaresY, static_cast<float>(square_m_),
                                                static_cast<float>(kMarkerOverSquare * square_m_),
@@ -118,7 +118,7 @@ class CharucoMethod : public MarkerMethod {
  private:
   double square_m_;
   cv::Matx33d camera_matrix_;
-  cv::Matx<double, 1, 5> distortion_;
+  std::vector<double> distortion_;
   cv::Ptr<cv::aruco::Dictionary> dictionary_;
   cv::Ptr<cv::aruco::CharucoBoard> board_;
   cv::Ptr<cv::aruco::DetectorParameters> parameters_;
@@ -139,34 +139,10 @@ cv::Matx<double, 1, 5> KudAsOpenCvDistortion(const Lens& camera) {
   return cv::Matx<double, 1, 5>(camera.kud(), 0.0, 0.0, 0.0, 0.0);
 }
 
-cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const Lens& camera, int width, int height) {
-  if (!camera.distorted()) return cv::Matx<double, 1, 5>::zeros();
-  if (camera.model() == Lens::Model::kOpenCV && !camera.distortion().IsRational()) {
-    const Distortion& d = camera.distortion();
-    return cv::Matx<double, 1, 5>(d.k1, d.k2, d.p1, d.p2, d.k3);
-  }
-  // Minimise over a grid of distorted pixels (u, v) the distance from (u, v) to
-  // u0 + px x (1 + k1 r^2 + k2 r^4 + k3 r^6) (and v), (x, y) the ideal point of (u, v) and
-  // r^2 = x^2 + y^2: linear in (k1, k2, k3).
-  constexpr int kSteps = 40;
-  cv::Matx33d normal = cv::Matx33d::zeros();
-  cv::Vec3d right(0.0, 0.0, 0.0);
-  for (int j = 0; j <= kSteps; ++j) {
-    for (int i = 0; i <= kSteps; ++i) {
-      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      const Point2d ideal = camera.Normalised(u, v);
-      const double x = ideal.u, y = ideal.v;
-      const double r2 = x * x + y * y;
-      const cv::Vec3d powers(r2, r2 * r2, r2 * r2 * r2);
-      const cv::Vec3d au = camera.px() * x * powers, av = camera.py() * y * powers;
-      const double bu = u - camera.u0() - camera.px() * x;
-      const double bv = v - camera.v0() - camera.py() * y;
-      normal += au * au.t() + av * av.t();
-      right += bu * au + bv * av;
-    }
-  }
-  const cv::Vec3d k = normal.solve(right, cv::DECOMP_CHOLESKY);
-  return cv::Matx<double, 1, 5>(k[0], k[1], 0.0, 0.0, k[2]);
+std::vector<double> OpenCvDistortion(const Lens& camera, int width, int height) {
+  const Lens opencv = camera.OpenCvCamera(width, height);
+  const auto c = opencv.distortion().ToArray();
+  return std::vector<double>(c.begin(), c.begin() + (opencv.distortion().IsRational() ? 8 : 5));
 }
 
 std::unique_ptr<MarkerMethod> MakeCharucoMethod(const LineTarget& sheet, const Lens& camera,

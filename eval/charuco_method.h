@@ -14,7 +14,8 @@
 // board's frame moved to the sheet's centre.
 //
 // The lens. OpenCV's camera matrix from px, py, u0, v0, and its distortion coefficients
-// (k1, k2, 0, 0, k3) fitted to the rendered lens over the image (KduAsOpenCvDistortion): the
+// (k1, k2, 0, 0, k3) fitted to a kdu lens over the image (OpenCvDistortion), a lens in OpenCV's
+// model as it is: the
 // renderer forms the image with ViSP's kdu model exactly (distorted pixel -> ray), which our
 // tracker and ViSP's AprilTag pose use as it is. ViSP's kud alone is exactly OpenCV's k1
 // (KudAsOpenCvDistortion: u = u0 + px x (1 + kud r^2), r^2 = x^2 + y^2 of the undistorted
@@ -34,6 +35,7 @@
 
 #include <memory>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "detector/lens.h"
 #include "eval/marker_method.h"
@@ -49,10 +51,10 @@ cv::Matx33d OpenCvCameraMatrix(const Lens& camera);
 /// ViSP's metre -> pixel direction (kud) as OpenCV's distortion coefficients: (kud, 0, 0, 0,
 /// 0), exactly; none for a camera without distortion.
 cv::Matx<double, 1, 5> KudAsOpenCvDistortion(const Lens& camera);
-/// ViSP's kdu lens (pixel -> metre, the one the renderer forms images with) as OpenCV's
-/// coefficients (k1, k2, 0, 0, k3): least squares over a grid of the width x height image's
-/// distorted pixels, as FitKud fits kud; none for a camera without distortion.
-cv::Matx<double, 1, 5> KduAsOpenCvDistortion(const Lens& camera, int width, int height);
+/// The lens as OpenCV's distortion coefficients (5, or 8 for the rational model): its own in
+/// OpenCV's model; for ViSP's kdu lens (pixel -> metre) the (k1, k2, 0, 0, k3) that best
+/// follow it over the width x height image (Lens::OpenCvCamera); zeros without distortion.
+std::vector<double> OpenCvDistortion(const Lens& camera, int width, int height);
 
 std::unique_ptr<MarkerMethod> MakeCharucoMethod(const LineTarget& sheet, const Lens& camera,
                                                 int width, int height);

@@ -40,6 +40,7 @@
 #include "io/camera_file.h"
 #include "io/image_source.h"
 #include "io/quiet_stderr.h"
+#include "io/rendered_dataset.h"
 #include "io/truth_file.h"
 #include "loop/lens_estimate.h"
 #include "scene/bench_scene.h"  // IsSheet
@@ -97,8 +98,9 @@ std::optional<CameraFile> CameraFor(const RunContext& run, const PlannedInput& i
   }
   const fs::path spec(input.spec);
   const fs::path dir = fs::is_directory(spec) ? spec : spec.parent_path();
-  const fs::path candidate = dir / "camera.xml";
-  if (!fs::is_regular_file(candidate)) return std::nullopt;
+  const std::optional<fs::path> found = FindDatasetCamera(dir);
+  if (!found) return std::nullopt;
+  const fs::path candidate = *found;
   *path = candidate.string();
   static std::mutex xml_mutex;  // XML parsing (libxml2, ViSP) from several jobs: one at a time
   std::lock_guard<std::mutex> lock(xml_mutex);

@@ -97,8 +97,7 @@ constexpr std::uint64_t kLensSeedOffset = 0x9e3779b97f4a7c15ULL;
 Lens EstimatedCamera(const EvaluationScenes& scenes, const PoseAccuracyOptions& options,
                      PoseAccuracyReport* report) {
   const Lens lens = scenes.For(0).options().camera;
-  Lens pinhole;
-  pinhole = Lens::Pinhole(lens.px(), lens.py(), lens.u0(), lens.v0());
+  Lens pinhole = Lens::Pinhole(lens.px(), lens.py(), lens.u0(), lens.v0());
   TargetPoseTracker tracker(options.target, pinhole, options.detector, options.pose,
                             options.tracking);
   std::uint64_t state = options.seed + kLensSeedOffset;

@@ -5,6 +5,7 @@
 #include <visp3/core/vpException.h>
 #include <visp3/core/vpXmlParserCamera.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -14,8 +15,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include "base/format.h"
 #include "detector/lens.h"
 #include "io/atomic_file.h"
+#include "io/camera_yaml.h"
 
 namespace oal {
 namespace {
@@ -168,12 +171,30 @@ const CameraEntry& ChooseCamera(const std::vector<CameraEntry>& cameras, const s
                            "' (cameras: " + names + ")");
 }
 
-}  // namespace
+std::string Extension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
+}
 
-CameraFile LoadCameraFile(const std::string& path, const std::string& camera_name) {
-  if (!std::filesystem::is_regular_file(path)) {
-    throw std::runtime_error("camera file '" + path + "' does not exist or is not a file");
+CameraFile LoadYamlCameraFile(const std::string& path, const std::string& camera_name) {
+  const YamlCamera read = ReadYamlCamera(path);
+  if (!camera_name.empty() && camera_name != read.name) {
+    throw std::runtime_error(
+        "camera file '" + path + "' holds " +
+        (read.ros ? "the camera '" + read.name + "'" : "one camera, without a name") + ", not '" +
+        camera_name + "' (a camera's name picks one of a ViSP camera XML's cameras)");
   }
+  CameraFile result;
+  result.camera = read.lens;
+  result.name = read.name;
+  result.width = read.width;
+  result.height = read.height;
+  result.format = read.ros ? CameraFileFormat::kRosCameraInfo : CameraFileFormat::kOpenCvYaml;
+  return result;
+}
+
+CameraFile LoadViSPCameraFile(const std::string& path, const std::string& camera_name) {
   const std::vector<CameraEntry> cameras = ListCameras(path);
   const CameraEntry& entry = ChooseCamera(cameras, path, camera_name);
   const std::string label = "camera '" + entry.name + "' in '" + path + "'";
@@ -207,11 +228,15 @@ CameraFile LoadCameraFile(const std::string& path, const std::string& camera_nam
   result.name = entry.name;
   result.width = entry.width;
   result.height = entry.height;
+  result.format = CameraFileFormat::kViSPXml;
   return result;
 }
 
-void SaveCameraFile(const std::string& path, const Lens& camera, const std::string& name,
-                    unsigned int width, unsigned int height) {
+void SaveViSPCameraFile(const std::string& path, const vpCameraParameters& camera,
+                        const std::string& name, unsigned int width, unsigned int height,
+                        const std::vector<std::string>& comments) {
+  std::string info;
+  for (const std::string& comment : comments) info += (info.empty() ? "" : " ") + comment;
   // vpXmlParserCamera::save adds to an existing file, so it writes a fresh temporary file
   // that then replaces `path`.
   const std::filesystem::path temp = TempPathFor(path);
@@ -220,8 +245,7 @@ void SaveCameraFile(const std::string& path, const Lens& camera, const std::stri
   {
     MuteStandardStreams mute;
     vpXmlParserCamera parser;
-    status = parser.save(camera.ViSPCamera(static_cast<int>(width), static_cast<int>(height)),
-                         temp.string(), name, width, height);
+    status = parser.save(camera, temp.string(), name, width, height, info);
   }
   std::error_code error;
   if (status == vpXmlParserCamera::SEQUENCE_OK && std::filesystem::is_regular_file(temp)) {
@@ -231,6 +255,94 @@ void SaveCameraFile(const std::string& path, const Lens& camera, const std::stri
   RemoveQuietly(temp);
   throw std::runtime_error("cannot write camera file '" + path + "'" +
                            (error ? ": " + error.message() : std::string()));
+}
+
+// The image size a file's approximation is fitted over: the file's, else the one the
+// principal point centres.
+std::pair<int, int> ApproximationSize(const Lens& lens, unsigned int width, unsigned int height) {
+  if (width > 0 && height > 0) return {static_cast<int>(width), static_cast<int>(height)};
+  return {static_cast<int>(std::lround(2.0 * lens.u0() + 1.0)),
+          static_cast<int>(std::lround(2.0 * lens.v0() + 1.0))};
+}
+
+std::string ApproximationNote(const Lens& lens, const Lens& written, int width, int height,
+                              const std::string& what) {
+  return what + " is the best approximation of the " + LensModelName(lens) + " lens over the " +
+         std::to_string(width) + " x " + std::to_string(height) + " image: it misses it by up to " +
+         Fixed(WorstIdealPixelDifference(lens, written, width, height), 2) + " px";
+}
+
+}  // namespace
+
+std::string CameraFileFormatName(CameraFileFormat format) {
+  switch (format) {
+    case CameraFileFormat::kViSPXml:
+      return "ViSP's camera XML";
+    case CameraFileFormat::kOpenCvYaml:
+      return "OpenCV's calibration YAML";
+    case CameraFileFormat::kRosCameraInfo:
+      return "ROS's camera_info YAML";
+  }
+  return "";
+}
+
+CameraFileFormat CameraFileFormatFor(const std::string& path, bool ros) {
+  const std::string extension = Extension(path);
+  if (extension == ".xml" && !ros) return CameraFileFormat::kViSPXml;
+  if (extension == ".yaml" || extension == ".yml") {
+    return ros ? CameraFileFormat::kRosCameraInfo : CameraFileFormat::kOpenCvYaml;
+  }
+  throw std::invalid_argument(
+      "camera file '" + path + "': " +
+      (ros ? std::string("ROS's camera_info is a .yaml or .yml file")
+           : "the extension names the format: .xml (ViSP's camera XML) or .yaml / .yml "
+             "(OpenCV's calibration YAML; ROS's camera_info when asked for)"));
+}
+
+CameraFile LoadCameraFile(const std::string& path, const std::string& camera_name) {
+  if (!std::filesystem::is_regular_file(path)) {
+    throw std::runtime_error("camera file '" + path + "' does not exist or is not a file");
+  }
+  const std::string extension = Extension(path);
+  if (extension == ".yaml" || extension == ".yml") return LoadYamlCameraFile(path, camera_name);
+  if (extension == ".xml") return LoadViSPCameraFile(path, camera_name);
+  throw std::runtime_error("camera file '" + path +
+                           "': the extension names the format: .xml (ViSP's camera XML), "
+                           ".yaml or .yml (OpenCV's calibration YAML or ROS's camera_info)");
+}
+
+std::optional<std::string> SaveCameraFile(const std::string& path, const Lens& camera,
+                                          const std::string& name, unsigned int width,
+                                          unsigned int height, CameraFileFormat format,
+                                          const std::vector<std::string>& comments) {
+  const auto [fit_width, fit_height] = ApproximationSize(camera, width, height);
+  std::optional<std::string> note;
+  if (format == CameraFileFormat::kViSPXml) {
+    const vpCameraParameters visp = camera.ViSPCamera(fit_width, fit_height);
+    if (camera.IsViSPApproximation()) {
+      note = ApproximationNote(camera, visp, fit_width, fit_height,
+                               "ViSP's camera XML holds one radial term each way: its kud, kdu");
+    }
+    SaveViSPCameraFile(path, visp, name, width, height, comments);
+    return note;
+  }
+  const Lens opencv = camera.OpenCvCamera(fit_width, fit_height);
+  if (camera.IsOpenCvApproximation()) {
+    note = ApproximationNote(camera, opencv, fit_width, fit_height,
+                             "the file's OpenCV model (k1, k2, k3 for ViSP's kdu)");
+  }
+  AtomicFile file(path);
+  file.stream() << (format == CameraFileFormat::kRosCameraInfo
+                        ? RosCameraInfoText(opencv, name, width, height, comments)
+                        : OpenCvYamlText(opencv, width, height, comments));
+  file.Commit();
+  return note;
+}
+
+std::optional<std::string> SaveCameraFile(const std::string& path, const Lens& camera,
+                                          const std::string& name, unsigned int width,
+                                          unsigned int height) {
+  return SaveCameraFile(path, camera, name, width, height, CameraFileFormatFor(path, false), {});
 }
 
 std::optional<std::string> CameraSizeMismatch(const CameraFile& camera, int width, int height,

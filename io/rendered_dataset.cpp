@@ -61,8 +61,19 @@ Json OccluderJson(const Occluder& occluder) {
 }  // namespace
 
 void SaveDatasetCamera(const fs::path& dir, const RenderOptions& render, const std::string& name) {
-  SaveCameraFile((dir / "camera.xml").string(), render.camera, name,
+  SaveCameraFile((dir / DatasetCameraName(render.camera)).string(), render.camera, name,
                  static_cast<unsigned int>(render.width), static_cast<unsigned int>(render.height));
+}
+
+std::string DatasetCameraName(const Lens& lens) {
+  return lens.model() == Lens::Model::kOpenCV ? "camera.yaml" : "camera.xml";
+}
+
+std::optional<fs::path> FindDatasetCamera(const fs::path& dir) {
+  for (const char* name : {"camera.xml", "camera.yaml"}) {
+    if (fs::is_regular_file(dir / name)) return dir / name;
+  }
+  return std::nullopt;
 }
 
 std::string DatasetFrameName(int index, const char* extension) {
@@ -73,7 +84,10 @@ std::string DatasetFrameName(int index, const char* extension) {
 
 bool IsDatasetFile(const fs::path& file) {
   const std::string name = file.filename().string();
-  if (name == "camera.xml" || name == "sequence.json" || name == "target.yaml") return true;
+  if (name == "camera.xml" || name == "camera.yaml" || name == "sequence.json" ||
+      name == "target.yaml") {
+    return true;
+  }
   const std::string stem = file.stem().string();
   const std::string extension = file.extension().string();
   return (extension == ".png" || extension == ".json") && stem.size() > 6 &&
@@ -130,7 +144,10 @@ void StagedDataset::Commit() {
     }
     auto rank = [](const fs::path& file) {
       const std::string name = file.filename().string();
-      return std::make_pair(name == "sequence.json" ? 2 : name == "camera.xml" ? 1 : 0, name);
+      return std::make_pair(name == "sequence.json"                           ? 2
+                            : (name == "camera.xml" || name == "camera.yaml") ? 1
+                                                                              : 0,
+                            name);
     };
     std::sort(files.begin(), files.end(),
               [&](const fs::path& a, const fs::path& b) { return rank(a) < rank(b); });

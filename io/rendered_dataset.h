@@ -3,7 +3,8 @@
 //
 //   DIR/frame_0000.png    8-bit grey frame
 //   DIR/frame_0000.json   ground truth (truth_file.h, FrameTruthJson)
-//   DIR/camera.xml        the ViSP camera file of the frames
+//   DIR/camera.xml        the camera file of the frames: ViSP's XML for a pinhole or ViSP's
+//   or camera.yaml        lens, OpenCV's calibration YAML for a lens in OpenCV's model
 //   DIR/sequence.json     a sequence's summary, written last: its presence means complete
 //
 // written all or nothing: into a temporary sibling folder, moved into DIR at the end.
@@ -11,6 +12,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +27,16 @@ namespace oal {
 std::string DatasetFrameName(int index, const char* extension);
 
 /// Whether `file` is one of the files a data set's writer owns: frame_NNNN.png,
-/// frame_NNNN.json, camera.xml, target.yaml or sequence.json.
+/// frame_NNNN.json, camera.xml, camera.yaml, target.yaml or sequence.json.
 bool IsDatasetFile(const std::filesystem::path& file);
+
+/// The name of a data set's camera file for `lens`: "camera.yaml" (OpenCV's calibration
+/// YAML) for a lens in OpenCV's model, which ViSP's XML cannot hold, else "camera.xml".
+std::string DatasetCameraName(const Lens& lens);
+
+/// The camera file of the data set in `dir`: camera.xml or camera.yaml, whichever it has
+/// (camera.xml when both); none when it has neither.
+std::optional<std::filesystem::path> FindDatasetCamera(const std::filesystem::path& dir);
 
 /// A data set's folder written all or nothing. The files go to a temporary sibling folder
 /// `<DIR>.tmp-<pid>`, which Commit() moves into place (one rename when DIR does not exist;
@@ -70,7 +80,7 @@ class StagedDataset {
 /// those of a lived-in scene when it has them (plane occluders, glares, motion blur, JPEG).
 Json EffectsJson(const FrameEffects& effects);
 
-/// Writes `dir`/camera.xml: `render`'s camera and image size, the camera named `name`.
+/// Writes `dir`/DatasetCameraName(): `render`'s camera and image size, the camera named `name`.
 void SaveDatasetCamera(const std::filesystem::path& dir, const RenderOptions& render,
                        const std::string& name);
 

@@ -355,8 +355,7 @@ TEST(Compare, APatternWithAGapIsWarnedAbout) {
 
 TEST(Compare, CameraForAnotherImageSizeIsWarnedAbout) {
   test::TestDir dir;
-  Lens camera;
-  camera = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
+  Lens camera = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   SaveCameraFile(dir / "camera.xml", camera, "cam", 640, 480);
   CompareOptions options;
   options.input = WriteEdgeImages(dir / "images", 2, 64, 48);

@@ -500,8 +500,7 @@ using ::testing::HasSubstr;
 // (relative to the config's folder) instead of the inline keys.
 TEST(ConfigCameraFile, TheFileGivesTheIntrinsicsAndTheImageSize) {
   const test::TestDir dir;
-  Lens lens;
-  lens = Lens::WithKudKdu(812.5, 810.25, 331.0, 244.5, -0.12, 0.13);
+  Lens lens = Lens::WithKudKdu(812.5, 810.25, 331.0, 244.5, -0.12, 0.13);
   SaveCameraFile(dir / "lens.xml", lens, "Wide", 800, 600);
   const AppConfig config =
       ParseConfig("camera:\n  file: lens.xml\n  name: Wide\n  noise: 1.5\n", dir / "servo.yaml");
@@ -518,8 +517,7 @@ TEST(ConfigCameraFile, TheFileGivesTheIntrinsicsAndTheImageSize) {
 
 TEST(ConfigCameraFile, ConflictsAndMissingFilesNameTheLine) {
   const test::TestDir dir;
-  Lens lens;
-  lens = Lens::Pinhole(600, 600, 159.5, 119.5);
+  Lens lens = Lens::Pinhole(600, 600, 159.5, 119.5);
   SaveCameraFile(dir / "lens.xml", lens, "Camera", 320, 240);
   const std::string yaml = dir / "servo.yaml";
   EXPECT_THAT(test::ConfigErrorOf("camera:\n  file: lens.xml\n  px: 700\n", yaml),

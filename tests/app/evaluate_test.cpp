@@ -434,9 +434,8 @@ TEST(Evaluate, ACameraFileThatMissesTheLensIsSaid) {
   render.target = "four-line-a3";
   render.kdu = 0.2;
   const std::string frames = test::RenderChecked(render);
-  Lens pinhole;
-  pinhole = Lens::Pinhole(render.fx_px, render.fx_px, 0.5 * (render.width - 1),
-                          0.5 * (render.height - 1));
+  Lens pinhole = Lens::Pinhole(render.fx_px, render.fx_px, 0.5 * (render.width - 1),
+                               0.5 * (render.height - 1));
   SaveCameraFile(dir / "pinhole.xml", pinhole, "Camera", render.width, render.height);
   for (const bool right : {true, false}) {
     EvaluateOptions options = Options({frames}, dir / (right ? "right" : "wrong"));

@@ -352,8 +352,7 @@ TEST(PoseCommand, EstimatesTheLensFromTheStripesAndUsesIt) {
   render.target = "four-line-a3";
   render.kdu = 0.15;
   test::RenderChecked(render);
-  Lens pinhole;
-  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   SaveCameraFile(dir / "pinhole.xml", pinhole, "Camera", 640, 480);
   PoseCommandOptions options;
   options.inputs = {dir / "data"};

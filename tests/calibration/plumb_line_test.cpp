@@ -140,8 +140,7 @@ TEST(PlumbLine, TheSheetsStripesTellTheLensInTenFrames) {
     DressAsBench(&render, scene);
     const SceneRenderer renderer(FourLineA3Target(), render);
     const PoseSampling sampling = SheetSampling(renderer.target());
-    Lens pinhole;
-    pinhole = Lens::Pinhole(kPx, kPx, kU0, kV0);
+    Lens pinhole = Lens::Pinhole(kPx, kPx, kU0, kV0);
     PoseOptions pose;
     pose.camera = pinhole;
     pose.image_width = 640;

@@ -104,8 +104,7 @@ TEST(CharucoMethod, PosesARenderedA3SheetWithinOnePercentAndOneDegree) {
 // checked in scene_tests).
 TEST(AprilTagMethod, TheTagsCornersAreFoundAtTheirProjectedPlanePoints) {
   const LineTarget sheet = FourLineA3Target();
-  Lens pinhole;
-  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   const std::unique_ptr<MarkerMethod> method = MakeAprilTagMethod(sheet, pinhole, 640, 480);
   const double h = 0.5 * AprilTagBlackSide(sheet);
   EXPECT_NEAR(2.0 * h, 0.25, 0.001) << "A3: the largest tag with a white border";
@@ -131,8 +130,7 @@ TEST(AprilTagMethod, TheTagsCornersAreFoundAtTheirProjectedPlanePoints) {
 // camera matrix whose principal point is moved by as much).
 TEST(CharucoMethod, TheBoardsCornersAreFoundAtTheirProjectedPlanePoints) {
   const LineTarget sheet = FourLineA3Target();
-  Lens pinhole;
-  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
+  Lens pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
   const std::unique_ptr<MarkerMethod> method = MakeCharucoMethod(sheet, pinhole, 640, 480);
   const double square = CharucoSquareSide(sheet);
   const auto dictionary = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100);
@@ -188,15 +186,13 @@ TEST(OpenCvDistortion, OpenCvsK1IsViSPsKud) {
     EXPECT_NEAR(projected[i].x, u, 1e-9);
     EXPECT_NEAR(projected[i].y, v, 1e-9);
   }
-  Lens pinhole;
-  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
-  EXPECT_EQ(KudAsOpenCvDistortion(pinhole)(0), 0.0);
+  EXPECT_EQ(KudAsOpenCvDistortion(Lens::Pinhole(600.0, 600.0, 319.5, 239.5))(0), 0.0);
 }
 
 // The worst distance over the image between where the rendered (kdu) lens puts the ideal point
 // of each pixel and where OpenCV's model with `distortion` puts it.
 double WorstPixelMiss(const Lens& camera, int width, int height,
-                      const cv::Matx<double, 1, 5>& distortion) {
+                      const std::vector<double>& distortion) {
   std::vector<cv::Point3d> rays;
   std::vector<cv::Point2d> pixels;
   for (int v = 0; v < height; v += 8) {
@@ -227,16 +223,22 @@ TEST(OpenCvDistortion, TheFittedCoefficientsFollowTheRenderedLens) {
   for (const auto& c : cases) {
     const Lens camera = Lens::WithKdu(c.focal_px, c.focal_px, 0.5 * (c.width - 1),
                                       0.5 * (c.height - 1), 0.15, c.width, c.height);
-    const cv::Matx<double, 1, 5> fitted = KduAsOpenCvDistortion(camera, c.width, c.height);
-    EXPECT_EQ(fitted(2), 0.0);
-    EXPECT_EQ(fitted(3), 0.0);
+    const std::vector<double> fitted = OpenCvDistortion(camera, c.width, c.height);
+    ASSERT_EQ(fitted.size(), 5u);
+    EXPECT_EQ(fitted[2], 0.0);
+    EXPECT_EQ(fitted[3], 0.0);
     EXPECT_LT(WorstPixelMiss(camera, c.width, c.height, fitted), c.fitted_px) << c.width;
-    EXPECT_GT(WorstPixelMiss(camera, c.width, c.height, KudAsOpenCvDistortion(camera)), c.kud_px)
+    const cv::Matx<double, 1, 5> kud = KudAsOpenCvDistortion(camera);
+    EXPECT_GT(WorstPixelMiss(camera, c.width, c.height, std::vector<double>(kud.val, kud.val + 5)),
+              c.kud_px)
         << c.width;
   }
-  Lens pinhole;
-  pinhole = Lens::Pinhole(600.0, 600.0, 319.5, 239.5);
-  EXPECT_EQ(KduAsOpenCvDistortion(pinhole, 640, 480), (cv::Matx<double, 1, 5>::zeros()));
+  EXPECT_EQ(OpenCvDistortion(Lens::Pinhole(600.0, 600.0, 319.5, 239.5), 640, 480),
+            std::vector<double>(5, 0.0));
+  // A lens in OpenCV's model goes as it is.
+  const Distortion d{-0.27, -0.04, 0.0018, -0.0003, 0.24};
+  EXPECT_EQ(OpenCvDistortion(Lens::WithDistortion(536.0, 536.0, 342.3, 235.6, d), 640, 480),
+            std::vector<double>({d.k1, d.k2, d.p1, d.p2, d.k3}));
 }
 
 // The sizes: the ChArUco squares 0.038 m on A3, in proportion on A4; the tag in proportion too.

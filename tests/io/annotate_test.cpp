@@ -26,8 +26,7 @@ TEST(LineInFrame, StraightWithoutCameraFromBorderToBorder) {
 
 // Curved runs, once undistorted, lie on the undistorted line, and span the frame.
 TEST(LineInFrame, CurvedWithDistortionAndOnTheLineOnceUndistorted) {
-  Lens camera;
-  camera = Lens::WithKudKdu(150.0, 150.0, 79.5, 59.5, -0.2, 0.3);
+  Lens camera = Lens::WithKudKdu(150.0, 150.0, 79.5, 59.5, -0.2, 0.3);
   const PointUndistorter undistorter(camera);
   // The undistorted image of a line through two distorted pixels near the top edge.
   const Point2d a = undistorter.Undistort({5.0, 10.0}), b = undistorter.Undistort({155.0, 15.0});
