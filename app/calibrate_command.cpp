@@ -54,12 +54,51 @@ void PrintReport(const CalibrationResult& result, const std::string& points) {
             << Fixed(camera.u0(), 2) << " +- " << Fixed(result.u0_sd, 2) << ", v0 "
             << Fixed(camera.v0(), 2) << " +- " << Fixed(result.v0_sd, 2) << " px\n";
   if (camera.distorted()) {
-    std::cout << "kud " << Fixed(camera.kud(), 5) << ", kdu " << Fixed(camera.kdu(), 5)
-              << " (OpenCV's k1 " << Fixed(result.lens.k1, 5) << " +- " << Fixed(result.k1_sd, 5)
-              << ", k2 " << Fixed(result.lens.k2, 5) << ")\n";
+    const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
+    const auto values = camera.distortion().ToArray(), sds = result.distortion_sd.ToArray();
+    std::string line;
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (values[i] == 0.0 && sds[i] == 0.0) continue;
+      line += (line.empty() ? "" : ", ") + std::string(names[i]) + " " + Fixed(values[i], 5) +
+              " +- " + Fixed(sds[i], 5);
+    }
+    std::cout << LensModelName(camera) << ": " << line << '\n';
+    for (const std::string& fixed : result.fixed_terms) std::cout << fixed << '\n';
   }
-  std::cout << "reprojection RMS " << Fixed(result.rms_px, 3) << " px\n";
+  std::cout << "reprojection RMS " << Fixed(result.rms_px, 3) << " px";
+  if (camera.distorted()) {
+    std::cout << " (ViSP's one-term approximation, kud/kdu: " << Fixed(result.visp_rms_px, 3)
+              << " px)";
+  }
+  std::cout << '\n';
   for (const std::string& advice : result.advice) Warn("calibrate", advice);
+}
+
+// What the camera file says of the calibration: each parameter's standard deviation, the
+// terms fixed at zero, the RMS of the model the file holds.
+std::vector<std::string> FileComments(const CalibrationResult& result, CameraFileFormat format) {
+  const Lens& camera = result.camera;
+  std::vector<std::string> comments = {
+      "oalservo calibrate: " + LensModelName(camera) + " lens",
+      "standard deviations: px " + Fixed(result.px_sd, 3) + ", py " + Fixed(result.py_sd, 3) +
+          ", u0 " + Fixed(result.u0_sd, 3) + ", v0 " + Fixed(result.v0_sd, 3) + " px"};
+  if (camera.distorted()) {
+    const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
+    const auto values = camera.distortion().ToArray(), sds = result.distortion_sd.ToArray();
+    std::string line;
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (values[i] == 0.0 && sds[i] == 0.0) continue;
+      line += (line.empty() ? "" : ", ") + std::string(names[i]) + " " + Fixed(sds[i], 6);
+    }
+    comments.back() += "; " + line;
+    for (const std::string& fixed : result.fixed_terms) comments.push_back(fixed);
+  }
+  comments.push_back(format == CameraFileFormat::kViSPXml && camera.distorted()
+                         ? "reprojection RMS of this file's one-term model " +
+                               Fixed(result.visp_rms_px, 3) + " px (the full model's " +
+                               Fixed(result.rms_px, 3) + " px)"
+                         : "reprojection RMS " + Fixed(result.rms_px, 3) + " px");
+  return comments;
 }
 
 // Finds the calibration target in a frame: the chessboard or the line target.
@@ -162,16 +201,18 @@ std::vector<CalibrationView> CollectViews(const std::vector<std::string>& inputs
 int RunCalibrate(int argc, char** argv) {
   CLI::App cli{
       "Calibrates the camera from views of the printed line target (default: four-line-a3, as "
-      "`oalservo target` writes it) or of a printed chessboard: px, py, u0, v0 and ViSP's "
-      "radial distortion (kud, kdu), with each view's reprojection RMS and the parameters' "
-      "standard deviations, written as a ViSP camera file (camera.xml) that detect, pose, "
-      "evaluate and servo read.",
+      "`oalservo target` writes it) or of a printed chessboard: px, py, u0, v0 and the lens in "
+      "OpenCV's model (k1, k2, p1, p2, k3; a term the views cannot tell from zero is fixed at "
+      "zero, and said), with each view's reprojection RMS and each parameter's standard "
+      "deviation, written as OpenCV's calibration YAML (--out camera.yaml), ROS's camera_info "
+      "(--ros) or ViSP's camera XML (--out camera.xml: one radial term, the best approximation, "
+      "and how far it misses); detect, pose, evaluate and servo read all three.",
       "oalservo calibrate"};
   std::vector<std::string> inputs;
   std::string chessboard_text, out_path, name = "Camera", config_path;
   std::string target_name = FourLineA3Target().name;
   ChessboardOptions chessboard;
-  bool no_distortion = false, live = false;
+  bool no_distortion = false, live = false, rational = false, ros = false;
   int wanted_views = 20;
   cli.add_option("INPUT", inputs,
                  "images, directories of images, printf patterns, videos or a camera "
@@ -193,10 +234,17 @@ int RunCalibrate(int argc, char** argv) {
                      "board of 10 x 7 squares)");
   CLI::Option* square_option =
       cli.add_option("--square", chessboard.square_m, "side of a square as printed, metres");
-  cli.add_option("--out", out_path, "the ViSP camera file to write")->required();
+  cli.add_option("--out", out_path,
+                 "the camera file to write: .yaml or .yml (OpenCV's calibration YAML, the full "
+                 "model), .xml (ViSP's camera XML: one radial term)")
+      ->required();
+  cli.add_flag("--ros", ros, "write ROS's camera_info YAML instead of OpenCV's (--out a .yaml)");
+  cli.add_flag("--rational", rational,
+               "fit OpenCV's rational model too (k4, k5, k6), for lenses wider than ~100 deg");
   cli.add_option("--name", name, "the camera's name in the file")->capture_default_str();
-  cli.add_flag("--no-distortion", no_distortion,
-               "a distortion-free model (perspectiveProjWithoutDistortion)");
+  CLI::Option* no_distortion_option =
+      cli.add_flag("--no-distortion", no_distortion,
+                   "a distortion-free model (perspectiveProjWithoutDistortion)");
   CLI::Option* live_option = cli.add_flag(
       "--live", live,
       "take a view only when the target has held still for a few frames and stands apart "
@@ -206,14 +254,17 @@ int RunCalibrate(int argc, char** argv) {
       ->check(CLI::Range(3, 1000))
       ->capture_default_str()
       ->needs(live_option);
+  no_distortion_option->excludes("--rational");
   chessboard_option->excludes(target_option)->excludes(config_option)->needs(square_option);
   square_option->needs(chessboard_option);
   cli.footer(
       "Examples:\n"
-      "  oalservo calibrate shots/ --out camera.xml                    # the A3 sheet\n"
-      "  oalservo calibrate shots/ --target four-line-a4 --out camera.xml\n"
-      "  oalservo calibrate shots/ --chessboard 9x6 --square 0.025 --out camera.xml\n"
-      "  oalservo calibrate /dev/video0 --live --out camera.xml        # move, hold, move...\n"
+      "  oalservo calibrate shots/ --out camera.yaml                   # the A3 sheet\n"
+      "  oalservo calibrate shots/ --target four-line-a4 --out camera.yaml\n"
+      "  oalservo calibrate shots/ --chessboard 9x6 --square 0.025 --out camera.yaml\n"
+      "  oalservo calibrate shots/ --out head_camera.yaml --ros      # ROS's camera_info\n"
+      "  oalservo calibrate shots/ --out camera.xml   # ViSP's XML, for ViSP's own tools\n"
+      "  oalservo calibrate /dev/video0 --live --out camera.yaml     # move, hold, move...\n"
       "Print at 100 % and check the scale bar (or measure a square); lay the sheet flat. The "
       "line target needs its four crossings in view; the stripes' points, which must lie on "
       "straight lines, tell the lens. Views in which the target is not found are listed and "
@@ -239,6 +290,12 @@ int RunCalibrate(int argc, char** argv) {
 
   // The output before the work: a bad --out fails now, and the file appears only whole.
   const std::filesystem::path out(out_path);
+  CameraFileFormat format = CameraFileFormat::kOpenCvYaml;
+  try {
+    format = CameraFileFormatFor(out_path, ros);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(std::string("--out ") + (ros ? "with --ros: " : "") + error.what());
+  }
   PrepareOutputFile(out, "--out");
 
   ViewFinder finder(use_chessboard ? std::optional<ChessboardOptions>(chessboard) : std::nullopt,
@@ -257,6 +314,7 @@ int RunCalibrate(int argc, char** argv) {
   options.width = width;
   options.height = height;
   options.estimate_distortion = !no_distortion;
+  options.rational = rational;
   if (use_chessboard) options.min_points_per_view = chessboard.columns * chessboard.rows;
   std::vector<CalibrationView> found;
   for (CalibrationView& view : views) {
@@ -279,10 +337,17 @@ int RunCalibrate(int argc, char** argv) {
     throw std::runtime_error(std::string(error.what()) + "\nnothing written to " + out_path);
   }
   PrintReport(result, use_chessboard ? "corners" : "stripe points");
-  SaveCameraFile(out_path, result.camera, name, static_cast<unsigned>(width),
-                 static_cast<unsigned>(height));
-  std::cout << "wrote " << out_path << " (camera '" << name << "', " << width << "x" << height
-            << ", " << found.size() << " of " << views.size() << " views)\n";
+  const std::optional<std::string> note =
+      SaveCameraFile(out_path, result.camera, name, static_cast<unsigned>(width),
+                     static_cast<unsigned>(height), format, FileComments(result, format));
+  std::cout << "wrote " << out_path << " (" << CameraFileFormatName(format) << ", camera '" << name
+            << "', " << width << "x" << height << ", " << found.size() << " of " << views.size()
+            << " views)\n";
+  if (note) {
+    Warn("calibrate", *note + "; reprojection RMS " + Fixed(result.visp_rms_px, 3) +
+                          " px against the full model's " + Fixed(result.rms_px, 3) +
+                          " px. For the full model write --out camera.yaml");
+  }
   return kExitOk;
 }
 

@@ -1,6 +1,7 @@
 #include "calibration/calibrate.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -26,6 +27,23 @@ constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 constexpr double kLooseFocalFraction = 0.003;
 constexpr double kLoosePrincipalPx = 1.5;
 constexpr double kLooseK1 = 0.01;
+// Views whose points reach less than this fraction of the way to the image's corners leave the
+// lens there extrapolated.
+constexpr double kCoveredFraction = 0.8;
+// k3 is fitted only when the views reach this fraction of the way to the image's corners.
+constexpr double kK3Reach = 0.6;
+
+// The largest distorted normalised radius of the views' points.
+double Reach(const std::vector<std::vector<cv::Point2f>>& image_points, const cv::Mat& k) {
+  double reach2 = 0.0;
+  for (const std::vector<cv::Point2f>& view : image_points) {
+    for (const cv::Point2f& p : view) {
+      reach2 = std::max(reach2, std::pow((p.x - k.at<double>(0, 2)) / k.at<double>(0, 0), 2) +
+                                    std::pow((p.y - k.at<double>(1, 2)) / k.at<double>(1, 1), 2));
+    }
+  }
+  return std::sqrt(reach2);
+}
 
 // Points on lines are paired with plane points again after each solve until none moves by
 // more than this (metres), or this many solves.
@@ -201,38 +219,9 @@ void CalibrationOptions::Check() const {
   RequireOption(min_tilted_views >= 0 && min_tilted_views <= 1000,
                 "CalibrationOptions::min_tilted_views", min_tilted_views,
                 "0 <= min_tilted_views <= 1000");
-}
-
-RadialFit FitViSPDistortion(const RadialDistortion& lens, double px, double py, double u0,
-                            double v0, int width, int height, double max_radius) {
-  // On a 32 x 32 grid of distorted pixels over the image: the ideal point x_u of each
-  // distorted one x_d (inverting x_d = x_u f(r_u^2) by fixed-point iteration), then each
-  // coefficient by linear least squares: kdu from x_u = x_d (1 + kdu r_d^2), kud from
-  // x_d = x_u (1 + kud r_u^2).
-  double kdu_num = 0.0, kdu_den = 0.0, kud_num = 0.0, kud_den = 0.0;
-  constexpr int kGrid = 32;
-  for (int j = 0; j <= kGrid; ++j) {
-    for (int i = 0; i <= kGrid; ++i) {
-      const double xd = ((width - 1.0) * i / kGrid - u0) / px;
-      const double yd = ((height - 1.0) * j / kGrid - v0) / py;
-      if (xd * xd + yd * yd > max_radius * max_radius) continue;
-      double xu = xd, yu = yd;
-      for (int iteration = 0; iteration < 100; ++iteration) {
-        const double r2 = xu * xu + yu * yu;
-        const double factor = 1.0 + r2 * (lens.k1 + r2 * (lens.k2 + r2 * lens.k3));
-        if (!(std::fabs(factor) > 1e-6)) break;
-        xu = xd / factor;
-        yu = yd / factor;
-      }
-      const double rd2 = xd * xd + yd * yd, ru2 = xu * xu + yu * yu;
-      kdu_num += xd * rd2 * (xu - xd) + yd * rd2 * (yu - yd);
-      kdu_den += (xd * rd2) * (xd * rd2) + (yd * rd2) * (yd * rd2);
-      kud_num += xu * ru2 * (xd - xu) + yu * ru2 * (yd - yu);
-      kud_den += (xu * ru2) * (xu * ru2) + (yu * ru2) * (yu * ru2);
-    }
-  }
-  return RadialFit{kud_den > 0.0 ? kud_num / kud_den : 0.0,
-                   kdu_den > 0.0 ? kdu_num / kdu_den : 0.0};
+  RequireOption(min_term_significance >= 0.0 && min_term_significance <= 10.0,
+                "CalibrationOptions::min_term_significance", min_term_significance,
+                "0 <= min_term_significance <= 10");
 }
 
 CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
@@ -267,15 +256,19 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   }
   RequireEnoughViews(result, used.size(), options.min_views);
 
-  // Two radial terms: enough to follow a lens that ViSP's one-term model in either direction
-  // describes (the inverse of one term is a series), so that px, py, u0, v0 are not bent to
-  // absorb what one term misses; a third follows the noise where the views have few points.
-  int flags = cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3;
-  if (!options.estimate_distortion) flags |= cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2;
-  cv::Mat camera_matrix, distortion = cv::Mat::zeros(5, 1, CV_64F), sd_intrinsics, sd_extrinsics,
-                         view_errors;
+  // OpenCV's model, k1, k2, p1, p2, k3 (and k4-k6 when asked), every term the views determine:
+  // a term whose value is within min_term_significance standard deviations of zero is fixed
+  // at zero and the camera solved again (a term the views cannot tell follows their noise, and
+  // bends px, u0 to absorb it). k3 (and the rational terms) first, then p1 and p2 together.
+  int flags = options.rational ? cv::CALIB_RATIONAL_MODEL : 0;
+  if (!options.estimate_distortion) {
+    flags |= cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST;
+  }
+  cv::Mat camera_matrix, distortion = cv::Mat::zeros(options.rational ? 8 : 5, 1, CV_64F),
+                         sd_intrinsics, sd_extrinsics, view_errors;
   std::vector<cv::Mat> rvecs, tvecs;
   std::vector<std::vector<cv::Point2f>> image_points;
+  std::vector<std::vector<cv::Point3f>> object_points;
   const cv::TermCriteria stop(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12);
   const bool any_lines =
       std::any_of(used_views.begin(), used_views.end(),
@@ -285,65 +278,117 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   // outliers, their pairing) remains.
   std::vector<LinePairing> first_pairings(views.size());  // by index in `views`
   for (std::size_t i = 0; i < used.size(); ++i) first_pairings[used[i]] = pairings[i];
-  for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
-    // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
-    // not flat or printed stretched) is left out: the outlier cut has left it too few points,
-    // or its points fit far worse than the other views'.
-    bool left_out = false;
-    for (std::size_t i = used_views.size(); i-- > 0;) {
-      const std::size_t points = used_views[i]->points.size() + pairings[i].kept();
-      std::string& rejected = result.views[used[i]].rejected;
-      if (rejected.empty() && static_cast<int>(points) >= options.min_points_per_view) continue;
-      if (rejected.empty()) {
-        rejected = "its points disagree with the other views' (" + std::to_string(points) + " of " +
-                   std::to_string(result.views[used[i]].points) + " kept)";
+  const auto solve = [&](int solve_flags, bool from_previous) {
+    for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
+      // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
+      // not flat or printed stretched) is left out: the outlier cut has left it too few
+      // points, or its points fit far worse than the other views'.
+      bool left_out = false;
+      for (std::size_t i = used_views.size(); i-- > 0;) {
+        const std::size_t points = used_views[i]->points.size() + pairings[i].kept();
+        std::string& rejected = result.views[used[i]].rejected;
+        if (rejected.empty() && static_cast<int>(points) >= options.min_points_per_view) continue;
+        if (rejected.empty()) {
+          rejected = "its points disagree with the other views' (" + std::to_string(points) +
+                     " of " + std::to_string(result.views[used[i]].points) + " kept)";
+        }
+        used_views.erase(used_views.begin() + static_cast<std::ptrdiff_t>(i));
+        used.erase(used.begin() + static_cast<std::ptrdiff_t>(i));
+        left_out = true;
       }
-      used_views.erase(used_views.begin() + static_cast<std::ptrdiff_t>(i));
-      used.erase(used.begin() + static_cast<std::ptrdiff_t>(i));
-      left_out = true;
-    }
-    RequireEnoughViews(result, used.size(), options.min_views);
-    if (left_out) {
-      pairings.clear();
-      for (const std::size_t k : used) pairings.push_back(first_pairings[k]);
-      pairing_round = 0;
-    }
-    std::vector<std::vector<cv::Point3f>> object_points;
-    image_points.clear();
-    for (std::size_t i = 0; i < used_views.size(); ++i) {
-      std::vector<cv::Point3f>& object = object_points.emplace_back();
-      std::vector<cv::Point2f>& image = image_points.emplace_back();
-      for (const CalibrationPoint& point : used_views[i]->points) {
-        object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
-        image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
+      RequireEnoughViews(result, used.size(), options.min_views);
+      if (left_out) {
+        pairings.clear();
+        for (const std::size_t k : used) pairings.push_back(first_pairings[k]);
+        pairing_round = 0;
       }
-      for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
-        if (pairings[i].outlier[k]) continue;
-        object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
-                            static_cast<float>(pairings[i].paired[k].y), 0.0f);
-        image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
-                           static_cast<float>(pairings[i].seen[k].y));
+      object_points.clear();
+      image_points.clear();
+      for (std::size_t i = 0; i < used_views.size(); ++i) {
+        std::vector<cv::Point3f>& object = object_points.emplace_back();
+        std::vector<cv::Point2f>& image = image_points.emplace_back();
+        for (const CalibrationPoint& point : used_views[i]->points) {
+          object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
+          image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
+        }
+        for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
+          if (pairings[i].outlier[k]) continue;
+          object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
+                              static_cast<float>(pairings[i].paired[k].y), 0.0f);
+          image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
+                             static_cast<float>(pairings[i].seen[k].y));
+        }
       }
+      const bool guess = pairing_round > 0 || from_previous;
+      result.rms_px = cv::calibrateCamera(
+          object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
+          distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors,
+          guess ? solve_flags | cv::CALIB_USE_INTRINSIC_GUESS : solve_flags, stop);
+      double moved = 0.0;
+      for (std::size_t i = 0; i < used_views.size() && any_lines; ++i) {
+        moved = std::max(moved, PairThroughCamera(*used_views[i], camera_matrix, distortion,
+                                                  rvecs[i], tvecs[i], &pairings[i]));
+      }
+      // Only once the pairing has nearly settled are the views and points that fit badly
+      // outliers: before, the lens is not yet right, and the points it bends most, near the
+      // image's edges, would go first and bias k1 low. A view that disagrees as a whole goes
+      // first, before the point cut could whittle it down to its points that happen to fit.
+      if (moved >= kOutliersAfterM && pairing_round < kOutliersByRound) continue;
+      if (MarkDisagreeingView(view_errors, used, &result)) continue;
+      const int changed =
+          any_lines ? MarkOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
+                    : 0;
+      if (moved < kPairingSettledM && changed == 0) break;
     }
-    result.rms_px = cv::calibrateCamera(
-        object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
-        distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors,
-        pairing_round == 0 ? flags : flags | cv::CALIB_USE_INTRINSIC_GUESS, stop);
-    double moved = 0.0;
-    for (std::size_t i = 0; i < used_views.size() && any_lines; ++i) {
-      moved = std::max(moved, PairThroughCamera(*used_views[i], camera_matrix, distortion, rvecs[i],
-                                                tvecs[i], &pairings[i]));
+  };
+  solve(flags, false);
+  if (options.estimate_distortion) {
+    // (indices in OpenCV's order of the intrinsics' deviations: fx, fy, cx, cy, k1, k2, p1,
+    // p2, k3, k4, k5, k6)
+    struct Group {
+      const char* names;
+      std::vector<int> terms;  // in the distortion vector
+      int fix;
+    };
+    std::vector<Group> groups;
+    if (options.rational) {
+      groups.push_back(
+          {"k4, k5, k6", {5, 6, 7}, cv::CALIB_FIX_K4 | cv::CALIB_FIX_K5 | cv::CALIB_FIX_K6});
     }
-    // Only once the pairing has nearly settled are the views and points that fit badly
-    // outliers: before, the lens is not yet right, and the points it bends most, near the
-    // image's edges, would go first and bias kdu low. A view that disagrees as a whole goes
-    // first, before the point cut could whittle it down to its points that happen to fit.
-    if (moved >= kOutliersAfterM && pairing_round < kOutliersByRound) continue;
-    if (MarkDisagreeingView(view_errors, used, &result)) continue;
-    const int changed =
-        any_lines ? MarkOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
-                  : 0;
-    if (moved < kPairingSettledM && changed == 0) break;
+    groups.push_back({"p1, p2", {2, 3}, cv::CALIB_ZERO_TANGENT_DIST});
+    // k3 (r^6) is told from k2 only where the views reach well out: nearer the middle, the two
+    // trade against each other and k3 is fixed.
+    const double reach = Reach(image_points, camera_matrix);
+    const double corner = std::sqrt(
+        CornerRadius2(Lens::Pinhole(camera_matrix.at<double>(0, 0), camera_matrix.at<double>(1, 1),
+                                    camera_matrix.at<double>(0, 2), camera_matrix.at<double>(1, 2)),
+                      options.width, options.height));
+    if (reach < kK3Reach * corner) {
+      result.fixed_terms.push_back(
+          "k3 fixed at 0: the views reach " + Fixed(100.0 * reach / corner, 0) +
+          " % of the way to the image's corners, too little to tell r^6 from r^4 (" +
+          Fixed(100.0 * kK3Reach, 0) + " % needed)");
+      flags |= cv::CALIB_FIX_K3;
+      distortion.at<double>(4) = 0.0;
+      solve(flags, true);
+    }
+    for (const Group& group : groups) {
+      bool significant = false;
+      std::string values;
+      for (const int term : group.terms) {
+        const double value = distortion.at<double>(term), sd = sd_intrinsics.at<double>(4 + term);
+        significant |= std::fabs(value) > options.min_term_significance * sd;
+        values += (values.empty() ? "" : ", ") + Fixed(value, 5) + " +- " + Fixed(sd, 5);
+      }
+      if (significant) continue;
+      result.fixed_terms.push_back(
+          std::string(group.names) + " fixed at 0: the views do not tell " +
+          (group.terms.size() == 1 ? "it" : "them") + " from 0 (" + values + "; " +
+          Fixed(options.min_term_significance, 1) + " standard deviations needed)");
+      flags |= group.fix;
+      for (const int term : group.terms) distortion.at<double>(term) = 0.0;
+      solve(flags, true);
+    }
   }
 
   int tilted = 0;
@@ -367,27 +412,39 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
 
   const double px = camera_matrix.at<double>(0, 0), py = camera_matrix.at<double>(1, 1);
   const double u0 = camera_matrix.at<double>(0, 2), v0 = camera_matrix.at<double>(1, 2);
-  result.lens = RadialDistortion{distortion.at<double>(0), distortion.at<double>(1),
-                                 distortion.at<double>(4)};
-  if (options.estimate_distortion) {
-    // Over the part of the image the views cover: beyond it the lens is extrapolated.
-    double max_radius = 0.0;
-    for (const std::vector<cv::Point2f>& view : image_points) {
-      for (const cv::Point2f& p : view) {
-        max_radius = std::max(max_radius, std::hypot((p.x - u0) / px, (p.y - v0) / py));
-      }
-    }
-    const RadialFit visp =
-        FitViSPDistortion(result.lens, px, py, u0, v0, options.width, options.height, max_radius);
-    result.camera = Lens::WithKudKdu(px, py, u0, v0, visp.kud, visp.kdu);
-  } else {
-    result.camera = Lens::Pinhole(px, py, u0, v0);
+  std::array<double, 8> coefficients{}, deviations{};
+  for (int i = 0; i < distortion.rows * distortion.cols && i < 8; ++i) {
+    coefficients[static_cast<std::size_t>(i)] = distortion.at<double>(i);
+    deviations[static_cast<std::size_t>(i)] = sd_intrinsics.at<double>(4 + i);
   }
+  result.camera = Lens::WithDistortion(px, py, u0, v0, Distortion::FromArray(coefficients));
+  result.distortion_sd = Distortion::FromArray(deviations);
   result.px_sd = sd_intrinsics.at<double>(0);
   result.py_sd = sd_intrinsics.at<double>(1);
   result.u0_sd = sd_intrinsics.at<double>(2);
   result.v0_sd = sd_intrinsics.at<double>(3);
-  result.k1_sd = options.estimate_distortion ? sd_intrinsics.at<double>(4) : 0.0;
+  if (result.camera.distorted()) {
+    // ViSP's one-term model of the lens, as its camera XML holds it: its RMS over the same
+    // points, the views where the full model put them.
+    const Lens one_term = result.camera.ViSPCamera(options.width, options.height);
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < object_points.size(); ++i) {
+      cv::Mat rotation;
+      cv::Rodrigues(rvecs[i], rotation);
+      for (std::size_t k = 0; k < object_points[i].size(); ++k) {
+        const cv::Point3f& o = object_points[i][k];
+        const cv::Mat c = rotation * (cv::Mat_<double>(3, 1) << o.x, o.y, o.z) + tvecs[i];
+        const double z = c.at<double>(2);
+        const Point2d p = one_term.Pixel(c.at<double>(0) / z, c.at<double>(1) / z);
+        sum += std::pow(p.u - image_points[i][k].x, 2) + std::pow(p.v - image_points[i][k].y, 2);
+        ++count;
+      }
+    }
+    result.visp_rms_px = count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+  } else {
+    result.visp_rms_px = result.rms_px;
+  }
 
   if (result.px_sd > kLooseFocalFraction * px || result.py_sd > kLooseFocalFraction * py) {
     result.advice.push_back("px, py are known to +-" + Fixed(100.0 * result.px_sd / px, 2) +
@@ -398,8 +455,29 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
                             Fixed(std::max(result.u0_sd, result.v0_sd), 1) +
                             " px: add views tilted about both image axes");
   }
-  if (result.k1_sd > kLooseK1) {
-    result.advice.push_back("the distortion is known to +-" + Fixed(result.k1_sd, 3) +
+  if (result.camera.distorted()) {
+    // The lens is known where the views saw the target; beyond, it is extrapolated, and a
+    // polynomial may fold over before the image's corners.
+    const double reach2 = std::pow(Reach(image_points, camera_matrix), 2);
+    const double corner2 = CornerRadius2(result.camera, options.width, options.height);
+    bool invertible = true;
+    try {
+      CheckInvertibleOver(result.camera, options.width, options.height, "lens");
+    } catch (const std::invalid_argument&) {
+      invertible = false;
+    }
+    if (!invertible || reach2 < kCoveredFraction * kCoveredFraction * corner2) {
+      result.advice.push_back(
+          "the views reach " + Fixed(100.0 * std::sqrt(reach2 / corner2), 0) +
+          " % of the way to the image's corners" +
+          (invertible ? std::string(": the lens beyond is extrapolated")
+                      : std::string(" and the fitted lens folds over before them (pixels there "
+                                    "have no ray)")) +
+          ": add views with the target near the image's corners");
+    }
+  }
+  if (result.distortion_sd.k1 > kLooseK1) {
+    result.advice.push_back("the distortion is known to +-" + Fixed(result.distortion_sd.k1, 3) +
                             ": add views with the target near the image's corners");
   }
   return result;

@@ -1,14 +1,15 @@
-// The camera's intrinsics (px, py, u0, v0) and ViSP's radial distortion (kud, kdu) from views
-// of a planar target whose points are known on its plane.
+// The camera's intrinsics (px, py, u0, v0) and its lens in OpenCV's model (k1, k2, p1, p2, k3,
+// and the rational k4-k6 when asked) from views of a planar target whose points are known on
+// its plane, each parameter with its standard deviation.
 //
 // The solver is OpenCV's calibrateCamera (Zhang's initialisation, then Levenberg-Marquardt on
 // the reprojection error, with each parameter's standard deviation and each view's RMS, which
-// vpCalibration does not give) with two radial terms, x_d = x (1 + k1 r^2 + k2 r^4)
-// on ideal normalised coordinates. ViSP's model has one term in each direction, kud (ideal to
-// distorted) and kdu (distorted to ideal), and the inverse of one term is a series: a single
-// term would bend px and u0 to absorb what it misses. So the lens is fitted with two, and
-// ViSP's kud and kdu are then each the least-squares best single term over the part of the
-// image the views cover.
+// vpCalibration does not give). Every term the views determine is kept: one whose value lies
+// within `min_term_significance` standard deviations of zero is fixed at zero, with the
+// reason, and the camera solved again (k3 first, then the tangential pair). ViSP's one-term
+// model (kud, kdu), for ViSP's own camera XML, is the lens's best approximation over the
+// image (Lens::ViSPCamera); its reprojection RMS on the same points is given beside the full
+// model's.
 #pragma once
 
 #include <string>
@@ -51,7 +52,11 @@ struct CalibrationOptions {
   /// at least min_tilted_views views must tilt more. Degrees, range [0, 80].
   double min_tilt_deg = 10.0;
   int min_tilted_views = 2;         ///< Range [0, 1000].
-  bool estimate_distortion = true;  ///< false: kud = kdu = 0
+  bool estimate_distortion = true;  ///< false: the pinhole
+  /// Fit OpenCV's rational model too (k4, k5, k6: lenses wider than ~100 degrees).
+  bool rational = false;
+  /// A term within this many standard deviations of zero is fixed at zero. Range [0, 10].
+  double min_term_significance = 2.0;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
@@ -66,21 +71,20 @@ struct CalibrationViewReport {
   double tilt_deg = 0.0;  ///< the target plane's angle to the image plane (used views)
 };
 
-/// OpenCV's radial distortion, ideal to distorted: x_d = x (1 + k1 r^2 + k2 r^4 + k3 r^6)
-/// (k3 = 0 from Calibrate).
-struct RadialDistortion {
-  double k1 = 0.0, k2 = 0.0, k3 = 0.0;
-};
-
 struct CalibrationResult {
-  /// perspectiveProjWithDistortion (px, py, u0, v0, kud, kdu), or without distortion when
+  /// OpenCV's model with the terms the views determine; the pinhole when
   /// estimate_distortion is false.
   Lens camera;
   double rms_px = 0.0;  ///< reprojection RMS over every point of the views used
-  /// The solver's lens: OpenCV's radial coefficients.
-  RadialDistortion lens;
-  /// Standard deviations of px, py, u0, v0 (pixels) and k1, from the solver's covariance.
-  double px_sd = 0.0, py_sd = 0.0, u0_sd = 0.0, v0_sd = 0.0, k1_sd = 0.0;
+  /// The reprojection RMS of ViSP's one-term approximation of `camera` over the image (what
+  /// a ViSP camera XML holds) on the same points and view poses.
+  double visp_rms_px = 0.0;
+  /// Standard deviations of px, py, u0, v0 (pixels) and of each distortion term, from the
+  /// solver's covariance; 0 for a term fixed at zero.
+  double px_sd = 0.0, py_sd = 0.0, u0_sd = 0.0, v0_sd = 0.0;
+  Distortion distortion_sd;
+  /// The terms fixed at zero, each with the reason ("k3 fixed at 0: ...").
+  std::vector<std::string> fixed_terms;
   std::vector<CalibrationViewReport> views;  ///< one per view given, in order
   /// What the user can do about poorly determined parameters ("tilt the target more").
   std::vector<std::string> advice;
@@ -91,16 +95,5 @@ struct CalibrationResult {
 /// views (each rejected view with its reason), or all of them nearly facing the camera.
 CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
                             const CalibrationOptions& options);
-
-/// ViSP's one-term coefficients in both directions.
-struct RadialFit {
-  double kud = 0.0, kdu = 0.0;
-};
-
-/// The kud and the kdu that best describe `lens` over a width x height image (least squares
-/// on a grid of its pixels), within `max_radius` (distorted normalised coordinates) of the
-/// principal point.
-RadialFit FitViSPDistortion(const RadialDistortion& lens, double px, double py, double u0,
-                            double v0, int width, int height, double max_radius = 1e9);
 
 }  // namespace oal

@@ -27,8 +27,9 @@ std::optional<CalibrationView> FindChessboard(const GrayImageView& image,
                      static_cast<std::size_t>(image.stride));
   const cv::Size pattern(options.columns, options.rows);
   std::vector<cv::Point2f> corners;
-  if (!cv::findChessboardCorners(gray, pattern, corners,
-                                 cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+  if (!cv::findChessboardCorners(
+          gray, pattern, corners,
+          cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
     return std::nullopt;
   }
   // The saddle point of each corner, searched within a third of the shortest spacing.

@@ -341,12 +341,14 @@ double FitKud(const Lens& lens, int width, int height) {
   return saa > 0.0 ? sab / saa : 0.0;
 }
 
-double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height) {
+double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height,
+                                 double max_radius_px) {
   constexpr int kSteps = 40;
   double worst = 0.0;
   for (int j = 0; j <= kSteps; ++j) {
     for (int i = 0; i <= kSteps; ++i) {
       const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
+      if (std::hypot(u - a.u0(), v - a.v0()) > max_radius_px) continue;
       const Point2d p = a.Normalised(u, v), q = b.Normalised(u, v);
       const double d = std::hypot(a.px() * p.u - b.px() * q.u + a.u0() - b.u0(),
                                   a.py() * p.v - b.py() * q.v + a.v0() - b.v0());

@@ -173,8 +173,10 @@ double FitKud(const Lens& lens, int width, int height);
 
 /// The largest distance between the ideal pixels (u0 + px x, v0 + py y) two lenses give the
 /// same distorted pixel, over a grid of a width x height image (how far an approximation
-/// misses); infinity where one has no ideal point.
-double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height);
+/// misses), within `max_radius_px` of a's principal point; infinity where one has no ideal
+/// point.
+double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height,
+                                 double max_radius_px = 1e300);
 
 /// The largest distorted normalised radius squared of a width x height image's corners.
 double CornerRadius2(const Lens& lens, int width, int height);

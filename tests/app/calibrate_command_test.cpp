@@ -52,6 +52,46 @@ TEST(CalibrateCommand, WritesACameraFileThatTheOtherCommandsRead) {
   EXPECT_NEAR(file.camera.kdu(), 0.25, 0.03 * 0.25);
   EXPECT_EQ(file.width, 640u);
   EXPECT_EQ(file.height, 480u);
+  // ViSP's XML holds one term: the command says so, and how far it misses.
+  EXPECT_NE(run.err.find("ViSP's camera XML holds one radial term each way: its kud, kdu is the "
+                         "best approximation of the plumb_bob lens"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.out.find("plumb_bob: k1 "), std::string::npos) << run.out;
+}
+
+// The full model goes to OpenCV's YAML and ROS's camera_info, with each term's deviation.
+TEST(CalibrateCommand, WritesTheFullModelToOpenCvAndRosFiles) {
+  const TestDir dir;
+  const Lens truth = Lens::WithKdu(700.0, 702.0, 326.0, 235.0, 0.25, 640, 480);
+  const std::string shots = WriteShots(dir, truth);
+  const std::string base = "calibrate '" + shots + "' --chessboard 9x6 --square 0.02 --out '";
+  const OalservoRun run = RunOalservo(dir, base + (dir / "camera.yaml") + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err.find("approximation"), std::string::npos) << run.err;
+  const CameraFile file = LoadCameraFile(dir / "camera.yaml");
+  EXPECT_EQ(file.format, CameraFileFormat::kOpenCvYaml);
+  EXPECT_EQ(file.camera.model(), Lens::Model::kOpenCV);
+  EXPECT_NEAR(file.camera.px(), 700.0, 0.003 * 700.0);
+  const std::string text = test::ReadText(dir / "camera.yaml");
+  EXPECT_NE(text.find("# standard deviations: px "), std::string::npos) << text;
+  EXPECT_NE(text.find("; k1 "), std::string::npos) << text;
+  EXPECT_NE(text.find("# reprojection RMS "), std::string::npos) << text;
+  const OalservoRun ros = RunOalservo(dir, base + (dir / "head.yaml") + "' --ros --name head");
+  ASSERT_EQ(ros.exit_code, 0) << ros.err;
+  const CameraFile ros_file = LoadCameraFile(dir / "head.yaml", "head");
+  EXPECT_EQ(ros_file.format, CameraFileFormat::kRosCameraInfo);
+  EXPECT_EQ(ros_file.camera, file.camera);
+  // An extension that names no camera format is refused before any work.
+  const OalservoRun bad = RunOalservo(dir, base + (dir / "camera.txt") + "'");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--out"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("the extension names the format"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "camera.txt"));
+  const OalservoRun ros_xml = RunOalservo(dir, base + (dir / "c.xml") + "' --ros");
+  EXPECT_EQ(ros_xml.exit_code, 2) << ros_xml.err;
+  EXPECT_NE(ros_xml.err.find("ROS's camera_info is a .yaml or .yml file"), std::string::npos)
+      << ros_xml.err;
 }
 
 // `views` views of the A3 sheet lying on the bench photographs, through `camera`, tilted
@@ -150,7 +190,7 @@ TEST(CalibrateCommand, LiveTakesAViewWhereTheSheetIsHeldStill) {
   EXPECT_NE(run.out.find("view 5 of 20 taken: " + video + "#"), std::string::npos) << run.out;
   EXPECT_EQ(run.out.find("view 6 of 20"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("hold the target still"), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find("(camera 'Camera', 640x480, 5 of 5 views)"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("camera 'Camera', 640x480, 5 of 5 views)"), std::string::npos) << run.out;
   const CameraFile file = LoadCameraFile(dir / "camera.xml", "Camera");
   EXPECT_NEAR(file.camera.px(), truth.px(), 0.03 * truth.px());
 }

@@ -1,5 +1,5 @@
 // Camera calibration (calibration/calibrate.h) from chessboard views rendered through a known
-// lens: the intrinsics and ViSP's distortion come back; views that cannot determine the
+// lens: the intrinsics and the lens come back in OpenCV's model; views that cannot determine the
 // camera are refused with the reason.
 #include "calibration/calibrate.h"
 
@@ -32,7 +32,34 @@ CalibrationOptions OptionsFor(int width, int height) {
   return options;
 }
 
-TEST(Calibrate, RecoversTheIntrinsicsAndViSPsDistortionFromChessboardViews) {
+// The largest distance between the ideal pixels two lenses give, within the largest radius
+// (from the principal point) where the views saw the target: beyond, a lens is extrapolated.
+double WorstDifferenceWhereSeen(const Lens& a, const Lens& b,
+                                const std::vector<CalibrationView>& views, double fraction = 1.0) {
+  double reach = 0.0;
+  for (const CalibrationView& view : views) {
+    for (const CalibrationPoint& p : view.points) {
+      reach = std::max(reach, std::hypot(p.u - a.u0(), p.v - a.v0()));
+    }
+  }
+  return WorstIdealPixelDifference(a, b, 640, 480, fraction * reach);
+}
+
+// `advised`: the advice expected (the last ones).
+void ExpectGoodFit(const CalibrationResult& result, std::size_t advised = 0) {
+  EXPECT_LT(result.rms_px, 0.2);
+  for (std::size_t i = 0; i + advised < result.advice.size(); ++i)
+    ADD_FAILURE() << result.advice[i];
+  for (const CalibrationViewReport& view : result.views) {
+    if (view.used) {
+      EXPECT_LT(view.rms_px, 0.3) << view.name;
+    }
+  }
+}
+
+// The lens ViSP's one-term model renders comes back as OpenCV's model that follows it: the
+// same ideal pixel, within 0.3 px, for every pixel the views cover.
+TEST(Calibrate, RecoversTheIntrinsicsAndAViSPLensFromChessboardViews) {
   for (const double kdu : {0.0, 0.2, 0.35}) {
     SCOPED_TRACE("kdu " + std::to_string(kdu));
     const Lens truth = Lens::WithKdu(760.0, 755.0, 331.0, 228.0, kdu, 640, 480);
@@ -48,32 +75,70 @@ TEST(Calibrate, RecoversTheIntrinsicsAndViSPsDistortionFromChessboardViews) {
     EXPECT_NEAR(result.camera.py(), truth.py(), 0.003 * truth.py());
     EXPECT_NEAR(result.camera.u0(), truth.u0(), 1.5);
     EXPECT_NEAR(result.camera.v0(), truth.v0(), 1.5);
-    EXPECT_NEAR(result.camera.kdu(), kdu, std::max(0.03 * kdu, 0.005));
-    // kud is the best single-term inverse over the part of the image the views cover (the
-    // truth's over the whole image differs by a few %): the two directions agree there, to
-    // what two single terms can (under a pixel at kdu 0.35).
-    const Lens& camera = result.camera;
-    for (double u = 120.0; u <= 520.0; u += 50.0) {
-      for (double v = 60.0; v <= 420.0; v += 45.0) {
-        const double xd = (u - camera.u0()) / camera.px();
-        const double yd = (v - camera.v0()) / camera.py();
-        const double grow = 1.0 + camera.kdu() * (xd * xd + yd * yd);
-        const double xu = xd * grow, yu = yd * grow;
-        const double shrink = 1.0 + camera.kud() * (xu * xu + yu * yu);
-        EXPECT_NEAR(camera.u0() + camera.px() * xu * shrink, u, 1.0) << u << ", " << v;
-        EXPECT_NEAR(camera.v0() + camera.py() * yu * shrink, v, 1.0) << u << ", " << v;
-      }
+    EXPECT_LT(WorstDifferenceWhereSeen(result.camera, truth, views), 0.3);
+    // These views keep to the middle of the image, and the result says so.
+    ASSERT_FALSE(result.advice.empty());
+    EXPECT_NE(result.advice.back().find("% of the way to the image's corners"), std::string::npos)
+        << result.advice.back();
+    // A term the views cannot tell from zero is fixed there, and said.
+    if (kdu == 0.0) {
+      EXPECT_FALSE(result.fixed_terms.empty());
     }
-    EXPECT_LT(result.rms_px, 0.2);
+    for (const std::string& fixed : result.fixed_terms) {
+      EXPECT_NE(fixed.find(" fixed at 0: the views "), std::string::npos) << fixed;
+    }
+    EXPECT_GE(result.visp_rms_px, result.rms_px - 1e-9);
     std::cout << "kdu " << kdu << ": px " << result.camera.px() << " py " << result.camera.py()
-              << " u0 " << result.camera.u0() << " v0 " << result.camera.v0() << " kdu "
-              << result.camera.kdu() << " RMS " << result.rms_px << " px\n";
-    for (const std::string& advice : result.advice) ADD_FAILURE() << advice;
-    for (const CalibrationViewReport& view : result.views) {
-      if (view.used) {
-        EXPECT_LT(view.rms_px, 0.3) << view.name;
+              << " u0 " << result.camera.u0() << " v0 " << result.camera.v0() << " "
+              << LensModelName(result.camera) << " k1 " << result.camera.distortion().k1 << " RMS "
+              << result.rms_px << " px (ViSP's one term " << result.visp_rms_px << ")\n";
+    ExpectGoodFit(result, 1);
+  }
+}
+
+// Lenses in OpenCV's model (the sample camera of OpenCV's tutorial, a wide lens) come back:
+// each coefficient fitted within three of its standard deviations, or fixed at zero when the
+// views cannot tell it, and OpenCV's model beats ViSP's one term.
+TEST(Calibrate, RecoversAnOpenCvLensWithEachTermsDeviation) {
+  const struct {
+    const char* name;
+    Lens lens;
+  } lenses[] = {
+      {"opencv-sample",
+       Lens::WithDistortion(535.9157, 535.9157, 342.2832, 235.5708,
+                            {-0.266373, -0.0385889, 0.00178319, -0.000281221, 0.238392})},
+      {"wide",
+       Lens::WithDistortion(420.0, 420.0, 322.0, 238.0, {-0.28, 0.08, 0.0006, -0.0004, -0.01})},
+  };
+  for (const auto& c : lenses) {
+    SCOPED_TRACE(c.name);
+    std::vector<vpHomogeneousMatrix> poses = test::CornerPoses(c.lens.px());
+    const std::vector<vpHomogeneousMatrix> varied = VariedPoses();
+    for (std::size_t k = 0; k < varied.size(); k += 2) poses.push_back(varied[k]);
+    const std::vector<CalibrationView> views = RenderedViews(c.lens, poses);
+    const CalibrationResult result = Calibrate(views, OptionsFor(640, 480));
+    ASSERT_EQ(result.camera.model(), Lens::Model::kOpenCV);
+    EXPECT_NEAR(result.camera.px(), c.lens.px(), 3.0 * result.px_sd + 0.5);
+    EXPECT_NEAR(result.camera.u0(), c.lens.u0(), 3.0 * result.u0_sd + 0.5);
+    const auto fitted = result.camera.distortion().ToArray();
+    const auto sd = result.distortion_sd.ToArray();
+    const auto truth = c.lens.distortion().ToArray();
+    for (std::size_t i = 0; i < 5; ++i) {
+      if (fitted[i] == 0.0 && sd[i] == 0.0) continue;  // fixed, and said
+      EXPECT_GT(sd[i], 0.0) << "term " << i;
+      // With a term fixed the others absorb what it did: only the lens as a whole is compared.
+      if (result.fixed_terms.empty()) {
+        EXPECT_NEAR(fitted[i], truth[i], 3.0 * sd[i]) << "term " << i;
       }
     }
+    for (const std::string& fixed : result.fixed_terms) {
+      std::cout << c.name << ": " << fixed << '\n';
+    }
+    // Near the edge of where the views reach, the terms' own uncertainty (one standard
+    // deviation each here) shows: the lens is compared inside 70 % of that.
+    EXPECT_LT(WorstDifferenceWhereSeen(result.camera, c.lens, views, 0.7), 0.6);
+    EXPECT_GT(result.visp_rms_px, result.rms_px);
+    ExpectGoodFit(result, 1);  // the corners themselves are not seen, and the result says so
   }
 }
 
@@ -105,19 +170,6 @@ TEST(Calibrate, TooFewUsableViewsNameEachRejectedView) {
   }
   CalibrationOptions bad = OptionsFor(0, 480);
   EXPECT_THROW(Calibrate(views, bad), std::invalid_argument);
-}
-
-TEST(FitViSPDistortion, OneTermLensesComeBackAsThemselves) {
-  // A lens that is exactly one kud term: kud comes back, and kdu is its best inverse: larger
-  // than -kud, as the inverse series' next term (3 kud^2 r^4) is positive.
-  const RadialFit fit =
-      FitViSPDistortion(RadialDistortion{-0.2, 0.0, 0.0}, 700, 700, 320, 240, 640, 480);
-  EXPECT_NEAR(fit.kud, -0.2, 1e-9);
-  EXPECT_GT(fit.kdu, 0.2);
-  EXPECT_LT(fit.kdu, 0.25);
-  const RadialFit none = FitViSPDistortion(RadialDistortion{}, 700, 700, 320, 240, 640, 480);
-  EXPECT_EQ(none.kud, 0.0);
-  EXPECT_EQ(none.kdu, 0.0);
 }
 
 TEST(FindChessboard, NoBoardNoView) {

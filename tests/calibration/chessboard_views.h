@@ -106,4 +106,25 @@ inline std::vector<vpHomogeneousMatrix> VariedPoses() {
   return poses;
 }
 
+// Eight views 0.35 m away with the board near each corner and each edge of a 640 x 480 image
+// of focal length `focal_px` (a lens's outer part is told only by views that reach it),
+// tilted 20 deg towards the image's centre (towards the corners, untilted).
+inline std::vector<vpHomogeneousMatrix> CornerPoses(double focal_px) {
+  std::vector<vpHomogeneousMatrix> poses;
+  constexpr double kDistanceM = 0.35;
+  const double reach_u = 0.7 * 320.0 / focal_px, reach_v = 0.45 * 240.0 / focal_px;
+  for (int k = 0; k < 8; ++k) {
+    const double angle = vpMath::rad(45.0 * k);
+    const double su = std::fabs(std::cos(angle)) < 1e-9 ? 0.0 : (std::cos(angle) > 0 ? 1.0 : -1.0);
+    const double sv = std::fabs(std::sin(angle)) < 1e-9 ? 0.0 : (std::sin(angle) > 0 ? 1.0 : -1.0);
+    // Towards the corners the board is kept nearer the middle and untilted, so it stays whole.
+    const bool diagonal = su != 0.0 && sv != 0.0;
+    const double reach = diagonal ? 0.75 : 1.0, tilt = diagonal ? 0.0 : 20.0;
+    poses.push_back(vpHomogeneousMatrix(reach * su * reach_u * kDistanceM,
+                                        reach * sv * reach_v * kDistanceM, 0, 0, 0, 0) *
+                    LookingAtTheBoard(kDistanceM, tilt * sv, -tilt * su, 10.0 * k));
+  }
+  return poses;
+}
+
 }  // namespace oal::test
