@@ -16,6 +16,7 @@
 #include "base/format.h"
 #include "base/statistics.h"
 #include "eval/pose_accuracy.h"
+#include "io/camera_file.h"
 #include "io/atomic_file.h"
 #include "io/json_io.h"
 #include "io/rendered_dataset.h"
@@ -262,6 +263,13 @@ int RunPoseAccuracy(int argc, char** argv) {
   cli.add_flag("--estimate-distortion", options.estimate_distortion,
                "do not tell the tracker the lens: estimate kdu from the target's stripes in "
                "frames of other poses, then use it");
+  std::string given_camera_path;
+  cli.add_option("--pose-camera", given_camera_path,
+                 "the camera file the tracker (or the marker's method) poses with, e.g. a "
+                 "calibration's result, instead of the rendered lens (--camera): what the "
+                 "camera file costs")
+      ->check(CLI::ExistingFile)
+      ->excludes("--estimate-distortion");
   cli.add_option("--estimate-frames", options.estimate_frames,
                  "frames with the target that --estimate-distortion tells the lens from")
       ->check(CLI::Range(1, 100))
@@ -301,6 +309,7 @@ int RunPoseAccuracy(int argc, char** argv) {
     }
   }
   ApplyRenderedCameraOptions(cli, camera_path, &options);
+  if (!given_camera_path.empty()) options.given_camera = LoadCameraFile(given_camera_path).camera;
 
   // Everything that can fail before the evaluation's minutes of work.
   AppConfig config;

@@ -82,6 +82,9 @@ void PoseAccuracyOptions::Check() const {
   RequireOption(estimate_frames >= 1 && estimate_frames <= 100,
                 "PoseAccuracyOptions::estimate_frames", estimate_frames,
                 "1 <= estimate_frames <= 100");
+  if (given_camera) CheckPerspectiveCamera(*given_camera, "PoseAccuracyOptions::given_camera");
+  RequireOption(!given_camera || !estimate_distortion, "PoseAccuracyOptions::estimate_distortion",
+                estimate_distortion, "false with a given camera");
   RequireOption(marker == SheetMarker::kOal || !estimate_distortion,
                 "PoseAccuracyOptions::estimate_distortion", estimate_distortion,
                 "false with a marker (the lens is told from our target's stripes)");
@@ -175,7 +178,8 @@ PoseAccuracyReport EvaluateMarkerPoseAccuracy(const PoseAccuracyOptions& options
   const EvaluationScenes scenes(options.target, options);
   const RenderOptions& render = scenes.For(0).options();
   const std::unique_ptr<MarkerMethod> method =
-      MakeMarkerMethod(options.marker, options.target, render.camera, render.width, render.height);
+      MakeMarkerMethod(options.marker, options.target, options.given_camera.value_or(render.camera),
+                       render.width, render.height);
   const MarkerPrint& print = method->Print();
   const EvaluationScenes printed(MarkerSheet(options.target, *method), options, print.picture);
 
@@ -224,8 +228,9 @@ PoseAccuracyReport EvaluatePoseAccuracy(
   if (options.marker != SheetMarker::kOal) return EvaluateMarkerPoseAccuracy(options, progress);
   const EvaluationScenes scenes(options.target, options);
   PoseAccuracyReport report;
-  const Lens camera = options.estimate_distortion ? EstimatedCamera(scenes, options, &report)
-                                                  : scenes.For(0).options().camera;
+  const Lens camera = options.estimate_distortion
+                          ? EstimatedCamera(scenes, options, &report)
+                          : options.given_camera.value_or(scenes.For(0).options().camera);
   TargetPoseTracker tracker(options.target, camera, options.detector, options.pose,
                             options.tracking);
   const PointUndistorter undistorter(camera);

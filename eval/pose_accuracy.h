@@ -6,6 +6,8 @@
 // board) and its own detection and pose.
 #pragma once
 
+#include <optional>
+
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -44,6 +46,10 @@ struct PoseAccuracyOptions : RenderedFrameOptions {
   /// finds it in, then used for every frame (loop/lens_estimate.h).
   bool estimate_distortion = false;
   int estimate_frames = kLensFrames;  ///< Range [1, 100].
+  /// The lens the tracker (or the marker's method) is told instead of the rendered one: a
+  /// calibration's result, to measure what it costs. Unset: the rendered lens. Not with
+  /// estimate_distortion.
+  std::optional<Lens> given_camera;
   /// What the sheet carries: our stripes, or a marker printed instead (kAprilTag, kCharuco),
   /// posed by its own method on the same frames: the same poses (drawn for `target`, its
   /// crossings in view), bench, lived-in effects and noise, the frame rendered with `target`'s

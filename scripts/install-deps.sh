@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   g++ cmake make pkg-config
-  libvisp-dev visp-images-data
+  libvisp-dev visp-images-data opencv-doc
   libopencv-dev libopencv-contrib-dev libeigen3-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libxml2-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -5,10 +5,14 @@
 
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
+#include <visp3/io/vpImageIo.h>
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <opencv2/calib3d.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -178,6 +182,61 @@ TEST(FindChessboard, NoBoardNoView) {
   ChessboardOptions bad;
   bad.square_m = 0.0;
   EXPECT_THROW(FindChessboard(ViewOf(blank), bad, "blank"), std::invalid_argument);
+}
+
+// OpenCV's own sample views (Debian's opencv-doc: left01-14.jpg, a 9 x 6 chessboard of 25 mm
+// squares): ours against OpenCV's calibrateCamera with its default model on the same corners.
+TEST(Calibrate, OpenCvsSampleViewsAgreeWithCalibrateCamera) {
+  const std::string dir = "/usr/share/doc/opencv-doc/examples/data/";
+  std::vector<CalibrationView> views;
+  ChessboardOptions chessboard;
+  chessboard.columns = 9;
+  chessboard.rows = 6;
+  chessboard.square_m = 0.025;
+  for (int k = 1; k <= 14; ++k) {
+    const std::string name = dir + "left" + (k < 10 ? "0" : "") + std::to_string(k) + ".jpg";
+    if (!std::filesystem::exists(name)) continue;  // the package has no left10.jpg
+    vpImage<unsigned char> image;
+    vpImageIo::read(image, name);
+    if (std::optional<CalibrationView> view = FindChessboard(ViewOf(image), chessboard, name)) {
+      views.push_back(*view);
+    }
+  }
+  if (views.empty()) GTEST_SKIP() << "Debian's opencv-doc (its sample views) is not installed";
+  ASSERT_EQ(views.size(), 13u);
+  const CalibrationResult ours = Calibrate(views, OptionsFor(640, 480));
+
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image;
+  for (const CalibrationView& view : views) {
+    object.emplace_back();
+    image.emplace_back();
+    for (const CalibrationPoint& p : view.points) {
+      object.back().emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), 0.0f);
+      image.back().emplace_back(static_cast<float>(p.u), static_cast<float>(p.v));
+    }
+  }
+  cv::Mat k, d, sd, sd_extrinsics, errors;
+  std::vector<cv::Mat> rvecs, tvecs;
+  const double rms = cv::calibrateCamera(object, image, cv::Size(640, 480), k, d, rvecs, tvecs, sd,
+                                         sd_extrinsics, errors);
+  const Lens& lens = ours.camera;
+  const double mine[] = {lens.px(), lens.py(), lens.u0(), lens.v0()};
+  for (int i = 0; i < 4; ++i) {
+    const double reference = i < 2 ? k.at<double>(i, i) : k.at<double>(i - 2, 2);
+    EXPECT_NEAR(mine[i], reference, 2.0 * sd.at<double>(i)) << "intrinsic " << i;
+  }
+  const auto coefficients = lens.distortion().ToArray();
+  for (int i = 0; i < 5; ++i) {
+    // A term ours fixed at zero: OpenCV's is within two of its deviations of zero too.
+    EXPECT_NEAR(coefficients[static_cast<std::size_t>(i)], d.at<double>(i),
+                2.0 * sd.at<double>(4 + i))
+        << "coefficient " << i;
+  }
+  EXPECT_NEAR(ours.rms_px, rms, 0.02 * rms);
+  std::cout << "ours px " << lens.px() << " u0 " << lens.u0() << " k1 " << coefficients[0]
+            << " RMS " << ours.rms_px << "; calibrateCamera px " << k.at<double>(0, 0) << " u0 "
+            << k.at<double>(0, 2) << " k1 " << d.at<double>(0) << " RMS " << rms << '\n';
 }
 
 }  // namespace
