@@ -131,6 +131,7 @@ class Lens {
   double max_ideal_r2_ = 0.0;  ///< OpenCV's model: the ideal radius^2 where it folds over
 
   static double FoldRadius2(const Distortion& distortion);
+  Point2d SolveFrom(double xd, double yd, const Point2d& guess) const;
 };
 
 /// Maps distorted feature pixels to ideal pixels of `lens` (same intrinsics, no distortion);

@@ -407,8 +407,8 @@ bool IsCompanionFile(const std::string& path) {
     return name.size() >= end.size() &&
            name.compare(name.size() - end.size(), end.size(), end) == 0;
   };
-  return name == "camera.xml" || name == "target.yaml" || LowerExtension(path) == ".json" ||
-         ends_with(".truth.csv");
+  return name == "camera.xml" || name == "camera.yaml" || name == "target.yaml" ||
+         LowerExtension(path) == ".json" || ends_with(".truth.csv");
 }
 
 bool HasVideoExtension(const std::string& path) {
