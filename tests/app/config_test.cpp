@@ -538,5 +538,29 @@ TEST(ConfigCameraFile, ConflictsAndMissingFilesNameTheLine) {
       320);
 }
 
+// OpenCV's model, inline or from OpenCV's calibration YAML.
+TEST(ConfigCameraFile, OpenCvsModelInlineOrFromItsFile) {
+  const test::TestDir dir;
+  const std::string yaml = dir / "servo.yaml";
+  const AppConfig inline_lens =
+      ParseConfig("camera:\n  distortion: [-0.27, -0.04, 0.0018, -0.0003, 0.24]\n", yaml);
+  const Lens lens = inline_lens.camera.Camera();
+  EXPECT_EQ(lens.model(), Lens::Model::kOpenCV);
+  EXPECT_DOUBLE_EQ(lens.distortion().k3, 0.24);
+  SaveCameraFile(dir / "lens.yaml", lens, "", 640, 480);
+  EXPECT_EQ(ParseConfig("camera:\n  file: lens.yaml\n", yaml).camera.Camera(), lens);
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  distortion: [0.1, 0.2, 0.3]\n", yaml),
+              HasSubstr("servo.yaml:2: 'camera.distortion' must be OpenCV's distortion "
+                        "coefficients [k1, k2, p1, p2, k3] (4, 5 or 8 numbers), got 'a sequence "
+                        "of 3'"));
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  distortion: [0.1, x, 0, 0, 0]\n", yaml),
+              HasSubstr("servo.yaml:2: 'camera.distortion[1]' must be a number"));
+  EXPECT_THAT(test::ConfigErrorOf("camera:\n  kdu: 0.1\n  distortion: [0.1, 0, 0, 0, 0]\n", yaml),
+              HasSubstr("kdu = 0 when distortion (OpenCV's coefficients) is given"));
+  EXPECT_THAT(
+      test::ConfigErrorOf("camera:\n  file: lens.yaml\n  distortion: [0.1, 0, 0, 0, 0]\n", yaml),
+      HasSubstr("'camera.distortion' and 'camera.file' (line 2) are both given"));
+}
+
 }  // namespace
 }  // namespace oal

@@ -1,5 +1,6 @@
-// The ViSP camera file reader (libxml2 to list the cameras, then vpXmlParserCamera) on
-// arbitrary files: a bad one is a std::exception with a message, never a crash.
+// The camera file readers on arbitrary files, each input read as every format: ViSP's XML
+// (libxml2 to list the cameras, then vpXmlParserCamera), OpenCV's calibration YAML and ROS's
+// camera_info (yaml-cpp): a bad one is a std::exception with a message, never a crash.
 #include <cstdint>
 #include <exception>
 #include <string>
@@ -8,11 +9,13 @@
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const std::string path = oal::fuzz::ScratchFile(data, size, ".xml");
-  for (const char* name : {"", "Camera"}) {
-    try {
-      oal::LoadCameraFile(path, name);
-    } catch (const std::exception&) {
+  for (const char* extension : {".xml", ".yaml"}) {
+    const std::string path = oal::fuzz::ScratchFile(data, size, extension);
+    for (const char* name : {"", "Camera"}) {
+      try {
+        oal::LoadCameraFile(path, name);
+      } catch (const std::exception&) {
+      }
     }
   }
   return 0;
