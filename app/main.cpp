@@ -13,6 +13,7 @@
 
 #include "app/calibrate_accuracy_command.h"
 #include "app/calibrate_command.h"
+#include "app/camera_command.h"
 #include "app/command_line.h"
 #include "app/compare_command.h"
 #include "app/demo_command.h"
@@ -62,6 +63,8 @@ constexpr oal::Command kCommands[] = {
      "accuracy of calibrate from the printed target on rendered views of known cameras"},
     {"hand-eye", &oal::RunHandEye,
      "the camera's mounting on the arm (eMc): move through stations, or from recorded pairs"},
+    {"camera", &oal::RunCamera,
+     "show a camera file's lens; write it as ViSP's XML, OpenCV's YAML or ROS's camera_info"},
     {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
     {"scorbot-sim", &oal::RunScorbotSim,
      "Scorbot ER-VII controller simulator (ACL) on a pseudo-terminal; --measure: link budget"},

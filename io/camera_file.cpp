@@ -235,8 +235,9 @@ CameraFile LoadViSPCameraFile(const std::string& path, const std::string& camera
 void SaveViSPCameraFile(const std::string& path, const vpCameraParameters& camera,
                         const std::string& name, unsigned int width, unsigned int height,
                         const std::vector<std::string>& comments) {
+  // ViSP keeps the elements of its additional information: one <note> a comment.
   std::string info;
-  for (const std::string& comment : comments) info += (info.empty() ? "" : " ") + comment;
+  for (const std::string& comment : comments) info += "<note>" + MarkupEscaped(comment) + "</note>";
   // vpXmlParserCamera::save adds to an existing file, so it writes a fresh temporary file
   // that then replaces `path`.
   const std::filesystem::path temp = TempPathFor(path);

@@ -24,7 +24,6 @@
 namespace oal {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Points closer to the camera plane than this are treated as behind the camera (metres).
 constexpr double kMinDepthM = 1e-6;
 // Rays meeting the board plane farther than this see background_grey (metres).
