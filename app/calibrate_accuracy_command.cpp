@@ -10,17 +10,31 @@
 #include "base/format.h"
 #include "detector/lens.h"
 #include "eval/calibrate_accuracy.h"
+#include "io/camera_file.h"
 
 namespace oal {
 namespace {
 
 nlohmann::json CameraJson(const Lens& camera) {
-  return {{"px", camera.px()}, {"py", camera.py()},   {"u0", camera.u0()},
-          {"v0", camera.v0()}, {"kdu", camera.kdu()}, {"kud", camera.kud()}};
+  nlohmann::json json = {{"model", LensModelName(camera)},
+                         {"px", camera.px()},
+                         {"py", camera.py()},
+                         {"u0", camera.u0()},
+                         {"v0", camera.v0()},
+                         {"kdu", camera.kdu()},
+                         {"kud", camera.kud()}};
+  if (camera.model() == Lens::Model::kOpenCV) json["distortion"] = camera.distortion().ToArray();
+  return json;
+}
+
+// "kdu 0.2100" or "k1 -0.2664" (ViSP's or OpenCV's leading term).
+std::string LensText(const Lens& camera) {
+  if (camera.model() == Lens::Model::kOpenCV) return "k1 " + Fixed(camera.distortion().k1, 4);
+  return "kdu " + Fixed(camera.kdu(), 4);
 }
 
 struct Worst {
-  double px_pct = 0.0, py_pct = 0.0, u0_px = 0.0, v0_px = 0.0, kdu = 0.0, rms_px = 0.0;
+  double px_pct = 0.0, py_pct = 0.0, u0_px = 0.0, v0_px = 0.0, lens_px = 0.0, rms_px = 0.0;
   int failed = 0;
 };
 
@@ -35,7 +49,7 @@ Worst WorstOf(const std::vector<CameraCalibrationTrial>& trials) {
     worst.py_pct = std::max(worst.py_pct, t.py_error_pct());
     worst.u0_px = std::max(worst.u0_px, t.u0_error_px());
     worst.v0_px = std::max(worst.v0_px, t.v0_error_px());
-    worst.kdu = std::max(worst.kdu, t.kdu_error());
+    worst.lens_px = std::max(worst.lens_px, t.lens_error_px);
     worst.rms_px = std::max(worst.rms_px, t.rms_px);
   }
   return worst;
@@ -44,30 +58,32 @@ Worst WorstOf(const std::vector<CameraCalibrationTrial>& trials) {
 std::string Table(const CalibrateAccuracyOptions& o,
                   const std::vector<CameraCalibrationTrial>& trials) {
   std::ostringstream out;
-  out << "| camera | px true / found | py true / found | u0 true / found | v0 true / found | kdu "
-         "true / found | views used | RMS (px) |\n|---|---|---|---|---|---|---:|---:|\n";
+  out << "| camera | px true / found | py true / found | u0 true / found | v0 true / found | lens "
+         "true / found | lens miss (px) | views used | RMS (px) |\n"
+         "|---|---|---|---|---|---|---:|---:|---:|\n";
   for (std::size_t c = 0; c < trials.size(); ++c) {
     const CameraCalibrationTrial& t = trials[c];
     out << "| " << c << " | ";
     if (!t.failed.empty()) {
-      out << Fixed(t.truth.px(), 1) << " / — | — | — | — | " << Fixed(t.truth.kdu(), 4)
-          << " / — | — | " << t.failed << " |\n";
+      out << Fixed(t.truth.px(), 1) << " / — | — | — | — | " << LensText(t.truth)
+          << " / — | — | — | " << t.failed << " |\n";
       continue;
     }
     out << Fixed(t.truth.px(), 1) << " / " << Fixed(t.found.px(), 1) << " ("
         << Fixed(t.px_error_pct(), 3) << " %) | " << Fixed(t.truth.py(), 1) << " / "
         << Fixed(t.found.py(), 1) << " (" << Fixed(t.py_error_pct(), 3) << " %) | "
         << Fixed(t.truth.u0(), 1) << " / " << Fixed(t.found.u0(), 1) << " | "
-        << Fixed(t.truth.v0(), 1) << " / " << Fixed(t.found.v0(), 1) << " | "
-        << Fixed(t.truth.kdu(), 4) << " / " << Fixed(t.found.kdu(), 4) << " | " << t.used << " / "
-        << t.views << " | " << Fixed(t.rms_px, 3) << " |\n";
+        << Fixed(t.truth.v0(), 1) << " / " << Fixed(t.found.v0(), 1) << " | " << LensText(t.truth)
+        << " / " << LensText(t.found) << " | " << Fixed(t.lens_error_px, 2) << " | " << t.used
+        << " / " << t.views << " | " << Fixed(t.rms_px, 3) << " |\n";
   }
   const Worst w = WorstOf(trials);
   out << "\n"
       << o.target.name << ", " << trials.size() << " cameras of " << o.frames
       << " views: " << w.failed << " not calibrated; worst px " << Fixed(w.px_pct, 3) << " %, py "
       << Fixed(w.py_pct, 3) << " %, u0 " << Fixed(w.u0_px, 2) << " px, v0 " << Fixed(w.v0_px, 2)
-      << " px, kdu " << Fixed(w.kdu, 2) << " of its allowance (3 % or 0.005), RMS "
+      << " px, lens " << Fixed(w.lens_px, 2) << " px (within "
+      << Fixed(100.0 * kLensJudgedFraction, 0) << " % of the way to the corners), RMS "
       << Fixed(w.rms_px, 3) << " px\n";
   return out.str();
 }
@@ -94,7 +110,7 @@ nlohmann::json ToJson(const CalibrateAccuracyOptions& o,
       camera["py_error_pct"] = t.py_error_pct();
       camera["u0_error_px"] = t.u0_error_px();
       camera["v0_error_px"] = t.v0_error_px();
-      camera["kdu_error_abs"] = t.kdu_error_abs();
+      camera["lens_error_px"] = t.lens_error_px;
     } else {
       camera["failed"] = t.failed;
     }
@@ -109,7 +125,7 @@ nlohmann::json ToJson(const CalibrateAccuracyOptions& o,
             {"py_error_pct", w.py_pct},
             {"u0_error_px", w.u0_px},
             {"v0_error_px", w.v0_px},
-            {"kdu_error_of_allowance", w.kdu},
+            {"lens_error_px", w.lens_px},
             {"rms_px", w.rms_px}}}};
 }
 
@@ -138,8 +154,15 @@ int RunCalibrateAccuracy(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--blur", options.blur_sigma_px, "blur sigma, pixels, [0, 20]")
       ->capture_default_str();
-  cli.add_option("--max-kdu", options.max_kdu, "the lens drawn in [0, this]")
-      ->capture_default_str();
+  CLI::Option* max_kdu =
+      cli.add_option("--max-kdu", options.max_kdu, "the lens drawn: ViSP's kdu in [0, this]")
+          ->capture_default_str();
+  std::string camera_path;
+  cli.add_option("--camera", camera_path,
+                 "every camera this file's (ViSP's .xml, OpenCV's or ROS's .yaml, at its image "
+                 "size) instead of drawn ones")
+      ->check(CLI::ExistingFile)
+      ->excludes(max_kdu);
   cli.add_option("--background", options.backgrounds,
                  "image of the surface the target lies on, several in turn (default: "
                  "photographs of Debian's visp-images-data)");
@@ -153,6 +176,14 @@ int RunCalibrateAccuracy(int argc, char** argv) {
     options.target = TargetByName(target_name);
   } catch (const std::invalid_argument& error) {
     throw UsageError(std::string("--target: ") + error.what());
+  }
+  if (!camera_path.empty()) {
+    const CameraFile file = LoadCameraFile(camera_path);
+    options.lens = file.camera;
+    if (file.width > 0) {
+      options.width = static_cast<int>(file.width);
+      options.height = static_cast<int>(file.height);
+    }
   }
   options.sampling = SheetSampling(options.target);
   options.sampling.max_tilt_deg = 45.0;

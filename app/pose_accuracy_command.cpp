@@ -261,8 +261,9 @@ int RunPoseAccuracy(int argc, char** argv) {
                "replace the data set already in --save-missed (its frame_NNNN.png/json, "
                "camera.xml and target.yaml; other files are kept)");
   cli.add_flag("--estimate-distortion", options.estimate_distortion,
-               "do not tell the tracker the lens: estimate kdu from the target's stripes in "
-               "frames of other poses, then use it");
+               "do not tell the tracker the lens: estimate one radial term (ViSP's kdu, all four "
+               "stripes can tell) from the target's stripes in frames of other poses, then use "
+               "it");
   std::string given_camera_path;
   cli.add_option("--pose-camera", given_camera_path,
                  "the camera file the tracker (or the marker's method) poses with, e.g. a "

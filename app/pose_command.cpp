@@ -330,9 +330,10 @@ int RunPose(int argc, char** argv) {
                "the frames of one input are a sequence, the target followed from one to the next "
                "and a pose that jumps away from the last one held until the next frame agrees");
   cli.add_flag("--estimate-distortion", options.estimate_distortion,
-               "the camera file has no distortion: tell the lens (ViSP's kdu) from the target's "
-               "stripes, which must be straight, in the first frames that show it, then use it "
-               "for every frame");
+               "the camera file has no distortion: tell the lens from the target's stripes, "
+               "which must be straight, in the first frames that show it, then use it for every "
+               "frame. Four stripes tell one radial term (ViSP's kdu), not OpenCV's k2, k3 or "
+               "tangential terms: for those, calibrate (oalservo calibrate)");
   cli.add_option("--estimate-frames", options.estimate_frames,
                  "frames with the target that --estimate-distortion reads ahead")
       ->capture_default_str();

@@ -15,6 +15,7 @@ namespace {
 enum Draw : std::uint64_t { kFocal = 11, kAspect, kCentreU, kCentreV, kLens };
 
 Lens DrawCamera(const CalibrateAccuracyOptions& o, int camera) {
+  if (o.lens) return *o.lens;
   const auto draw = [&](double lo, double hi, Draw stream) {
     return lo + (hi - lo) * Uniform01(o.seed, camera, stream);
   };
@@ -44,6 +45,7 @@ void CalibrateAccuracyOptions::Check() const {
   RequireOption(max_centre_offset_px >= 0.0 && max_centre_offset_px <= 0.25 * width,
                 "--max-centre-offset", max_centre_offset_px,
                 "0 <= --max-centre-offset <= a quarter of the width");
+  if (lens) CheckInvertibleOver(*lens, width, height, "--camera");
   RequireOption(min_kdu > -1.0 && min_kdu <= max_kdu && max_kdu < 1.0, "--min-kdu", min_kdu,
                 "-1 < --min-kdu <= --max-kdu < 1");
   RequireOption(min_tilt_deg >= 0.0 && min_tilt_deg < sampling.max_tilt_deg, "--min-tilt-deg",
@@ -61,12 +63,6 @@ double CameraCalibrationTrial::u0_error_px() const {
 }
 double CameraCalibrationTrial::v0_error_px() const {
   return std::fabs(found.v0() - truth.v0());
-}
-double CameraCalibrationTrial::kdu_error_abs() const {
-  return std::fabs(found.kdu() - truth.kdu());
-}
-double CameraCalibrationTrial::kdu_error() const {
-  return kdu_error_abs() / std::max(0.005, 0.03 * std::fabs(truth.kdu()));
 }
 
 std::vector<CameraCalibrationTrial> EvaluateCalibration(
@@ -105,6 +101,9 @@ std::vector<CameraCalibrationTrial> EvaluateCalibration(
     try {
       const CalibrationResult result = Calibrate(views, calibration);
       trial.found = result.camera;
+      trial.lens_error_px = WorstIdealPixelDifference(
+          trial.found, trial.truth, options.width, options.height,
+          kLensJudgedFraction * 0.5 * std::hypot(options.width, options.height));
       trial.rms_px = result.rms_px;
       trial.used = static_cast<int>(std::count_if(result.views.begin(), result.views.end(),
                                                   [](const auto& view) { return view.used; }));

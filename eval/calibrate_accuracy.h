@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,10 @@ struct CalibrateAccuracyOptions : RenderedFrameOptions {
   int cameras = 5;  ///< cameras drawn, [1, 1000]; RenderedFrameOptions::frames: views of each
   double min_focal_px = 600.0, max_focal_px = 900.0;  ///< px drawn in; py within 1 % of it
   double max_centre_offset_px = 20.0;                 ///< u0, v0 this far from the centre
-  double min_kdu = 0.0, max_kdu = 0.35;               ///< the lens drawn in
+  double min_kdu = 0.0, max_kdu = 0.35;               ///< the lens drawn in (ViSP's kdu)
+  /// Every camera this lens (e.g. OpenCV's model from a camera file) instead of drawn ones,
+  /// its views drawn afresh for each; the image size is then the lens's.
+  std::optional<Lens> lens;
   /// The views: the camera aimed near the sheet's middle from its near to far distances,
   /// tilted min..max_tilt_deg in any direction, any roll, the crossings in view.
   PoseSampling sampling;
@@ -46,11 +50,14 @@ struct CameraCalibrationTrial {
   double py_error_pct() const;
   double u0_error_px() const;
   double v0_error_px() const;
-  /// |kdu found - kdu true| as a fraction of its allowance, the larger of 3 % of the true kdu
-  /// and 0.005 (a lens with almost no distortion is judged absolutely): <= 1 passes.
-  double kdu_error() const;
-  double kdu_error_abs() const;
+  /// The worst distance between the ideal pixels the found and the true lens give the same
+  /// pixel, within kLensJudgedFraction of the way to the image's corners (beyond, the views
+  /// rarely reach and the lens is extrapolated), pixels.
+  double lens_error_px = 0.0;
 };
+
+/// How far towards the image's corners a calibrated lens is judged.
+constexpr double kLensJudgedFraction = 0.7;
 
 std::vector<CameraCalibrationTrial> EvaluateCalibration(
     const CalibrateAccuracyOptions& options,
