@@ -11,21 +11,10 @@
 #include "detector/lens.h"
 #include "eval/calibrate_accuracy.h"
 #include "io/camera_file.h"
+#include "io/json_io.h"
 
 namespace oal {
 namespace {
-
-nlohmann::json CameraJson(const Lens& camera) {
-  nlohmann::json json = {{"model", LensModelName(camera)},
-                         {"px", camera.px()},
-                         {"py", camera.py()},
-                         {"u0", camera.u0()},
-                         {"v0", camera.v0()},
-                         {"kdu", camera.kdu()},
-                         {"kud", camera.kud()}};
-  if (camera.model() == Lens::Model::kOpenCV) json["distortion"] = camera.distortion().ToArray();
-  return json;
-}
 
 // "kdu 0.2100" or "k1 -0.2664" (ViSP's or OpenCV's leading term).
 std::string LensText(const Lens& camera) {
@@ -101,9 +90,9 @@ nlohmann::json ToJson(const CalibrateAccuracyOptions& o,
   options["distance_m"] = {o.sampling.min_distance_m, o.sampling.max_distance_m};
   nlohmann::json cameras = nlohmann::json::array();
   for (const CameraCalibrationTrial& t : trials) {
-    nlohmann::json camera = {{"truth", CameraJson(t.truth)}, {"views", t.views}};
+    nlohmann::json camera = {{"truth", CameraJson(t.truth, o.width, o.height)}, {"views", t.views}};
     if (t.failed.empty()) {
-      camera["found"] = CameraJson(t.found);
+      camera["found"] = CameraJson(t.found, o.width, o.height);
       camera["used"] = t.used;
       camera["rms_px"] = t.rms_px;
       camera["px_error_pct"] = t.px_error_pct();

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <stdexcept>
@@ -38,6 +39,21 @@ void ParseChessboard(const std::string& text, ChessboardOptions* options) {
   options->rows = rows;
 }
 
+// "k1 <text>, k2 <text>, ..." over the distortion terms fitted (those fixed at zero left
+// out), `text` of each term's value and standard deviation.
+std::string FittedTerms(const CalibrationResult& result,
+                        const std::function<std::string(double, double)>& text) {
+  const auto values = result.camera.distortion().ToArray();
+  const auto sds = result.distortion_sd.ToArray();
+  std::string line;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (values[i] == 0.0 && sds[i] == 0.0) continue;
+    line += (line.empty() ? "" : ", ") + std::string(Distortion::kNames[i]) + " " +
+            text(values[i], sds[i]);
+  }
+  return line;
+}
+
 // `points`: what a view's points are ("corners", "stripe points").
 void PrintReport(const CalibrationResult& result, const std::string& points) {
   for (const CalibrationViewReport& view : result.views) {
@@ -54,15 +70,9 @@ void PrintReport(const CalibrationResult& result, const std::string& points) {
             << Fixed(camera.u0(), 2) << " +- " << Fixed(result.u0_sd, 2) << ", v0 "
             << Fixed(camera.v0(), 2) << " +- " << Fixed(result.v0_sd, 2) << " px\n";
   if (camera.distorted()) {
-    const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
-    const auto values = camera.distortion().ToArray(), sds = result.distortion_sd.ToArray();
-    std::string line;
-    for (std::size_t i = 0; i < values.size(); ++i) {
-      if (values[i] == 0.0 && sds[i] == 0.0) continue;
-      line += (line.empty() ? "" : ", ") + std::string(names[i]) + " " + Fixed(values[i], 5) +
-              " +- " + Fixed(sds[i], 5);
-    }
-    std::cout << LensModelName(camera) << ": " << line << '\n';
+    std::cout << LensModelName(camera) << ": " << FittedTerms(result, [](double value, double sd) {
+      return Fixed(value, 5) + " +- " + Fixed(sd, 5);
+    }) << '\n';
     for (const std::string& fixed : result.fixed_terms) std::cout << fixed << '\n';
   }
   std::cout << "reprojection RMS " << Fixed(result.rms_px, 3) << " px";
@@ -83,14 +93,7 @@ std::vector<std::string> FileComments(const CalibrationResult& result, CameraFil
       "standard deviations: px " + Fixed(result.px_sd, 3) + ", py " + Fixed(result.py_sd, 3) +
           ", u0 " + Fixed(result.u0_sd, 3) + ", v0 " + Fixed(result.v0_sd, 3) + " px"};
   if (camera.distorted()) {
-    const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
-    const auto values = camera.distortion().ToArray(), sds = result.distortion_sd.ToArray();
-    std::string line;
-    for (std::size_t i = 0; i < values.size(); ++i) {
-      if (values[i] == 0.0 && sds[i] == 0.0) continue;
-      line += (line.empty() ? "" : ", ") + std::string(names[i]) + " " + Fixed(sds[i], 6);
-    }
-    comments.back() += "; " + line;
+    comments.back() += "; " + FittedTerms(result, [](double, double sd) { return Fixed(sd, 6); });
     for (const std::string& fixed : result.fixed_terms) comments.push_back(fixed);
   }
   comments.push_back(format == CameraFileFormat::kViSPXml && camera.distorted()

@@ -28,10 +28,10 @@ void PrintCamera(const CameraFile& file, const std::string& path) {
   if (lens.model() == Lens::Model::kViSP) {
     std::cout << ", kud " << Fixed(lens.kud(), 6) << ", kdu " << Fixed(lens.kdu(), 6);
   } else if (lens.model() == Lens::Model::kOpenCV) {
-    const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
     const auto values = lens.distortion().ToArray();
     const std::size_t count = lens.distortion().IsRational() ? 8 : 5;
-    for (std::size_t i = 0; i < count; ++i) std::cout << ", " << names[i] << " " << values[i];
+    for (std::size_t i = 0; i < count; ++i)
+      std::cout << ", " << Distortion::kNames[i] << " " << values[i];
   }
   std::cout << '\n';
 }

@@ -135,6 +135,16 @@ struct Forward {
   return f;
 }
 
+// Calls f(u, v) on a 41 x 41 grid of pixels over a width x height image, its corners included:
+// where a lens is fitted to another over the image, and compared with it.
+template <typename F>
+void ForEachGridPixel(int width, int height, F&& f) {
+  constexpr int kSteps = 40;
+  for (int j = 0; j <= kSteps; ++j) {
+    for (int i = 0; i <= kSteps; ++i) f((width - 1.0) * i / kSteps, (height - 1.0) * j / kSteps);
+  }
+}
+
 }  // namespace
 
 double Lens::FoldRadius2(const Distortion& d) {
@@ -248,19 +258,15 @@ vpCameraParameters Lens::ViSPCamera(int width, int height) const {
   } else if (model_ == Model::kOpenCV) {
     // Least squares over a grid of the image's pixels of the ideal pixel error of
     // x = xd (1 + kdu rd^2): linear in kdu.
-    constexpr int kSteps = 40;
     double saa = 0.0, sab = 0.0;
-    for (int j = 0; j <= kSteps; ++j) {
-      for (int i = 0; i <= kSteps; ++i) {
-        const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-        const Point2d ideal = Normalised(u, v);
-        if (!std::isfinite(ideal.u)) continue;
-        const double xd = (u - u0_) / px_, yd = (v - v0_) / py_, rd2 = xd * xd + yd * yd;
-        const double au = px_ * xd * rd2, av = py_ * yd * rd2;
-        saa += au * au + av * av;
-        sab += au * px_ * (ideal.u - xd) + av * py_ * (ideal.v - yd);
-      }
-    }
+    ForEachGridPixel(width, height, [&](double u, double v) {
+      const Point2d ideal = Normalised(u, v);
+      if (!std::isfinite(ideal.u)) return;
+      const double xd = (u - u0_) / px_, yd = (v - v0_) / py_, rd2 = xd * xd + yd * yd;
+      const double au = px_ * xd * rd2, av = py_ * yd * rd2;
+      saa += au * au + av * av;
+      sab += au * px_ * (ideal.u - xd) + av * py_ * (ideal.v - yd);
+    });
     const double kdu = saa > 0.0 ? sab / saa : 0.0;
     const Lens one_term = WithKdu(px_, py_, u0_, v0_, kdu, width, height);
     camera.initPersProjWithDistortion(px_, py_, u0_, v0_, one_term.kud(), one_term.kdu());
@@ -273,25 +279,21 @@ Lens Lens::OpenCvCamera(int width, int height) const {
   // Minimise over a grid of distorted pixels (u, v) the distance from (u, v) to
   // u0 + px x (1 + k1 r^2 + k2 r^4 + k3 r^6) (and v), (x, y) the ideal point of (u, v): linear
   // in (k1, k2, k3), solved by its 3 x 3 normal equations.
-  constexpr int kSteps = 40;
   double a[3][3] = {}, b[3] = {};
-  for (int j = 0; j <= kSteps; ++j) {
-    for (int i = 0; i <= kSteps; ++i) {
-      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      const Point2d ideal = Normalised(u, v);
-      if (!std::isfinite(ideal.u)) continue;
-      const double r2 = ideal.u * ideal.u + ideal.v * ideal.v;
-      const double powers[3] = {r2, r2 * r2, r2 * r2 * r2};
-      const double bu = u - u0_ - px_ * ideal.u, bv = v - v0_ - py_ * ideal.v;
-      for (int r = 0; r < 3; ++r) {
-        const double ur = px_ * ideal.u * powers[r], vr = py_ * ideal.v * powers[r];
-        b[r] += ur * bu + vr * bv;
-        for (int c = 0; c < 3; ++c) {
-          a[r][c] += ur * px_ * ideal.u * powers[c] + vr * py_ * ideal.v * powers[c];
-        }
+  ForEachGridPixel(width, height, [&](double u, double v) {
+    const Point2d ideal = Normalised(u, v);
+    if (!std::isfinite(ideal.u)) return;
+    const double r2 = ideal.u * ideal.u + ideal.v * ideal.v;
+    const double powers[3] = {r2, r2 * r2, r2 * r2 * r2};
+    const double bu = u - u0_ - px_ * ideal.u, bv = v - v0_ - py_ * ideal.v;
+    for (int r = 0; r < 3; ++r) {
+      const double ur = px_ * ideal.u * powers[r], vr = py_ * ideal.v * powers[r];
+      b[r] += ur * bu + vr * bv;
+      for (int c = 0; c < 3; ++c) {
+        a[r][c] += ur * px_ * ideal.u * powers[c] + vr * py_ * ideal.v * powers[c];
       }
     }
-  }
+  });
   const auto det3 = [](const double m[3][3]) {
     return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
            m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
@@ -341,37 +343,29 @@ double FitKud(const Lens& lens, int width, int height) {
   if (lens.kdu() == 0.0) return 0.0;
   // Minimise sum over a grid of distorted pixels of |u0 + px x (1 + kud r^2) - u|^2 (and v),
   // (x, y) the ideal point of (u, v): linear in kud.
-  constexpr int kSteps = 40;
   double saa = 0.0, sab = 0.0;
-  for (int j = 0; j <= kSteps; ++j) {
-    for (int i = 0; i <= kSteps; ++i) {
-      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      const Point2d ideal = lens.Normalised(u, v);
-      const double x = ideal.u, y = ideal.v, r2 = x * x + y * y;
-      const double au = lens.px() * x * r2, av = lens.py() * y * r2;
-      const double bu = u - lens.u0() - lens.px() * x;
-      const double bv = v - lens.v0() - lens.py() * y;
-      saa += au * au + av * av;
-      sab += au * bu + av * bv;
-    }
-  }
+  ForEachGridPixel(width, height, [&](double u, double v) {
+    const Point2d ideal = lens.Normalised(u, v);
+    const double x = ideal.u, y = ideal.v, r2 = x * x + y * y;
+    const double au = lens.px() * x * r2, av = lens.py() * y * r2;
+    const double bu = u - lens.u0() - lens.px() * x;
+    const double bv = v - lens.v0() - lens.py() * y;
+    saa += au * au + av * av;
+    sab += au * bu + av * bv;
+  });
   return saa > 0.0 ? sab / saa : 0.0;
 }
 
 double WorstIdealPixelDifference(const Lens& a, const Lens& b, int width, int height,
                                  double max_radius_px) {
-  constexpr int kSteps = 40;
   double worst = 0.0;
-  for (int j = 0; j <= kSteps; ++j) {
-    for (int i = 0; i <= kSteps; ++i) {
-      const double u = (width - 1.0) * i / kSteps, v = (height - 1.0) * j / kSteps;
-      if (std::hypot(u - a.u0(), v - a.v0()) > max_radius_px) continue;
-      const Point2d p = a.Normalised(u, v), q = b.Normalised(u, v);
-      const double d = std::hypot(a.px() * p.u - b.px() * q.u + a.u0() - b.u0(),
-                                  a.py() * p.v - b.py() * q.v + a.v0() - b.v0());
-      worst = std::isfinite(d) ? std::max(worst, d) : std::numeric_limits<double>::infinity();
-    }
-  }
+  ForEachGridPixel(width, height, [&](double u, double v) {
+    if (std::hypot(u - a.u0(), v - a.v0()) > max_radius_px) return;
+    const Point2d p = a.Normalised(u, v), q = b.Normalised(u, v);
+    const double d = std::hypot(a.px() * p.u - b.px() * q.u + a.u0() - b.u0(),
+                                a.py() * p.v - b.py() * q.v + a.v0() - b.v0());
+    worst = std::isfinite(d) ? std::max(worst, d) : std::numeric_limits<double>::infinity();
+  });
   return worst;
 }
 
@@ -388,11 +382,10 @@ void CheckPerspectiveCamera(const Lens& lens, const std::string& field) {
   RequireOption(std::isfinite(lens.v0()), field + ".v0", lens.v0(), "v0 is finite");
   RequireOption(std::isfinite(lens.kdu()), field + ".kdu", lens.kdu(), "kdu is finite");
   RequireOption(std::isfinite(lens.kud()), field + ".kud", lens.kud(), "kud is finite");
-  const char* names[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
   const auto coefficients = lens.distortion().ToArray();
   for (std::size_t i = 0; i < coefficients.size(); ++i) {
-    RequireOption(std::isfinite(coefficients[i]), field + "." + names[i], coefficients[i],
-                  std::string(names[i]) + " is finite");
+    RequireOption(std::isfinite(coefficients[i]), field + "." + Distortion::kNames[i],
+                  coefficients[i], std::string(Distortion::kNames[i]) + " is finite");
   }
 }
 

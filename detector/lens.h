@@ -33,6 +33,10 @@ namespace oal {
 
 /// OpenCV's distortion coefficients, in calib3d's order (k1, k2, p1, p2, k3, k4, k5, k6).
 struct Distortion {
+  /// The coefficients' names, in calib3d's order.
+  static constexpr std::array<const char*, 8> kNames = {"k1", "k2", "p1", "p2",
+                                                        "k3", "k4", "k5", "k6"};
+
   double k1 = 0.0, k2 = 0.0, p1 = 0.0, p2 = 0.0, k3 = 0.0, k4 = 0.0, k5 = 0.0, k6 = 0.0;
 
   /// In calib3d's order.
