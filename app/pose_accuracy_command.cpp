@@ -16,8 +16,8 @@
 #include "base/format.h"
 #include "base/statistics.h"
 #include "eval/pose_accuracy.h"
-#include "io/camera_file.h"
 #include "io/atomic_file.h"
+#include "io/camera_file.h"
 #include "io/json_io.h"
 #include "io/rendered_dataset.h"
 #include "io/truth_file.h"
@@ -120,6 +120,8 @@ std::string MarkerTable(const PoseAccuracyReport& r) {
 nlohmann::json ToJson(const PoseAccuracyReport& r, const std::string& config_path) {
   const PoseAccuracyOptions& o = r.options;
   nlohmann::json options = RenderedFrameJson(o);
+  // The lens the pose was told, when it is not the rendered one (--pose-camera).
+  if (o.given_camera) options["pose_camera"] = CameraJson(*o.given_camera, o.width, o.height);
   options["target"] = o.target.name;
   options["min_distance_m"] = o.sampling.min_distance_m;
   options["max_distance_m"] = o.sampling.max_distance_m;

@@ -8,6 +8,7 @@
 #include "base/random.h"
 #include "detector/lens.h"
 #include "io/image_source.h"
+#include "io/json_io.h"
 
 namespace oal {
 namespace {
@@ -143,9 +144,7 @@ nlohmann::json RenderedFrameJson(const RenderedFrameOptions& options) {
                       {"illumination_gradient", options.illumination_gradient},
                       {"backgrounds", options.backgrounds}};
   if (options.camera) {
-    const Lens& c = *options.camera;
-    json["camera"] = {
-        {"px", c.px()}, {"py", c.py()}, {"u0", c.u0()}, {"v0", c.v0()}, {"kdu", c.kdu()}};
+    json["camera"] = CameraJson(*options.camera, options.width, options.height);
   }
   if (options.scene.lived_in.Any()) {
     const LivedInOptions& l = options.scene.lived_in;

@@ -16,6 +16,7 @@
 #include "app/detector_accuracy_command.h"
 #include "app/pose_accuracy_command.h"
 #include "eval/pose_accuracy.h"
+#include "io/camera_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
 
@@ -108,6 +109,31 @@ TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
             report.at("roll_error_deg_max").get<double>());
   EXPECT_THAT(run.out, HasSubstr("| roll error median / max (deg) |"));
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
+}
+
+// --camera renders through a lens in OpenCV's model, --pose-camera poses with another file
+// (here ViSP's one-term approximation of it): the report names both lenses; a --pose-camera that
+// is missing, or given with --estimate-distortion, is refused before any work.
+TEST(PoseAccuracy, TheRenderedAndThePosingLensesAreBothReported) {
+  test::TestDir dir;
+  const std::string lens = std::string(OAL_SOURCE_DIR) + "/config/lenses/opencv-sample.yaml";
+  SaveCameraFile(dir / "one-term.xml", LoadCameraFile(lens).camera, "Camera", 640, 480);
+  const test::OalservoRun run = test::RunOalservo(
+      dir, "pose-accuracy" + kFewFrames + " --camera '" + lens + "' --pose-camera '" +
+               dir / "one-term.xml" + "' --out '" + dir / "report.json" + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json options = json::parse(test::ReadText(dir / "report.json")).at("options");
+  EXPECT_EQ(options.at("camera").at("model"), "plumb_bob");
+  EXPECT_EQ(options.at("pose_camera").at("model"), "perspectiveProjWithDistortion");
+  const test::OalservoRun missing =
+      test::RunOalservo(dir, "pose-accuracy --frames 1 --pose-camera '" + dir / "none.yaml" + "'");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.err, HasSubstr("--pose-camera"));
+  const test::OalservoRun both =
+      test::RunOalservo(dir, "pose-accuracy --frames 1 --estimate-distortion --pose-camera '" +
+                                 dir / "one-term.xml" + "'");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_THAT(both.err, HasSubstr("excludes"));
 }
 
 // --marker apriltag: the AprilTag printed on the sheet instead of the stripes, on the same three
