@@ -49,6 +49,19 @@ double Reach(const std::vector<std::vector<cv::Point2f>>& image_points, const cv
 // more than this (metres), or this many solves.
 constexpr double kPairingSettledM = 1e-6;
 constexpr int kMaxPairingRounds = 40;
+constexpr double kOverRelax = 1.0;
+// A run crosses its stripe from edge to edge when its ends lie this far inside the stripe's
+// printed ends (times its width) and it spans its width within this fraction (the runs of a
+// blurred stripe are a few tenths of a pixel short).
+constexpr double kRunEndMarginWidths = 0.5;
+constexpr double kRunSpanTolerance = 0.3;
+// Runs' middles are moved again after each solve (CentreRuns) until none moves by more than
+// this, pixels.
+constexpr double kCentringSettledPx = 1e-3;
+// The polish on the lines' distances stops when a step lowers their sum of squares by less than
+// this fraction, or after this many steps.
+constexpr double kPolishSettled = 1e-10;
+constexpr int kPolishIterations = 50;
 // A line point farther from its line than this many robust standard deviations of them all is
 // left out, but not nearer than the floor (pixels).
 constexpr double kOutlierSigmas = 4.0;
@@ -76,13 +89,19 @@ double TiltDeg(const cv::Mat& rvec) {
 // the plane, moved across onto the line. Pairing again after each solve converges to the
 // points' fit across their lines: along a line, the pairing leaves no residual.
 struct LinePairing {
-  std::vector<cv::Point2d> seen;     // distorted pixels
+  std::vector<cv::Point2d> seen;     // distorted pixels, a run's middle moved (CentreRuns)
+  std::vector<cv::Point2d> middle;   // as given
+  std::vector<cv::Point2d> run;      // the run across its stripe, (0, 0) when unknown
   std::vector<std::size_t> line_of;  // index in the view's lines
   std::vector<cv::Point2d> paired;   // plane, metres
   std::vector<char> outlier;         // left out of the solve, for now (MarkOutliers)
+  std::vector<char> partial_run;     // a run not across its stripe, for now (CentreRuns)
 
+  bool used(std::size_t k) const { return !outlier[k] && !partial_run[k]; }
   std::size_t kept() const {
-    return seen.size() - static_cast<std::size_t>(std::count(outlier.begin(), outlier.end(), 1));
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < seen.size(); ++k) count += used(k);
+    return count;
   }
 };
 
@@ -91,15 +110,124 @@ LinePairing PairThroughHomography(const CalibrationView& view, const cv::Matx33d
   const cv::Matx33d image_to_plane = plane_to_image.inv();
   for (std::size_t l = 0; l < view.lines.size(); ++l) {
     const PlaneLine line = OnPlane(view.lines[l]);
-    for (const Point2d& p : view.lines[l].seen) {
+    const CalibrationLine& seen_line = view.lines[l];
+    for (std::size_t k = 0; k < seen_line.seen.size(); ++k) {
+      const Point2d& p = seen_line.seen[k];
       const cv::Vec3d q = image_to_plane * cv::Vec3d(p.u, p.v, 1.0);
       pairing.seen.emplace_back(p.u, p.v);
+      pairing.middle.emplace_back(p.u, p.v);
+      const bool has_run = seen_line.width_m > 0.0 && k < seen_line.runs.size();
+      pairing.run.push_back(has_run ? cv::Point2d(seen_line.runs[k].u, seen_line.runs[k].v)
+                                    : cv::Point2d(0.0, 0.0));
       pairing.line_of.push_back(l);
       pairing.paired.push_back(Snap(line, cv::Point2d(q[0] / q[2], q[1] / q[2])));
       pairing.outlier.push_back(0);
+      pairing.partial_run.push_back(0);
     }
   }
   return pairing;
+}
+
+// The camera a solve has reached, as a Lens.
+Lens SolvedLens(const cv::Mat& camera_matrix, const cv::Mat& distortion) {
+  std::array<double, 8> coefficients{};
+  for (int i = 0; i < distortion.rows * distortion.cols && i < 8; ++i) {
+    coefficients[static_cast<std::size_t>(i)] = distortion.at<double>(i);
+  }
+  return Lens::WithDistortion(camera_matrix.at<double>(0, 0), camera_matrix.at<double>(1, 1),
+                              camera_matrix.at<double>(0, 2), camera_matrix.at<double>(1, 2),
+                              Distortion::FromArray(coefficients));
+}
+
+// Where the solved camera and view pose take distorted pixels back to the view's plane: each
+// pixel's ray meets it (NaN for a ray along it).
+std::vector<cv::Point2d> OnViewPlane(const std::vector<cv::Point2d>& pixels,
+                                     const cv::Mat& camera_matrix, const cv::Mat& distortion,
+                                     const cv::Mat& rvec, const cv::Mat& tvec) {
+  std::vector<cv::Point2d> plane;
+  if (pixels.empty()) return plane;
+  // Through the lens's own Newton solve: cv::undistortPoints' five fixed-point steps leave a
+  // strong lens's outer points pixels off, and the pairing would settle where they put them.
+  const Lens lens = SolvedLens(camera_matrix, distortion);
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  const cv::Matx33d plane_from_camera = rotation.t();
+  const cv::Vec3d centre = -(plane_from_camera * cv::Vec3d(tvec));
+  for (const cv::Point2d& pixel : pixels) {
+    const Point2d x = lens.Normalised(pixel.x, pixel.y);
+    const cv::Vec3d ray = plane_from_camera * cv::Vec3d(x.u, x.v, 1.0);
+    const double s = std::fabs(ray[2]) < 1e-12 ? std::nan("") : -centre[2] / ray[2];
+    plane.emplace_back(centre[0] + s * ray[0], centre[1] + s * ray[1]);
+  }
+  return plane;
+}
+
+// Where along a run, t in [-1, 1] from one end to the other, the quadratic through the runs'
+// ends and middle, `across` at t = -1, 0, 1, reaches `value` (Newton from the chord's answer).
+double WhereAcross(const std::array<double, 3>& across, double value) {
+  const double c0 = across[1], c1 = 0.5 * (across[2] - across[0]),
+               c2 = 0.5 * (across[2] + across[0]) - across[1];
+  double t = (value - c0) / c1;
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    t -= (c0 + t * (c1 + t * c2) - value) / (c1 + 2.0 * t * c2);
+  }
+  return t;
+}
+
+// Moves each run's middle along its run to where the solved camera and view pose put the
+// centre line of its stripe: the middle of a run between the images of the two edges is off
+// the image of the centre line, by how perspective and the lens bend the stripe across
+// (hundredths of a pixel, a tenth near the corners of a strong lens: enough to bias the focal
+// length and the lens if left). Each run's span is taken back to the plane at its ends and
+// middle; where it crosses the edges and the centre follows from the quadratic through them.
+// Returns the largest change of a point's move, pixels (infinite when a run was left out or
+// taken back).
+double CentreRuns(const CalibrationView& view, const cv::Mat& camera_matrix,
+                  const cv::Mat& distortion, const cv::Mat& rvec, const cv::Mat& tvec,
+                  LinePairing* pairing) {
+  std::vector<std::size_t> with_run;
+  std::vector<cv::Point2d> samples;
+  for (std::size_t k = 0; k < pairing->seen.size(); ++k) {
+    if (pairing->run[k] == cv::Point2d(0.0, 0.0)) continue;
+    with_run.push_back(k);
+    for (const double t : {-0.5, 0.0, 0.5})
+      samples.push_back(pairing->middle[k] + t * pairing->run[k]);
+  }
+  const std::vector<cv::Point2d> plane =
+      OnViewPlane(samples, camera_matrix, distortion, rvec, tvec);
+  double changed = 0.0;
+  for (std::size_t i = 0; i < with_run.size(); ++i) {
+    const std::size_t k = with_run[i];
+    const CalibrationLine& seen_line = view.lines[pairing->line_of[k]];
+    const PlaneLine line = OnPlane(seen_line);
+    std::array<double, 3> across{};
+    for (std::size_t j = 0; j < 3; ++j) {
+      across[j] = (plane[3 * i + j] - line.point).cross(line.direction);
+    }
+    const double half = 0.5 * seen_line.width_m;
+    // A run that does not cross its stripe from edge to edge (one through the stripe's end,
+    // cut short by a mark, or run on into a shadow) has its middle off the centre line by
+    // pixels; it is left out while the camera says so.
+    const double length = std::hypot(seen_line.dx, seen_line.dy);
+    const double margin = kRunEndMarginWidths * seen_line.width_m;
+    bool across_stripe =
+        std::fabs(std::fabs(across[2] - across[0]) / seen_line.width_m - 1.0) < kRunSpanTolerance;
+    for (const std::size_t j : {std::size_t{0}, std::size_t{2}}) {
+      const double along = (plane[3 * i + j] - line.point).dot(line.direction);
+      across_stripe = across_stripe && along > margin && along < length - margin;
+    }
+    if (pairing->partial_run[k] != (across_stripe ? 0 : 1)) changed = HUGE_VAL;
+    pairing->partial_run[k] = across_stripe ? 0 : 1;
+    const double shift =
+        WhereAcross(across, 0.0) - 0.5 * (WhereAcross(across, -half) + WhereAcross(across, half));
+    // A shift beyond a tenth of the run: a camera too far off yet to say.
+    const cv::Point2d seen = std::fabs(shift) < 0.1
+                                 ? pairing->middle[k] + 0.5 * shift * pairing->run[k]
+                                 : pairing->middle[k];
+    changed = std::max(changed, cv::norm(seen - pairing->seen[k]));
+    pairing->seen[k] = seen;
+  }
+  return changed;
 }
 
 // Pairs again through the solved camera: each seen point's ray meets the plane of the view.
@@ -107,24 +235,239 @@ LinePairing PairThroughHomography(const CalibrationView& view, const cv::Matx33d
 double PairThroughCamera(const CalibrationView& view, const cv::Mat& camera_matrix,
                          const cv::Mat& distortion, const cv::Mat& rvec, const cv::Mat& tvec,
                          LinePairing* pairing) {
-  if (pairing->seen.empty()) return 0.0;
-  std::vector<cv::Point2d> ideal;
-  cv::undistortPoints(pairing->seen, ideal, camera_matrix, distortion);
-  cv::Matx33d rotation;
-  cv::Rodrigues(rvec, rotation);
-  const cv::Matx33d plane_from_camera = rotation.t();
-  const cv::Vec3d centre = -(plane_from_camera * cv::Vec3d(tvec));
+  const std::vector<cv::Point2d> plane =
+      OnViewPlane(pairing->seen, camera_matrix, distortion, rvec, tvec);
   double moved = 0.0;
-  for (std::size_t k = 0; k < ideal.size(); ++k) {
-    const cv::Vec3d ray = plane_from_camera * cv::Vec3d(ideal[k].x, ideal[k].y, 1.0);
-    if (std::fabs(ray[2]) < 1e-12) continue;
-    const double s = -centre[2] / ray[2];
-    const cv::Point2d q(centre[0] + s * ray[0], centre[1] + s * ray[1]);
+  for (std::size_t k = 0; k < plane.size(); ++k) {
+    const cv::Point2d& q = plane[k];
+    if (!std::isfinite(q.x) || !std::isfinite(q.y)) continue;
     const cv::Point2d snapped = Snap(OnPlane(view.lines[pairing->line_of[k]]), q);
     moved = std::max(moved, cv::norm(snapped - pairing->paired[k]));
-    pairing->paired[k] = snapped;
+    pairing->paired[k] += kOverRelax * (snapped - pairing->paired[k]);
   }
   return moved;
+}
+
+// The distortion terms a solve's flags leave free, as indices in the distortion vector.
+std::vector<int> FreeDistortionTerms(int flags, int terms) {
+  std::vector<int> free;
+  const auto open = [&](int index, int fix) {
+    if (index < terms && !(flags & fix)) free.push_back(index);
+  };
+  open(0, cv::CALIB_FIX_K1);
+  open(1, cv::CALIB_FIX_K2);
+  open(2, cv::CALIB_ZERO_TANGENT_DIST);
+  open(3, cv::CALIB_ZERO_TANGENT_DIST);
+  open(4, cv::CALIB_FIX_K3);
+  if (flags & cv::CALIB_RATIONAL_MODEL) {
+    open(5, cv::CALIB_FIX_K4);
+    open(6, cv::CALIB_FIX_K5);
+    open(7, cv::CALIB_FIX_K6);
+  }
+  return free;
+}
+
+// The camera and view poses after calibrateCamera, their deviations and the fit's RMS, as
+// PolishAcrossLines leaves them.
+struct Solution {
+  cv::Mat camera_matrix, distortion;
+  std::vector<cv::Mat> rvecs, tvecs;
+  cv::Mat sd_intrinsics;  // fx, fy, cx, cy, then the distortion terms: OpenCV's order
+  cv::Mat view_errors;    // RMS of each view's points
+  double rms_px = 0.0;
+};
+
+// One view's rows of the polish: the residuals (pixels) and their derivatives by the
+// intrinsics (fx, fy, cx, cy, every distortion term) and by the view's pose (rvec, tvec).
+// A known point gives two rows (u, v); a point on a line one: its distance across the line's
+// image, the projection of its paired plane point minus where it is seen, along the normal
+// of the line's image there. The pairing slides along the line only, so holding it while
+// differentiating leaves the derivative across the line exact to first order.
+struct ViewRows {
+  std::vector<double> residuals;
+  cv::Mat by_intrinsics, by_pose;  // rows x (4 + terms), rows x 6
+  int points = 0;
+};
+
+ViewRows RowsOf(const CalibrationView& view, const LinePairing& pairing, const Solution& solution,
+                std::size_t i) {
+  std::vector<cv::Point3d> object;
+  for (const CalibrationPoint& point : view.points) object.emplace_back(point.x, point.y, 0.0);
+  std::vector<std::size_t> line_points;
+  for (std::size_t k = 0; k < pairing.seen.size(); ++k) {
+    if (!pairing.used(k)) continue;
+    line_points.push_back(k);
+    const cv::Point2d direction = OnPlane(view.lines[pairing.line_of[k]]).direction;
+    const cv::Point2d q = pairing.paired[k];
+    object.emplace_back(q.x, q.y, 0.0);
+    // A step along the line, for the direction of its image there.
+    object.emplace_back(q.x + 1e-3 * direction.x, q.y + 1e-3 * direction.y, 0.0);
+  }
+  ViewRows rows;
+  const int terms = solution.distortion.rows * solution.distortion.cols;
+  const int rows_count =
+      2 * static_cast<int>(view.points.size()) + static_cast<int>(line_points.size());
+  rows.by_intrinsics = cv::Mat::zeros(rows_count, 4 + terms, CV_64F);
+  rows.by_pose = cv::Mat::zeros(rows_count, 6, CV_64F);
+  rows.points = static_cast<int>(view.points.size() + line_points.size());
+  if (object.empty()) return rows;
+  std::vector<cv::Point2d> image;
+  cv::Mat jacobian;  // 2 per point: rvec, tvec, fx, fy, cx, cy, the distortion terms
+  cv::projectPoints(object, solution.rvecs[i], solution.tvecs[i], solution.camera_matrix,
+                    solution.distortion, image, jacobian);
+  const auto add_row = [&](int row, int point, double nu, double nv, double residual) {
+    rows.residuals.push_back(residual);
+    for (int c = 0; c < 6; ++c) {
+      rows.by_pose.at<double>(row, c) =
+          nu * jacobian.at<double>(2 * point, c) + nv * jacobian.at<double>(2 * point + 1, c);
+    }
+    for (int c = 0; c < 4 + terms; ++c) {
+      rows.by_intrinsics.at<double>(row, c) = nu * jacobian.at<double>(2 * point, 6 + c) +
+                                              nv * jacobian.at<double>(2 * point + 1, 6 + c);
+    }
+  };
+  int row = 0;
+  for (std::size_t p = 0; p < view.points.size(); ++p) {
+    const int point = static_cast<int>(p);
+    add_row(row++, point, 1.0, 0.0, image[p].x - view.points[p].u);
+    add_row(row++, point, 0.0, 1.0, image[p].y - view.points[p].v);
+  }
+  for (std::size_t j = 0; j < line_points.size(); ++j) {
+    const int point = static_cast<int>(view.points.size() + 2 * j);
+    const cv::Point2d tangent =
+        image[static_cast<std::size_t>(point) + 1] - image[static_cast<std::size_t>(point)];
+    const double length = cv::norm(tangent);
+    const double nu = -tangent.y / length, nv = tangent.x / length;
+    const cv::Point2d off = image[static_cast<std::size_t>(point)] - pairing.seen[line_points[j]];
+    add_row(row++, point, nu, nv, nu * off.x + nv * off.y);
+  }
+  return rows;
+}
+
+// Polishes the camera and the view poses on what the line points tell: their distances across
+// their lines, each point free to slide along its line (Levenberg-Marquardt on the distances,
+// each point paired again with its line after each step). calibrateCamera measures a line
+// point's distance to a paired plane point fixed during each solve, so the pairing creeps
+// along the lines over dozens of solves and stops short, the focal length a few tenths of a
+// percent off under a strong lens; here it follows each step. Known points keep their two
+// rows. The deviations come from this fit's normal equations.
+void PolishAcrossLines(const std::vector<const CalibrationView*>& views, int flags,
+                       std::vector<LinePairing>* pairings, Solution* solution) {
+  const int terms = solution->distortion.rows * solution->distortion.cols;
+  const std::vector<int> free = FreeDistortionTerms(flags, terms);
+  const int intrinsics = 4 + static_cast<int>(free.size());
+  const int unknowns = intrinsics + 6 * static_cast<int>(views.size());
+  const auto repair = [&](Solution* at) {
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      CentreRuns(*views[i], at->camera_matrix, at->distortion, at->rvecs[i], at->tvecs[i],
+                 &(*pairings)[i]);
+      PairThroughCamera(*views[i], at->camera_matrix, at->distortion, at->rvecs[i], at->tvecs[i],
+                        &(*pairings)[i]);
+    }
+  };
+  const auto cost_of = [&](const Solution& at, std::vector<ViewRows>* rows) {
+    double cost = 0.0;
+    rows->clear();
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      rows->push_back(RowsOf(*views[i], (*pairings)[i], at, i));
+      for (const double r : rows->back().residuals) cost += r * r;
+    }
+    return cost;
+  };
+  repair(solution);
+  std::vector<ViewRows> rows;
+  double cost = cost_of(*solution, &rows);
+  double damping = 1e-3;
+  cv::Mat normal;
+  for (int iteration = 0; iteration < kPolishIterations; ++iteration) {
+    normal = cv::Mat::zeros(unknowns, unknowns, CV_64F);
+    cv::Mat gradient = cv::Mat::zeros(unknowns, 1, CV_64F);
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      // This view's columns: the free intrinsics, then its pose.
+      cv::Mat columns(static_cast<int>(rows[i].residuals.size()), intrinsics + 6, CV_64F);
+      for (int c = 0; c < 4; ++c) rows[i].by_intrinsics.col(c).copyTo(columns.col(c));
+      for (std::size_t t = 0; t < free.size(); ++t) {
+        rows[i].by_intrinsics.col(4 + free[t]).copyTo(columns.col(4 + static_cast<int>(t)));
+      }
+      rows[i].by_pose.copyTo(columns.colRange(intrinsics, intrinsics + 6));
+      const cv::Mat residuals(rows[i].residuals, false);
+      const cv::Mat block = columns.t() * columns, pulled = columns.t() * residuals;
+      const int pose = intrinsics + 6 * static_cast<int>(i);
+      std::vector<int> index(static_cast<std::size_t>(intrinsics + 6));
+      for (int c = 0; c < intrinsics; ++c) index[static_cast<std::size_t>(c)] = c;
+      for (int c = 0; c < 6; ++c) index[static_cast<std::size_t>(intrinsics + c)] = pose + c;
+      for (int a = 0; a < intrinsics + 6; ++a) {
+        gradient.at<double>(index[static_cast<std::size_t>(a)]) += pulled.at<double>(a);
+        for (int b = 0; b < intrinsics + 6; ++b) {
+          normal.at<double>(index[static_cast<std::size_t>(a)],
+                            index[static_cast<std::size_t>(b)]) += block.at<double>(a, b);
+        }
+      }
+    }
+    bool improved = false;
+    while (damping < 1e8) {
+      cv::Mat damped = normal.clone();
+      for (int d = 0; d < unknowns; ++d) damped.at<double>(d, d) *= 1.0 + damping;
+      cv::Mat step;
+      if (!cv::solve(damped, -gradient, step, cv::DECOMP_CHOLESKY)) {
+        damping *= 10.0;
+        continue;
+      }
+      Solution next = *solution;
+      next.camera_matrix = solution->camera_matrix.clone();
+      next.distortion = solution->distortion.clone();
+      next.camera_matrix.at<double>(0, 0) += step.at<double>(0);
+      next.camera_matrix.at<double>(1, 1) += step.at<double>(1);
+      next.camera_matrix.at<double>(0, 2) += step.at<double>(2);
+      next.camera_matrix.at<double>(1, 2) += step.at<double>(3);
+      for (std::size_t t = 0; t < free.size(); ++t) {
+        next.distortion.at<double>(free[t]) += step.at<double>(4 + static_cast<int>(t));
+      }
+      for (std::size_t i = 0; i < views.size(); ++i) {
+        const int pose = intrinsics + 6 * static_cast<int>(i);
+        next.rvecs[i] = solution->rvecs[i] + step.rowRange(pose, pose + 3);
+        next.tvecs[i] = solution->tvecs[i] + step.rowRange(pose + 3, pose + 6);
+      }
+      const std::vector<LinePairing> before = *pairings;
+      repair(&next);
+      std::vector<ViewRows> next_rows;
+      const double next_cost = cost_of(next, &next_rows);
+      if (next_cost <= cost) {
+        const bool settled = cost - next_cost <= kPolishSettled * cost;
+        *solution = next;
+        rows = std::move(next_rows);
+        cost = next_cost;
+        damping = std::max(damping / 10.0, 1e-9);
+        improved = !settled;
+        break;
+      }
+      *pairings = before;
+      damping *= 10.0;
+    }
+    if (!improved) break;
+  }
+
+  // The fit's deviations, from its normal equations at the solution.
+  int residual_count = 0, points = 0;
+  std::vector<double> view_errors;
+  for (const ViewRows& view : rows) {
+    double sum = 0.0;
+    for (const double r : view.residuals) sum += r * r;
+    residual_count += static_cast<int>(view.residuals.size());
+    points += view.points;
+    view_errors.push_back(view.points > 0 ? std::sqrt(sum / view.points) : 0.0);
+  }
+  solution->rms_px = points > 0 ? std::sqrt(cost / points) : 0.0;
+  solution->view_errors = cv::Mat(view_errors, true);
+  solution->sd_intrinsics = cv::Mat::zeros(4 + 8, 1, CV_64F);
+  cv::Mat covariance;
+  if (residual_count > unknowns && cv::invert(normal, covariance, cv::DECOMP_CHOLESKY) != 0.0) {
+    const double variance = cost / (residual_count - unknowns);
+    for (int c = 0; c < intrinsics; ++c) {
+      const int at = c < 4 ? c : 4 + free[static_cast<std::size_t>(c - 4)];
+      solution->sd_intrinsics.at<double>(at) = std::sqrt(variance * covariance.at<double>(c, c));
+    }
+  }
 }
 
 // Marks as outliers the line points the solved camera leaves farther from their lines than
@@ -278,6 +621,26 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   // outliers, their pairing) remains.
   std::vector<LinePairing> first_pairings(views.size());  // by index in `views`
   for (std::size_t i = 0; i < used.size(); ++i) first_pairings[used[i]] = pairings[i];
+  // The solver's points: the known points and the line points used, paired.
+  const auto gather = [&]() {
+    object_points.clear();
+    image_points.clear();
+    for (std::size_t i = 0; i < used_views.size(); ++i) {
+      std::vector<cv::Point3f>& object = object_points.emplace_back();
+      std::vector<cv::Point2f>& image = image_points.emplace_back();
+      for (const CalibrationPoint& point : used_views[i]->points) {
+        object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
+        image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
+      }
+      for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
+        if (!pairings[i].used(k)) continue;
+        object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
+                            static_cast<float>(pairings[i].paired[k].y), 0.0f);
+        image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
+                           static_cast<float>(pairings[i].seen[k].y));
+      }
+    }
+  };
   const auto solve = [&](int solve_flags, bool from_previous) {
     for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
       // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
@@ -302,30 +665,16 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
         for (const std::size_t k : used) pairings.push_back(first_pairings[k]);
         pairing_round = 0;
       }
-      object_points.clear();
-      image_points.clear();
-      for (std::size_t i = 0; i < used_views.size(); ++i) {
-        std::vector<cv::Point3f>& object = object_points.emplace_back();
-        std::vector<cv::Point2f>& image = image_points.emplace_back();
-        for (const CalibrationPoint& point : used_views[i]->points) {
-          object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
-          image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
-        }
-        for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
-          if (pairings[i].outlier[k]) continue;
-          object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
-                              static_cast<float>(pairings[i].paired[k].y), 0.0f);
-          image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
-                             static_cast<float>(pairings[i].seen[k].y));
-        }
-      }
+      gather();
       const bool guess = pairing_round > 0 || from_previous;
       result.rms_px = cv::calibrateCamera(
           object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
           distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors,
           guess ? solve_flags | cv::CALIB_USE_INTRINSIC_GUESS : solve_flags, stop);
-      double moved = 0.0;
+      double moved = 0.0, centred = 0.0;
       for (std::size_t i = 0; i < used_views.size() && any_lines; ++i) {
+        centred = std::max(centred, CentreRuns(*used_views[i], camera_matrix, distortion, rvecs[i],
+                                               tvecs[i], &pairings[i]));
         moved = std::max(moved, PairThroughCamera(*used_views[i], camera_matrix, distortion,
                                                   rvecs[i], tvecs[i], &pairings[i]));
       }
@@ -338,8 +687,20 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
       const int changed =
           any_lines ? MarkOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
                     : 0;
-      if (moved < kPairingSettledM && changed == 0) break;
+      if (moved < kPairingSettledM && centred < kCentringSettledPx && changed == 0) break;
     }
+    if (!any_lines) return;
+    Solution solution{camera_matrix, distortion,  rvecs,        tvecs,
+                      sd_intrinsics, view_errors, result.rms_px};
+    PolishAcrossLines(used_views, solve_flags, &pairings, &solution);
+    camera_matrix = solution.camera_matrix;
+    distortion = solution.distortion;
+    rvecs = solution.rvecs;
+    tvecs = solution.tvecs;
+    sd_intrinsics = solution.sd_intrinsics;
+    view_errors = solution.view_errors;
+    result.rms_px = solution.rms_px;
+    gather();
   };
   solve(flags, false);
   if (options.estimate_distortion) {

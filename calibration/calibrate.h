@@ -33,6 +33,15 @@ struct CalibrationLine {
   double x = 0.0, y = 0.0;    ///< a point of the line on the target's plane, metres
   double dx = 1.0, dy = 0.0;  ///< its direction on the plane (any length > 0)
   std::vector<Point2d> seen;  ///< distorted pixels of points on it (e.g. a stripe's middle)
+  /// When `seen` are the middles of dark runs across a stripe printed along the line: the
+  /// stripe's width (metres, > 0) and each point's run (its length times its direction,
+  /// distorted pixels; (0, 0) when unknown). Under perspective and a lens a run's middle is
+  /// off the image of the centre line; Calibrate moves each along its run to where the camera
+  /// it solves puts the centre line, and leaves out a run that does not cross the stripe
+  /// from edge to edge; the stripe's printed ends are then (x, y) and (x + dx, y + dy).
+  /// Empty: the points lie on the line itself.
+  double width_m = 0.0;
+  std::vector<Point2d> runs;
 };
 
 struct CalibrationView {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 
 #include "base/check.h"
@@ -47,14 +48,25 @@ void SheetViewOptions::Check() const {
 }
 
 CalibrationView SheetView(const LineTarget& target, const std::vector<std::vector<Point2d>>& seen,
-                          std::string name, const SheetViewOptions& options) {
+                          std::string name, const SheetViewOptions& options,
+                          const std::vector<std::vector<Point2d>>& runs) {
   options.Check();
+  if (!runs.empty() && runs.size() != seen.size()) {
+    throw std::invalid_argument("SheetView: one list of runs per stripe");
+  }
   CalibrationView all{std::move(name), {}, {}};
   std::vector<std::size_t> stripe_of;
   for (std::size_t k = 0; k < target.lines.size() && k < seen.size(); ++k) {
     if (static_cast<int>(seen[k].size()) < options.min_points_per_stripe) continue;
     CalibrationLine line = CentreLine(target.lines[k]);
     line.seen = seen[k];
+    if (!runs.empty()) {
+      if (runs[k].size() != seen[k].size()) {
+        throw std::invalid_argument("SheetView: one run per seen point");
+      }
+      line.runs = runs[k];
+      line.width_m = target.lines[k].width_m;
+    }
     all.lines.push_back(std::move(line));
     stripe_of.push_back(k);
   }
@@ -65,7 +77,9 @@ CalibrationView SheetView(const LineTarget& target, const std::vector<std::vecto
   for (std::size_t l = 0; l < all.lines.size(); ++l) {
     CalibrationLine kept = all.lines[l];
     kept.seen.clear();
-    for (const Point2d& p : all.lines[l].seen) {
+    kept.runs.clear();
+    for (std::size_t i = 0; i < all.lines[l].seen.size(); ++i) {
+      const Point2d& p = all.lines[l].seen[i];
       const cv::Vec3d h = image_to_plane * cv::Vec3d(p.u, p.v, 1.0);
       const cv::Point2d q(h[0] / h[2], h[1] / h[2]);
       bool keep = Outside(target.lines[stripe_of[l]], q) <= options.off_own_stripe_m;
@@ -73,7 +87,9 @@ CalibrationView SheetView(const LineTarget& target, const std::vector<std::vecto
         if (other == stripe_of[l]) continue;
         keep = Outside(target.lines[other], q) >= options.clear_of_other_stripes_m;
       }
-      if (keep) kept.seen.push_back(p);
+      if (!keep) continue;
+      kept.seen.push_back(p);
+      if (!all.lines[l].runs.empty()) kept.runs.push_back(all.lines[l].runs[i]);
     }
     if (static_cast<int>(kept.seen.size()) >= options.min_points_per_stripe) {
       view.lines.push_back(std::move(kept));

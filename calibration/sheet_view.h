@@ -28,8 +28,11 @@ struct SheetViewOptions {
 /// `seen[k]` are distorted pixels of points along `target.lines[k]` (e.g. the middles of the
 /// stripe's dark runs). The view has those of them that stay clear of the other stripes and
 /// on their own, judged on the plane through the homography of the stripes' crossings; with
-/// fewer than four crossings seen it has no lines (Calibrate then says why).
+/// fewer than four crossings seen it has no lines (Calibrate then says why). `runs`, when
+/// given, holds each seen point's run across its stripe (CalibrationLine::runs): the points
+/// are the runs' middles, which Calibrate moves onto the centre line through the lens.
 CalibrationView SheetView(const LineTarget& target, const std::vector<std::vector<Point2d>>& seen,
-                          std::string name, const SheetViewOptions& options = SheetViewOptions());
+                          std::string name, const SheetViewOptions& options = SheetViewOptions(),
+                          const std::vector<std::vector<Point2d>>& runs = {});
 
 }  // namespace oal

@@ -215,15 +215,24 @@ std::array<std::vector<Point2d>, 4> TargetPoseTracker::StripePoints(double toler
   std::array<std::vector<Point2d>, 4> stripes;
   if (frame_.status != TargetStatus::kOk) return stripes;
   const vpHomography plane_to_image = PlaneToImage(frame_.pose.cMo);
-  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(plane_to_image);
+  const std::array<std::vector<FramePoint>, 4> runs = StripeRuns(tolerance_px);
   for (std::size_t k = 0; k < 4; ++k) {
-    const LineParams& line = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
     const StripeOutline stripe =
         StripeOutline::Of(layout_, static_cast<int>(k), plane_to_image, camera_);
-    ForEachPointOnStretch(line, detector_.feature_points(), tolerance_px, ends[k],
-                          [&](const FramePoint& point, double, double) {
-                            stripes[k].push_back(stripe.CentreOfRun(point));
-                          });
+    for (const FramePoint& point : runs[k]) stripes[k].push_back(stripe.CentreOfRun(point));
+  }
+  return stripes;
+}
+
+std::array<std::vector<FramePoint>, 4> TargetPoseTracker::StripeRuns(double tolerance_px) const {
+  std::array<std::vector<FramePoint>, 4> stripes;
+  if (frame_.status != TargetStatus::kOk) return stripes;
+  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(PlaneToImage(frame_.pose.cMo));
+  for (std::size_t k = 0; k < 4; ++k) {
+    const LineParams& line = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
+    ForEachPointOnStretch(
+        line, detector_.feature_points(), tolerance_px, ends[k],
+        [&](const FramePoint& point, double, double) { stripes[k].push_back(point); });
   }
   return stripes;
 }

@@ -212,6 +212,10 @@ class TargetPoseTracker {
   /// along its run onto the image of the stripe's centre line as the pose projects it (under
   /// perspective a run's middle is not on it).
   std::array<std::vector<Point2d>, 4> StripePoints(double tolerance_px) const;
+  /// StripePoints' feature points as the detector found them: each run's middle and the run
+  /// across the stripe (FramePoint::across_u, across_v), not moved. For those who model the
+  /// runs' middles themselves, through a lens the tracker's camera does not know.
+  std::array<std::vector<FramePoint>, 4> StripeRuns(double tolerance_px) const;
   /// The lines of the last scan that gave the frame's pose (or of the last scan), best first.
   const std::vector<DetectedLine>& lines() const { return lines_; }
   const OalDetector& detector() const { return detector_; }

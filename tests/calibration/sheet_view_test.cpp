@@ -101,6 +101,59 @@ TEST(CalibrateFromTheSheet, RecoversTheIntrinsicsAndTheLensFromTheStripes) {
   }
 }
 
+TEST(CalibrateFromTheSheet, ExactPointsOnTheStripesGiveAStrongLensExactly) {
+  // The points slide along their lines freely: the fit settles where the lines' distances
+  // are least, not where a pairing with plane points stopped creeping.
+  const LineTarget target = FourLineA3Target();
+  const Lens truth =
+      Lens::WithDistortion(535.9157, 535.9157, 342.2832, 235.5708,
+                           {-0.266373, -0.0385889, 0.00178319, -0.000281221, 0.238392});
+  std::mt19937 random(4);
+  std::vector<CalibrationView> views;
+  for (const vpHomogeneousMatrix& pose : VariedSheetPoses()) {
+    views.push_back(SheetView(target, SeenAlongStripes(target, truth, pose, 0.0, &random),
+                              "view" + std::to_string(views.size())));
+  }
+  CalibrationOptions options = Options640x480();
+  options.min_term_significance = 0.0;  // keep every term: the points are exact
+  const CalibrationResult result = Calibrate(views, options);
+  EXPECT_NEAR(result.camera.px(), truth.px(), 1e-4 * truth.px());
+  EXPECT_NEAR(result.camera.u0(), truth.u0(), 0.05);
+  EXPECT_LT(result.rms_px, 1e-3);
+  EXPECT_LT(WorstIdealPixelDifference(result.camera, truth, 640, 480, 200.0), 0.01);
+}
+
+TEST(CalibrateFromTheSheet, RunsMiddlesAreMovedOntoTheCentreLineThroughTheLens) {
+  // Under perspective and a strong lens the middle of a run between a stripe's two edges is
+  // off the centre line's image; given the runs, the calibration moves each middle back
+  // through the lens it solves, and leaves out the runs through a stripe's ends.
+  const LineTarget target = FourLineA3Target();
+  const Lens truth =
+      Lens::WithDistortion(535.9157, 535.9157, 342.2832, 235.5708,
+                           {-0.266373, -0.0385889, 0.00178319, -0.000281221, 0.238392});
+  CalibrationOptions options = Options640x480();
+  options.min_term_significance = 0.0;
+  std::vector<CalibrationView> with_runs, middles_alone;
+  for (const vpHomogeneousMatrix& pose : VariedSheetPoses()) {
+    std::vector<std::vector<Point2d>> runs;
+    const std::vector<std::vector<Point2d>> middles =
+        test::RunsAcrossStripes(target, truth, pose, &runs, 0.015);
+    const std::string name = "view" + std::to_string(with_runs.size());
+    with_runs.push_back(SheetView(target, middles, name, SheetViewOptions(), runs));
+    middles_alone.push_back(SheetView(target, middles, name));
+  }
+  ASSERT_FALSE(with_runs[0].lines.empty());
+  EXPECT_GT(with_runs[0].lines[0].width_m, 0.0);
+  EXPECT_EQ(with_runs[0].lines[0].runs.size(), with_runs[0].lines[0].seen.size());
+  const CalibrationResult centred = Calibrate(with_runs, options);
+  const CalibrationResult uncentred = Calibrate(middles_alone, options);
+  const double centred_error = std::fabs(centred.camera.px() - truth.px());
+  EXPECT_LT(centred_error, 2e-4 * truth.px());
+  EXPECT_LT(WorstIdealPixelDifference(centred.camera, truth, 640, 480, 200.0), 0.02);
+  // The middles taken as centre-line points (and the runs through the ends kept) bias it.
+  EXPECT_GT(std::fabs(uncentred.camera.px() - truth.px()), 5.0 * centred_error);
+}
+
 TEST(CalibrateFromTheSheet, AViewWhosePointsDisagreeWithTheOthersIsLeftOut) {
   const LineTarget target = FourLineA3Target();
   const Lens truth = Lens::WithKdu(720.0, 716.0, 333.0, 229.0, 0.15, 640, 480);
