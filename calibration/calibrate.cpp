@@ -351,103 +351,143 @@ ViewRows RowsOf(const CalibrationView& view, const LinePairing& pairing, const S
 // along the lines over dozens of solves and stops short, the focal length a few tenths of a
 // percent off under a strong lens; here it follows each step. Known points keep their two
 // rows. The deviations come from this fit's normal equations.
+// The unknowns of the polish: fx, fy, cx, cy, the free distortion terms, then each view's
+// rvec and tvec.
+class PolishUnknowns {
+ public:
+  PolishUnknowns(int flags, int terms, std::size_t views)
+      : free_(FreeDistortionTerms(flags, terms)),
+        intrinsics_(4 + static_cast<int>(free_.size())),
+        count_(intrinsics_ + 6 * static_cast<int>(views)) {}
+
+  int count() const { return count_; }
+
+  // The normal equations J^T J and J^T r of every view's rows.
+  void NormalEquations(const std::vector<ViewRows>& rows, cv::Mat* normal,
+                       cv::Mat* gradient) const {
+    *normal = cv::Mat::zeros(count_, count_, CV_64F);
+    *gradient = cv::Mat::zeros(count_, 1, CV_64F);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const cv::Mat columns = ViewColumns(rows[i]);
+      const cv::Mat residuals(rows[i].residuals, false);
+      const cv::Mat block = columns.t() * columns, pulled = columns.t() * residuals;
+      // Where the view's columns (the intrinsics, its pose) sit among all the unknowns.
+      std::vector<int> index;
+      for (int c = 0; c < intrinsics_; ++c) index.push_back(c);
+      for (int c = 0; c < 6; ++c) index.push_back(PoseAt(i) + c);
+      for (std::size_t a = 0; a < index.size(); ++a) {
+        gradient->at<double>(index[a]) += pulled.at<double>(static_cast<int>(a));
+        for (std::size_t b = 0; b < index.size(); ++b) {
+          normal->at<double>(index[a], index[b]) +=
+              block.at<double>(static_cast<int>(a), static_cast<int>(b));
+        }
+      }
+    }
+  }
+
+  // `from` moved by `step`.
+  Solution Stepped(const Solution& from, const cv::Mat& step) const {
+    Solution next = from;
+    next.camera_matrix = from.camera_matrix.clone();
+    next.distortion = from.distortion.clone();
+    next.camera_matrix.at<double>(0, 0) += step.at<double>(0);
+    next.camera_matrix.at<double>(1, 1) += step.at<double>(1);
+    next.camera_matrix.at<double>(0, 2) += step.at<double>(2);
+    next.camera_matrix.at<double>(1, 2) += step.at<double>(3);
+    for (std::size_t t = 0; t < free_.size(); ++t) {
+      next.distortion.at<double>(free_[t]) += step.at<double>(4 + static_cast<int>(t));
+    }
+    for (std::size_t i = 0; i < from.rvecs.size(); ++i) {
+      next.rvecs[i] = from.rvecs[i] + step.rowRange(PoseAt(i), PoseAt(i) + 3);
+      next.tvecs[i] = from.tvecs[i] + step.rowRange(PoseAt(i) + 3, PoseAt(i) + 6);
+    }
+    return next;
+  }
+
+  // The intrinsics' standard deviations in OpenCV's order (fx, fy, cx, cy, k1 ... k6; 0 for a
+  // fixed term) from the normal equations and the residuals' variance.
+  cv::Mat Deviations(const cv::Mat& normal, double variance) const {
+    cv::Mat deviations = cv::Mat::zeros(4 + 8, 1, CV_64F), covariance;
+    if (cv::invert(normal, covariance, cv::DECOMP_CHOLESKY) == 0.0) return deviations;
+    for (int c = 0; c < intrinsics_; ++c) {
+      const int at = c < 4 ? c : 4 + free_[static_cast<std::size_t>(c - 4)];
+      deviations.at<double>(at) = std::sqrt(variance * covariance.at<double>(c, c));
+    }
+    return deviations;
+  }
+
+ private:
+  int PoseAt(std::size_t view) const { return intrinsics_ + 6 * static_cast<int>(view); }
+
+  // A view's derivatives by its unknowns: the free intrinsics, then its pose.
+  cv::Mat ViewColumns(const ViewRows& rows) const {
+    cv::Mat columns(static_cast<int>(rows.residuals.size()), intrinsics_ + 6, CV_64F);
+    rows.by_intrinsics.colRange(0, 4).copyTo(columns.colRange(0, 4));
+    for (std::size_t t = 0; t < free_.size(); ++t) {
+      rows.by_intrinsics.col(4 + free_[t]).copyTo(columns.col(4 + static_cast<int>(t)));
+    }
+    rows.by_pose.copyTo(columns.colRange(intrinsics_, intrinsics_ + 6));
+    return columns;
+  }
+
+  std::vector<int> free_;
+  int intrinsics_, count_;
+};
+
+// Polishes the camera and the view poses on what the line points tell: their distances across
+// their lines, each point free to slide along its line (Levenberg-Marquardt on the distances,
+// each point paired again with its line after each step). calibrateCamera measures a line
+// point's distance to a paired plane point fixed during each solve, so the pairing creeps
+// along the lines over dozens of solves and stops short, the focal length a few tenths of a
+// percent off under a strong lens; here it follows each step. Known points keep their two
+// rows. The deviations come from this fit's normal equations.
 void PolishAcrossLines(const std::vector<const CalibrationView*>& views, int flags,
                        std::vector<LinePairing>* pairings, Solution* solution) {
-  const int terms = solution->distortion.rows * solution->distortion.cols;
-  const std::vector<int> free = FreeDistortionTerms(flags, terms);
-  const int intrinsics = 4 + static_cast<int>(free.size());
-  const int unknowns = intrinsics + 6 * static_cast<int>(views.size());
-  const auto repair = [&](Solution* at) {
-    for (std::size_t i = 0; i < views.size(); ++i) {
-      CentreRuns(*views[i], at->camera_matrix, at->distortion, at->rvecs[i], at->tvecs[i],
-                 &(*pairings)[i]);
-      PairThroughCamera(*views[i], at->camera_matrix, at->distortion, at->rvecs[i], at->tvecs[i],
-                        &(*pairings)[i]);
-    }
-  };
-  const auto cost_of = [&](const Solution& at, std::vector<ViewRows>* rows) {
+  const PolishUnknowns unknowns(flags, solution->distortion.rows * solution->distortion.cols,
+                                views.size());
+  // Pairs the points through `at` and gives their rows and their sum of squares.
+  const auto pair_and_measure = [&](const Solution& at, std::vector<ViewRows>* rows) {
     double cost = 0.0;
     rows->clear();
     for (std::size_t i = 0; i < views.size(); ++i) {
-      rows->push_back(RowsOf(*views[i], (*pairings)[i], at, i));
+      LinePairing& pairing = (*pairings)[i];
+      CentreRuns(*views[i], at.camera_matrix, at.distortion, at.rvecs[i], at.tvecs[i], &pairing);
+      PairThroughCamera(*views[i], at.camera_matrix, at.distortion, at.rvecs[i], at.tvecs[i],
+                        &pairing);
+      rows->push_back(RowsOf(*views[i], pairing, at, i));
       for (const double r : rows->back().residuals) cost += r * r;
     }
     return cost;
   };
-  repair(solution);
   std::vector<ViewRows> rows;
-  double cost = cost_of(*solution, &rows);
+  double cost = pair_and_measure(*solution, &rows);
   double damping = 1e-3;
-  cv::Mat normal;
+  cv::Mat normal, gradient;
   for (int iteration = 0; iteration < kPolishIterations; ++iteration) {
-    normal = cv::Mat::zeros(unknowns, unknowns, CV_64F);
-    cv::Mat gradient = cv::Mat::zeros(unknowns, 1, CV_64F);
-    for (std::size_t i = 0; i < views.size(); ++i) {
-      // This view's columns: the free intrinsics, then its pose.
-      cv::Mat columns(static_cast<int>(rows[i].residuals.size()), intrinsics + 6, CV_64F);
-      for (int c = 0; c < 4; ++c) rows[i].by_intrinsics.col(c).copyTo(columns.col(c));
-      for (std::size_t t = 0; t < free.size(); ++t) {
-        rows[i].by_intrinsics.col(4 + free[t]).copyTo(columns.col(4 + static_cast<int>(t)));
-      }
-      rows[i].by_pose.copyTo(columns.colRange(intrinsics, intrinsics + 6));
-      const cv::Mat residuals(rows[i].residuals, false);
-      const cv::Mat block = columns.t() * columns, pulled = columns.t() * residuals;
-      const int pose = intrinsics + 6 * static_cast<int>(i);
-      std::vector<int> index(static_cast<std::size_t>(intrinsics + 6));
-      for (int c = 0; c < intrinsics; ++c) index[static_cast<std::size_t>(c)] = c;
-      for (int c = 0; c < 6; ++c) index[static_cast<std::size_t>(intrinsics + c)] = pose + c;
-      for (int a = 0; a < intrinsics + 6; ++a) {
-        gradient.at<double>(index[static_cast<std::size_t>(a)]) += pulled.at<double>(a);
-        for (int b = 0; b < intrinsics + 6; ++b) {
-          normal.at<double>(index[static_cast<std::size_t>(a)],
-                            index[static_cast<std::size_t>(b)]) += block.at<double>(a, b);
-        }
-      }
-    }
+    unknowns.NormalEquations(rows, &normal, &gradient);
     bool improved = false;
-    while (damping < 1e8) {
-      cv::Mat damped = normal.clone();
-      for (int d = 0; d < unknowns; ++d) damped.at<double>(d, d) *= 1.0 + damping;
-      cv::Mat step;
-      if (!cv::solve(damped, -gradient, step, cv::DECOMP_CHOLESKY)) {
-        damping *= 10.0;
+    for (; damping < 1e8; damping *= 10.0) {
+      cv::Mat damped = normal.clone(), step;
+      for (int d = 0; d < unknowns.count(); ++d) damped.at<double>(d, d) *= 1.0 + damping;
+      if (!cv::solve(damped, -gradient, step, cv::DECOMP_CHOLESKY)) continue;
+      const Solution next = unknowns.Stepped(*solution, step);
+      const std::vector<LinePairing> before = *pairings;
+      std::vector<ViewRows> next_rows;
+      const double next_cost = pair_and_measure(next, &next_rows);
+      if (next_cost > cost) {
+        *pairings = before;
         continue;
       }
-      Solution next = *solution;
-      next.camera_matrix = solution->camera_matrix.clone();
-      next.distortion = solution->distortion.clone();
-      next.camera_matrix.at<double>(0, 0) += step.at<double>(0);
-      next.camera_matrix.at<double>(1, 1) += step.at<double>(1);
-      next.camera_matrix.at<double>(0, 2) += step.at<double>(2);
-      next.camera_matrix.at<double>(1, 2) += step.at<double>(3);
-      for (std::size_t t = 0; t < free.size(); ++t) {
-        next.distortion.at<double>(free[t]) += step.at<double>(4 + static_cast<int>(t));
-      }
-      for (std::size_t i = 0; i < views.size(); ++i) {
-        const int pose = intrinsics + 6 * static_cast<int>(i);
-        next.rvecs[i] = solution->rvecs[i] + step.rowRange(pose, pose + 3);
-        next.tvecs[i] = solution->tvecs[i] + step.rowRange(pose + 3, pose + 6);
-      }
-      const std::vector<LinePairing> before = *pairings;
-      repair(&next);
-      std::vector<ViewRows> next_rows;
-      const double next_cost = cost_of(next, &next_rows);
-      if (next_cost <= cost) {
-        const bool settled = cost - next_cost <= kPolishSettled * cost;
-        *solution = next;
-        rows = std::move(next_rows);
-        cost = next_cost;
-        damping = std::max(damping / 10.0, 1e-9);
-        improved = !settled;
-        break;
-      }
-      *pairings = before;
-      damping *= 10.0;
+      improved = cost - next_cost > kPolishSettled * cost;
+      *solution = next;
+      rows = std::move(next_rows);
+      cost = next_cost;
+      damping = std::max(damping / 10.0, 1e-9);
+      break;
     }
     if (!improved) break;
   }
 
-  // The fit's deviations, from its normal equations at the solution.
   int residual_count = 0, points = 0;
   std::vector<double> view_errors;
   for (const ViewRows& view : rows) {
@@ -459,15 +499,11 @@ void PolishAcrossLines(const std::vector<const CalibrationView*>& views, int fla
   }
   solution->rms_px = points > 0 ? std::sqrt(cost / points) : 0.0;
   solution->view_errors = cv::Mat(view_errors, true);
-  solution->sd_intrinsics = cv::Mat::zeros(4 + 8, 1, CV_64F);
-  cv::Mat covariance;
-  if (residual_count > unknowns && cv::invert(normal, covariance, cv::DECOMP_CHOLESKY) != 0.0) {
-    const double variance = cost / (residual_count - unknowns);
-    for (int c = 0; c < intrinsics; ++c) {
-      const int at = c < 4 ? c : 4 + free[static_cast<std::size_t>(c - 4)];
-      solution->sd_intrinsics.at<double>(at) = std::sqrt(variance * covariance.at<double>(c, c));
-    }
-  }
+  unknowns.NormalEquations(rows, &normal, &gradient);
+  solution->sd_intrinsics =
+      residual_count > unknowns.count()
+          ? unknowns.Deviations(normal, cost / (residual_count - unknowns.count()))
+          : cv::Mat::zeros(4 + 8, 1, CV_64F);
 }
 
 // Marks as outliers the line points the solved camera leaves farther from their lines than
