@@ -12,6 +12,8 @@
 #include "app/config.h"
 #include "base/format.h"
 #include "io/atomic_file.h"
+#include "print/target_pdf.h"
+#include "print/target_svg.h"
 
 namespace oal {
 
@@ -34,7 +36,13 @@ void TargetCommandOptions::Check() const {
         "--landscape is for a sheet (--page a4, a3 or letter): --page full is the board's own "
         "size and orientation");
   }
-  if (out.empty()) throw std::invalid_argument("no output file given (--out FILE.svg)");
+  if (out.empty()) throw std::invalid_argument("no output file given (--out FILE.pdf or FILE.svg)");
+  const std::string extension = Lowercase(fs::path(out).extension().string());
+  if (extension != ".pdf" && extension != ".svg") {
+    throw std::invalid_argument("--out " + out +
+                                ": the file's extension names its format: .pdf "
+                                "(to print) or .svg (to edit or view)");
+  }
 }
 
 LineTarget TargetToPrint(const TargetCommandOptions& options) {
@@ -43,7 +51,7 @@ LineTarget TargetToPrint(const TargetCommandOptions& options) {
   return TargetByName(SheetTargetName(options.page));
 }
 
-TargetDrawing WriteTargetSvg(const TargetCommandOptions& options) {
+TargetPage WriteTargetPage(const TargetCommandOptions& options) {
   options.Check();
   const fs::path out(options.out);
   const fs::path dir = out.parent_path();
@@ -54,17 +62,18 @@ TargetDrawing WriteTargetSvg(const TargetCommandOptions& options) {
   if (fs::is_directory(out)) {
     throw std::runtime_error("cannot write --out " + options.out + ": it is a directory");
   }
-  const TargetDrawing drawing =
-      DrawTargetSvg(TargetToPrint(options), options.page, options.landscape);
-  WriteFileAtomically(out, drawing.svg);
-  return drawing;
+  const TargetPage page = DrawTargetPage(TargetToPrint(options), options.page, options.landscape);
+  const bool pdf = Lowercase(out.extension().string()) == ".pdf";
+  WriteFileAtomically(out, pdf ? TargetPdf(page) : TargetSvg(page));
+  return page;
 }
 
 int RunTarget(int argc, char** argv) {
   TargetCommandOptions options;
   const std::string names = TargetNameList();
   CLI::App cli(
-      "Write a printable, true-scale SVG of a line target on one page (1 unit = 1 mm): the "
+      "Write a printable, true-scale page of a line target: a PDF (--out x.pdf, to print at "
+      "100 %) or an SVG (--out x.svg, 1 unit = 1 mm): the "
       "stripes in black, and, small and grey and at least 5 mm clear of every stripe and of the "
       "page's edge, the line numbers, the target's name, \"print at 100 %, do not scale\" and a "
       "100 mm scale bar. Without --target or --config it prints the sheet target made for the "
@@ -89,11 +98,11 @@ int RunTarget(int argc, char** argv) {
       ->capture_default_str();
   cli.add_flag("--landscape", options.landscape,
                "the page's long side across (a4, a3, letter): the sheet targets print upright");
-  cli.add_option("--out", options.out, "the SVG file to write")->required();
+  cli.add_option("--out", options.out, "the file to write: .pdf (to print) or .svg")->required();
   cli.footer(
       "Examples:\n"
-      "  oalservo target --out four-line-a3.svg\n"
-      "      four-line-a3 on an A3 page (portrait: drawn turned, the same print)\n"
+      "  oalservo target --out four-line-a3.pdf\n"
+      "      four-line-a3 on an A3 page, to print (portrait: drawn turned, the same print)\n"
       "  oalservo target --page a3 --landscape --out four-line-a3.svg\n"
       "      the same, upright on a landscape A3 page\n"
       "  oalservo target --page a4 --landscape --out four-line-a4.svg\n"
@@ -105,7 +114,7 @@ int RunTarget(int argc, char** argv) {
       "Print at 100 % (no \"fit to page\") and check the scale bar with a ruler: the pose takes "
       "the target's lengths as printed.");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
-  const TargetDrawing drawing = WriteTargetSvg(options);
+  const TargetPage drawing = WriteTargetPage(options);
   if (!drawing.warning.empty()) Warn("target", drawing.warning);
   std::cerr << "oalservo target: " << options.out << " written (" << drawing.page << ", "
             << Number(drawing.page_width_mm) << " x " << Number(drawing.page_height_mm) << " mm)\n";

@@ -1,11 +1,11 @@
-// `oalservo target`: a printable, true-scale SVG of a planar line target on one page
-// (target/target_svg.h lays it out and draws it).
+// `oalservo target`: a printable, true-scale page of a planar line target, written as PDF or
+// SVG by the output's extension (print/ lays it out and writes it).
 #pragma once
 
 #include <string>
 
+#include "print/target_page.h"
 #include "target/line_target.h"
-#include "target/target_svg.h"
 
 namespace oal {
 
@@ -16,7 +16,7 @@ struct TargetCommandOptions {
   std::string config;
   std::string page = "a3";  ///< a4, a3, letter or full
   bool landscape = false;   ///< the sheet's long side across the page; not with full
-  std::string out;          ///< the SVG file to write; required
+  std::string out;          ///< the file to write: .pdf or .svg; required
 
   /// Throws std::invalid_argument naming the command-line option that is wrong.
   void Check() const;
@@ -26,10 +26,11 @@ struct TargetCommandOptions {
 /// `page` (four-line-a3 for full).
 LineTarget TargetToPrint(const TargetCommandOptions& options);
 
-/// Checks the options, draws the target and writes options.out atomically. Throws on bad
-/// options, a target the page does not hold (TargetDoesNotFit) or an I/O error, and then
-/// writes nothing (a file already at options.out is left as it was).
-TargetDrawing WriteTargetSvg(const TargetCommandOptions& options);
+/// Checks the options, draws the target and writes options.out atomically, as PDF or SVG by
+/// its extension. Throws on bad options (another extension among them), a target the page
+/// does not hold (TargetDoesNotFit) or an I/O error, and then writes nothing (a file already
+/// at options.out is left as it was).
+TargetPage WriteTargetPage(const TargetCommandOptions& options);
 
 /// `oalservo target ...`; argv[0] is "target".
 int RunTarget(int argc, char** argv);

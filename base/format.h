@@ -23,6 +23,14 @@ inline std::string Number(double value, int significant = 6) {
   return text.str();
 }
 
+/// `text` in lower case (ASCII): file extensions, names compared without case.
+inline std::string Lowercase(std::string text) {
+  for (char& c : text) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return text;
+}
+
 /// `text` with & < > " ' escaped, for HTML and XML (SVG) text and attribute values.
 inline std::string MarkupEscaped(const std::string& text) {
   std::string out;

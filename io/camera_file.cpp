@@ -172,9 +172,7 @@ const CameraEntry& ChooseCamera(const std::vector<CameraEntry>& cameras, const s
 }
 
 std::string Extension(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return extension;
+  return Lowercase(std::filesystem::path(path).extension().string());
 }
 
 CameraFile LoadYamlCameraFile(const std::string& path, const std::string& camera_name) {

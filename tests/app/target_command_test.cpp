@@ -17,8 +17,9 @@
 
 #include "app/config.h"
 #include "app/render_command.h"
+#include "print/target_svg.h"
 #include "scene/scene.h"
-#include "tests/target/svg_reading.h"
+#include "tests/print/svg_reading.h"
 #include "tests/test_util.h"
 
 namespace oal {
@@ -88,10 +89,10 @@ TEST(TargetCommand, WritesTheConfigsTargetAtomically) {
   options.config = dir / "small.yaml";
   options.out = dir / "small.svg";
   options.page = "a4";
-  const TargetDrawing drawing = WriteTargetSvg(options);
+  const TargetPage drawing = WriteTargetPage(options);
   EXPECT_FALSE(drawing.turned);
   const std::string svg = test::ReadText(options.out);
-  EXPECT_EQ(svg, drawing.svg);
+  EXPECT_EQ(svg, TargetSvg(drawing));
   ExpectStripesMatch(svg, SmallTarget(), 210.0, 297.0, false);
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
@@ -107,20 +108,20 @@ TEST(TargetCommand, ShippedConfigsDrawTheBuiltInTargets) {
     options.page = sheet.page;
     options.landscape = true;
     options.out = dir / (std::string(sheet.page) + ".svg");
-    WriteTargetSvg(options);
+    WriteTargetPage(options);
     ExpectStripesMatch(test::ReadText(options.out), sheet.target(), sheet.long_mm, sheet.short_mm,
                        false);
   }
   TargetCommandOptions options;
   options.config = config_dir + "four-line-board.yaml";
   options.out = dir / "board.svg";
-  EXPECT_THROW(WriteTargetSvg(options), TargetDoesNotFit);
+  EXPECT_THROW(WriteTargetPage(options), TargetDoesNotFit);
   options.page = "full";
-  WriteTargetSvg(options);
+  WriteTargetPage(options);
   ExpectStripesMatch(test::ReadText(options.out), FourLineTarget(), 2020.0, 2020.0, false);
   options.config = config_dir + "two-line-target.yaml";
   options.out = dir / "two.svg";
-  WriteTargetSvg(options);
+  WriteTargetPage(options);
   ExpectStripesMatch(test::ReadText(options.out), TwoLineTarget(), 2020.0, 2020.0, false);
 }
 
@@ -131,10 +132,10 @@ TEST(TargetCommand, RefusalWritesNothingAndLeavesAFileAlone) {
   options.target = "four-line-board";
   options.page = "a4";
   options.out = dir / "board.svg";
-  EXPECT_THROW(WriteTargetSvg(options), TargetDoesNotFit);
+  EXPECT_THROW(WriteTargetPage(options), TargetDoesNotFit);
   EXPECT_TRUE(fs::is_empty(dir.path()));
   test::WriteText(options.out, "the previous file\n");
-  EXPECT_THROW(WriteTargetSvg(options), TargetDoesNotFit);
+  EXPECT_THROW(WriteTargetPage(options), TargetDoesNotFit);
   EXPECT_EQ(test::ReadText(options.out), "the previous file\n");
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
 }
@@ -144,16 +145,52 @@ TEST(TargetCommand, BadOutputDirectoryIsAClearErrorAndLeavesNothing) {
   TargetCommandOptions options;
   options.out = dir / "missing/target.svg";
   try {
-    WriteTargetSvg(options);
+    WriteTargetPage(options);
     FAIL() << "no error";
   } catch (const std::runtime_error& error) {
     EXPECT_THAT(error.what(), HasSubstr("--out"));
     EXPECT_THAT(error.what(), HasSubstr("missing"));
     EXPECT_THAT(error.what(), HasSubstr("does not exist"));
   }
-  options.out = dir.path().string();  // a directory
-  EXPECT_THROW(WriteTargetSvg(options), std::runtime_error);
+  fs::create_directory(dir / "folder.svg");
+  options.out = dir / "folder.svg";  // a directory
+  EXPECT_THROW(WriteTargetPage(options), std::runtime_error);
+  fs::remove(dir / "folder.svg");
   EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(TargetCommand, ThePdfIsOnePageOfTheSheetsSizeAndOtherExtensionsAreRefused) {
+  test::TestDir dir;
+  TargetCommandOptions options;
+  options.out = dir / "a3.PDF";
+  const TargetPage page = WriteTargetPage(options);
+  const std::string pdf = test::ReadText(dir / "a3.PDF");
+  EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u);
+  // One page, A3 portrait in points (297 x 420 mm), named in the title.
+  EXPECT_EQ(Count(pdf, "/Type /Page\n") + Count(pdf, "/Type /Page "), 1);
+  const std::size_t box = pdf.find("/MediaBox [");
+  ASSERT_NE(box, std::string::npos);
+  std::istringstream corners(pdf.substr(box + 11, 80));
+  double x0 = -1, y0 = -1, x1 = 0, y1 = 0;
+  corners >> x0 >> y0 >> x1 >> y1;
+  EXPECT_EQ(x0, 0.0);
+  EXPECT_EQ(y0, 0.0);
+  EXPECT_NEAR(x1, 297.0 / 25.4 * 72.0, 1e-3);
+  EXPECT_NEAR(y1, 420.0 / 25.4 * 72.0, 1e-3);
+  EXPECT_THAT(pdf, HasSubstr("oalservo target four-line-a3, A3 portrait"));
+  EXPECT_EQ(page.page, "A3 portrait");
+  // The extension names the format: anything else is refused and nothing is written.
+  for (const char* name : {"a3.png", "a3", "a3.svg.txt"}) {
+    options.out = dir / name;
+    try {
+      WriteTargetPage(options);
+      FAIL() << name << ": no error";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_THAT(error.what(), HasSubstr("--out " + (dir / name)));
+      EXPECT_THAT(error.what(), HasSubstr(".pdf (to print) or .svg"));
+    }
+    EXPECT_FALSE(fs::exists(dir / name)) << name;
+  }
 }
 
 TEST(TargetCommand, BadConfigNamesTheFile) {
@@ -163,7 +200,7 @@ TEST(TargetCommand, BadConfigNamesTheFile) {
   options.config = dir / "bad.yaml";
   options.out = dir / "t.svg";
   try {
-    WriteTargetSvg(options);
+    WriteTargetPage(options);
     FAIL() << "no error";
   } catch (const std::runtime_error& error) {
     EXPECT_THAT(error.what(), HasSubstr(dir / "bad.yaml:2: 'target.name' = 'five-line'"));
@@ -239,7 +276,7 @@ TEST(TargetCommand, BinaryHelpHasAnExampleForEachCase) {
       std::string("'") + OAL_OALSERVO_PATH + "' target --help >'" + (dir / "help.txt") + "'";
   ASSERT_EQ(std::system(help.c_str()), 0);
   const std::string text = test::ReadText(dir / "help.txt");
-  EXPECT_THAT(text, HasSubstr("oalservo target --out four-line-a3.svg\n"));
+  EXPECT_THAT(text, HasSubstr("oalservo target --out four-line-a3.pdf\n"));
   EXPECT_THAT(text, HasSubstr("oalservo target --page a3 --landscape --out four-line-a3.svg\n"));
   EXPECT_THAT(text, HasSubstr("oalservo target --page a4 --landscape --out four-line-a4.svg\n"));
   EXPECT_THAT(text, HasSubstr("--target four-line-board --page full --out"));

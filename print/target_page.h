@@ -1,4 +1,5 @@
-// A printable, true-scale SVG of a planar line target on one page (`oalservo target`).
+// A printable, true-scale page of a planar line target (`oalservo target`): laid out here,
+// written as SVG (print/target_svg.h) or PDF (print/target_pdf.h) from the same geometry.
 //
 // The target: any LineTarget; `oalservo target` takes a built-in by name, a config's
 // `target:`, or the sheet target made for the page (SheetTargetName: four-line-a4 for a4,
@@ -13,7 +14,8 @@
 // (TargetDoesNotFit, saying what to print instead); nothing is tiled or scaled.
 //
 // What is printed: the stripes, black filled polygons exactly as the target has them (the
-// centre line widened by width / 2 on both sides, flat ends), clipped to the board; the board's
+// centre line widened by width / 2 on both sides, flat ends), cut to the board here (no
+// renderer's clipping is needed, so every renderer draws them alike); the board's
 // outline is not printed (the sheet is the board, and an outline would be one more line for
 // the camera). Everything else is small and thin (text 3 mm, strokes at most 0.3 mm, grey),
 // because a camera looks at the sheet and a thick mark would be a line: the line numbers
@@ -31,6 +33,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "target/line_target.h"
 
@@ -52,23 +55,64 @@ class TargetDoesNotFit : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// A drawing of a target and the page it was laid out on.
-struct TargetDrawing {
-  std::string svg;              ///< the whole SVG document
-  double page_width_mm = 0.0;   ///< the SVG's width
-  double page_height_mm = 0.0;  ///< the SVG's height
-  std::string page;             ///< "A4 portrait", "A3 landscape", ..., or "full size"
-  bool turned = false;          ///< drawn turned by 90 degrees (clockwise) to fit the page
-  std::string note;             ///< when turned: what that means for printing; else empty
-  std::string warning;          ///< a stripe within kClearanceMm of the page's edge; else empty
+/// A point on the page, millimetres from its top left corner, y down.
+struct PagePoint {
+  double x_mm = 0.0, y_mm = 0.0;
+};
+
+/// A stripe as printed: a filled black polygon, its corners in order.
+struct PageStripe {
+  int line = 0;  ///< 1-based, as the target numbers its lines
+  std::vector<PagePoint> corners;
+};
+
+/// Which printed group a mark belongs to (the SVG's groups, the PDF's drawing order).
+enum class PageGroup { kLineNumbers, kLegend, kScale };
+
+/// A thin grey line (the scale bar and its ticks), flat ends.
+struct PageLine {
+  PagePoint a, b;
+  double stroke_mm = 0.0;
+  PageGroup group = PageGroup::kScale;
+  std::string id;     ///< the SVG's id (one mark), or empty
+  std::string klass;  ///< the SVG's class (a kind of mark), or empty
+};
+
+/// A grey sans-serif text of kPageTextMm, `at` the middle of its baseline, turned by
+/// angle_deg (clockwise on the page) about it.
+struct PageText {
+  PagePoint at;
+  double angle_deg = 0.0;
+  std::string text;
+  PageGroup group = PageGroup::kLegend;
+  std::string id, klass;
+};
+
+/// Font size of every text, mm, and the grey of everything but the stripes (0 black, 1 white).
+inline constexpr double kPageTextMm = 3.0;
+inline constexpr double kPageGrey = 0.5;
+
+/// A target laid out on a page.
+struct TargetPage {
+  double page_width_mm = 0.0;
+  double page_height_mm = 0.0;
+  std::string page;         ///< "A4 portrait", "A3 landscape", ..., or "full size"
+  bool turned = false;      ///< drawn turned by 90 degrees (clockwise) to fit the page
+  std::string note;         ///< when turned: what that means for printing; else empty
+  std::string warning;      ///< a stripe within kClearanceMm of the page's edge; else empty
+  std::string target_name;  ///< "unnamed" for a target without a name
+  std::string description;  ///< what the page is and how to print it (SVG <desc>, PDF subject)
+  std::vector<PageStripe> stripes;
+  std::vector<PageLine> lines;
+  std::vector<PageText> texts;
 };
 
 /// Lays `target` out on `page` ("a4", "a3", "letter" or "full"), portrait unless
 /// `landscape` (not with "full"). Throws std::invalid_argument for another page name, for
 /// landscape with "full" or for a target that fails Check(), TargetDoesNotFit for a board the
 /// page does not hold, std::runtime_error when the legend finds no room.
-TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page,
-                            bool landscape = false);
+TargetPage DrawTargetPage(const LineTarget& target, const std::string& page,
+                          bool landscape = false);
 
 /// Throws std::invalid_argument unless `page` is a4, a3, letter or full.
 void CheckPageName(const std::string& page);

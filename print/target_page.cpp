@@ -1,6 +1,6 @@
-// The page is laid out by a search over the cells of the target for its legend and scale bar,
-// and drawn from the same page geometry: one file, as the two share every shape and constant.
-#include "target/target_svg.h"
+// The page is laid out by a search over the cells of the target for its legend and scale bar;
+// what is printed is handed on as page geometry (the writers only draw it).
+#include "print/target_page.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,15 +21,17 @@ namespace {
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 constexpr double kFullMarginMm = 10.0;  // --page full: blank paper around the board
 constexpr double kGapMm = 1.5;          // between two printed items other than stripes
-constexpr double kSlackMm = 0.02;       // kept beyond every clearance (survives rounding)
-constexpr double kTextMm = 3.0;         // font size of everything printed
+// A line number keeps farther from the other marks, so that it is read as its stripe's and not
+// as a part of the scale bar or the legend beside it.
+constexpr double kNumberGapMm = 6.0;
+constexpr double kSlackMm = 0.02;  // kept beyond every clearance (survives rounding)
+constexpr double kTextMm = kPageTextMm;
 constexpr double kLineSpacingMm = 4.5;  // the legend's lines, baseline to baseline
 constexpr double kScaleBarMm = 100.0;
 constexpr double kBarStrokeMm = 0.3;
 constexpr double kTickStrokeMm = 0.25;
 constexpr double kLongTickMm = 3.0;   // at 0, 50 and 100 mm
 constexpr double kShortTickMm = 1.5;  // every other 10 mm
-const char* const kGrey = "#808080";
 
 struct Sheet {
   const char* name;            // as on the command line
@@ -199,6 +201,27 @@ Polygon StripeOf(const TargetLine& line) {
                         {1000.0 * line.x2_m, 1000.0 * line.y2_m}, 500.0 * line.width_m);
 }
 
+// `polygon` cut to the convex `window` (Sutherland-Hodgman): the part of a stripe on the board.
+Polygon ClippedToConvex(const Polygon& polygon, const Polygon& window) {
+  Polygon out = polygon;
+  const double orientation = Cross(window[1] - window[0], window[2] - window[1]) > 0.0 ? 1.0 : -1.0;
+  for (std::size_t e = 0; e < window.size() && !out.empty(); ++e) {
+    const P a = window[e], b = window[(e + 1) % window.size()];
+    const auto inside = [&](P p) { return orientation * Cross(b - a, p - a) >= 0.0; };
+    const Polygon in = out;
+    out.clear();
+    for (std::size_t i = 0; i < in.size(); ++i) {
+      const P p = in[i], q = in[(i + 1) % in.size()];
+      if (inside(p)) out.push_back(p);
+      if (inside(p) != inside(q)) {
+        const double t = Cross(b - a, p - a) / Cross(b - a, p - q);
+        out.push_back(p + t * (q - p));
+      }
+    }
+  }
+  return out;
+}
+
 // ------------------------------------------------------------------------------------------
 // What is printed besides the stripes: items made of texts and thin lines, in their own
 // frame; an item's pose puts its origin at `at` on the board, turned by angle_deg.
@@ -206,13 +229,13 @@ Polygon StripeOf(const TargetLine& line) {
 struct TextPart {
   P centre;  // of its estimated extent
   std::string text;
-  std::string attributes;  // id or class
+  std::string id, klass;  // the page's (one of them)
 };
 
 struct LinePart {
   P a, b;
   double stroke_mm;
-  std::string attributes;
+  std::string id, klass;  // the page's (one of them)
 };
 
 struct Item {
@@ -297,9 +320,10 @@ class Layout {
   }
 
   // The smallest of: room to the page's edge, to every stripe and to the middle cell, each
-  // less kClearanceMm, and to every item placed, less kGapMm. >= 0: the item may go there.
+  // less kClearanceMm, and to every item placed, less item_gap. >= 0: the item may go there.
   // Stops early (returning a value below `bound`) once it is below `bound`.
-  double Clearance(const std::vector<Polygon>& parts, double bound) const {
+  double Clearance(const std::vector<Polygon>& parts, double bound,
+                   double item_gap = kGapMm) const {
     double room = std::numeric_limits<double>::infinity();
     for (const Polygon& part : parts) {
       for (const P& p : part) {
@@ -313,7 +337,7 @@ class Layout {
       for (const auto& [polygons, keep] :
            {std::pair<const Shapes*, double>{&stripes_, kClearanceMm},
             {&obstacles_, kClearanceMm},
-            {&items_, kGapMm}}) {
+            {&items_, item_gap}}) {
         for (const auto& [polygon, box] : *polygons) {
           if (BoxDistance(part_box, box) - keep >= room) continue;
           room = std::min(room, PolygonDistance(part, polygon) - keep);
@@ -482,7 +506,7 @@ std::optional<Pose> PlaceLineNumber(const Item& number, const TargetLine& line, 
       for (const double extra : {0.0, 0.5, 1.0, 2.0, 4.0, 8.0}) {
         const Pose pose{end + t * along + (sign * (side + extra)) * across, 0.0};
         PlaceInto(parts, pose, &placed);
-        if (layout.Clearance(placed, kSlackMm) >= kSlackMm) return pose;
+        if (layout.Clearance(placed, kSlackMm, kNumberGapMm) >= kSlackMm) return pose;
       }
     }
   }
@@ -496,23 +520,23 @@ std::string SheetSize(const LineTarget& target) {
 Item ScaleBar() {
   Item bar;
   const double half = 0.5 * kScaleBarMm;
-  bar.lines.push_back({{-half, 0.0}, {half, 0.0}, kBarStrokeMm, "id=\"scale-bar\""});
+  bar.lines.push_back({{-half, 0.0}, {half, 0.0}, kBarStrokeMm, "scale-bar", ""});
   for (int mm = 0; mm <= static_cast<int>(kScaleBarMm); mm += 10) {
     const double tick = mm % 50 == 0 ? kLongTickMm : kShortTickMm;
     const double x = -half + mm;
-    bar.lines.push_back({{x, 0.0}, {x, -tick}, kTickStrokeMm, "class=\"scale-tick\""});
+    bar.lines.push_back({{x, 0.0}, {x, -tick}, kTickStrokeMm, "", "scale-tick"});
   }
   const double label_y = 0.5 * kBarStrokeMm + 0.8 + 0.5 * kTextHeightEm * kTextMm;
-  bar.texts.push_back({{0.0, label_y}, "100 mm", "id=\"scale-label\""});
+  bar.texts.push_back({{0.0, label_y}, "100 mm", "scale-label", ""});
   return bar;
 }
 
 Item Legend(const LineTarget& target) {
   const std::string name = target.name.empty() ? "unnamed" : target.name;
   Item legend;
-  legend.texts.push_back({{0.0, -kLineSpacingMm}, "target " + name, "id=\"name\""});
-  legend.texts.push_back({{0.0, 0.0}, "board " + SheetSize(target), "id=\"size\""});
-  legend.texts.push_back({{0.0, kLineSpacingMm}, "print at 100 %, do not scale", "id=\"note\""});
+  legend.texts.push_back({{0.0, -kLineSpacingMm}, "target " + name, "name", ""});
+  legend.texts.push_back({{0.0, 0.0}, "board " + SheetSize(target), "size", ""});
+  legend.texts.push_back({{0.0, kLineSpacingMm}, "print at 100 %, do not scale", "note", ""});
   return legend;
 }
 
@@ -585,11 +609,10 @@ Page LayOutPage(const LineTarget& target, const std::string& page_name, bool lan
 
 }  // namespace
 
-TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page_name,
-                            bool landscape) {
+TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name, bool landscape) {
   target.Check();
   const Page page = LayOutPage(target, page_name, landscape);
-  TargetDrawing drawing;
+  TargetPage drawing;
   drawing.page_width_mm = page.width_mm;
   drawing.page_height_mm = page.height_mm;
   drawing.page = page.label;
@@ -662,7 +685,7 @@ TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page_na
   std::vector<Drawn> numbers;
   for (std::size_t i = 0; i < target.lines.size(); ++i) {
     Item number;
-    number.texts.push_back({{0.0, 0.0}, std::to_string(i + 1), "class=\"line-number\""});
+    number.texts.push_back({{0.0, 0.0}, std::to_string(i + 1), "", "line-number"});
     for (const bool at_from : {true, false}) {
       if (const auto pose = PlaceLineNumber(number, target.lines[i], at_from, layout)) {
         layout.Place(Placed(PartsOf(number), *pose));
@@ -671,85 +694,55 @@ TargetDrawing DrawTargetSvg(const LineTarget& target, const std::string& page_na
     }
   }
 
-  // The SVG, in page coordinates.
-  const auto text_svg = [&](const TextPart& text, const Pose& pose) {
+  // What is printed, in page coordinates.
+  const auto add_text = [&](const TextPart& text, const Pose& pose, PageGroup group) {
     const double angle = pose.angle_deg * kRadPerDeg;
     const P baseline = text.centre + P{0.0, kTextBaselineEm * kTextMm};
     const P at = to_page(pose.at + Rotated(baseline, angle));
-    const double turn = pose.angle_deg + extra_turn_deg;
-    std::string out = "    <text " + text.attributes + " x=\"" + Mm(at.x) + "\" y=\"" + Mm(at.y) +
-                      "\" font-size=\"" + Mm(kTextMm) + "\"";
-    if (turn != 0.0) {
-      out += " transform=\"rotate(" + Mm(turn) + " " + Mm(at.x) + " " + Mm(at.y) + ")\"";
-    }
-    return out + ">" + MarkupEscaped(text.text) + "</text>\n";
+    drawing.texts.push_back(
+        {{at.x, at.y}, pose.angle_deg + extra_turn_deg, text.text, group, text.id, text.klass});
   };
-  const auto line_svg = [&](const LinePart& line, const Pose& pose) {
+  const auto add_line = [&](const LinePart& line, const Pose& pose) {
     const double angle = pose.angle_deg * kRadPerDeg;
     const P a = to_page(pose.at + Rotated(line.a, angle));
     const P b = to_page(pose.at + Rotated(line.b, angle));
-    return "    <line " + line.attributes + " x1=\"" + Mm(a.x) + "\" y1=\"" + Mm(a.y) + "\" x2=\"" +
-           Mm(b.x) + "\" y2=\"" + Mm(b.y) + "\" stroke=\"" + kGrey + "\" stroke-width=\"" +
-           Mm(line.stroke_mm) + "\"/>\n";
+    drawing.lines.push_back(
+        {{a.x, a.y}, {b.x, b.y}, line.stroke_mm, PageGroup::kScale, line.id, line.klass});
   };
-  const P board_corner =
-      to_page(page.turned ? P{-500.0 * target.board_width_m, 500.0 * target.board_height_m}
-                          : P{-500.0 * target.board_width_m, -500.0 * target.board_height_m});
-  const double board_page_w = 1000.0 * (page.turned ? target.board_height_m : target.board_width_m);
-  const double board_page_h = 1000.0 * (page.turned ? target.board_width_m : target.board_height_m);
-  const std::string escaped = MarkupEscaped(name);
-
-  std::ostringstream svg;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << Mm(page.width_mm)
-      << "mm\" height=\"" << Mm(page.height_mm) << "mm\" viewBox=\"0 0 " << Mm(page.width_mm) << " "
-      << Mm(page.height_mm) << "\">\n"
-      << "  <title>oalservo target " << escaped << "</title>\n"
-      << "  <desc>Target " << escaped << " (board " << SheetSize(target) << "), page " << page.label
-      << ", " << Mm(page.width_mm) << " x " << Mm(page.height_mm)
-      << " mm. True scale: 1 unit = 1 mm; print at 100 %, do not scale, and check the 100 mm "
-         "scale bar. ";
-  if (page.turned) {
-    svg << "The target is drawn turned by 90 degrees clockwise to fit the page: its x axis "
-           "points down the page and its y axis to the left; print it as it is (the print is "
-           "the same target) and hold the sheet turned a quarter turn counterclockwise to see "
-           "it upright, or write it with --landscape. ";
-  } else {
-    svg << "Object frame: x to the right, y down. ";
-  }
-  svg << "The board's centre, the object origin, is at (" << Mm(cx) << ", " << Mm(cy)
-      << "); its outline is not printed.</desc>\n"
-      << "  <defs>\n"
-      << "    <clipPath id=\"board-clip\"><rect x=\"" << Mm(board_corner.x) << "\" y=\""
-      << Mm(board_corner.y) << "\" width=\"" << Mm(board_page_w) << "\" height=\""
-      << Mm(board_page_h) << "\"/></clipPath>\n"
-      << "  </defs>\n"
-      << "  <g id=\"stripes\" clip-path=\"url(#board-clip)\" fill=\"#000000\" stroke=\"none\">\n";
+  const Polygon board = Rectangle(-500.0 * target.board_width_m, -500.0 * target.board_height_m,
+                                  500.0 * target.board_width_m, 500.0 * target.board_height_m);
   for (std::size_t i = 0; i < target.lines.size(); ++i) {
-    std::string points;
-    for (const P& corner : StripeOf(target.lines[i])) {
+    PageStripe stripe{static_cast<int>(i + 1), {}};
+    for (const P& corner : ClippedToConvex(StripeOf(target.lines[i]), board)) {
       const P p = to_page(corner);
-      points += (points.empty() ? "" : " ") + Mm(p.x) + "," + Mm(p.y);
+      stripe.corners.push_back({p.x, p.y});
     }
-    svg << "    <polygon class=\"stripe\" id=\"line-" << i + 1 << "\" points=\"" << points
-        << "\"/>\n";
+    if (stripe.corners.size() >= 3) drawing.stripes.push_back(std::move(stripe));
   }
-  svg << "  </g>\n"
-      << "  <g id=\"line-numbers\" fill=\"" << kGrey
-      << "\" stroke=\"none\" font-family=\"sans-serif\" text-anchor=\"middle\">\n";
-  for (const Drawn& number : numbers) svg << text_svg(number.item.texts[0], number.pose);
-  svg << "  </g>\n"
-      << "  <g id=\"legend\" fill=\"" << kGrey
-      << "\" stroke=\"none\" font-family=\"sans-serif\" text-anchor=\"middle\">\n";
-  for (const TextPart& text : legend.texts) svg << text_svg(text, *legend_pose);
-  svg << "  </g>\n"
-      << "  <g id=\"scale\" fill=\"" << kGrey
-      << "\" stroke=\"none\" stroke-linecap=\"butt\" font-family=\"sans-serif\" "
-         "text-anchor=\"middle\">\n";
-  for (const LinePart& line : bar.lines) svg << line_svg(line, *bar_pose);
-  for (const TextPart& text : bar.texts) svg << text_svg(text, *bar_pose);
-  svg << "  </g>\n"
-      << "</svg>\n";
-  drawing.svg = svg.str();
+  for (const Drawn& number : numbers) {
+    add_text(number.item.texts[0], number.pose, PageGroup::kLineNumbers);
+  }
+  for (const TextPart& text : legend.texts) add_text(text, *legend_pose, PageGroup::kLegend);
+  for (const LinePart& line : bar.lines) add_line(line, *bar_pose);
+  for (const TextPart& text : bar.texts) add_text(text, *bar_pose, PageGroup::kScale);
+
+  drawing.target_name = name;
+  std::ostringstream description;
+  description << "Target " << name << " (board " << SheetSize(target) << "), page " << page.label
+              << ", " << Mm(page.width_mm) << " x " << Mm(page.height_mm)
+              << " mm. True scale: 1 unit = 1 mm; print at 100 %, do not scale, and check the "
+                 "100 mm scale bar. ";
+  if (page.turned) {
+    description << "The target is drawn turned by 90 degrees clockwise to fit the page: its x "
+                   "axis points down the page and its y axis to the left; print it as it is (the "
+                   "print is the same target) and hold the sheet turned a quarter turn "
+                   "counterclockwise to see it upright, or write it with --landscape. ";
+  } else {
+    description << "Object frame: x to the right, y down. ";
+  }
+  description << "The board's centre, the object origin, is at (" << Mm(cx) << ", " << Mm(cy)
+              << "); its outline is not printed.";
+  drawing.description = description.str();
   return drawing;
 }
 
