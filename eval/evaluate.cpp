@@ -163,7 +163,8 @@ struct Tally {
   std::set<int> track_ids;
   int pose_jumps = 0;
   std::vector<int> jump_frames;
-  std::vector<RadialBend> lens;  ///< of the target tracker's frames with a pose
+  std::vector<RadialBend> lens;                     ///< of the target tracker's frames with a pose
+  std::map<std::size_t, int> frames_by_lines_held;  ///< readable frames by lines held
 };
 
 // The evaluation of one input: decoder, tracker and writer (file comment of evaluate.h).
@@ -490,6 +491,7 @@ class InputEvaluation {
                                : held.empty() ? FrameStatus::kLost
                                               : FrameStatus::kPartial;
     CountFrame(detected, pose_ok, out.pose);
+    ++tally_.frames_by_lines_held[held.size()];
 
     const FrameTruth truth = truth_.Get(frame.source, frame.index, w, h);
     PlotSeries::Row row;
@@ -545,21 +547,44 @@ class InputEvaluation {
     return out;
   }
 
-  // Nearly nothing detected: what the detector looked for, and what to try.
+  // Nearly nothing detected: what the detector looked for, and what to try, likeliest first,
+  // never what the run already does: when most frames held fewer lines than asked, that
+  // number; a single edge needs the edge polarity, unless it is the one used.
   std::string LowDetectionHint(const Tally& t) const {
     const DetectorOptions& detector = run_.setup.detector;
-    std::string looked_for =
-        detector.polarity == Polarity::kEdges
-            ? "straight light/dark edges"
-            : std::string(detector.polarity == Polarity::kLightLines ? "light" : "dark") +
-                  " stripes " + std::to_string(static_cast<int>(detector.min_width_px)) + "-" +
-                  std::to_string(static_cast<int>(detector.max_width_px)) + " px wide";
-    return "the target's " + std::to_string(run_.target_lines) + " lines were found in only " +
-           std::to_string(t.detected) + " of " + std::to_string(t.readable) +
-           " frames; the detector looked for " + looked_for +
-           " (the config's detector: section). A single edge, as in ViSP's line/ sequence, "
-           "needs polarity: edges (config/visp_line_edges.yaml); another number of lines, "
-           "--lines N";
+    const bool edges = detector.polarity == Polarity::kEdges;
+    const std::string looked_for =
+        edges ? "straight light/dark edges"
+              : std::string(detector.polarity == Polarity::kLightLines ? "light" : "dark") +
+                    " stripes " + std::to_string(static_cast<int>(detector.min_width_px)) + "-" +
+                    std::to_string(static_cast<int>(detector.max_width_px)) + " px wide";
+    std::string hint = "the target's " + std::to_string(run_.target_lines) +
+                       " lines were found in only " + std::to_string(t.detected) + " of " +
+                       std::to_string(t.readable) + " frames; the detector looked for " +
+                       looked_for + " (the config's detector: section)";
+    std::size_t usual = 0;
+    int usual_frames = 0;
+    for (const auto& [lines, frames] : t.frames_by_lines_held) {
+      if (frames > usual_frames) usual = lines, usual_frames = frames;
+    }
+    std::vector<std::string> tries;
+    if (usual > 0 && usual < run_.target_lines) {
+      tries.push_back(std::to_string(usual) + " line" + (usual == 1 ? " was" : "s were") +
+                      " held in " + std::to_string(usual_frames) + " of " +
+                      std::to_string(t.readable) + " frames: if the scene has " +
+                      std::to_string(usual) + ", evaluate with --lines " + std::to_string(usual));
+    }
+    if (!edges) {
+      tries.push_back(
+          "a single edge, as in ViSP's line/ sequence, needs polarity: edges "
+          "(config/visp_line_edges.yaml)");
+    } else if (usual == 0) {
+      tries.push_back(
+          "no edge was held: lower the detector's min_contrast, or check that the "
+          "frames show one");
+    }
+    for (std::size_t k = 0; k < tries.size(); ++k) hint += (k == 0 ? ". " : "; or ") + tries[k];
+    return hint;
   }
 
   Json Summary(const ImageSource* source, const DecodeStats& decode) const {

@@ -71,6 +71,18 @@ TEST(Oalservo, EvaluateSaysOnTheConsoleWhatItsSummaryWarnsAbout) {
   EXPECT_THAT(run.err, ::testing::ContainsRegex("oalservo evaluate: warning: [^:]+: the target's "
                                                 "[0-9]+ lines were found in only 0 of 3 frames"));
   EXPECT_THAT(run.err, HasSubstr("config/visp_line_edges.yaml"));
+
+  // With the edge polarity already given, the hint does not advise it again: the sequence's
+  // one edge is held in most frames, and the hint says so and how to ask for one line.
+  const test::OalservoRun edges =
+      test::RunOalservo(dir, "evaluate '" + pattern + "' --no-video --config '" + OAL_SOURCE_DIR +
+                                 "/config/visp_line_edges.yaml' --out '" + dir / "edges" + "'");
+  EXPECT_EQ(edges.exit_code, 0) << edges.err;
+  EXPECT_THAT(edges.err, HasSubstr("lines were found in only 0 of 33 frames"));
+  EXPECT_THAT(edges.err, Not(HasSubstr("visp_line_edges.yaml")));
+  EXPECT_THAT(edges.err, Not(HasSubstr("polarity: edges")));
+  EXPECT_THAT(edges.err, ::testing::ContainsRegex("1 line was held in [0-9]+ of 33 frames: if the "
+                                                  "scene has 1, evaluate with --lines 1"));
 }
 
 TEST(Oalservo, Version) {
