@@ -11,6 +11,8 @@
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/frame_command.h"
+#include "app/live_window.h"
+#include "base/format.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "detector/line_fit.h"
@@ -38,6 +40,7 @@ struct DetectRun {
   std::optional<CameraFile> camera;
   std::vector<std::unique_ptr<ImageSource>> sources;
   std::optional<Lens> undistorted_by;  ///< set when lines are undistorted
+  std::unique_ptr<LiveView> view;      ///< --display
 };
 
 OalDetector MakeDetector(const DetectorOptions& options, const std::optional<CameraFile>& camera) {
@@ -119,6 +122,14 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
       }
       summary->lines += static_cast<int>(lines.size());
       ++summary->frames;
+      if (run->view && !run->view->Show(AnnotateLines(frame.gray, lines, run->undistorted_by),
+                                        "frame " + std::to_string(summary->frames - 1) + ": " +
+                                            std::to_string(lines.size()) + " lines, " +
+                                            Fixed(1e-3 * time_us, 2) + " ms",
+                                        frame.taken_s.has_value())) {
+        summary->stopped_by_user = true;
+        return;
+      }
     }
   }
 }
@@ -127,6 +138,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
 
 void DetectCommandOptions::Check() const {
   CheckFrameCommand(inputs, max_frames, out_path);
+  CheckDisplayOptions(*this);
   if (!camera_name.empty() && camera_path.empty()) {
     throw std::invalid_argument("DetectCommandOptions::camera_name '" + camera_name +
                                 "' needs camera_path (the camera file to read it from)");
@@ -137,9 +149,10 @@ DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& ou
   options.Check();
   DetectSummary summary;
   std::optional<CameraFile> camera = LoadCamera(options);
-  DetectRun run{MakeDetector(LoadDetectorOptions(options), camera), std::move(camera), {}, {}};
+  DetectRun run{MakeDetector(LoadDetectorOptions(options), camera), std::move(camera), {}, {}, {}};
   if (run.detector.Undistorts()) run.undistorted_by = run.camera->camera;
   run.sources = OpenInputs(options, &summary.warnings);
+  if (options.display) run.view = OpenLiveView("oalservo detect", options);
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
@@ -169,16 +182,21 @@ int RunDetect(int argc, char** argv) {
       ->needs(camera);
   AddOutputOptions(cli, &options,
                    "directory for one PNG per frame with the lines drawn (created if missing)");
+  AddDisplayOptions(cli, &options);
   cli.footer(
       "Examples:\n"
       "  oalservo detect frames/ --out lines.jsonl --annotate annotated/\n"
       "  oalservo detect data/ --camera data/camera.xml\n"
       "  oalservo detect '/usr/share/visp-images-data/ViSP-images/line/image.%04d.pgm' "
       "--config config/visp_line_edges.yaml\n"
-      "  oalservo detect /dev/video0 --max-frames 100");
+      "  oalservo detect /dev/video0 --max-frames 100\n"
+      "  oalservo detect /dev/video0 --display   # the lines found, live");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   const DetectSummary summary = DetectImages(options, std::cout);
   for (const std::string& warning : summary.warnings) Warn("detect", warning);
+  if (summary.stopped_by_user) {
+    std::cerr << "oalservo detect: stopped from the window after " << summary.frames << " frames\n";
+  }
   if (!options.out_path.empty()) {
     std::cerr << "oalservo detect: " << summary.frames << " frames, " << summary.lines
               << " lines written to " << options.out_path << '\n';

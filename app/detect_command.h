@@ -44,6 +44,7 @@ struct DetectSummary {
   std::vector<std::string> warnings;
   /// Each frame's straightness_px (frames with at least four lines).
   std::vector<double> straightness_px;
+  bool stopped_by_user = false;  ///< a click or a key in the live window (--display)
 };
 
 /// Detects lines in every frame of every input. Output goes to options.out_path (atomically:

@@ -1,7 +1,10 @@
 #include "app/frame_command.h"
 
 #include <CLI/CLI.hpp>
+#include <stdexcept>
 
+#include "app/live_window.h"
+#include "base/format.h"
 #include "io/image_source.h"
 
 namespace oal {
@@ -44,6 +47,35 @@ void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options) {
                  "0 or 1 up to the first missing file, with a warning if files follow the gap), "
                  "video file, or V4L2 device /dev/videoN")
       ->required();
+}
+
+void CheckDisplayOptions(const FrameCommandOptions& options) {
+  if (options.display && !(options.display_fps > 0.0 && options.display_fps <= 1000.0)) {
+    throw std::invalid_argument("--display-fps = " + Number(options.display_fps) +
+                                ": give a rate above 0 and at most 1000 frames a second");
+  }
+}
+
+std::unique_ptr<LiveView> OpenLiveView(const std::string& title,
+                                       const FrameCommandOptions& options) {
+  try {
+    return std::make_unique<LiveView>(title, options.display_fps);
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error("--display: " + std::string(error.what()) +
+                             "; run without --display (--annotate DIR writes the same pictures), "
+                             "or where $DISPLAY names a running X server (e.g. Xvfb)");
+  }
+}
+
+void AddDisplayOptions(CLI::App& cli, FrameCommandOptions* options) {
+  cli.add_flag("--display", options->display,
+               "show each frame annotated in a window (X11: $DISPLAY); a click or a key in it "
+               "stops, the output written so far is kept");
+  cli.add_option("--display-fps", options->display_fps,
+                 "with --display, frames from files are shown at this rate (a camera's as they "
+                 "come)")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
 }
 
 void AddOutputOptions(CLI::App& cli, FrameCommandOptions* options,

@@ -18,6 +18,7 @@ class App;
 namespace oal {
 
 class ImageSource;
+class LiveView;
 
 /// The inputs and outputs of a command over image sources; each command adds its own options.
 struct FrameCommandOptions {
@@ -32,6 +33,11 @@ struct FrameCommandOptions {
   std::string annotate_dir;
   /// Stop after this many frames (for cameras); 0: all. Range [0, inf).
   int max_frames = 0;
+  /// A live window (app/live_window.h) shows each annotated frame; a click or a key stops.
+  bool display = false;
+  /// Frames from files are shown at most this many a second (a camera's as they come).
+  /// Range (0, 1000].
+  double display_fps = 30.0;
 };
 
 /// The folder where `oalservo render` leaves its companion files for `inputs`: the first
@@ -59,6 +65,17 @@ void WriteFrameRecords(const FrameCommandOptions& options, std::ostream& console
 
 /// Adds the INPUT argument (required) to a command's command line.
 void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options);
+
+/// Throws std::invalid_argument for a display_fps out of its range (with display).
+void CheckDisplayOptions(const FrameCommandOptions& options);
+
+/// The live window of a command with --display, open: throws std::runtime_error saying why
+/// none can be opened (naming $DISPLAY) and what to do instead.
+std::unique_ptr<LiveView> OpenLiveView(const std::string& title,
+                                       const FrameCommandOptions& options);
+
+/// Adds --display and --display-fps.
+void AddDisplayOptions(CLI::App& cli, FrameCommandOptions* options);
 
 /// Adds --out, --annotate (described by `annotate_help`) and --max-frames.
 void AddOutputOptions(CLI::App& cli, FrameCommandOptions* options,

@@ -17,6 +17,8 @@
 #include "app/command_line.h"
 #include "app/config.h"
 #include "app/frame_command.h"
+#include "app/live_window.h"
+#include "base/format.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "io/annotate.h"
@@ -58,6 +60,7 @@ struct PoseRun {
   TargetPoseTracker tracker;
   std::vector<std::unique_ptr<ImageSource>> sources;
   std::optional<Lens> undistorted_by;  ///< set when lines are undistorted
+  std::unique_ptr<LiveView> view;      ///< --display
 };
 
 // The configuration: --config, else the target.yaml `oalservo render` writes next to its
@@ -227,8 +230,27 @@ void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* r
   summary->notes.push_back(said.str());
 }
 
+// The frame in the live window: lines 1-4, the corners and the axes (a refused pose drawn as
+// none), the region scanned, and a caption with the status, the time and the lens check.
+// False once the user asked to stop.
+bool ShowPose(const Frame& frame, const TargetFrame& result, const PoseRun& run, int index) {
+  PoseResult drawn = result.pose;
+  if (result.status != TargetStatus::kOk) drawn.status = PoseStatus::kDegenerate;
+  std::string caption = "frame " + std::to_string(index) + ": " + ToString(result.status);
+  if (!result.message.empty()) caption += " (" + result.message + ")";
+  caption += ", " + Fixed(1e-3 * (result.find_us + result.detect_us + result.pose_us), 1) + " ms";
+  if (MeasuresLens(result) && std::isfinite(result.lens.kdu_error_sd)) {
+    caption += ContradictsLens(result.lens) ? ", lens check: the stripes bend (kdu off by " +
+                                                  Fixed(result.lens.kdu_error, 3) + ")"
+                                            : ", lens check: ok";
+  }
+  return run.view->Show(AnnotatePose(frame.gray, run.tracker.lines(), drawn, run.camera.camera,
+                                     run.undistorted_by, result.region),
+                        caption, frame.taken_s.has_value());
+}
+
 // Runs the detector and the pose over every frame, writing to `sink`; returns when the
-// sources end or max_frames is reached.
+// sources end, max_frames is reached or the user stops it from the live window.
 void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream& sink,
                    bool flush_each, PoseSummary* summary) {
   FrameFeed feed(&run->sources);
@@ -261,6 +283,10 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
     if (result.status == TargetStatus::kOk) ++summary->ok;
     if (MeasuresLens(result)) summary->lens.push_back(result.lens);
     ++summary->frames;
+    if (run->view && !ShowPose(frame, result, *run, summary->frames - 1)) {
+      summary->stopped_by_user = true;
+      break;
+    }
   }
 }
 
@@ -268,6 +294,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
 
 void PoseCommandOptions::Check() const {
   CheckFrameCommand(inputs, max_frames, out_path);
+  CheckDisplayOptions(*this);
   if (estimate_frames < 1 || estimate_frames > 100) {
     throw std::invalid_argument("--estimate-frames = " + std::to_string(estimate_frames) +
                                 ": give 1 to 100 frames");
@@ -288,12 +315,17 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   // The target and the options with the camera, before any frame: a bad one fails here.
   TargetPoseTracker tracker(config.target, camera.camera, config.detector, config.pose,
                             config.tracking);
-  PoseRun run{std::move(config), std::move(camera), std::move(tracker), {}, {}};
+  PoseRun run{std::move(config), std::move(camera), std::move(tracker), {}, {}, {}};
   if (run.tracker.detector().Undistorts()) run.undistorted_by = run.camera.camera;
   run.sources = OpenInputs(options, &summary.warnings);
+  if (options.display) run.view = OpenLiveView("oalservo pose", options);
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });
+  if (summary.stopped_by_user) {
+    summary.notes.push_back("stopped from the window after " + std::to_string(summary.frames) +
+                            " frames");
+  }
   const LensCheck lens = CheckLens(summary.lens);
   if (lens.mismatch) {
     summary.warnings.push_back(LensMismatchWarning(
@@ -340,12 +372,14 @@ int RunPose(int argc, char** argv) {
   AddOutputOptions(cli, &options,
                    "directory for one PNG per frame with lines 1-4 and the target's axes drawn "
                    "(created if missing)");
+  AddDisplayOptions(cli, &options);
   cli.footer(
       "Examples:\n"
       "  oalservo render --count 20 --out data/ && oalservo pose data/ --independent --out "
       "poses.jsonl\n"
       "  oalservo pose frames/ --camera camera.xml --config config/pose.yaml --annotate ann/\n"
-      "  oalservo pose /dev/video0 --camera camera.xml --max-frames 100");
+      "  oalservo pose /dev/video0 --camera camera.xml --max-frames 100\n"
+      "  oalservo pose /dev/video0 --camera camera.yaml --display   # what the tracker sees, live");
   if (const auto exit = ParseCommandLine(cli, argc, argv)) return *exit;
   const PoseSummary summary = EstimatePoses(options, std::cout);
   for (const std::string& note : summary.notes) std::cerr << "oalservo pose: " << note << '\n';

@@ -83,6 +83,7 @@ struct PoseSummary {
   std::vector<std::string> warnings;
   /// What was done for the user (the lens estimated).
   std::vector<std::string> notes;
+  bool stopped_by_user = false;  ///< a click or a key in the live window (--display)
   /// kdu told from the stripes (--estimate-distortion), when it was.
   std::optional<double> estimated_kdu;
   /// TargetFrame::lens of the frames with a pose, in order.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/command_line.h"
+#include "app/live_window.h"
 #include "app/servo_default_config.h"
 #include "app/servo_output.h"
 #include "io/atomic_file.h"
@@ -112,6 +113,8 @@ struct FoldersMadeForARun {
   }
 };
 
+constexpr const char* kWindowTitle = "oalservo servo (click or a key to stop)";
+
 // The window or the annotated frames, fed by the loop's on_frame hook.
 class FrameOutput {
  public:
@@ -122,15 +125,14 @@ class FrameOutput {
     const int width = config.camera.width, height = config.camera.height;
     if (output.display == DisplayMode::kOn) {
       try {
-        window_ = std::make_unique<ServoWindow>(width, height);
+        window_ = std::make_unique<LiveWindow>(width, height, kWindowTitle);
       } catch (const std::runtime_error& error) {
-        if (!CanOpenServoWindow()) throw;  // the message says output.display already
         throw std::runtime_error("output.display is on but " + std::string(error.what()) +
-                                 "; use output.display auto or off (--display)");
+                                 "; use output.display: auto or off (--display)");
       }
-    } else if (output.display == DisplayMode::kAuto && CanOpenServoWindow()) {
+    } else if (output.display == DisplayMode::kAuto && CanOpenLiveWindow()) {
       try {
-        window_ = std::make_unique<ServoWindow>(width, height);
+        window_ = std::make_unique<LiveWindow>(width, height, kWindowTitle);
       } catch (const std::runtime_error& error) {
         Warn("servo", std::string(error.what()) + "; going on without a window (output.display " +
                           "auto; off to skip this, on to make it an error)");
@@ -155,7 +157,7 @@ class FrameOutput {
   }
 
   bool Active() const { return window_ != nullptr || save_; }
-  ServoWindow* window() { return window_.get(); }
+  LiveWindow* window() { return window_.get(); }
   bool HasWindow() const { return window_ != nullptr; }
 
   // Shows or writes the frame; true when the user asked to stop (a click in the window).
@@ -163,7 +165,7 @@ class FrameOutput {
     const cv::Mat annotated = AnnotateServoFrame(frame);
     if (window_) {
       window_->Show(annotated);
-      return window_->StopClicked();
+      return window_->StopAsked();
     }
     char name[32];
     std::snprintf(name, sizeof(name), "iter_%04d.png", frame.row.iteration);
@@ -173,7 +175,7 @@ class FrameOutput {
 
  private:
   fs::path frames_dir_;
-  std::unique_ptr<ServoWindow> window_;
+  std::unique_ptr<LiveWindow> window_;
   bool save_ = false;
 };
 
@@ -272,7 +274,7 @@ ServoRunReport RunServoWithOutputs(const ServoAppConfig& config, const std::stri
                                                    : std::string())
         << '\n';
   }
-  if (ServoWindow* window = frames.window(); window != nullptr && !window->StopClicked()) {
+  if (LiveWindow* window = frames.window(); window != nullptr && !window->StopAsked()) {
     out << "oalservo servo: click in the window to close it" << std::endl;
     window->WaitForClick(hooks.interrupt);
   }

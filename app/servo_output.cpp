@@ -1,17 +1,5 @@
 #include "app/servo_output.h"
 
-#include <visp3/core/vpConfig.h>
-#include <visp3/core/vpDisplay.h>
-#include <visp3/core/vpException.h>
-#include <visp3/core/vpImage.h>
-#include <visp3/core/vpImageConvert.h>
-#include <visp3/core/vpRGBa.h>
-
-#include "detector/lens.h"
-#ifdef VISP_HAVE_X11
-#include <visp3/gui/vpDisplayX.h>
-#endif
-
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -31,6 +19,7 @@
 #include <vector>
 
 #include "base/format.h"
+#include "detector/lens.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 
@@ -184,80 +173,6 @@ void CheckWritableDirectory(const std::filesystem::path& dir, const std::string&
   }
   ::close(fd);
   RemoveQuietly(probe);
-}
-
-bool CanOpenServoWindow() {
-#ifdef VISP_HAVE_X11
-  const char* display = std::getenv("DISPLAY");
-  return display != nullptr && *display != '\0';
-#else
-  return false;
-#endif
-}
-
-struct ServoWindow::Impl {
-  vpImage<vpRGBa> image;
-#ifdef VISP_HAVE_X11
-  vpDisplayX display;
-#endif
-  bool open = false;
-  bool clicked = false;
-
-  // Opens the window on `image` (its size); throws std::runtime_error saying why it cannot.
-  void Open() {
-#ifdef VISP_HAVE_X11
-    try {
-      display.init(image, 0, 0, "oalservo servo (click to stop)");
-    } catch (const vpException& error) {
-      const char* name = std::getenv("DISPLAY");
-      throw std::runtime_error(
-          "cannot open a window on the X display '" + std::string(name != nullptr ? name : "") +
-          "' ($DISPLAY): " + error.getMessage() + " (is the X server running and reachable?)");
-    }
-    open = true;
-#endif
-  }
-};
-
-ServoWindow::ServoWindow(int width, int height) {
-  if (!CanOpenServoWindow()) {
-    throw std::runtime_error(
-        "output.display is on but no window can be opened (no X11 display: $DISPLAY is unset "
-        "or this ViSP has no X11); use output.display: auto or off");
-  }
-  impl_ = std::make_unique<Impl>();
-  impl_->image.init(static_cast<unsigned>(height), static_cast<unsigned>(width), vpRGBa(0));
-  impl_->Open();
-}
-
-ServoWindow::~ServoWindow() = default;
-
-void ServoWindow::Show(const cv::Mat& bgr) {
-#ifdef VISP_HAVE_X11
-  if (impl_->open && (static_cast<int>(impl_->image.getWidth()) != bgr.cols ||
-                      static_cast<int>(impl_->image.getHeight()) != bgr.rows)) {
-    vpDisplay::close(impl_->image);  // reopened below at the frame's size
-    impl_->open = false;
-  }
-  vpImageConvert::convert(bgr, impl_->image);
-  if (!impl_->open) impl_->Open();
-  vpDisplay::display(impl_->image);
-  vpDisplay::flush(impl_->image);
-#else
-  (void)bgr;
-#endif
-}
-
-bool ServoWindow::StopClicked() {
-  if (impl_->open && !impl_->clicked) impl_->clicked = vpDisplay::getClick(impl_->image, false);
-  return impl_->clicked;
-}
-
-void ServoWindow::WaitForClick(const std::atomic<bool>* interrupt) {
-  while (impl_->open && !vpDisplay::getClick(impl_->image, false)) {
-    if (interrupt != nullptr && interrupt->load()) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
 }
 
 }  // namespace oal

@@ -1,5 +1,5 @@
-// What `oalservo servo` shows and writes besides the table: the pose-error plot, the
-// annotated frames of a headless run and the live vpDisplayX window.
+// What `oalservo servo` writes besides the table: the pose-error plot and the annotated
+// frames of a headless run (the live window is app/live_window.h).
 //
 //   DIR/servo.csv          one row per iteration (WriteServoCsv, loop/servo_loop.h)
 //   DIR/servo-error.png    translation (mm) and rotation (deg) error per iteration, estimated
@@ -13,9 +13,7 @@
 // began (the robot connected).
 #pragma once
 
-#include <atomic>
 #include <filesystem>
-#include <memory>
 #include <opencv2/core/mat.hpp>
 #include <string>
 
@@ -40,33 +38,5 @@ cv::Mat AnnotateServoFrame(const ServoFrame& frame);
 /// missing, then creates and removes a file in it. Throws std::runtime_error naming `what`
 /// (e.g. "output directory (--out)"), the directory and the reason.
 void CheckWritableDirectory(const std::filesystem::path& dir, const std::string& what);
-
-/// True when a window may be tried: this ViSP has X11 and $DISPLAY is set (the X server may
-/// still be unreachable: ServoWindow's constructor says so).
-bool CanOpenServoWindow();
-
-/// A vpDisplayX window that shows annotated frames; a click in it asks the loop to stop.
-class ServoWindow {
- public:
-  /// Opens the window now, blank, `width` x `height` (the frames' size), so that a missing or
-  /// unreachable X display is found before the robot is touched. Throws std::runtime_error
-  /// saying why when it cannot be opened.
-  ServoWindow(int width, int height);
-  ~ServoWindow();
-  ServoWindow(const ServoWindow&) = delete;
-  ServoWindow& operator=(const ServoWindow&) = delete;
-
-  /// Shows a BGR frame (the window takes its size).
-  void Show(const cv::Mat& bgr);
-  /// True once the user has clicked in the window.
-  bool StopClicked();
-  /// Waits for a click in the window (for the user to look at the last frame), or until
-  /// `*interrupt` is set (Ctrl-C).
-  void WaitForClick(const std::atomic<bool>* interrupt);
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
 
 }  // namespace oal

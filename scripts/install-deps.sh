@@ -11,7 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libjs-chart.js chromium
   gnuplot-nox
-  libcairo2-dev fonts-dejavu-core librsvg2-bin imagemagick gsfonts poppler-utils
+  libcairo2-dev fonts-dejavu-core librsvg2-bin imagemagick gsfonts poppler-utils xvfb
 )
 
 missing=()

@@ -17,6 +17,7 @@
 #include "app/servo_accuracy.h"
 #include "app/servo_accuracy_command.h"
 #include "app/servo_command.h"
+#include "app/live_window.h"
 #include "app/servo_output.h"
 #include "app/servo_run.h"
 #include "scene/scene.h"
@@ -331,7 +332,7 @@ TEST(ServoOutput, AnUnreachableDisplayFallsBackToFramesInAutoAndFailsBeforeMovin
   test::WriteText(config_path,
                   "camera: {px: 300, py: 300, u0: 159.5, v0: 119.5, width: 320, height: 240}\n");
   const UnreachableDisplay display;
-  if (!CanOpenServoWindow()) GTEST_SKIP() << "this ViSP has no X11";
+  if (!CanOpenLiveWindow()) GTEST_SKIP() << "this ViSP has no X11";
   ServoCommandOptions options;
   options.config_path = config_path;
   options.out_dir = dir / "auto";
