@@ -879,6 +879,18 @@ const std::vector<Field<SourceConfig>>& SourceFields() {
        }},
       {"device",
        [](const Value& value, O* source) { source->device = value.As<std::string>("a path"); }},
+      {"format",
+       [](const Value& value, O* source) {
+         const std::string word = value.As<std::string>("a string");
+         const std::optional<CameraFormat> format = CameraFormatFromString(word);
+         if (!format) {
+           value.Fail("'" + value.key + "' is invalid: '" + word +
+                      "' is not one of auto, mjpeg, yuyv, grey");
+         }
+         source->format = *format;
+       }},
+      IntField("width", &O::width),
+      IntField("height", &O::height),
       IntField("fps", &O::fps),
       {"path", [](const Value& value, O* source) { source->path = PathNextTo(value.file, value); }},
   };
@@ -1345,8 +1357,12 @@ void RobotConfig::Check() const {
 void SourceConfig::Check() const {
   if (type == SourceType::kV4l2 && device.empty())
     Violated("SourceConfig::device", "''", "a device path");
-  if (fps != 0 && fps != 25 && fps != 50) {
-    Violated("SourceConfig::fps", Number(fps), "fps is 0 (the driver's), 25 or 50");
+  if (fps < 0 || fps > 1000) {
+    Violated("SourceConfig::fps", Number(fps), "fps is 0 (the mode's highest) or up to 1000");
+  }
+  if (width < 0 || height < 0 || (width > 0) != (height > 0)) {
+    Violated("SourceConfig::width", std::to_string(width) + "x" + std::to_string(height),
+             "width and height both above 0, or both 0 (camera.width, camera.height)");
   }
   if (type == SourceType::kReplay && path.empty()) {
     Violated("SourceConfig::path", "''", "a video, directory or pattern to replay");

@@ -34,7 +34,7 @@
 //   servo:    the law (ServoOptions) and the loop's limits             (ServoLoopOptions)
 //   goal:     cdMo, the target as the camera should see it at the goal, or image: a taught goal
 //   target_pose: wMo, the target's pose in the world (robot base) frame
-//   source:   simulated (rendered), v4l2 (device, fps) or replay (path)  (SourceConfig)
+//   source:   simulated (rendered), v4l2 (device, format, width, height, fps) or replay (path)
 //   output:   directory, display (auto/on/off), save_frames               (OutputConfig)
 //
 // A pose is a map {translation_m: [x, y, z], rxyz_deg: [rx, ry, rz]} with the rotation
@@ -56,6 +56,7 @@
 #include "detector/lens.h"
 #include "detector/options.h"
 #include "io/scene_options.h"
+#include "io/v4l2_modes.h"
 #include "loop/servo_loop.h"
 #include "robots/safe_robot.h"
 #include "robots/scorbot_controller_sim.h"
@@ -147,8 +148,13 @@ struct RobotConfig {
 /// `source:` where the servo loop's frames come from.
 struct SourceConfig {
   SourceType type = SourceType::kSimulated;
-  std::string device = "/dev/video0";  ///< v4l2: the device; its size is camera.width/height
-  int fps = 0;                         ///< v4l2: 25 or 50 (vpV4l2Grabber's rates); 0: driver's
+  std::string device = "/dev/video0";  ///< v4l2: the device
+  /// v4l2: the pixel format (auto: YUYV where it gives the size and rate, else MJPEG), the
+  /// size (0: camera.width/height) and the rate (0: the highest of the mode): one of the
+  /// modes `oalservo cameras` lists (io/v4l2_modes.h).
+  CameraFormat format = CameraFormat::kAuto;
+  int width = 0, height = 0;
+  int fps = 0;  ///< Range [0, 1000].
   /// replay: what to play (io/image_source.h); relative paths are relative to the config file.
   std::string path;
 

@@ -139,6 +139,7 @@ void ProcessFrames(const DetectCommandOptions& options, DetectRun* run, std::ost
 void DetectCommandOptions::Check() const {
   CheckFrameCommand(inputs, max_frames, out_path);
   CheckDisplayOptions(*this);
+  CameraModeRequest(*this);  // a bad --camera-mode fails before any input is opened
   if (!camera_name.empty() && camera_path.empty()) {
     throw std::invalid_argument("DetectCommandOptions::camera_name '" + camera_name +
                                 "' needs camera_path (the camera file to read it from)");

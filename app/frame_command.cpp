@@ -29,7 +29,11 @@ std::vector<std::unique_ptr<ImageSource>> OpenInputs(const FrameCommandOptions& 
                                                      std::vector<std::string>* warnings) {
   std::vector<std::unique_ptr<ImageSource>> sources;
   for (const std::string& input : options.inputs) {
-    sources.push_back(OpenImageSource(input, warnings));
+    if (IsDevicePath(input)) {
+      sources.push_back(OpenV4l2Source(input, CameraModeRequest(options)));
+    } else {
+      sources.push_back(OpenImageSource(input, warnings));
+    }
   }
   return sources;
 }
@@ -41,12 +45,25 @@ std::filesystem::path AnnotationPath(const FrameCommandOptions& options, const s
   return std::filesystem::path(options.annotate_dir) / (prefix + "_" + number + ".png");
 }
 
+CameraRequest CameraModeRequest(const FrameCommandOptions& options) {
+  if (options.camera_mode.empty()) return CameraRequest();
+  try {
+    return ParseCameraRequest(options.camera_mode);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument("--camera-mode " + std::string(error.what()));
+  }
+}
+
 void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options) {
   cli.add_option("INPUT", options->inputs,
                  "image, directory of images, printf pattern (frames/img%04d.png: from index "
                  "0 or 1 up to the first missing file, with a warning if files follow the gap), "
                  "video file, or V4L2 device /dev/videoN")
       ->required();
+  cli.add_option("--camera-mode", options->camera_mode,
+                 "a /dev/videoN input's mode, FORMAT:WIDTHxHEIGHT@FPS, any part left out: "
+                 "mjpeg:1280x720@30, yuyv:640x480, 1920x1080@30 (oalservo cameras lists the "
+                 "modes; default: the largest at the highest rate, YUYV before MJPEG)");
 }
 
 void CheckDisplayOptions(const FrameCommandOptions& options) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "io/atomic_file.h"
+#include "io/v4l2_modes.h"
 
 namespace CLI {
 class App;
@@ -25,6 +26,9 @@ struct FrameCommandOptions {
   /// Image, directory, printf pattern, video or /dev/videoN (io/image_source.h); read one
   /// after the other.
   std::vector<std::string> inputs;
+  /// A /dev/videoN input's mode, as ParseCameraRequest reads it ("mjpeg:1280x720@30");
+  /// empty: the camera's largest at its highest rate.
+  std::string camera_mode;
   /// Camera to read from the command's camera file; empty: the first camera of the file.
   std::string camera_name;
   /// JSON Lines output, written atomically; empty: the stream passed to the command's function.
@@ -63,7 +67,11 @@ void WriteFrameRecords(const FrameCommandOptions& options, std::ostream& console
   WriteToFileOrConsole(options.out_path, console, write);
 }
 
-/// Adds the INPUT argument (required) to a command's command line.
+/// The camera mode `options.camera_mode` asks for. Throws std::invalid_argument naming
+/// --camera-mode and what is wrong.
+CameraRequest CameraModeRequest(const FrameCommandOptions& options);
+
+/// Adds the INPUT argument (required) and --camera-mode to a command's command line.
 void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options);
 
 /// Throws std::invalid_argument for a display_fps out of its range (with display).

@@ -14,6 +14,7 @@
 #include "app/calibrate_accuracy_command.h"
 #include "app/calibrate_command.h"
 #include "app/camera_command.h"
+#include "app/cameras_command.h"
 #include "app/command_line.h"
 #include "app/compare_command.h"
 #include "app/demo_command.h"
@@ -65,7 +66,8 @@ constexpr oal::Command kCommands[] = {
      "the camera's mounting on the arm (eMc): move through stations, or from recorded pairs"},
     {"camera", &oal::RunCamera,
      "show a camera file's lens; write it as ViSP's XML, OpenCV's YAML or ROS's camera_info"},
-    {"target", &oal::RunTarget, "write a printable, true-scale SVG of the line target"},
+    {"cameras", &oal::RunCameras, "list the V4L2 cameras and their modes (format, size, rate)"},
+    {"target", &oal::RunTarget, "write a printable, true-scale PDF or SVG of the line target"},
     {"scorbot-sim", &oal::RunScorbotSim,
      "Scorbot ER-VII controller simulator (ACL) on a pseudo-terminal; --measure: link budget"},
 };

@@ -295,6 +295,7 @@ void ProcessFrames(const PoseCommandOptions& options, PoseRun* run, std::ostream
 void PoseCommandOptions::Check() const {
   CheckFrameCommand(inputs, max_frames, out_path);
   CheckDisplayOptions(*this);
+  CameraModeRequest(*this);  // a bad --camera-mode fails before any input is opened
   if (estimate_frames < 1 || estimate_frames > 100) {
     throw std::invalid_argument("--estimate-frames = " + std::to_string(estimate_frames) +
                                 ": give 1 to 100 frames");

@@ -129,8 +129,9 @@ std::unique_ptr<FrameSource> OpenFrames(const ServoAppConfig& config,
   try {
     if (v4l2) {
       V4l2Settings settings;
-      settings.width = config.camera.width;
-      settings.height = config.camera.height;
+      settings.format = source.format;
+      settings.width = source.width > 0 ? source.width : config.camera.width;
+      settings.height = source.height > 0 ? source.height : config.camera.height;
       settings.fps = source.fps;
       return std::make_unique<RecordedFrames>(OpenV4l2Source(source.device, settings));
     }

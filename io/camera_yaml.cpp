@@ -68,9 +68,8 @@ std::vector<double> MatrixData(const std::string& path, const YAML::Node& root,
     Size(Key{path, matrix.node[dimension], name + "." + dimension});
   }
   if (matrix.node["rows"] && matrix.node["cols"]) {
-    const unsigned int count =
-        Size(Key{path, matrix.node["rows"], name + ".rows"}) *
-        Size(Key{path, matrix.node["cols"], name + ".cols"});
+    const unsigned int count = Size(Key{path, matrix.node["rows"], name + ".rows"}) *
+                               Size(Key{path, matrix.node["cols"], name + ".cols"});
     if (count != values.size()) {
       data.Fail("has " + std::to_string(values.size()) + " numbers where rows x cols is " +
                 std::to_string(count));
@@ -115,7 +114,8 @@ Distortion Coefficients(const std::string& path, const YAML::Node& root) {
   for (std::size_t i = 8; i < n; ++i) {
     if (d[i] != 0.0) {
       data.Fail("has thin-prism or tilted-sensor terms (coefficient " + std::to_string(i + 1) +
-                " = " + std::to_string(d[i]) + "): only k1, k2, p1, p2, k3 and k4-k6 are supported");
+                " = " + std::to_string(d[i]) +
+                "): only k1, k2, p1, p2, k3 and k4-k6 are supported");
     }
   }
   std::array<double, 8> c{};
@@ -204,7 +204,8 @@ YamlCamera ReadYamlCamera(const std::string& path) {
     }
     if (root["camera_name"]) {
       const Key camera_name{path, root["camera_name"], "camera_name"};
-      if (!camera_name.node.IsScalar()) camera_name.Fail("must be a name, got " + Text(camera_name.node));
+      if (!camera_name.node.IsScalar())
+        camera_name.Fail("must be a name, got " + Text(camera_name.node));
       camera.name = camera_name.node.Scalar();
     }
   }

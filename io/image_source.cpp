@@ -273,14 +273,14 @@ class VideoSource : public ImageSource {
 #ifdef VISP_HAVE_V4L2
 class V4l2Source : public ImageSource {
  public:
-  V4l2Source(const std::string& device, const V4l2Settings& settings) : device_(device) {
+  V4l2Source(const std::string& device, int width, int height, double fps) : device_(device) {
     grabber_.setDevice(device);
     grabber_.setInput(0);  // USB cameras have one input; ViSP's default (2) is for TV boards
     grabber_.setScale(1);  // full resolution; ViSP's default halves it
-    if (settings.width > 0) grabber_.setWidth(static_cast<unsigned>(settings.width));
-    if (settings.height > 0) grabber_.setHeight(static_cast<unsigned>(settings.height));
-    if (settings.fps == 25) grabber_.setFramerate(vpV4l2Grabber::framerate_25fps);
-    if (settings.fps == 50) grabber_.setFramerate(vpV4l2Grabber::framerate_50fps);
+    if (width > 0) grabber_.setWidth(static_cast<unsigned>(width));
+    if (height > 0) grabber_.setHeight(static_cast<unsigned>(height));
+    if (fps == 25.0) grabber_.setFramerate(vpV4l2Grabber::framerate_25fps);
+    if (fps == 50.0) grabber_.setFramerate(vpV4l2Grabber::framerate_50fps);
     try {
       grabber_.open(image_);
     } catch (const vpException& error) {
@@ -320,9 +320,56 @@ class V4l2Source : public ImageSource {
 };
 #endif
 
-bool IsDevicePath(const std::string& spec) {
-  return spec.rfind("/dev/video", 0) == 0 || spec.rfind("/dev/v4l/", 0) == 0;
-}
+// A V4L2 camera through OpenCV's V4L2 backend, in the mode asked: MJPEG decoded there (the
+// only way most webcams give 720p and 1080p at 30 frames a second), or a rate vpV4l2Grabber
+// cannot ask for.
+class OpenCvCameraSource : public ImageSource {
+ public:
+  OpenCvCameraSource(const std::string& device, const ChosenMode& chosen) : device_(device) {
+    if (!capture_.open(device, cv::CAP_V4L2)) {
+      throw std::runtime_error("cannot open V4L2 device '" + device + "' through OpenCV");
+    }
+    const std::string& fourcc = chosen.mode.fourcc;
+    capture_.set(cv::CAP_PROP_FOURCC,
+                 cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]));
+    capture_.set(cv::CAP_PROP_FRAME_WIDTH, chosen.mode.width);
+    capture_.set(cv::CAP_PROP_FRAME_HEIGHT, chosen.mode.height);
+    if (chosen.fps > 0.0) capture_.set(cv::CAP_PROP_FPS, chosen.fps);
+    const int width = static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH));
+    const int height = static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT));
+    if (width != chosen.mode.width || height != chosen.mode.height) {
+      throw std::runtime_error("V4L2 device '" + device + "' was asked for " +
+                               chosen.mode.Describe() + " and gives " + std::to_string(width) +
+                               "x" + std::to_string(height));
+    }
+  }
+
+  bool Next(Frame* frame) override {
+    frame->source = device_ + "#" + std::to_string(index_++);
+    if (!capture_.read(buffer_) || buffer_.empty()) {
+      throw std::runtime_error("cannot grab from V4L2 device '" + device_ + "'");
+    }
+    // The driver's buffer timestamp, ms (UVC cameras: the monotonic clock); 0 when none.
+    const double taken_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+    frame->taken_s.reset();
+    if (taken_ms > 0.0) frame->taken_s = 1e-3 * taken_ms;
+    if (buffer_.channels() == 1) {
+      frame->gray = buffer_;
+    } else {
+      cv::cvtColor(buffer_, gray_, cv::COLOR_BGR2GRAY);
+      frame->gray = gray_;
+    }
+    return true;
+  }
+  std::string Name() const override { return "V4L2 device '" + device_ + "'"; }
+
+ private:
+  std::string device_;
+  cv::VideoCapture capture_;
+  cv::Mat buffer_, gray_;
+  int index_ = 0;
+};
+
 
 // Parsed "prefix%0<width>dsuffix"; "%%" stands for a literal '%'.
 struct Pattern {
@@ -429,13 +476,30 @@ std::string ExpandPattern(const std::string& text, int index) {
 
 std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
                                             const V4l2Settings& settings) {
+  settings.Check();
   if (!fs::exists(device)) throw std::runtime_error("no V4L2 device at " + device);
+  const std::vector<CameraMode> modes = ModesOfDevice(device);
+  if (!modes.empty()) {
+    const ChosenMode chosen = ChooseCameraMode(modes, settings);
+    const bool grabber_can = chosen.mode.fourcc != "MJPG" && chosen.mode.fourcc != "JPEG" &&
+                             (chosen.fps == 0.0 || chosen.fps == 25.0 || chosen.fps == 50.0);
 #ifdef VISP_HAVE_V4L2
-  return std::make_unique<V4l2Source>(device, settings);
+    if (grabber_can) {
+      return std::make_unique<V4l2Source>(device, chosen.mode.width, chosen.mode.height,
+                                          chosen.fps);
+    }
+#endif
+    return std::make_unique<OpenCvCameraSource>(device, chosen);
+  }
+#ifdef VISP_HAVE_V4L2
+  return std::make_unique<V4l2Source>(device, settings.width, settings.height, settings.fps);
 #else
-  (void)settings;
   throw std::runtime_error("cannot read " + device + ": this ViSP build has no V4L2 support");
 #endif
+}
+
+bool IsDevicePath(const std::string& spec) {
+  return spec.rfind("/dev/video", 0) == 0 || spec.rfind("/dev/v4l/", 0) == 0;
 }
 
 std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,

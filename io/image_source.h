@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "detector/image_view.h"
+#include "io/v4l2_modes.h"
 
 namespace oal {
 
@@ -62,18 +63,23 @@ class ImageSource {
 /// video without frames, a missing device and an unsupported input. Files skipped in a
 /// directory, and files after the gap that ends a printf pattern, are reported in
 /// `warnings` (if given).
+/// True for a V4L2 device path (/dev/videoN, /dev/v4l/...).
+bool IsDevicePath(const std::string& spec);
+
 std::unique_ptr<ImageSource> OpenImageSource(const std::string& spec,
                                              std::vector<std::string>* warnings = nullptr);
 
-/// What to ask of a V4L2 camera; 0 leaves the driver's choice.
-struct V4l2Settings {
-  int width = 0, height = 0;  ///< frame size, pixels
-  int fps = 0;                ///< 25 or 50 (vpV4l2Grabber's rates)
-};
+/// What to ask of a V4L2 camera: CameraRequest (io/v4l2_modes.h), the format, size and rate;
+/// 0 leaves a value to the mode chosen.
+using V4l2Settings = CameraRequest;
 
-/// Opens the V4L2 camera `device` (e.g. /dev/video0) with `settings`. Throws
-/// std::runtime_error saying so when the device does not exist, cannot be opened, or this ViSP
-/// has no V4L2 support.
+/// Opens the V4L2 camera `device` (e.g. /dev/video0) in the mode ChooseCameraMode picks for
+/// `settings` among the modes the device lists: an MJPEG mode, or a rate other than 25 or 50,
+/// through OpenCV's V4L2 backend (which decodes MJPEG), else through vpV4l2Grabber; a device
+/// that lists no modes through vpV4l2Grabber as asked. Frames carry the driver's capture
+/// timestamps. Throws std::runtime_error saying so when the device does not exist, cannot be
+/// opened, gives no mode as asked (listing those that come nearest), or this build cannot
+/// read it.
 std::unique_ptr<ImageSource> OpenV4l2Source(const std::string& device,
                                             const V4l2Settings& settings = V4l2Settings());
 

@@ -85,6 +85,19 @@ TEST(Oalservo, EvaluateSaysOnTheConsoleWhatItsSummaryWarnsAbout) {
                                                   "scene has 1, evaluate with --lines 1"));
 }
 
+TEST(Oalservo, CamerasSaysPlainlyWhenThereIsNone) {
+  test::TestDir dir;
+  const test::OalservoRun run =
+      test::RunOalservo(dir, "cameras --dev '" + dir.path().string() + "'");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_THAT(run.out,
+              HasSubstr("no V4L2 camera: " + dir.path().string() + " has no video capture device"));
+  // A bad camera mode is refused before any device is opened, saying what is wrong.
+  const test::OalservoRun bad = test::RunOalservo(dir, "pose /dev/video0 --camera-mode mjpeg:1280");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.err, HasSubstr("--camera-mode 'mjpeg:1280': the size is WIDTHxHEIGHT"));
+}
+
 TEST(Oalservo, Version) {
   test::TestDir dir;
   const test::OalservoRun version = test::RunOalservo(dir, "--version");

@@ -14,10 +14,10 @@
 #include <string>
 
 #include "app/config.h"
+#include "app/live_window.h"
 #include "app/servo_accuracy.h"
 #include "app/servo_accuracy_command.h"
 #include "app/servo_command.h"
-#include "app/live_window.h"
 #include "app/servo_output.h"
 #include "app/servo_run.h"
 #include "scene/scene.h"
@@ -61,8 +61,22 @@ TEST(ServoConfigSections, SourceOutputAndGoalImageAreReadAndChecked) {
 
   EXPECT_THAT(ErrorOf("source: {type: webcam}\n"),
               HasSubstr("dir/servo.yaml:1: 'source.type' is invalid"));
-  EXPECT_THAT(ErrorOf("source: {type: v4l2, fps: 30}\n"),
-              HasSubstr("'source.fps' is invalid: 30 (needs"));
+  // A camera's mode: format, size and rate, as `oalservo cameras` lists them.
+  const AppConfig camera = ParseConfig(
+      "source: {type: v4l2, device: /dev/video2, format: mjpeg, width: 1280, height: 720, "
+      "fps: 30}\n",
+      "dir/servo.yaml");
+  EXPECT_EQ(camera.source.format, CameraFormat::kMjpeg);
+  EXPECT_EQ(camera.source.width, 1280);
+  EXPECT_EQ(camera.source.height, 720);
+  EXPECT_EQ(camera.source.fps, 30);
+  EXPECT_THAT(ErrorOf("source: {type: v4l2, fps: 2000}\n"),
+              HasSubstr("'source.fps' is invalid: 2000 (needs"));
+  EXPECT_THAT(ErrorOf("source:\n  type: v4l2\n  format: h264\n"),
+              HasSubstr("dir/servo.yaml:3: 'source.format' is invalid: 'h264' is not one of auto, "
+                        "mjpeg, yuyv, grey"));
+  EXPECT_THAT(ErrorOf("source: {type: v4l2, width: 1280}\n"),
+              HasSubstr("'source.width' is invalid: 1280x0 (needs"));
   EXPECT_THAT(ErrorOf("source: {type: replay}\n"),
               HasSubstr("dir/servo.yaml:1: section 'source' is invalid: source.path = '' (needs"));
   EXPECT_THAT(ErrorOf("output:\n  display: maybe\n"),
