@@ -5,6 +5,8 @@
 
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
+#include "app/frame_command.h"
+#include "app/live_window.h"
 #include "eval/evaluate.h"
 
 namespace oal {
@@ -59,6 +61,14 @@ int RunEvaluate(int argc, char** argv) {
                  "lines held for the target to count as detected (0: the target's lines)")
       ->capture_default_str();
   cli.add_option("--max-frames", options.max_frames, "frames per input at most (0: all)");
+  bool display = false;
+  double display_fps = 30.0;
+  cli.add_flag("--display", display,
+               "show each frame annotated in a window as it is evaluated (one input; X11: "
+               "$DISPLAY); a click or a key ends the input there, its frames so far evaluated");
+  cli.add_option("--display-fps", display_fps, "with --display, frames shown a second at most")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
   cli.add_option("--thumbnails", options.thumbnails, "worst frames shown per report")
       ->capture_default_str();
   cli.footer(
@@ -78,7 +88,22 @@ int RunEvaluate(int argc, char** argv) {
   }
   options.write_video = !no_video;
   options.setup = TrackerSetupOf(config_path, options.inputs);
-  const EvaluateResult result = Evaluate(options, FrameProgress("evaluate: frame"));
+  std::unique_ptr<LiveView> view;
+  if (display) {
+    if (options.inputs.size() != 1 || options.jobs != 1) {
+      throw UsageError("--display shows one input evaluated alone (got " +
+                       std::to_string(options.inputs.size()) + " inputs, --jobs " +
+                       std::to_string(options.jobs) + ")");
+    }
+    FrameCommandOptions shown;
+    shown.display_fps = display_fps;
+    view = OpenLiveView("oalservo evaluate", shown);
+  }
+  const FrameViewer viewer = [&view](const cv::Mat& annotated, const std::string& caption) {
+    return view->Show(annotated, caption, false);
+  };
+  const EvaluateResult result =
+      Evaluate(options, FrameProgress("evaluate: frame"), view ? viewer : FrameViewer());
   int failed = 0, resumed = 0;
   for (const InputOutcome& input : result.inputs) {
     if (input.status == "failed") {

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -110,6 +111,28 @@ void LiveWindow::WaitForClick(const std::atomic<bool>* interrupt) {
   }
 }
 
+namespace {
+
+// `text` in lines that fit `width_px` in the caption's font, broken between words.
+std::vector<std::string> WrappedToWidth(const std::string& text, int width_px) {
+  std::vector<std::string> lines(1);
+  std::istringstream words(text);
+  for (std::string word; words >> word;) {
+    const std::string longer = lines.back().empty() ? word : lines.back() + " " + word;
+    int baseline = 0;
+    const int width =
+        cv::getTextSize(longer, cv::FONT_HERSHEY_SIMPLEX, 0.5, 1, &baseline).width + 12;
+    if (width > width_px && !lines.back().empty()) {
+      lines.push_back(word);
+    } else {
+      lines.back() = longer;
+    }
+  }
+  return lines;
+}
+
+}  // namespace
+
 LiveView::LiveView(const std::string& title, double paced_fps)
     : window_(640, 480, title + " (click or a key to quit)"), paced_fps_(paced_fps) {}
 
@@ -129,8 +152,8 @@ bool LiveView::Show(cv::Mat annotated, const std::string& caption, bool live) {
   last_shown_ = now;
   // The caption in a band under the frame: white on black, a line each.
   const std::string fps = shown_fps_ > 0.0 ? Fixed(shown_fps_, 1) + " frames/s" : "";
-  const std::vector<std::string> lines = {
-      caption, fps + (fps.empty() ? "" : "   ") + "click or a key in the window: quit"};
+  std::vector<std::string> lines = WrappedToWidth(caption, annotated.cols);
+  lines.push_back(fps + (fps.empty() ? "" : "   ") + "click or a key in the window: quit");
   constexpr int kLineHeight = 20;
   cv::Mat shown(annotated.rows + kLineHeight * static_cast<int>(lines.size()) + 6, annotated.cols,
                 CV_8UC3, cv::Scalar(0, 0, 0));

@@ -227,10 +227,20 @@ void AnnotatedVideo::Commit() {
 
 void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::size_t thumbnails,
                  const std::optional<CameraFile>& camera, const std::optional<Lens>& undistorted_by,
-                 WriterResult* result) {
+                 WriterResult* result,
+                 const std::function<bool(const cv::Mat&, const std::string&)>& viewer,
+                 std::atomic<bool>* stop) {
   WorstFrames worst(thumbnails);
   try {
     while (std::optional<TrackedFrame> frame = queue->Pop()) {
+      if (viewer && !(stop != nullptr && stop->load())) {
+        const std::string caption =
+            "frame " + std::to_string(frame->index) + (frame->why.empty() ? "" : ": " + frame->why);
+        if (!viewer(Annotate(*frame, camera, undistorted_by, frame->gray.size()), caption) &&
+            stop != nullptr) {
+          stop->store(true);
+        }
+      }
       const StageClock::time_point start = StageClock::now();
       const bool wanted = worst.Wants(frame->index, frame->badness);
       if (video != nullptr || wanted) {

@@ -3,7 +3,9 @@
 // report's thumbnails.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 #include <optional>
@@ -73,8 +75,12 @@ struct WriterResult {
 /// thumbnails need (`video` may be null: thumbnails only) and keeps the `thumbnails` worst.
 /// `undistorted_by`: the camera whose undistortion the tracked lines are in. An error is kept
 /// in result->error and closes the queue.
+/// `viewer`, when set, is shown every frame annotated at its own size with a caption; when it
+/// returns false, `*stop` is set (the decoder then ends the input).
 void WriteFrames(BoundedQueue<TrackedFrame>* queue, AnnotatedVideo* video, std::size_t thumbnails,
                  const std::optional<CameraFile>& camera, const std::optional<Lens>& undistorted_by,
-                 WriterResult* result);
+                 WriterResult* result,
+                 const std::function<bool(const cv::Mat&, const std::string&)>& viewer = {},
+                 std::atomic<bool>* stop = nullptr);
 
 }  // namespace oal

@@ -181,7 +181,8 @@ class InputEvaluation {
   }
 
   // Evaluates and writes every file; `on_frame` after each frame.
-  Json Run(ImageSource* source, const std::function<void()>& on_frame, Json* timing) {
+  Json Run(ImageSource* source, const std::function<void()>& on_frame, const FrameViewer& viewer,
+           Json* timing) {
     const StageClock::time_point start = StageClock::now();
     fs::create_directories(dir_);
     TrackerOptions tracker_options;
@@ -222,11 +223,13 @@ class InputEvaluation {
     BoundedQueue<TrackedFrame> tracked(kQueueFrames);
     DecodeStats decode_stats;
     WriterResult writer_result;
+    std::atomic<bool> stop{false};  // the viewer's request
     Joined decoder(
-        std::thread(DecodeFrames, source, run_.options.max_frames, &decoded, &decode_stats));
+        std::thread(DecodeFrames, source, run_.options.max_frames, &decoded, &decode_stats, &stop));
     Joined writer(std::thread(WriteFrames, &tracked, video ? &*video : nullptr,
                               static_cast<std::size_t>(run_.options.thumbnails), std::cref(camera_),
-                              std::cref(undistorted_by_), &writer_result));
+                              std::cref(undistorted_by_), &writer_result, std::cref(viewer),
+                              &stop));
     SampleStats track_us, pose_us;
     try {
       while (std::optional<DecodedFrame> frame = decoded.Pop()) {
@@ -766,6 +769,11 @@ void EvaluateOptions::Check() const {
 
 EvaluateResult Evaluate(const EvaluateOptions& options,
                         const std::function<void(int, int)>& progress) {
+  return Evaluate(options, progress, FrameViewer());
+}
+
+EvaluateResult Evaluate(const EvaluateOptions& options,
+                        const std::function<void(int, int)>& progress, const FrameViewer& viewer) {
   options.Check();
   RunContext run{options,      options.setup, options.setup.target.value_or(FourLineA3Target()),
                  std::nullopt, LoadChartJs(), 4};
@@ -779,6 +787,11 @@ EvaluateResult Evaluate(const EvaluateOptions& options,
   }
   const InputPlan plan = PlanInputs(options.inputs);
   if (plan.inputs.empty()) throw std::runtime_error(NoInputsMessage(options.inputs, plan));
+  if (viewer && (plan.inputs.size() != 1 || options.jobs != 1)) {
+    throw std::invalid_argument("a viewer shows one input evaluated alone, but there are " +
+                                std::to_string(plan.inputs.size()) + " inputs and " +
+                                std::to_string(options.jobs) + " jobs");
+  }
   if (!options.truth_path.empty() && plan.inputs.size() != 1) {
     throw std::invalid_argument("--truth applies to one input, but there are " +
                                 std::to_string(plan.inputs.size()) +
@@ -846,7 +859,7 @@ EvaluateResult Evaluate(const EvaluateOptions& options,
         std::unique_ptr<ImageSource> source = OpenImageSource(shard[i]->spec, &warnings);
         InputEvaluation evaluation(run, *shard[i], out / shard[i]->name);
         evaluation.AddWarnings(warnings);
-        outcome.summary = evaluation.Run(source.get(), on_frame, &timings[i]);
+        outcome.summary = evaluation.Run(source.get(), on_frame, viewer, &timings[i]);
         outcome.status = "complete";
       } catch (const std::exception& error) {
         outcome.status = "failed";

@@ -36,6 +36,7 @@
 #pragma once
 
 #include <functional>
+#include <opencv2/core/mat.hpp>
 #include <string>
 #include <vector>
 
@@ -114,6 +115,15 @@ struct EvaluateResult {
 /// from one thread at a time. Throws std::invalid_argument for bad options and
 /// std::runtime_error for no input at all (before anything is written), a bad camera
 /// file, a missing Chart.js (report.h) or an output that cannot be written.
+/// Shown each annotated frame (BGR, the frame's size) with a caption, from the writer's
+/// thread; returns false to stop: the input ends there, its frames so far evaluated.
+using FrameViewer = std::function<bool(const cv::Mat& annotated, const std::string& caption)>;
+
+/// As above; a `viewer` is given every frame of the one input (it needs one input and one
+/// job: std::invalid_argument otherwise).
+EvaluateResult Evaluate(const EvaluateOptions& options,
+                        const std::function<void(int done, int total)>& progress,
+                        const FrameViewer& viewer);
 EvaluateResult Evaluate(const EvaluateOptions& options,
                         const std::function<void(int done, int total)>& progress = {});
 

@@ -10,10 +10,14 @@ constexpr int kMaxConsecutiveUnreadable = 50;  // then the input is given up as 
 }  // namespace
 
 void DecodeFrames(ImageSource* source, int max_frames, BoundedQueue<DecodedFrame>* queue,
-                  DecodeStats* stats) {
+                  DecodeStats* stats, const std::atomic<bool>* stop) {
   Frame frame;
   int consecutive_errors = 0;
   for (int index = 0; max_frames == 0 || index < max_frames; ++index) {
+    if (stop != nullptr && stop->load()) {
+      stats->stop_reason = "stopped from the viewer after " + std::to_string(index) + " frames";
+      break;
+    }
     DecodedFrame item;
     item.index = index;
     bool more = true;

@@ -2,6 +2,7 @@
 // read into a bounded queue, each timed, unreadable ones passed on with their error.
 #pragma once
 
+#include <atomic>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -25,8 +26,9 @@ struct DecodeStats {
 };
 
 /// Reads `source` (at most max_frames frames; 0: all) into `queue`, then closes it. Gives up
-/// after a run of unreadable frames, saying so in stats->stop_reason.
+/// after a run of unreadable frames, saying so in stats->stop_reason; stops when `*stop` is
+/// set (a viewer's request), saying so too.
 void DecodeFrames(ImageSource* source, int max_frames, BoundedQueue<DecodedFrame>* queue,
-                  DecodeStats* stats);
+                  DecodeStats* stats, const std::atomic<bool>* stop = nullptr);
 
 }  // namespace oal

@@ -109,13 +109,18 @@ TEST(Display, WithoutADisplayPoseAndDetectSayWhyBeforeAnyOutput) {
     EXPECT_THAT(said, HasSubstr("$DISPLAY"));
     EXPECT_FALSE(fs::exists(out));
   }
+  // evaluate shows one input evaluated alone.
+  EXPECT_EQ(ExitCodeOf(Oalservo() + " evaluate '" + dir / "frames" + "' '" + dir / "frames" +
+                       "' --display --out '" + dir / "ev" + "' 2>'" + dir / "err.txt" + "'"),
+            2);
+  EXPECT_THAT(test::ReadText(dir / "err.txt"), HasSubstr("--display shows one input"));
   // A rate out of range is refused by the command line (a usage error).
   EXPECT_EQ(ExitCodeOf(Oalservo() + " pose '" + dir / "frames" +
                        "' --display --display-fps 0 >/dev/null 2>&1"),
             2);
 }
 
-TEST(Display, PoseAndDetectShowEachFrameInAWindowAndEndWithTheInput) {
+TEST(Display, PoseDetectAndEvaluateShowEachFrameInAWindowAndEndWithTheInput) {
   if (!HasProgram("Xvfb")) GTEST_SKIP() << "no Xvfb (Debian's xvfb)";
   if (!HasProgram("import")) GTEST_SKIP() << "no import (Debian's imagemagick)";
   test::TestDir dir;
@@ -124,9 +129,10 @@ TEST(Display, PoseAndDetectShowEachFrameInAWindowAndEndWithTheInput) {
             0);
   const VirtualDisplay display;
   ASSERT_TRUE(display.Ready()) << "Xvfb " << display.name() << " did not start";
-  for (const char* command : {"pose", "detect"}) {
+  for (const char* command : {"pose", "detect", "evaluate"}) {
     SCOPED_TRACE(command);
-    const std::string out = dir / (std::string(command) + ".jsonl");
+    const bool evaluate = std::string(command) == "evaluate";
+    const std::string out = dir / (std::string(command) + (evaluate ? "" : ".jsonl"));
     // 30 frames at 10 a second: the window is photographed until it shows a frame.
     std::thread run([&] {
       EXPECT_EQ(ExitCodeOf("DISPLAY=" + display.name() + " " + Oalservo() + " " + command + " '" +
@@ -153,7 +159,7 @@ TEST(Display, PoseAndDetectShowEachFrameInAWindowAndEndWithTheInput) {
     const cv::Mat caption = screen(cv::Rect(0, 480, 640, 40));
     EXPECT_GT(cv::countNonZero(caption.reshape(1) > 200), 100);
     // Every frame was processed and written, the window notwithstanding.
-    EXPECT_EQ(test::ReadLines(out).size(), 30u);
+    EXPECT_EQ(test::ReadLines(evaluate ? out + "/frames/frames.jsonl" : out).size(), 30u);
   }
 }
 
