@@ -329,10 +329,16 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   }
   const LensCheck lens = CheckLens(summary.lens);
   if (lens.mismatch) {
+    // What to do, never what this run already did.
     summary.warnings.push_back(LensMismatchWarning(
-        lens, "'" + summary.camera_path + "'",
-        "Calibrate the camera (oalservo calibrate), or give one without distortion and "
-        "--estimate-distortion"));
+        lens,
+        options.estimate_distortion ? "the lens told from the stripes"
+                                    : "'" + summary.camera_path + "'",
+        options.estimate_distortion
+            ? "Calibrate the camera (oalservo calibrate): one radial term told from four "
+              "stripes does not hold this lens"
+            : "Calibrate the camera (oalservo calibrate), or give one without distortion and "
+              "--estimate-distortion"));
   }
   return summary;
 }

@@ -866,10 +866,17 @@ class ServoRun {
     lens_frames_.push_back(tracked.lens);
     const LensCheck lens = CheckLens(lens_frames_, static_cast<int>(kLensCheckFrames));
     if (lens.mismatch) {
+      // What to do, never what this run already did.
       log_ << "oalservo servo: warning: "
-           << LensMismatchWarning(lens, "the camera model",
-                                  "Calibrate the camera (oalservo calibrate), or set "
-                                  "camera.estimate_distortion")
+           << LensMismatchWarning(
+                  lens,
+                  setup_.estimate_distortion ? "the lens told from the stripes"
+                                             : "the camera model",
+                  setup_.estimate_distortion
+                      ? "Calibrate the camera (oalservo calibrate): one radial term told from "
+                        "four stripes does not hold this lens"
+                      : "Calibrate the camera (oalservo calibrate), or set "
+                        "camera.estimate_distortion")
            << '\n';
     }
   }
