@@ -16,6 +16,11 @@
 #include <string>
 #include <thread>
 
+#ifdef OAL_TEST_HAVE_X11
+#include <X11/Xlib.h>
+#include <X11/keysym.h>
+#endif
+
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"
 
@@ -162,6 +167,76 @@ TEST(Display, PoseDetectAndEvaluateShowEachFrameInAWindowAndEndWithTheInput) {
     EXPECT_EQ(test::ReadLines(evaluate ? out + "/frames/frames.jsonl" : out).size(), 30u);
   }
 }
+
+#ifdef OAL_TEST_HAVE_X11
+// Sends a key press (q) to the top-level window whose title begins with `title` on the X
+// display `display_name`, as a user's key would arrive; false when there is no such window.
+bool PressKeyIn(const std::string& display_name, const std::string& title) {
+  ::Display* display = XOpenDisplay(display_name.c_str());
+  if (display == nullptr) return false;
+  const ::Window root = DefaultRootWindow(display);
+  ::Window root_return = 0, parent = 0, *children = nullptr;
+  unsigned int count = 0;
+  bool sent = false;
+  if (XQueryTree(display, root, &root_return, &parent, &children, &count) != 0) {
+    for (unsigned int i = 0; i < count && !sent; ++i) {
+      char* name = nullptr;
+      if (XFetchName(display, children[i], &name) == 0 || name == nullptr) continue;
+      if (std::string(name).rfind(title, 0) == 0) {
+        XKeyEvent key{};
+        key.type = KeyPress;
+        key.display = display;
+        key.window = children[i];
+        key.root = root;
+        key.same_screen = True;
+        key.keycode = XKeysymToKeycode(display, XK_q);
+        sent = XSendEvent(display, children[i], True, KeyPressMask,
+                          reinterpret_cast<XEvent*>(&key)) != 0;
+      }
+      XFree(name);
+    }
+    if (children != nullptr) XFree(children);
+  }
+  XFlush(display);
+  XCloseDisplay(display);
+  return sent;
+}
+
+TEST(Display, AKeyInTheWindowStopsKeepingWhatWasWritten) {
+  if (!HasProgram("Xvfb")) GTEST_SKIP() << "no Xvfb (Debian's xvfb)";
+  test::TestDir dir;
+  ASSERT_EQ(ExitCodeOf(Oalservo() + " render --count 100 --seed 5 --out '" + dir / "frames" +
+                       "' >/dev/null 2>&1"),
+            0);
+  const VirtualDisplay display;
+  ASSERT_TRUE(display.Ready());
+  const std::string out = dir / "poses.jsonl";
+  // 100 frames at 5 a second: 20 s unless the key stops it.
+  const auto start = std::chrono::steady_clock::now();
+  std::thread run([&] {
+    EXPECT_EQ(
+        ExitCodeOf("DISPLAY=" + display.name() + " " + Oalservo() + " pose '" + dir / "frames" +
+                   "' --display --display-fps 5 --out '" + out + "' 2>'" + dir / "err.txt" + "'"),
+        0)
+        << test::ReadText(dir / "err.txt");
+  });
+  bool pressed = false;
+  for (int attempt = 0; attempt < 40 && !pressed; ++attempt) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    pressed = PressKeyIn(display.name(), "oalservo pose");
+  }
+  run.join();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(pressed) << "no window titled 'oalservo pose' on " << display.name();
+  EXPECT_LT(seconds, 15.0);
+  const std::size_t written = test::ReadLines(out).size();
+  EXPECT_GT(written, 0u);
+  EXPECT_LT(written, 100u);
+  EXPECT_THAT(test::ReadText(dir / "err.txt"),
+              HasSubstr("stopped from the window after " + std::to_string(written) + " frames"));
+}
+#endif
 
 }  // namespace
 }  // namespace oal
