@@ -12,6 +12,7 @@ packages=(
   libjs-chart.js chromium
   gnuplot-nox
   libcairo2-dev fonts-dejavu-core librsvg2-bin imagemagick gsfonts poppler-utils xvfb
+  pybind11-dev python3-pybind11 python3-numpy python3-pytest
 )
 
 missing=()
