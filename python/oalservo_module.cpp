@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/config.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "io/camera_file.h"
@@ -88,6 +89,30 @@ vpHomogeneousMatrix HomogeneousOf(const py::array_t<double>& array) {
   return m;
 }
 
+// The tracker's options, as a configuration's detector:, pose: and tracking: sections give them.
+struct TrackingOptions {
+  DetectorOptions detector;
+  PoseOptions pose;
+  TargetTrackerOptions tracking;
+
+  void Check() const {
+    detector.Check();
+    pose.Check();
+    tracking.Check();
+  }
+};
+
+// A configuration file read as `oalservo pose --config` reads it: its target and options.
+struct ConfigFile {
+  LineTarget target;
+  TrackingOptions options;
+};
+
+ConfigFile LoadConfigFile(const std::string& path) {
+  const AppConfig config = LoadConfig(path);
+  return {config.target, {config.detector, config.pose, config.tracking}};
+}
+
 // What Python gets of a tracked frame: plain values, copied out of the tracker.
 struct PyTargetFrame {
   std::string status, message;
@@ -97,10 +122,17 @@ struct PyTargetFrame {
   double time_us = 0.0;  ///< the tracker's own time on the frame, microseconds
 };
 
+// `options`, once they pass their checks (the tracker scales some of them first, which could
+// hide a bad value).
+const TrackingOptions& Checked(const TrackingOptions& options) {
+  options.Check();
+  return options;
+}
+
 class PyTracker {
  public:
-  PyTracker(const LineTarget& target, const Lens& camera)
-      : tracker_(target, camera, DetectorOptions(), PoseOptions(), TargetTrackerOptions()) {}
+  PyTracker(const LineTarget& target, const Lens& camera, const TrackingOptions& options)
+      : tracker_(target, camera, Checked(options).detector, options.pose, options.tracking) {}
 
   PyTargetFrame Track(const py::array& image) {
     const PythonFrame frame = FrameOf(image);
@@ -137,9 +169,9 @@ struct PyLine {
   std::array<double, 2> end_a, end_b;
 };
 
-std::vector<PyLine> Detect(const py::array& image) {
+std::vector<PyLine> Detect(const py::array& image, const TrackingOptions& options) {
   const PythonFrame frame = FrameOf(image);
-  OalDetector detector{DetectorOptions()};
+  OalDetector detector{options.detector};
   std::vector<DetectedLine> lines;
   {
     py::gil_scoped_release release;
@@ -219,7 +251,44 @@ PYBIND11_MODULE(_oalservo, m) {
   py::class_<LineTarget>(m, "Target", "A planar line target (target/line_target.h)")
       .def_static("builtin", &TargetByName, py::arg("name") = "four-line-a3",
                   "A built-in target by name: four-line-a3, four-line-a4, ...")
+      .def_static(
+          "from_yaml", [](const std::string& path) { return LoadConfig(path).target; },
+          py::arg("path"), "The target: section of a configuration (config/four-line-a3.yaml)")
       .def_readonly("name", &LineTarget::name);
+
+  py::class_<DetectorOptions>(m, "DetectorOptions",
+                              "The detector's options, as a configuration's detector: section")
+      .def(py::init<>())
+      .def_readwrite("start_px", &DetectorOptions::start_px)
+      .def_readwrite("step_px", &DetectorOptions::step_px)
+      .def_property(
+          "polarity", [](const DetectorOptions& o) { return ToString(o.polarity); },
+          [](DetectorOptions& o, const std::string& text) {
+            o.polarity = PolarityFromString(text);
+          })
+      .def_readwrite("fixed_threshold", &DetectorOptions::fixed_threshold)
+      .def_readwrite("min_contrast", &DetectorOptions::min_contrast)
+      .def_readwrite("min_width_px", &DetectorOptions::min_width_px)
+      .def_readwrite("max_width_px", &DetectorOptions::max_width_px)
+      .def_readwrite("min_crossing_angle_deg", &DetectorOptions::min_crossing_angle_deg)
+      .def_readwrite("max_points_per_border", &DetectorOptions::max_points_per_border)
+      .def("check", &DetectorOptions::Check,
+           "Raises ValueError naming the field, its value and the constraint");
+
+  py::class_<TrackingOptions>(m, "Options",
+                              "The tracker's options: detector (a DetectorOptions), and the "
+                              "pose's and the tracking's, as a configuration's sections")
+      .def(py::init<>())
+      .def_readwrite("detector", &TrackingOptions::detector)
+      .def("check", &TrackingOptions::Check,
+           "Raises ValueError naming the field, its value and the constraint");
+
+  py::class_<ConfigFile>(m, "Config", "A configuration file's target and options")
+      .def_readonly("target", &ConfigFile::target)
+      .def_readonly("options", &ConfigFile::options);
+  m.def("load_config", &LoadConfigFile, py::arg("path"),
+        "A YAML configuration as `oalservo pose --config` reads it (config/pose.yaml): its "
+        "target and options; errors name the file, the line and the key");
 
   py::class_<PyTargetFrame>(m, "TargetFrame", "What the tracker found in one frame")
       .def_readonly("status", &PyTargetFrame::status)
@@ -232,7 +301,11 @@ PYBIND11_MODULE(_oalservo, m) {
   py::class_<PyTracker>(m, "TargetPoseTracker",
                         "The four-line target's pose over a stream of frames "
                         "(servo/target_tracker.h)")
-      .def(py::init<const LineTarget&, const Lens&>(), py::arg("target"), py::arg("camera"))
+      .def(py::init([](const LineTarget& target, const Lens& camera,
+                       const std::optional<TrackingOptions>& options) {
+             return PyTracker(target, camera, options.value_or(TrackingOptions()));
+           }),
+           py::arg("target"), py::arg("camera"), py::arg("options") = py::none())
       .def("track", &PyTracker::Track, py::arg("image"),
            "The pose in `image` (uint8 H x W grey, read in place, or H x W x 3 BGR)")
       .def("reset", &PyTracker::Reset, "Forget the previous frames");
@@ -245,7 +318,12 @@ PYBIND11_MODULE(_oalservo, m) {
       .def_readonly("end_a", &PyLine::end_a)
       .def_readonly("end_b", &PyLine::end_b);
 
-  m.def("detect", &Detect, py::arg("image"), "The OAL detector's lines in `image`");
+  m.def(
+      "detect",
+      [](const py::array& image, const std::optional<TrackingOptions>& options) {
+        return Detect(image, options.value_or(TrackingOptions()));
+      },
+      py::arg("image"), py::arg("options") = py::none(), "The OAL detector's lines in `image`");
   m.def("render", &Render, py::arg("target"), py::arg("camera"), py::arg("width") = 640,
         py::arg("height") = 480, py::arg("seed") = 1, py::arg("cMo") = py::none(),
         "A rendered frame of `target` on a bench and its true cMo: (image, cMo)");

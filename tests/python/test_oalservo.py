@@ -115,3 +115,38 @@ def test_the_examples_are_valid_python(tmp_path):
     for name in ("webcam_pose.py", "ros2_pose_node.py", "overhead.py"):
         py_compile.compile(os.path.join(examples, name), cfile=str(tmp_path / (name + "c")),
                            doraise=True)
+
+
+def source_path(*parts):
+    import os
+
+    return os.path.join(os.environ.get("OAL_SOURCE_DIR", "."), *parts)
+
+
+def test_options_are_plain_objects_checked_as_the_yaml_sections():
+    options = oalservo.Options()
+    assert options.detector.step_px == 5 and options.detector.polarity == "dark"
+    options.detector.step_px = 4
+    options.detector.check()
+    image, _ = oalservo.render(A3, CAMERA, seed=3)
+    assert oalservo.TargetPoseTracker(A3, CAMERA, options).track(image).status == "ok"
+    assert len(oalservo.detect(image, options)) >= 4
+    options.detector.step_px = 0
+    with pytest.raises(ValueError, match="step_px"):
+        options.check()
+    with pytest.raises(ValueError, match="step_px"):
+        oalservo.TargetPoseTracker(A3, CAMERA, options)
+    with pytest.raises(ValueError, match="dark"):
+        options.detector.polarity = "purple"
+
+
+def test_a_configuration_file_gives_its_target_and_options_and_its_errors(tmp_path):
+    config = oalservo.load_config(source_path("config", "four-line-a4.yaml"))
+    assert config.target.name == "four-line-a4"
+    assert oalservo.Target.from_yaml(source_path("config", "four-line-a4.yaml")).name == "four-line-a4"
+    edges = oalservo.load_config(source_path("config", "visp_line_edges.yaml"))
+    assert edges.options.detector.polarity == "edges"
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("detector:\n  step_px: 0\n")
+    with pytest.raises(Exception, match="bad.yaml:2"):
+        oalservo.load_config(str(bad))
