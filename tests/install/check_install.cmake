@@ -1,7 +1,9 @@
 # ctest's install check: `cmake --install` the build tree into a fresh prefix, then configure,
 # build and run tests/install/consumer against it alone, as another project would.
 # -D BUILD_DIR (this build), WORK_DIR (scratch), CONSUMER_DIR (the consumer's sources),
-# SANITIZE_FLAGS (the build's sanitizer flags, ;-separated; empty: none).
+# SANITIZE_FLAGS (the build's sanitizer flags, ;-separated; empty: none), PYTHON and
+# PYTHON_SITE (the Python module's interpreter and its directory under the prefix; empty: the
+# module is not built).
 function(run_step what)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT status EQUAL 0)
@@ -19,6 +21,11 @@ foreach(file bin/oalservo include/oalservo/detector/detector.h share/oalservo/co
   endif()
 endforeach()
 run_step("installed oalservo --version" ${prefix}/bin/oalservo --version)
+if(PYTHON)
+  run_step("installed Python module"
+           ${CMAKE_COMMAND} -E env PYTHONPATH=${prefix}/${PYTHON_SITE} PYTHONDONTWRITEBYTECODE=1
+           ${PYTHON} -c "import oalservo; print(oalservo.Target.builtin('four-line-a3').name)")
+endif()
 # A sanitized library links only into a program built with the same sanitizers.
 string(REPLACE ";" " " sanitize "${SANITIZE_FLAGS}")
 run_step("consumer configure" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build
