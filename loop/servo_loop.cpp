@@ -305,7 +305,7 @@ void WarnIfOutsideWorkspace(SafeRobot& robot, std::ostream& log) {
   if (!at.result.ok()) return;  // the loop's first read reports it
   const std::string why = safety.OutsideWorkspace(at.pose.getTranslationVector());
   if (why.empty()) return;
-  log << "oalservo servo: warning: the robot starts outside the workspace box: the "
+  log << "warning: the robot starts outside the workspace box: the "
       << ToString(safety.workspace_frame) << "'s " << why
       << " (robot.workspace_min_m / workspace_max_m); every move is still checked against the "
          "box and may be refused: bring the arm into the box or widen it\n";
@@ -867,7 +867,7 @@ class ServoRun {
     const LensCheck lens = CheckLens(lens_frames_, static_cast<int>(kLensCheckFrames));
     if (lens.mismatch) {
       // What to do, never what this run already did.
-      log_ << "oalservo servo: warning: "
+      log_ << "warning: "
            << LensMismatchWarning(
                   lens,
                   setup_.estimate_distortion ? "the lens told from the stripes"
