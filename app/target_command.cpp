@@ -30,7 +30,11 @@ void TargetCommandOptions::Check() const {
       throw std::invalid_argument("--target = " + target + ": it is one of " + TargetNameList());
     }
   }
-  CheckPageName(page);
+  try {
+    CheckPageName(page);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument("--page = " + page + ": it is one of a4, a3, letter, full");
+  }
   if (landscape && page == "full") {
     throw std::invalid_argument(
         "--landscape is for a sheet (--page a4, a3 or letter): --page full is the board's own "
@@ -51,6 +55,34 @@ LineTarget TargetToPrint(const TargetCommandOptions& options) {
   return TargetByName(SheetTargetName(options.page));
 }
 
+namespace {
+
+// The page, its refusal and its note in the command's words: which options print instead.
+TargetPage DrawInCommandWords(const LineTarget& target, const TargetCommandOptions& options) {
+  try {
+    TargetPage page = DrawTargetPage(target, options.page, options.landscape);
+    if (page.turned) page.note += " (--landscape)";
+    return page;
+  } catch (const TargetDoesNotFit& refused) {
+    const TargetDoesNotFit::Alternatives& instead = refused.alternatives();
+    std::string message = refused.what();
+    message = message.substr(0, message.find(" Instead: ")) +
+              " Instead: print the target made for this sheet (--page " + instead.page +
+              " without --target or --config prints " + instead.page_target + ")";
+    std::string larger;
+    for (const std::string& sheet : instead.larger) {
+      larger += std::string(larger.empty() ? "" : " or ") + "--page " + sheet;
+    }
+    if (!larger.empty()) message += ", or a page that holds this one (" + larger + ")";
+    message += ", or this target at its full size with --page full (" +
+               Number(instead.full_width_mm) + " x " + Number(instead.full_height_mm) +
+               " mm, for a plotter or a print shop)";
+    throw TargetDoesNotFit(message, instead);
+  }
+}
+
+}  // namespace
+
 TargetPage WriteTargetPage(const TargetCommandOptions& options) {
   options.Check();
   const fs::path out(options.out);
@@ -62,7 +94,7 @@ TargetPage WriteTargetPage(const TargetCommandOptions& options) {
   if (fs::is_directory(out)) {
     throw std::runtime_error("cannot write --out " + options.out + ": it is a directory");
   }
-  const TargetPage page = DrawTargetPage(TargetToPrint(options), options.page, options.landscape);
+  const TargetPage page = DrawInCommandWords(TargetToPrint(options), options);
   const bool pdf = Lowercase(out.extension().string()) == ".pdf";
   WriteFileAtomically(out, pdf ? TargetPdf(page) : TargetSvg(page));
   return page;

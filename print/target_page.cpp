@@ -19,7 +19,7 @@ namespace oal {
 namespace {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-constexpr double kFullMarginMm = 10.0;  // --page full: blank paper around the board
+constexpr double kFullMarginMm = 10.0;  // the full page: blank paper around the board
 constexpr double kGapMm = 1.5;          // between two printed items other than stripes
 // A line number keeps farther from the other marks, so that it is read as its stripe's and not
 // as a part of the scale bar or the legend beside it.
@@ -55,7 +55,7 @@ const Sheet* SheetByName(const std::string& name) {
 
 void CheckPageName(const std::string& page) {
   if (page != "full" && SheetByName(page) == nullptr) {
-    throw std::invalid_argument("--page = " + page + ": it is one of a4, a3, letter, full");
+    throw std::invalid_argument("page '" + page + "': it is one of a4, a3, letter, full");
   }
 }
 
@@ -553,30 +553,34 @@ struct Page {
   bool turned = false;
 };
 
-std::string DoesNotFit(const LineTarget& target, const Sheet& sheet, const Page& page) {
+TargetDoesNotFit DoesNotFit(const LineTarget& target, const Sheet& sheet, const Page& page) {
   const auto holds = [&](const Sheet& other) {
     const double w = 1000.0 * target.board_width_m, h = 1000.0 * target.board_height_m;
     const double eps = 1e-6;
     return (w <= other.width_mm + eps && h <= other.height_mm + eps) ||
            (h <= other.width_mm + eps && w <= other.height_mm + eps);
   };
+  TargetDoesNotFit::Alternatives instead;
+  instead.page = sheet.name;
+  instead.page_target = sheet.target;
   std::string larger;
   for (const Sheet& other : kSheets) {
-    if (holds(other)) larger += std::string(larger.empty() ? "" : " or ") + "--page " + other.name;
+    if (!holds(other)) continue;
+    instead.larger.push_back(other.name);
+    larger += std::string(larger.empty() ? "" : " or ") + other.label;
   }
+  instead.full_width_mm = 1000.0 * target.board_width_m + 2.0 * kFullMarginMm;
+  instead.full_height_mm = 1000.0 * target.board_height_m + 2.0 * kFullMarginMm;
   std::ostringstream message;
   message << "target '" << target.name << "' (board " << SheetSize(target)
           << ") does not fit on the " << sheet.label << " page (" << Mm(page.width_mm) << " x "
           << Mm(page.height_mm) << " mm), upright or turned, and is not scaled to fit (the "
           << "pose takes the target's lengths as printed); nothing was written. Instead: "
-          << "print the target made for this sheet (--page " << sheet.name
-          << " without --target or --config prints " << sheet.target << ")";
+          << "print the target made for this sheet (" << sheet.target << ")";
   if (!larger.empty()) message << ", or a page that holds this one (" << larger << ")";
-  message << ", or this target at its full size with --page full ("
-          << Mm(1000.0 * target.board_width_m + 2.0 * kFullMarginMm) << " x "
-          << Mm(1000.0 * target.board_height_m + 2.0 * kFullMarginMm)
-          << " mm, for a plotter or a print shop)";
-  return message.str();
+  message << ", or this target at its full size (" << Mm(instead.full_width_mm) << " x "
+          << Mm(instead.full_height_mm) << " mm, for a plotter or a print shop)";
+  return TargetDoesNotFit(message.str(), std::move(instead));
 }
 
 Page LayOutPage(const LineTarget& target, const std::string& page_name, bool landscape) {
@@ -587,7 +591,7 @@ Page LayOutPage(const LineTarget& target, const std::string& page_name, bool lan
   if (sheet == nullptr) {
     if (landscape) {
       throw std::invalid_argument(
-          "--landscape is for a sheet (--page a4, a3 or letter): --page full is the board's own "
+          "a landscape page is for a sheet (a4, a3 or letter): the full page is the board's own "
           "size and orientation");
     }
     page.width_mm = board_w + 2.0 * kFullMarginMm;
@@ -604,7 +608,7 @@ Page LayOutPage(const LineTarget& target, const std::string& page_name, bool lan
     page.turned = true;
     return page;
   }
-  throw TargetDoesNotFit(DoesNotFit(target, *sheet, page));
+  throw DoesNotFit(target, *sheet, page);
 }
 
 }  // namespace
@@ -623,7 +627,7 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
                    ") is drawn turned by 90 degrees to fit the " + page.label +
                    " page: print it as it is, at 100 % (the print is the same target), and "
                    "hold the sheet turned a quarter turn counterclockwise to see it upright; "
-                   "or write it with --landscape to have it upright on a landscape page";
+                   "or lay it out on a landscape page to have it upright";
   }
 
   // Board frame -> page: the board centred on the page, turned by +90 degrees (clockwise on
@@ -667,7 +671,7 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
     throw std::runtime_error("target '" + name + "': no room on the " + page.label +
                              " page for the 100 mm scale bar " + Mm(kClearanceMm) +
                              " mm clear of every stripe and of the page's edge; use a larger "
-                             "page (--page full prints the board at its full size)");
+                             "page (the full page prints the board at its full size)");
   }
   layout.Place(Placed(PartsOf(bar), *bar_pose));
   drawn.push_back({bar, *bar_pose});
@@ -736,7 +740,7 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
     description << "The target is drawn turned by 90 degrees clockwise to fit the page: its x "
                    "axis points down the page and its y axis to the left; print it as it is (the "
                    "print is the same target) and hold the sheet turned a quarter turn "
-                   "counterclockwise to see it upright, or write it with --landscape. ";
+                   "counterclockwise to see it upright, or lay it out on a landscape page. ";
   } else {
     description << "Object frame: x to the right, y down. ";
   }

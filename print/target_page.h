@@ -33,6 +33,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "target/line_target.h"
@@ -52,7 +53,19 @@ inline constexpr double kTextBaselineEm = 0.275;
 /// what to do instead.
 class TargetDoesNotFit : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  /// What a caller needs to say what to print instead, in its own words.
+  struct Alternatives {
+    std::string page;                 ///< the page asked ("a3")
+    std::string page_target;          ///< the target made for that page ("four-line-a3")
+    std::vector<std::string> larger;  ///< sheets that hold this board ("a3", ...)
+    double full_width_mm = 0.0, full_height_mm = 0.0;  ///< the page "full" would be
+  };
+  TargetDoesNotFit(const std::string& message, Alternatives alternatives)
+      : std::runtime_error(message), alternatives_(std::move(alternatives)) {}
+  const Alternatives& alternatives() const { return alternatives_; }
+
+ private:
+  Alternatives alternatives_;
 };
 
 /// A point on the page, millimetres from its top left corner, y down.

@@ -224,6 +224,7 @@ TEST(TargetCommand, BinaryWritesTheA3SheetByDefault) {
   EXPECT_THAT(err, HasSubstr("oalservo target: " + (dir / "t.svg") +
                              " written (A3 portrait, 297 x 420 mm)"));
   EXPECT_THAT(err, HasSubstr("'four-line-a3' (board 420 x 297 mm) is drawn turned by 90 degrees"));
+  EXPECT_THAT(err, HasSubstr("or lay it out on a landscape page to have it upright (--landscape)"));
   const std::string svg = test::ReadText(dir / "t.svg");
   ExpectPage(svg, 297.0, 420.0);
   ExpectStripesMatch(svg, FourLineA3Target(), 297.0, 420.0, true);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "print/target_svg.h"
 #include "tests/print/svg_reading.h"
@@ -19,7 +20,7 @@ using ::testing::Not;
 using namespace test;  // the SVG reading helpers
 
 // Each sheet target on its own page: the page is exactly the sheet, portrait with the target
-// turned, or --landscape with it upright; its stripes are the target's to 0.01 mm.
+// turned, or on a landscape page upright; its stripes are the target's to 0.01 mm.
 TEST(TargetCommandSvg, SheetTargetsOnTheirOwnPage) {
   for (const SheetCase& sheet : kSheetCases) {
     SCOPED_TRACE(sheet.page);
@@ -31,7 +32,7 @@ TEST(TargetCommandSvg, SheetTargetsOnTheirOwnPage) {
     EXPECT_EQ(portrait.page, std::string(sheet.label) + " portrait");
     EXPECT_TRUE(portrait.turned);
     EXPECT_THAT(portrait.note, HasSubstr("drawn turned by 90 degrees"));
-    EXPECT_THAT(portrait.note, HasSubstr("--landscape"));
+    EXPECT_THAT(portrait.note, HasSubstr("or lay it out on a landscape page"));
     EXPECT_TRUE(portrait.warning.empty()) << portrait.warning;
     EXPECT_THAT(TargetSvg(portrait), HasSubstr("drawn turned by 90 degrees clockwise"));
     ExpectPage(TargetSvg(portrait), sheet.short_mm, sheet.long_mm);
@@ -235,9 +236,15 @@ TEST(TargetCommandSvg, BoardLargerThanThePageIsRefused) {
     EXPECT_THAT(message, HasSubstr("target 'four-line-board' (board 2000 x 2000 mm) does not fit "
                                    "on the A3 page (297 x 420 mm), upright or turned"));
     EXPECT_THAT(message, HasSubstr("nothing was written"));
-    EXPECT_THAT(message, HasSubstr("--page a3 without --target or --config prints four-line-a3"));
-    EXPECT_THAT(message, HasSubstr("--page full (2020 x 2020 mm, for a plotter or a print shop)"));
+    // In the library's own words (the command line says which options): the alternatives.
+    EXPECT_THAT(message, HasSubstr("print the target made for this sheet (four-line-a3)"));
+    EXPECT_THAT(message, HasSubstr("at its full size (2020 x 2020 mm, for a plotter or a print"));
+    EXPECT_THAT(message, Not(HasSubstr("--")));
     EXPECT_THAT(message, Not(HasSubstr("a page that holds")));  // no sheet does
+    EXPECT_EQ(error.alternatives().page, "a3");
+    EXPECT_EQ(error.alternatives().page_target, "four-line-a3");
+    EXPECT_TRUE(error.alternatives().larger.empty());
+    EXPECT_EQ(error.alternatives().full_width_mm, 2020.0);
   }
   // The A3 target on an A4 page: the A4 target, or the A3 page.
   try {
@@ -245,9 +252,9 @@ TEST(TargetCommandSvg, BoardLargerThanThePageIsRefused) {
     FAIL() << "no error";
   } catch (const TargetDoesNotFit& error) {
     EXPECT_THAT(error.what(), HasSubstr("does not fit on the A4 page (297 x 210 mm)"));
-    EXPECT_THAT(error.what(), HasSubstr("--page a4 without --target or --config prints "
-                                        "four-line-a4"));
-    EXPECT_THAT(error.what(), HasSubstr("a page that holds this one (--page a3)"));
+    EXPECT_THAT(error.what(), HasSubstr("the target made for this sheet (four-line-a4)"));
+    EXPECT_THAT(error.what(), HasSubstr("a page that holds this one (A3)"));
+    EXPECT_EQ(error.alternatives().larger, std::vector<std::string>{"a3"});
   }
   // The A4 sheet is longer than US letter.
   EXPECT_THROW(DrawTargetPage(FourLineA4Target(), "letter"), TargetDoesNotFit);
