@@ -49,7 +49,6 @@ double Reach(const std::vector<std::vector<cv::Point2f>>& image_points, const cv
 // more than this (metres), or this many solves.
 constexpr double kPairingSettledM = 1e-6;
 constexpr int kMaxPairingRounds = 40;
-constexpr double kOverRelax = 1.0;
 // A run crosses its stripe from edge to edge when its ends lie this far inside the stripe's
 // printed ends (times its width) and it spans its width within this fraction (the runs of a
 // blurred stripe are a few tenths of a pixel short).
@@ -243,7 +242,7 @@ double PairThroughCamera(const CalibrationView& view, const cv::Mat& camera_matr
     if (!std::isfinite(q.x) || !std::isfinite(q.y)) continue;
     const cv::Point2d snapped = Snap(OnPlane(view.lines[pairing->line_of[k]]), q);
     moved = std::max(moved, cv::norm(snapped - pairing->paired[k]));
-    pairing->paired[k] += kOverRelax * (snapped - pairing->paired[k]);
+    pairing->paired[k] = snapped;
   }
   return moved;
 }
