@@ -67,6 +67,15 @@ struct Value {
     return value;
   }
 
+  // Enum from text through a mapping that says nullopt for an unknown word.
+  template <typename Enum>
+  Enum OneOf(std::optional<Enum> (*from_string)(const std::string&), const char* choices) const {
+    const std::string word = As<std::string>("a string");
+    const std::optional<Enum> value = from_string(word);
+    if (!value) Fail("'" + key + "' is invalid: '" + word + "' is not one of " + choices);
+    return *value;
+  }
+
   // Enum from text through the one place that maps strings to enums (options.h).
   template <typename Enum>
   Enum Choice(Enum (*from_string)(const std::string&), const char* choices) const {
@@ -869,25 +878,13 @@ const std::vector<Field<SourceConfig>>& SourceFields() {
   static const std::vector<Field<O>> fields = {
       {"type",
        [](const Value& value, O* source) {
-         const std::string word = value.As<std::string>("a string");
-         const std::optional<SourceType> type = SourceTypeFromString(word);
-         if (!type) {
-           value.Fail("'" + value.key + "' is invalid: '" + word +
-                      "' is not one of simulated, v4l2, replay");
-         }
-         source->type = *type;
+         source->type = value.OneOf(&SourceTypeFromString, "simulated, v4l2, replay");
        }},
       {"device",
        [](const Value& value, O* source) { source->device = value.As<std::string>("a path"); }},
       {"format",
        [](const Value& value, O* source) {
-         const std::string word = value.As<std::string>("a string");
-         const std::optional<CameraFormat> format = CameraFormatFromString(word);
-         if (!format) {
-           value.Fail("'" + value.key + "' is invalid: '" + word +
-                      "' is not one of auto, mjpeg, yuyv, grey");
-         }
-         source->format = *format;
+         source->format = value.OneOf(&CameraFormatFromString, "auto, mjpeg, yuyv, grey");
        }},
       IntField("width", &O::width),
       IntField("height", &O::height),
@@ -908,12 +905,7 @@ const std::vector<Field<OutputConfig>>& OutputFields() {
        [](const Value& value, O* output) { output->directory = value.As<std::string>("a path"); }},
       {"display",
        [](const Value& value, O* output) {
-         const std::string word = value.As<std::string>("a string");
-         const std::optional<DisplayMode> mode = DisplayModeFromString(word);
-         if (!mode) {
-           value.Fail("'" + value.key + "' is invalid: '" + word + "' is not one of auto, on, off");
-         }
-         output->display = *mode;
+         output->display = value.OneOf(&DisplayModeFromString, "auto, on, off");
        }},
       BoolField("save_frames", &O::save_frames),
   };

@@ -153,7 +153,7 @@ DetectSummary DetectImages(const DetectCommandOptions& options, std::ostream& ou
   DetectRun run{MakeDetector(LoadDetectorOptions(options), camera), std::move(camera), {}, {}, {}};
   if (run.detector.Undistorts()) run.undistorted_by = run.camera->camera;
   run.sources = OpenInputs(options, &summary.warnings);
-  if (options.display) run.view = OpenLiveView("oalservo detect", options);
+  if (options.display) run.view = OpenLiveView("oalservo detect", options.display_fps);
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });

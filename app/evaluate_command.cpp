@@ -95,9 +95,7 @@ int RunEvaluate(int argc, char** argv) {
                        std::to_string(options.inputs.size()) + " inputs, --jobs " +
                        std::to_string(options.jobs) + ")");
     }
-    FrameCommandOptions shown;
-    shown.display_fps = display_fps;
-    view = OpenLiveView("oalservo evaluate", shown);
+    view = OpenLiveView("oalservo evaluate", display_fps);
   }
   const FrameViewer viewer = [&view](const cv::Mat& annotated, const std::string& caption) {
     return view->Show(annotated, caption, false);

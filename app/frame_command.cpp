@@ -73,10 +73,9 @@ void CheckDisplayOptions(const FrameCommandOptions& options) {
   }
 }
 
-std::unique_ptr<LiveView> OpenLiveView(const std::string& title,
-                                       const FrameCommandOptions& options) {
+std::unique_ptr<LiveView> OpenLiveView(const std::string& title, double display_fps) {
   try {
-    return std::make_unique<LiveView>(title, options.display_fps);
+    return std::make_unique<LiveView>(title, display_fps);
   } catch (const std::runtime_error& error) {
     throw std::runtime_error("--display: " + std::string(error.what()) +
                              "; run without --display (--annotate DIR writes the same pictures), "

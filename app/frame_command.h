@@ -77,10 +77,10 @@ void AddInputsArgument(CLI::App& cli, FrameCommandOptions* options);
 /// Throws std::invalid_argument for a display_fps out of its range (with display).
 void CheckDisplayOptions(const FrameCommandOptions& options);
 
-/// The live window of a command with --display, open: throws std::runtime_error saying why
-/// none can be opened (naming $DISPLAY) and what to do instead.
-std::unique_ptr<LiveView> OpenLiveView(const std::string& title,
-                                       const FrameCommandOptions& options);
+/// The live window of a command with --display (frames from files shown at `display_fps`),
+/// open: throws std::runtime_error saying why none can be opened (naming $DISPLAY) and what to
+/// do instead.
+std::unique_ptr<LiveView> OpenLiveView(const std::string& title, double display_fps);
 
 /// Adds --display and --display-fps.
 void AddDisplayOptions(CLI::App& cli, FrameCommandOptions* options);

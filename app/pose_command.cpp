@@ -319,7 +319,7 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   PoseRun run{std::move(config), std::move(camera), std::move(tracker), {}, {}, {}};
   if (run.tracker.detector().Undistorts()) run.undistorted_by = run.camera.camera;
   run.sources = OpenInputs(options, &summary.warnings);
-  if (options.display) run.view = OpenLiveView("oalservo pose", options);
+  if (options.display) run.view = OpenLiveView("oalservo pose", options.display_fps);
   WriteFrameRecords(options, out, [&](std::ostream& sink, bool flush_each) {
     ProcessFrames(options, &run, sink, flush_each, &summary);
   });

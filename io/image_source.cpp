@@ -15,6 +15,8 @@
 #include <opencv2/videoio.hpp>
 #include <optional>
 #include <stdexcept>
+
+#include "base/format.h"
 #ifdef VISP_HAVE_V4L2
 #include <visp3/sensor/vpV4l2Grabber.h>
 #endif
@@ -29,10 +31,7 @@ std::string Quoted(const fs::path& path) {
 }
 
 std::string LowerExtension(const std::string& path) {
-  std::string extension = fs::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
+  return Lowercase(fs::path(path).extension().string());
 }
 
 bool OneOf(const std::string& value, std::initializer_list<const char*> choices) {
@@ -369,7 +368,6 @@ class OpenCvCameraSource : public ImageSource {
   cv::Mat buffer_, gray_;
   int index_ = 0;
 };
-
 
 // Parsed "prefix%0<width>dsuffix"; "%%" stands for a literal '%'.
 struct Pattern {

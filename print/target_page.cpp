@@ -64,10 +64,7 @@ std::string SheetTargetName(const std::string& page) {
   return sheet != nullptr ? sheet->target : TargetNames().front();
 }
 
-namespace {
-
-// Millimetres with at most 4 decimals, trailing zeros dropped ("12.5", "-80", "0.0125").
-std::string Mm(double value) {
+std::string FormatMm(double value) {
   char text[64];
   std::snprintf(text, sizeof(text), "%.4f", value);
   std::string out = text;
@@ -76,6 +73,8 @@ std::string Mm(double value) {
   if (out == "-0") out = "0";
   return out;
 }
+
+namespace {
 
 // ------------------------------------------------------------------------------------------
 // Plane geometry, millimetres, in the board's frame (origin at its centre, x right, y down).
@@ -514,7 +513,8 @@ std::optional<Pose> PlaceLineNumber(const Item& number, const TargetLine& line, 
 }
 
 std::string SheetSize(const LineTarget& target) {
-  return Mm(1000.0 * target.board_width_m) + " x " + Mm(1000.0 * target.board_height_m) + " mm";
+  return FormatMm(1000.0 * target.board_width_m) + " x " +
+         FormatMm(1000.0 * target.board_height_m) + " mm";
 }
 
 Item ScaleBar() {
@@ -573,13 +573,14 @@ TargetDoesNotFit DoesNotFit(const LineTarget& target, const Sheet& sheet, const 
   instead.full_height_mm = 1000.0 * target.board_height_m + 2.0 * kFullMarginMm;
   std::ostringstream message;
   message << "target '" << target.name << "' (board " << SheetSize(target)
-          << ") does not fit on the " << sheet.label << " page (" << Mm(page.width_mm) << " x "
-          << Mm(page.height_mm) << " mm), upright or turned, and is not scaled to fit (the "
+          << ") does not fit on the " << sheet.label << " page (" << FormatMm(page.width_mm)
+          << " x " << FormatMm(page.height_mm)
+          << " mm), upright or turned, and is not scaled to fit (the "
           << "pose takes the target's lengths as printed); nothing was written. Instead: "
           << "print the target made for this sheet (" << sheet.target << ")";
   if (!larger.empty()) message << ", or a page that holds this one (" << larger << ")";
-  message << ", or this target at its full size (" << Mm(instead.full_width_mm) << " x "
-          << Mm(instead.full_height_mm) << " mm, for a plotter or a print shop)";
+  message << ", or this target at its full size (" << FormatMm(instead.full_width_mm) << " x "
+          << FormatMm(instead.full_height_mm) << " mm, for a plotter or a print shop)";
   return TargetDoesNotFit(message.str(), std::move(instead));
 }
 
@@ -651,7 +652,7 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
     }
     if (room < kClearanceMm - 1e-9) {
       drawing.warning += std::string(drawing.warning.empty() ? "" : "; ") + "line " +
-                         std::to_string(i + 1) + "'s stripe comes within " + Mm(room) +
+                         std::to_string(i + 1) + "'s stripe comes within " + FormatMm(room) +
                          " mm of the page's edge, where printers leave 3-6 mm blank: its ink "
                          "there will be missing (end the stripes at least 10 mm inside the board)";
     }
@@ -662,30 +663,28 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
     Item item;
     Pose pose;
   };
-  std::vector<Drawn> drawn;
-  const std::vector<SearchStep> bar_steps = {
-      {true, {0.0}}, {true, {-90.0}}, {false, {0.0}}, {false, {-90.0}}, {false, SlantsDeg(), 2.5}};
+  // Places `item` by `steps`, or says that the page has no room for `what` and what to do.
+  const auto place = [&](const Item& item, const std::vector<SearchStep>& steps,
+                         const std::string& what, const std::string& instead) {
+    const std::optional<Pose> pose = PlaceItem(item, steps, layout);
+    if (!pose) {
+      throw std::runtime_error("target '" + name + "': no room on the " + page.label +
+                               " page for " + what + " " + FormatMm(kClearanceMm) +
+                               " mm clear of every stripe and of the page's edge; " + instead);
+    }
+    layout.Place(Placed(PartsOf(item), *pose));
+    return *pose;
+  };
   const Item bar = ScaleBar();
-  const std::optional<Pose> bar_pose = PlaceItem(bar, bar_steps, layout);
-  if (!bar_pose) {
-    throw std::runtime_error("target '" + name + "': no room on the " + page.label +
-                             " page for the 100 mm scale bar " + Mm(kClearanceMm) +
-                             " mm clear of every stripe and of the page's edge; use a larger "
-                             "page (the full page prints the board at its full size)");
-  }
-  layout.Place(Placed(PartsOf(bar), *bar_pose));
-  drawn.push_back({bar, *bar_pose});
+  const Pose bar_pose = place(
+      bar,
+      {{true, {0.0}}, {true, {-90.0}}, {false, {0.0}}, {false, {-90.0}}, {false, SlantsDeg(), 2.5}},
+      "the 100 mm scale bar",
+      "use a larger page (the full page prints the board at its full size)");
   const Item legend = Legend(target);
-  const std::optional<Pose> legend_pose =
-      PlaceItem(legend, {{true, {0.0}}, {false, {0.0}}, {true, {-90.0}}, {false, {-90.0}}}, layout);
-  if (!legend_pose) {
-    throw std::runtime_error("target '" + name + "': no room on the " + page.label +
-                             " page for its name and \"print at 100 %\" " + Mm(kClearanceMm) +
-                             " mm clear of every stripe and of the page's edge; use a larger "
-                             "page or a shorter name");
-  }
-  layout.Place(Placed(PartsOf(legend), *legend_pose));
-  drawn.push_back({legend, *legend_pose});
+  const Pose legend_pose =
+      place(legend, {{true, {0.0}}, {false, {0.0}}, {true, {-90.0}}, {false, {-90.0}}},
+            "its name and \"print at 100 %\"", "use a larger page or a shorter name");
   std::vector<Drawn> numbers;
   for (std::size_t i = 0; i < target.lines.size(); ++i) {
     Item number;
@@ -726,14 +725,14 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
   for (const Drawn& number : numbers) {
     add_text(number.item.texts[0], number.pose, PageGroup::kLineNumbers);
   }
-  for (const TextPart& text : legend.texts) add_text(text, *legend_pose, PageGroup::kLegend);
-  for (const LinePart& line : bar.lines) add_line(line, *bar_pose);
-  for (const TextPart& text : bar.texts) add_text(text, *bar_pose, PageGroup::kScale);
+  for (const TextPart& text : legend.texts) add_text(text, legend_pose, PageGroup::kLegend);
+  for (const LinePart& line : bar.lines) add_line(line, bar_pose);
+  for (const TextPart& text : bar.texts) add_text(text, bar_pose, PageGroup::kScale);
 
   drawing.target_name = name;
   std::ostringstream description;
   description << "Target " << name << " (board " << SheetSize(target) << "), page " << page.label
-              << ", " << Mm(page.width_mm) << " x " << Mm(page.height_mm)
+              << ", " << FormatMm(page.width_mm) << " x " << FormatMm(page.height_mm)
               << " mm. True scale: 1 unit = 1 mm; print at 100 %, do not scale, and check the "
                  "100 mm scale bar. ";
   if (page.turned) {
@@ -744,8 +743,8 @@ TargetPage DrawTargetPage(const LineTarget& target, const std::string& page_name
   } else {
     description << "Object frame: x to the right, y down. ";
   }
-  description << "The board's centre, the object origin, is at (" << Mm(cx) << ", " << Mm(cy)
-              << "); its outline is not printed.";
+  description << "The board's centre, the object origin, is at (" << FormatMm(cx) << ", "
+              << FormatMm(cy) << "); its outline is not printed.";
   drawing.description = description.str();
   return drawing;
 }

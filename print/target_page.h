@@ -127,6 +127,10 @@ struct TargetPage {
 TargetPage DrawTargetPage(const LineTarget& target, const std::string& page,
                           bool landscape = false);
 
+/// Millimetres as the page's files write them: at most 4 decimals, trailing zeros dropped
+/// ("12.5", "-80", "0.0125").
+std::string FormatMm(double value);
+
 /// Throws std::invalid_argument unless `page` is a4, a3, letter or full.
 void CheckPageName(const std::string& page);
 

@@ -8,17 +8,6 @@
 namespace oal {
 namespace {
 
-// Millimetres with at most 4 decimals, trailing zeros dropped ("12.5", "-80", "0.0125").
-std::string Mm(double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.4f", value);
-  std::string out = text;
-  while (out.back() == '0') out.pop_back();
-  if (out.back() == '.') out.pop_back();
-  if (out == "-0") out = "0";
-  return out;
-}
-
 std::string Grey() {
   char text[16];
   const int level = static_cast<int>(kPageGrey * 255.0 + 0.5);
@@ -34,19 +23,21 @@ std::string IdAndClass(const std::string& id, const std::string& klass) {
 }
 
 std::string TextSvg(const PageText& text) {
-  std::string out = "    <text " + IdAndClass(text.id, text.klass) + "x=\"" + Mm(text.at.x_mm) +
-                    "\" y=\"" + Mm(text.at.y_mm) + "\" font-size=\"" + Mm(kPageTextMm) + "\"";
+  std::string out = "    <text " + IdAndClass(text.id, text.klass) + "x=\"" +
+                    FormatMm(text.at.x_mm) + "\" y=\"" + FormatMm(text.at.y_mm) +
+                    "\" font-size=\"" + FormatMm(kPageTextMm) + "\"";
   if (text.angle_deg != 0.0) {
-    out += " transform=\"rotate(" + Mm(text.angle_deg) + " " + Mm(text.at.x_mm) + " " +
-           Mm(text.at.y_mm) + ")\"";
+    out += " transform=\"rotate(" + FormatMm(text.angle_deg) + " " + FormatMm(text.at.x_mm) + " " +
+           FormatMm(text.at.y_mm) + ")\"";
   }
   return out + ">" + MarkupEscaped(text.text) + "</text>\n";
 }
 
 std::string LineSvg(const PageLine& line) {
-  return "    <line " + IdAndClass(line.id, line.klass) + "x1=\"" + Mm(line.a.x_mm) + "\" y1=\"" +
-         Mm(line.a.y_mm) + "\" x2=\"" + Mm(line.b.x_mm) + "\" y2=\"" + Mm(line.b.y_mm) +
-         "\" stroke=\"" + Grey() + "\" stroke-width=\"" + Mm(line.stroke_mm) + "\"/>\n";
+  return "    <line " + IdAndClass(line.id, line.klass) + "x1=\"" + FormatMm(line.a.x_mm) +
+         "\" y1=\"" + FormatMm(line.a.y_mm) + "\" x2=\"" + FormatMm(line.b.x_mm) + "\" y2=\"" +
+         FormatMm(line.b.y_mm) + "\" stroke=\"" + Grey() + "\" stroke-width=\"" +
+         FormatMm(line.stroke_mm) + "\"/>\n";
 }
 
 // One group of grey marks.
@@ -68,16 +59,16 @@ void WriteGroup(const TargetPage& page, PageGroup group, const char* id, std::os
 std::string TargetSvg(const TargetPage& page) {
   std::ostringstream svg;
   svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\""
-      << Mm(page.page_width_mm) << "mm\" height=\"" << Mm(page.page_height_mm)
-      << "mm\" viewBox=\"0 0 " << Mm(page.page_width_mm) << " " << Mm(page.page_height_mm)
-      << "\">\n"
+      << FormatMm(page.page_width_mm) << "mm\" height=\"" << FormatMm(page.page_height_mm)
+      << "mm\" viewBox=\"0 0 " << FormatMm(page.page_width_mm) << " "
+      << FormatMm(page.page_height_mm) << "\">\n"
       << "  <title>oalservo target " << MarkupEscaped(page.target_name) << "</title>\n"
       << "  <desc>" << MarkupEscaped(page.description) << "</desc>\n"
       << "  <g id=\"stripes\" fill=\"#000000\" stroke=\"none\">\n";
   for (const PageStripe& stripe : page.stripes) {
     std::string points;
     for (const PagePoint& p : stripe.corners) {
-      points += (points.empty() ? "" : " ") + Mm(p.x_mm) + "," + Mm(p.y_mm);
+      points += (points.empty() ? "" : " ") + FormatMm(p.x_mm) + "," + FormatMm(p.y_mm);
     }
     svg << "    <polygon class=\"stripe\" id=\"line-" << stripe.line << "\" points=\"" << points
         << "\"/>\n";

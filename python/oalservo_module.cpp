@@ -68,6 +68,10 @@ PythonFrame FrameOf(const py::array& array) {
   return frame;
 }
 
+Lens CameraOfFile(const std::string& path, const std::string& name) {
+  return LoadCameraFile(path, name).camera;
+}
+
 py::array_t<double> MatrixOf(const vpHomogeneousMatrix& m) {
   py::array_t<double> out({4, 4});
   auto view = out.mutable_unchecked<2>();
@@ -225,19 +229,10 @@ PYBIND11_MODULE(_oalservo, m) {
                }),
            py::arg("px"), py::arg("py"), py::arg("u0"), py::arg("v0"), py::arg("kdu") = 0.0,
            py::arg("width") = 640, py::arg("height") = 480)
-      .def_static(
-          "from_file",
-          [](const std::string& path, const std::string& name) {
-            return LoadCameraFile(path, name).camera;
-          },
-          py::arg("path"), py::arg("name") = "",
-          "A camera file: ViSP's XML, OpenCV's calibration YAML or ROS's camera_info")
-      .def_static(
-          "from_xml",
-          [](const std::string& path, const std::string& name) {
-            return LoadCameraFile(path, name).camera;
-          },
-          py::arg("path"), py::arg("name") = "")
+      .def_static("from_file", &CameraOfFile, py::arg("path"), py::arg("name") = "",
+                  "A camera file: ViSP's XML, OpenCV's calibration YAML or ROS's camera_info")
+      .def_static("from_xml", &CameraOfFile, py::arg("path"), py::arg("name") = "",
+                  "The same as from_file (any of the three formats)")
       .def_property_readonly("px", &Lens::px)
       .def_property_readonly("py", &Lens::py)
       .def_property_readonly("u0", &Lens::u0)
