@@ -9,7 +9,7 @@
 #include "app/evaluation_config.h"
 #include "base/format.h"
 #include "detector/lens.h"
-#include "eval/calibrate_accuracy.h"
+#include "eval/rendered/calibrate_accuracy.h"
 #include "io/camera_file.h"
 #include "io/json_io.h"
 
@@ -178,7 +178,14 @@ int RunCalibrateAccuracy(int argc, char** argv) {
   options.sampling.max_tilt_deg = 45.0;
   options.scene = BenchScene();
   if (options.backgrounds.empty()) options.backgrounds = DefaultBenchPhotos();
-  CheckInOptionWords([&] { options.Check(); }, {});
+  CheckInOptionWords([&] { options.Check(); },
+                     {{"CalibrateAccuracyOptions::cameras", "--cameras"},
+                      {"CalibrateAccuracyOptions::frames", "--views"},
+                      {"RenderedFrameOptions::frames", "--views"},
+                      {"RenderedFrameOptions::noise_sigma", "--noise"},
+                      {"RenderedFrameOptions::blur_sigma_px", "--blur"},
+                      {"CalibrateAccuracyOptions::lens", "--camera"},
+                      {"CalibrateAccuracyOptions::max_kdu", "--max-kdu"}});
   CheckReportFile(out_path);
   const std::vector<CameraCalibrationTrial> trials =
       EvaluateCalibration(options, FrameProgress("view", 10.0, "views"));

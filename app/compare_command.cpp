@@ -6,7 +6,7 @@
 
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
-#include "eval/compare.h"
+#include "eval/lines/compare.h"
 #include "io/json_io.h"
 #include "io/quiet_stderr.h"
 
@@ -68,6 +68,7 @@ int RunCompare(int argc, char** argv) {
                                                 {"VpMeLineOptions::threshold", "--me-threshold"},
                                                 {"VpMeLineOptions::sample_step_px", "--me-step"}});
   options.setup = TrackerSetupOf(config_path, {options.input});
+  options.names = {{"camera_path", "--camera"}, {"truth", "--truth"}};
   CompareReport report;
   {
     std::optional<QuietStderr> quiet;

@@ -1,5 +1,5 @@
 // `oalservo compare INPUT [--truth FILE|DIR] [--config FILE] [--camera FILE] [--out DIR]
-// [--lines N]`: line detectors and trackers head to head (eval/compare.h has the methods, the
+// [--lines N]`: line detectors and trackers head to head (eval/lines/compare.h has the methods, the
 // truth formats and the metric definitions).
 #pragma once
 

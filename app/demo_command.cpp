@@ -19,7 +19,7 @@
 #include "base/pose_distance.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
-#include "eval/line_scoring.h"
+#include "eval/lines/line_scoring.h"
 #include "io/annotate.h"
 #include "io/atomic_file.h"
 #include "io/image_source.h"
@@ -50,7 +50,7 @@ RenderOptions CheapCamera() {
   return options;
 }
 
-// The visible true lines matched one to one with the detected ones (eval/line_scoring.h's
+// The visible true lines matched one to one with the detected ones (eval/lines/line_scoring.h's
 // MatchLines), in undistorted pixels: a detected line more than kMaxMatchAngleDeg from a true
 // one is not its match; the offset is bounded only by the image. Missed lines get a row too.
 std::vector<DemoMatch> MatchTruth(const std::vector<TruthLine>& truth,

@@ -10,7 +10,7 @@
 #include "app/config.h"
 #include "app/evaluation_config.h"
 #include "base/statistics.h"
-#include "eval/detector_accuracy.h"
+#include "eval/rendered/detector_accuracy.h"
 
 namespace oal {
 namespace {
@@ -118,10 +118,10 @@ int RunDetectAccuracy(int argc, char** argv) {
   const bool scene_given = !config_path.empty() && ConfigHasSection(config_path, "scene");
   options.target = AccuracyTarget(target_name, target->count() > 0, config_path, config);
   ApplySheetDefaults(cli, options.target, scene_given, &options, &options.sampling);
-  CheckInOptionWords([&] { options.Check(); }, {{"PoseSampling::min_distance_m", "--min-distance"},
-                                                {"PoseSampling::max_distance_m", "--max-distance"},
-                                                {"PoseSampling::max_tilt_deg", "--max-tilt-deg"},
-                                                {"PoseSampling::max_offset_m", "--max-offset"}});
+  auto words = RenderedFrameOptionWords();
+  words.insert(words.end(), {{"AccuracyOptions::max_angle_deg", "--max-angle-deg"},
+                             {"AccuracyOptions::max_offset_px", "--max-offset-px"}});
+  CheckInOptionWords([&] { options.Check(); }, words);
   CheckReportFile(out_path);
   const AccuracyReport report = EvaluateDetectorAccuracy(options, TerminalFrameProgress());
   PrintAccuracyReport(Table(report), ToJson(report), out_path);

@@ -3,7 +3,7 @@
 namespace oal {
 
 /// `oalservo detect-accuracy`: the detector's accuracy evaluation on rendered frames
-/// (eval/detector_accuracy.h), printed as a table and optionally written as JSON.
+/// (eval/rendered/detector_accuracy.h), printed as a table and optionally written as JSON.
 int RunDetectAccuracy(int argc, char** argv);
 
 }  // namespace oal

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "app/command_line.h"
-#include "eval/edge_reference.h"
+#include "eval/lines/edge_reference.h"
 #include "io/atomic_file.h"
 
 namespace oal {

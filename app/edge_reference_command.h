@@ -3,7 +3,7 @@
 namespace oal {
 
 /// `oalservo edge-reference PATTERN --out FILE.csv`: the independent sub-pixel edge fit of
-/// eval/edge_reference.h over an image sequence, written as compare's truth CSV.
+/// eval/lines/edge_reference.h over an image sequence, written as compare's truth CSV.
 int RunEdgeReference(int argc, char** argv);
 
 }  // namespace oal

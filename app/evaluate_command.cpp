@@ -7,7 +7,7 @@
 #include "app/evaluation_config.h"
 #include "app/frame_command.h"
 #include "app/live_window.h"
-#include "eval/evaluate.h"
+#include "eval/recordings/evaluate.h"
 
 namespace oal {
 
@@ -83,9 +83,13 @@ int RunEvaluate(int argc, char** argv) {
     try {
       std::tie(options.shard_index, options.shard_count) = ParseShard(shard);
     } catch (const std::invalid_argument& error) {
-      throw UsageError(error.what());
+      throw UsageError(std::string("--shard ") + error.what());
     }
   }
+  options.names = {{"target_lines", "--lines"},
+                   {"video_codec", "--video-codec"},
+                   {"camera_path", "--camera"},
+                   {"calibrate", "oalservo calibrate"}};
   options.write_video = !no_video;
   options.setup = TrackerSetupOf(config_path, options.inputs);
   std::unique_ptr<LiveView> view;
@@ -100,8 +104,21 @@ int RunEvaluate(int argc, char** argv) {
   const FrameViewer viewer = [&view](const cv::Mat& annotated, const std::string& caption) {
     return view->Show(annotated, caption, false);
   };
-  const EvaluateResult result =
-      Evaluate(options, FrameProgress("evaluate: frame"), view ? viewer : FrameViewer());
+  EvaluateResult result;
+  CheckInOptionWords(
+      [&] {
+        result = Evaluate(options, FrameProgress("evaluate: frame"), view ? viewer : FrameViewer());
+      },
+      {{"EvaluateOptions::inputs", "INPUT"},
+       {"EvaluateOptions::out_dir", "--out"},
+       {"EvaluateOptions::jobs", "--jobs"},
+       {"EvaluateOptions::shard", "--shard"},
+       {"EvaluateOptions::max_frames", "--max-frames"},
+       {"EvaluateOptions::video_scale", "--video-scale"},
+       {"EvaluateOptions::video_codec", "--video-codec"},
+       {"EvaluateOptions::thumbnails", "--thumbnails"},
+       {"EvaluateOptions::target_lines", "--lines"},
+       {"EvaluateOptions::truth_path", "--truth"}});
   int failed = 0, resumed = 0;
   for (const InputOutcome& input : result.inputs) {
     if (input.status == "failed") {

@@ -1,6 +1,6 @@
 // `oalservo evaluate INPUT... --out DIR [--config FILE] [--camera FILE] [--truth FILE]
 // [--compare] [--jobs N] [--shard I/N] [--resume]`: offline evaluation of the tracker and the
-// pose on recorded videos, with an HTML report (eval/evaluate.h; docs/EVALUATE.md).
+// pose on recorded videos, with an HTML report (eval/recordings/evaluate.h; docs/EVALUATE.md).
 #pragma once
 
 namespace oal {

@@ -55,6 +55,21 @@ void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
                  "for the sheet targets: photographs of Debian's visp-images-data)");
 }
 
+std::vector<std::pair<std::string, std::string>> RenderedFrameOptionWords() {
+  return {{"RenderedFrameOptions::frames", "--frames"},
+          {"RenderedFrameOptions::kdu", "--kdu"},
+          {"RenderedFrameOptions::noise_sigma", "--noise"},
+          {"RenderedFrameOptions::blur_sigma_px", "--blur"},
+          {"RenderedFrameOptions::noise_max", "--noise-max"},
+          {"RenderedFrameOptions::blur_max_px", "--blur-max"},
+          {"RenderedFrameOptions::illumination_gradient", "--gradient"},
+          {"RenderedFrameOptions::focal_px", "--focal"},
+          {"PoseSampling::min_distance_m", "--min-distance"},
+          {"PoseSampling::max_distance_m", "--max-distance"},
+          {"PoseSampling::max_tilt_deg", "--max-tilt-deg"},
+          {"PoseSampling::max_offset_m", "--max-offset"}};
+}
+
 void AddRenderedCameraOptions(CLI::App& cli, RenderedFrameOptions* options,
                               std::string* camera_path) {
   cli.add_option("--width", options->width, "image width, pixels, [16, 8192]")

@@ -8,11 +8,12 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/config.h"
-#include "eval/oal_methods.h"
-#include "eval/rendered_frames.h"
+#include "eval/lines/oal_methods.h"
+#include "eval/rendered/rendered_frames.h"
 #include "scene/bench_scene.h"  // IsSheet, SheetSampling
 #include "scene/scene.h"
 
@@ -30,6 +31,11 @@ CLI::Option* AddSeedOption(CLI::App& cli, std::uint64_t* seed, const std::string
 /// Adds --frames, --seed (AddSeedOption), --kdu (described by `kdu_help`), --noise and --blur.
 void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
                              const std::string& kdu_help);
+
+/// The fields of RenderedFrameOptions (and the PoseSampling it holds) as the options
+/// AddRenderedFrameOptions, AddRenderedCameraOptions and the accuracy commands name them, for
+/// CheckInOptionWords.
+std::vector<std::pair<std::string, std::string>> RenderedFrameOptionWords();
 
 /// Adds the rendered camera's options: --width, --height, --focal, and --camera FILE (a ViSP
 /// camera file, whose camera and image size replace them and --kdu).

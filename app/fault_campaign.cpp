@@ -1,5 +1,7 @@
 #include "app/fault_campaign.h"
 
+#include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -28,6 +30,28 @@ void CheckCampaignConfig(const ServoAppConfig& config) {
   }
 }
 
+// The servo job's servo.csv (RunServoWithOutputs) is whole: one row per iteration of the
+// loop's report, the last row the run's last; "" when it is, else what is wrong.
+std::string CheckServoCsv(const std::string& dir, const ServoRunReport& report) {
+  std::ifstream csv(std::filesystem::path(dir) / "servo.csv");
+  if (!csv) return "servo.csv is missing";
+  std::string line, last;
+  int rows = -1;  // the header
+  while (std::getline(csv, line)) {
+    ++rows;
+    last = line;
+  }
+  if (rows != static_cast<int>(report.iterations.size())) {
+    return "servo.csv has " + std::to_string(rows) + " rows for " +
+           std::to_string(report.iterations.size()) + " iterations";
+  }
+  if (!report.iterations.empty() &&
+      last.substr(last.rfind(',') + 1) != report.iterations.back().status) {
+    return "servo.csv's last row is not the run's last: " + last;
+  }
+  return "";
+}
+
 }  // namespace
 
 FaultedRobot FaultedRobotOf(RobotType type) {
@@ -42,7 +66,7 @@ FaultCampaignReport RunFaultCampaign(const ServoAppConfig& config,
   FaultCampaignSetup setup;
   setup.robot = FaultedRobotOf(config.robot.type);
   if (setup.robot == FaultedRobot::kScorbot) setup.controller = ControllerSimOptions(config);
-  setup.outcome_prefix = "oalservo servo: ";  // RunServoWithOutputs' outcome line
+  setup.check_outputs = CheckServoCsv;
   setup.max_lost_frames = config.servo.max_lost_frames;
   setup.run = [&config](const FaultRunRequest& request, std::ostream& log) {
     ServoAppConfig run = config;

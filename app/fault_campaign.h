@@ -1,4 +1,4 @@
-// `oalservo servo-accuracy --faults N`: the fault campaign (eval/fault_campaign.h) on the
+// `oalservo servo-accuracy --faults N`: the fault campaign (eval/campaigns/fault_campaign.h) on the
 // configuration's servo job, as `oalservo servo` runs it (outputs written, no window): a
 // simulated camera, and the simulated robot or the Scorbot through its Controller-A simulator.
 #pragma once
@@ -6,7 +6,7 @@
 #include <functional>
 
 #include "app/config.h"
-#include "eval/fault_campaign.h"
+#include "eval/campaigns/fault_campaign.h"
 
 namespace oal {
 

@@ -15,7 +15,7 @@
 #include "app/evaluation_config.h"
 #include "base/format.h"
 #include "base/statistics.h"
-#include "eval/pose_accuracy.h"
+#include "eval/rendered/pose_accuracy.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/json_io.h"
@@ -328,10 +328,7 @@ int RunPoseAccuracy(int argc, char** argv) {
   const bool scene_given = !config_path.empty() && ConfigHasSection(config_path, "scene");
   options.target = AccuracyTarget(target_name, target->count() > 0, config_path, config);
   ApplyTargetDefaults(cli, scene_given, &options);
-  CheckInOptionWords([&] { options.Check(); }, {{"PoseSampling::min_distance_m", "--min-distance"},
-                                                {"PoseSampling::max_distance_m", "--max-distance"},
-                                                {"PoseSampling::max_tilt_deg", "--max-tilt-deg"},
-                                                {"PoseSampling::max_offset_m", "--max-offset"}});
+  CheckInOptionWords([&] { options.Check(); }, RenderedFrameOptionWords());
   CheckReportFile(out_path);
   std::optional<StagedDataset> missed;
   if (!missed_dir.empty())

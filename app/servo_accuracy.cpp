@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "app/servo_run.h"
-#include "eval/motion_audit.h"
+#include "eval/campaigns/motion_audit.h"
 
 namespace oal {
 

@@ -1,12 +1,12 @@
-// `oalservo servo-accuracy`'s runs (eval/servo_accuracy.h) from a servo configuration: the
-// starts drawn around its target and camera, each run as `oalservo servo` runs it.
+// `oalservo servo-accuracy`'s runs (eval/campaigns/servo_accuracy.h) from a servo configuration:
+// the starts drawn around its target and camera, each run as `oalservo servo` runs it.
 #pragma once
 
 #include <functional>
 #include <vector>
 
 #include "app/config.h"
-#include "eval/servo_accuracy.h"
+#include "eval/campaigns/servo_accuracy.h"
 
 namespace oal {
 

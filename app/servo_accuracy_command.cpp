@@ -165,12 +165,23 @@ int RunServoAccuracy(int argc, char** argv) {
   if (fault_campaign) {
     faults.runs = fault_runs;
     faults.seed = options.seed;
-    faults.Check();
+    CheckInOptionWords([&] { faults.Check(); },
+                       {{"FaultCampaignOptions::runs", "--faults"},
+                        {"FaultCampaignOptions::time_scale", "--time-scale"},
+                        {"FaultCampaignOptions::jobs", "--jobs"},
+                        {"FaultCampaignOptions::work_dir", "--work-dir"}});
   }
   if (!laws.empty()) {
     options.modes.clear();
     for (const std::string& law : laws) options.modes.push_back(ServoModeFromString(law));
   }
+  CheckInOptionWords([&] { options.Check(); },
+                     {{"ServoAccuracyOptions::starts", "--starts"},
+                      {"ServoAccuracyOptions::min_distance_m", "--min-distance"},
+                      {"ServoAccuracyOptions::max_distance_m", "--max-distance"},
+                      {"ServoAccuracyOptions::max_off_deg", "--max-off-deg"},
+                      {"ServoAccuracyOptions::max_iterations", "--max-iterations"},
+                      {"ServoAccuracyOptions::modes", "--laws"}});
   ServoCommandOptions servo;
   servo.config_path = config_path;
   ServoAppConfig config = LoadServoConfig(servo);

@@ -26,6 +26,27 @@ RenderOptions RenderOptionsOf(const ServoAppConfig& config) {
   return render;
 }
 
+// The loop's fields as a configuration names them, for the loop's messages.
+FieldNames ServoConfigNames() {
+  return {{"width", "camera.width"},
+          {"height", "camera.height"},
+          {"estimate_distortion", "camera.estimate_distortion"},
+          {"latency_s", "camera.latency_s"},
+          {"loop.max_iterations", "servo.max_iterations"},
+          {"loop.max_time_s", "servo.max_time_s"},
+          {"loop.max_pose_jump_m", "servo.max_pose_jump_m"},
+          {"loop.max_pose_jump_deg", "servo.max_pose_jump_deg"},
+          {"loop.max_step_m", "servo.max_step_m"},
+          {"loop.max_step_deg", "servo.max_step_deg"},
+          {"loop.max_lost_frames", "servo.max_lost_frames"},
+          {"loop.max_lost_s", "servo.max_lost_s"},
+          {"loop.law.delta", "servo.delta"},
+          {"loop.law.mode", "servo.mode"},
+          {"safety.workspace_min_m", "robot.workspace_min_m"},
+          {"safety.workspace_max_m", "robot.workspace_max_m"},
+          {"calibrate", "oalservo calibrate"}};
+}
+
 }  // namespace
 
 ServoSetup ServoSetupOf(const ServoAppConfig& config) {
@@ -47,6 +68,7 @@ ServoSetup ServoSetupOf(const ServoAppConfig& config) {
   setup.cdMo = config.goal_cdMo;
   setup.open_loop = config.source.type == SourceType::kReplay;
   setup.true_eMc = camera.true_eMc;
+  setup.names = ServoConfigNames();
   return setup;
 }
 

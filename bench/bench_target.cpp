@@ -29,7 +29,8 @@ namespace {
 
 constexpr int kFrames = 32;
 
-// Three of the photographs the accuracy commands use as benches (eval/rendered_frames.cpp).
+// Three of the photographs the accuracy commands use as benches
+// (eval/rendered/rendered_frames.cpp).
 std::vector<std::shared_ptr<const vpImage<unsigned char>>> BenchPhotos() {
   const std::string root = "/usr/share/visp-images-data/ViSP-images";
   std::vector<std::shared_ptr<const vpImage<unsigned char>>> photos;

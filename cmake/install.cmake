@@ -1,6 +1,6 @@
 # `cmake --install build [--prefix DIR]`: the oalservo executable in bin/, the example
 # configurations in share/oalservo/config/, and the libraries (base, detector, target, scene,
-# servo, robots, calibration, io, loop, eval) with their headers and a CMake package, so that
+# servo, robots, calibration, io, loop, and eval's lines, rendered, recordings, campaigns) with their headers and a CMake package, so that
 # another project can write
 #
 #   find_package(oalservo 0.1 REQUIRED)
@@ -12,7 +12,7 @@
 include(CMakePackageConfigHelpers)
 
 set(OAL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/oalservo)
-foreach(folder base detector target scene servo robots calibration io loop eval)
+foreach(folder base detector target scene servo robots calibration io loop)
   set_target_properties(oal_${folder} PROPERTIES EXPORT_NAME ${folder})
   install(TARGETS oal_${folder} EXPORT oalservoTargets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
@@ -21,6 +21,14 @@ foreach(folder base detector target scene servo robots calibration io loop eval)
           DESTINATION ${OAL_INSTALL_INCLUDEDIR}/${folder}
           FILES_MATCHING PATTERN "*.h")
 endforeach()
+foreach(subject lines rendered recordings campaigns)
+  set_target_properties(oal_eval_${subject} PROPERTIES EXPORT_NAME eval_${subject})
+  install(TARGETS oal_eval_${subject} EXPORT oalservoTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endforeach()
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/eval/ DESTINATION ${OAL_INSTALL_INCLUDEDIR}/eval
+        FILES_MATCHING PATTERN "*.h")
 install(EXPORT oalservoTargets NAMESPACE oal:: DESTINATION ${OAL_INSTALL_CMAKEDIR})
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/oalservoConfig.cmake.in

@@ -33,7 +33,7 @@ void SceneOptions::ApplyTo(RenderOptions* render) const {
   render->background.reset();
   if (background.empty()) return;
   const std::string where = (background_origin.empty() ? "" : background_origin + ": ") +
-                            "scene.background '" + background + "'";
+                            "background image '" + background + "'";
   try {
     render->background = Surface(ReadGrayImage(background));
   } catch (const std::runtime_error& error) {

@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/field_names.h"
 #include "base/format.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
@@ -137,23 +138,30 @@ std::string InterruptedBy(const ServoLoopHooks& hooks) {
 }
 
 // "1 move", "3 moves".
+// The setup's image size as its user names it ("width x height").
+std::string SizeWords(const FieldNames& names) {
+  return names("width") + " x " + names("height");
+}
+
 std::string Counted(int count, const std::string& noun) {
   return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
 }
 
 // Step 1 (after the operator's stop): the time and the iteration limits. A recording that
 // ends where the iteration limit does was played to its end: end-of-input.
-std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int iteration,
-                                 std::chrono::steady_clock::time_point start, FrameSource& frames) {
+std::optional<Stop> LimitReached(const ServoLoopOptions& loop, const FieldNames& names, int limit,
+                                 int iteration, std::chrono::steady_clock::time_point start,
+                                 FrameSource& frames) {
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (elapsed_s > loop.max_time_s) {
-    return Stop{ServoRunStatus::kTimeLimit,
-                "time limit reached: servo.max_time_s = " + Number(loop.max_time_s) + " s (" +
-                    Fixed(elapsed_s, 3) + " s elapsed) without converging"};
+    return Stop{ServoRunStatus::kTimeLimit, "time limit reached: " + names("loop.max_time_s") +
+                                                " = " + Number(loop.max_time_s) + " s (" +
+                                                Fixed(elapsed_s, 3) +
+                                                " s elapsed) without converging"};
   }
   if (iteration >= limit) {
-    const std::string setting = "servo.max_iterations = " + std::to_string(limit) +
+    const std::string setting = names("loop.max_iterations") + " = " + std::to_string(limit) +
                                 (loop.max_iterations == 0 ? ", the law's own" : "");
     if (frames.AtEnd()) {
       return Stop{ServoRunStatus::kEndOfInput, "end of " + frames.Name() + " after " +
@@ -168,8 +176,9 @@ std::optional<Stop> LimitReached(const ServoLoopOptions& loop, int limit, int it
 
 // The frame of this iteration, of the camera's size; a stop when there is none.
 // `on_grab` (ServoLoopHooks) sees the frame before it is checked.
-std::optional<Stop> Grab(FrameSource& frames, int width, int height, const Capture& capture,
-                         const std::function<void(int, cv::Mat*)>& on_grab, cv::Mat* gray) {
+std::optional<Stop> Grab(FrameSource& frames, int width, int height, const FieldNames& names,
+                         const Capture& capture, const std::function<void(int, cv::Mat*)>& on_grab,
+                         cv::Mat* gray) {
   const int iteration = capture.iteration;
   bool have_frame = false;
   try {
@@ -190,9 +199,9 @@ std::optional<Stop> Grab(FrameSource& frames, int width, int height, const Captu
   }
   if (gray->cols != width || gray->rows != height) {
     return Stop{ServoRunStatus::kError, frames.Name() + " gives " + std::to_string(gray->cols) +
-                                            "x" + std::to_string(gray->rows) +
-                                            " frames but camera.width x camera.height is " +
-                                            std::to_string(width) + "x" + std::to_string(height)};
+                                            "x" + std::to_string(gray->rows) + " frames but " +
+                                            SizeWords(names) + " is " + std::to_string(width) +
+                                            "x" + std::to_string(height)};
   }
   return std::nullopt;
 }
@@ -247,11 +256,11 @@ std::optional<PoseDistance> Disagreement(const vpHomogeneousMatrix& cMo,
   return jump;
 }
 
-std::string Apart(const PoseDistance& jump, const ServoLoopOptions& loop) {
+std::string Apart(const PoseDistance& jump, const ServoLoopOptions& loop, const FieldNames& names) {
   return Fixed(jump.translation_m * 1e3, 1) + " mm and " +
          Fixed(vpMath::deg(jump.rotation_rad), 2) + " deg (limits " +
          Fixed(loop.max_pose_jump_m * 1e3, 1) + " mm, " + Fixed(loop.max_pose_jump_deg, 2) +
-         " deg: servo.max_pose_jump_m, max_pose_jump_deg)";
+         " deg: " + names("loop.max_pose_jump_m") + ", " + names("loop.max_pose_jump_deg") + ")";
 }
 
 // A motion that failed: refused before it began (`started` false: the robot did not move),
@@ -270,9 +279,9 @@ Stop RefusalStop(const RobotResult& moved, bool started, const SafeRobot& robot,
               moved.message};
 }
 
-// A position step larger than servo.max_step_m / max_step_deg: the run stops before it.
+// A position step larger than max_step_m / max_step_deg: the run stops before it.
 std::optional<Stop> StepTooLarge(const ServoStep& step, const ServoLoopOptions& loop,
-                                 int iteration) {
+                                 const FieldNames& names, int iteration) {
   const PoseDistance size = Distance(vpHomogeneousMatrix(), step.c_T_cnew);
   if (size.translation_m <= loop.max_step_m &&
       vpMath::deg(size.rotation_rad) <= loop.max_step_deg) {
@@ -281,10 +290,12 @@ std::optional<Stop> StepTooLarge(const ServoStep& step, const ServoLoopOptions& 
   return Stop{ServoRunStatus::kLimit,
               "limit at iteration " + std::to_string(iteration) + ": the move of " +
                   Fixed(size.translation_m * 1e3, 1) + " mm and " +
-                  Fixed(vpMath::deg(size.rotation_rad), 2) + " deg exceeds servo.max_step_m = " +
-                  Number(loop.max_step_m) + " m or max_step_deg = " + Number(loop.max_step_deg) +
+                  Fixed(vpMath::deg(size.rotation_rad), 2) + " deg exceeds " +
+                  names("loop.max_step_m") + " = " + Number(loop.max_step_m) + " m or " +
+                  names("loop.max_step_deg") + " = " + Number(loop.max_step_deg) +
                   " deg, the robot did not move (a wrong pose, or a goal farther than one move "
-                  "may go: raise them, or use the exponential law with a smaller servo.delta)"};
+                  "may go: raise them, or use the exponential law with a smaller " +
+                  names("loop.law.delta") + ")"};
 }
 
 // What the end of the run did to the robot, appended to the stop message.
@@ -299,15 +310,16 @@ std::string StopOutcome(const RobotResult& stopped, ServoRunStatus status, bool 
 
 // A robot that starts outside the workspace box (a real arm stands where it stands): a
 // warning, since every move is still checked against the box.
-void WarnIfOutsideWorkspace(SafeRobot& robot, std::ostream& log) {
+void WarnIfOutsideWorkspace(SafeRobot& robot, const FieldNames& names, std::ostream& log) {
   const SafetyOptions& safety = robot.options();
   const RobotPose at = robot.GetPosition(safety.workspace_frame);
   if (!at.result.ok()) return;  // the loop's first read reports it
   const std::string why = safety.OutsideWorkspace(at.pose.getTranslationVector());
   if (why.empty()) return;
   log << "warning: the robot starts outside the workspace box: the "
-      << ToString(safety.workspace_frame) << "'s " << why
-      << " (robot.workspace_min_m / workspace_max_m); every move is still checked against the "
+      << ToString(safety.workspace_frame) << "'s " << why << " (" << names("safety.workspace_min_m")
+      << " / " << names("safety.workspace_max_m")
+      << "); every move is still checked against the "
          "box and may be refused: bring the arm into the box or widen it\n";
 }
 
@@ -419,7 +431,7 @@ vpHomogeneousMatrix TeachGoal(const ServoSetup& setup, const cv::Mat& gray,
                               const std::string& where) {
   if (gray.cols != setup.width || gray.rows != setup.height) {
     throw std::runtime_error(where + " is " + std::to_string(gray.cols) + "x" +
-                             std::to_string(gray.rows) + " but camera.width x camera.height is " +
+                             std::to_string(gray.rows) + " but " + SizeWords(setup.names) + " is " +
                              std::to_string(setup.width) + "x" + std::to_string(setup.height));
   }
   TargetPoseTracker tracker = MakeTracker(setup);
@@ -541,7 +553,7 @@ class ServoRun {
       if (std::optional<Stop> stop = Interrupted(iteration)) return Finish(*stop);
       // Frames held count towards the hold's own limits, not the law's.
       if (std::optional<Stop> stop =
-              LimitReached(setup_.loop, iteration_limit,
+              LimitReached(setup_.loop, setup_.names, iteration_limit,
                            iteration - report_.held_frames - skipped_frames_, start, frames_)) {
         return Finish(*stop);
       }
@@ -554,9 +566,9 @@ class ServoRun {
   void Prepare() {
     const bool velocity_law = setup_.loop.law.mode == ServoMode::kVelocity;
     if (velocity_law && !rig_.driver->Capabilities().velocity) {
-      throw std::invalid_argument("servo.mode velocity needs a robot driven in velocity; " +
-                                  rig_.driver->Name() +
-                                  " takes position moves only: use exponential or point-and-go");
+      throw std::invalid_argument(
+          setup_.names("loop.law.mode") + " velocity needs a robot driven in velocity; " +
+          rig_.driver->Name() + " takes position moves only: use exponential or point-and-go");
     }
     const bool taught = !setup_.goal_image.empty();
     report_.cdMo =
@@ -581,7 +593,7 @@ class ServoRun {
     if (RobotResult r = robot_.Enable(); !r.ok()) {
       return Stop{ServoRunStatus::kError, "cannot enable the robot: " + r.message};
     }
-    WarnIfOutsideWorkspace(robot_, log_);
+    WarnIfOutsideWorkspace(robot_, setup_.names, log_);
     period_s_ = rig_.driver->Capabilities().sampling_time_s;
     begun_ = std::chrono::steady_clock::now();
     report_.started = true;
@@ -623,8 +635,8 @@ class ServoRun {
     vpHomogeneousMatrix wMc = capture.time_s < now_s ? history_.At(capture.time_s) : read.pose;
     capture.true_cMo = wMc.inverse() * setup_.wMo;
     capture.velocity = velocity_;
-    if (std::optional<Stop> stop =
-            Grab(frames_, setup_.width, setup_.height, capture, hooks_.on_grab, &gray_)) {
+    if (std::optional<Stop> stop = Grab(frames_, setup_.width, setup_.height, setup_.names, capture,
+                                        hooks_.on_grab, &gray_)) {
       return stop;
     }
     // A camera that says when it took the frame (V4L2 timestamps, the monotonic clock).
@@ -649,8 +661,9 @@ class ServoRun {
         const Stop stop{ServoRunStatus::kError,
                         std::to_string(skipped_in_a_row_) + " frames in a row were taken " +
                             Fixed(*move_ended_s_ - capture.time_s, 3) +
-                            " s or more before the last move ended: the camera's timestamps (or "
-                            "camera.latency_s) say its frames are older than they can be"};
+                            " s or more before the last move ended: the camera's timestamps (or " +
+                            setup_.names("latency_s") +
+                            ") say its frames are older than they can be"};
         current.status = ToString(stop.status);
         LogRow(current, columns_, log_);
         return stop;
@@ -749,9 +762,10 @@ class ServoRun {
       if (predicted_cMo && !hold_) {
         if (std::optional<PoseDistance> jump = Disagreement(cMo, *predicted_cMo, setup_.loop)) {
           previous_cMo_.reset();
-          verdict.hold = HoldReason{
-              "pose jump: the estimate is " + Apart(*jump, setup_.loop) + " from the previous one",
-              ServoRunStatus::kPoseJump};
+          verdict.hold =
+              HoldReason{"pose jump: the estimate is " + Apart(*jump, setup_.loop, setup_.names) +
+                             " from the previous one",
+                         ServoRunStatus::kPoseJump};
         }
       }
       return verdict;
@@ -763,7 +777,7 @@ class ServoRun {
         candidate_cMo_ = cMo;  // the next frame may confirm this one
         verdict.hold = HoldReason{
             "pose not confirmed: estimated on its own, this frame puts the target " +
-                Apart(*jump, setup_.loop) +
+                Apart(*jump, setup_.loop, setup_.names) +
                 " from where the last frame did, the robot still (the pose is ambiguous or "
                 "wrong)",
             ServoRunStatus::kPoseJump};
@@ -775,7 +789,7 @@ class ServoRun {
               Stop{ServoRunStatus::kPoseJump,
                    "pose jump at iteration " + std::to_string(iteration) +
                        ": found again and confirmed by two frames, the target is " +
-                       Apart(*jump, setup_.loop) +
+                       Apart(*jump, setup_.loop, setup_.names) +
                        " from where the robot's motion puts it: the target or the robot was moved "
                        "while the loop held; the robot was not moved since"};
         }
@@ -795,9 +809,10 @@ class ServoRun {
     }
     if (predicted_cMo) {
       if (std::optional<PoseDistance> jump = Disagreement(cMo, *predicted_cMo, setup_.loop)) {
-        verdict.hold = HoldReason{"pose jump: the estimate is " + Apart(*jump, setup_.loop) +
-                                      " from the previous one moved by the robot",
-                                  ServoRunStatus::kPoseJump};
+        verdict.hold =
+            HoldReason{"pose jump: the estimate is " + Apart(*jump, setup_.loop, setup_.names) +
+                           " from the previous one moved by the robot",
+                       ServoRunStatus::kPoseJump};
       }
     }
     return verdict;
@@ -835,9 +850,9 @@ class ServoRun {
                 std::string(lost ? "target lost" : "no pose confirmed") + ": held " +
                     Counted(hold_->frames, "frame") + " (" + Fixed(held_s, 2) +
                     " s) since iteration " + std::to_string(hold_->since_iteration) +
-                    " without a confirmed pose (servo.max_lost_frames = " +
-                    std::to_string(loop.max_lost_frames) + ", max_lost_s = " +
-                    Number(loop.max_lost_s) + "); the last reason: " + hold_->reason.why};
+                    " without a confirmed pose (" + setup_.names("loop.max_lost_frames") + " = " +
+                    std::to_string(loop.max_lost_frames) + ", " + setup_.names("loop.max_lost_s") +
+                    " = " + Number(loop.max_lost_s) + "); the last reason: " + hold_->reason.why};
   }
 
   // While the loop holds, a velocity law commands zero (a position move has ended already).
@@ -873,10 +888,10 @@ class ServoRun {
                   setup_.estimate_distortion ? "the lens told from the stripes"
                                              : "the camera model",
                   setup_.estimate_distortion
-                      ? "Calibrate the camera (oalservo calibrate): one radial term told from "
-                        "four stripes does not hold this lens"
-                      : "Calibrate the camera (oalservo calibrate), or set "
-                        "camera.estimate_distortion")
+                      ? setup_.names.With("Calibrate the camera", "calibrate") +
+                            ": one radial term told from four stripes does not hold this lens"
+                      : setup_.names.With("Calibrate the camera", "calibrate") + ", or set " +
+                            setup_.names("estimate_distortion"))
            << '\n';
     }
   }
@@ -885,7 +900,8 @@ class ServoRun {
   std::optional<Stop> Move(int iteration, const vpHomogeneousMatrix& wMc, const ServoStep& step) {
     const bool velocity_law = setup_.loop.law.mode == ServoMode::kVelocity;
     if (!velocity_law) {
-      if (std::optional<Stop> too_large = StepTooLarge(step, setup_.loop, iteration)) {
+      if (std::optional<Stop> too_large =
+              StepTooLarge(step, setup_.loop, setup_.names, iteration)) {
         return too_large;
       }
     }

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "base/field_names.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "loop/frame_source.h"
@@ -90,6 +91,11 @@ struct ServoSetup {
   /// A simulation's camera as it is really mounted on the end effector, when the robot's
   /// eMc is only what the loop believes (TrueCameraPose); unset: the robot's camera pose.
   std::optional<vpHomogeneousMatrix> true_eMc;
+  /// How the caller's user names the setup's fields in the loop's messages: "width",
+  /// "height", "estimate_distortion", "latency_s" (the frame source's), "loop.max_step_m",
+  /// "loop.law.delta", "safety.workspace_min_m", ... (a path from here), and "calibrate" (how
+  /// the user calibrates a camera); each unnamed one keeps its own name.
+  FieldNames names;
 };
 
 /// The target tracker the setup describes (TargetPoseTracker with its camera, detector, pose

@@ -13,7 +13,7 @@ namespace oal {
 /// Sets `render`'s fall-off, shadow, paper, annotations and clutter to the bench's (vignetting
 /// 0.3, shadow 0.3, texture 3 grey levels, the marks printed, two pages and four tools within
 /// 25 cm of the sheet, laid out from `scene_seed`); camera, noise, blur and surface are left
-/// as they are. eval/rendered_frames.cpp's BenchScene() is the same scene as a config.
+/// as they are. eval/rendered/rendered_frames.cpp's BenchScene() is the same scene as a config.
 void DressAsBench(RenderOptions* render, std::uint64_t scene_seed);
 
 /// Whether `target` is a sheet (both sides at most 1 m) rather than the paper's 2 m board.

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -49,6 +50,17 @@ class TestDir {
  private:
   fs::path path_;
 };
+
+/// The message of the `Exception` that `call` throws, or "" if it returns.
+template <typename Exception = std::exception, typename Call>
+std::string ErrorMessageOf(Call&& call) {
+  try {
+    call();
+  } catch (const Exception& error) {
+    return error.what();
+  }
+  return "";
+}
 
 inline void WriteText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

@@ -15,7 +15,7 @@
 #include "app/command_line.h"
 #include "app/detector_accuracy_command.h"
 #include "app/pose_accuracy_command.h"
-#include "eval/pose_accuracy.h"
+#include "eval/rendered/pose_accuracy.h"
 #include "io/camera_file.h"
 #include "tests/app/command_test_util.h"
 #include "tests/test_util.h"

@@ -53,17 +53,6 @@ inline std::string RenderChecked(const RenderCommandOptions& options) {
   return options.out_dir;
 }
 
-/// The message of the `Exception` that `call` throws, or "" if it returns.
-template <typename Exception = std::exception, typename Call>
-std::string ErrorMessageOf(Call&& call) {
-  try {
-    call();
-  } catch (const Exception& error) {
-    return error.what();
-  }
-  return "";
-}
-
 /// The message ParseConfig throws for `yaml` read as `file_name`; empty if it is accepted.
 inline std::string ConfigErrorOf(const std::string& yaml, const std::string& file_name) {
   return ErrorMessageOf<std::runtime_error>([&] { ParseConfig(yaml, file_name); });

@@ -1,4 +1,4 @@
-#include "eval/edge_reference.h"
+#include "eval/lines/edge_reference.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@
 
 #include "app/edge_reference_command.h"
 #include "tests/app/command_test_util.h"
-#include "tests/eval/synthetic_edge.h"
+#include "tests/eval/lines/synthetic_edge.h"
 #include "tests/test_util.h"
 
 namespace oal {

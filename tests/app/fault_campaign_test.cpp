@@ -123,9 +123,10 @@ TEST(FaultCampaign, RefusesARealArmOrCamera) {
       test::ErrorMessageOf<std::invalid_argument>([&] { RunFaultCampaign(config, options); }),
       HasSubstr("source.type must be simulated, not replay"));
   options.runs = 0;
-  EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>(
-                  [&] { RunFaultCampaign(DefaultServoConfig(), options); }),
-              HasSubstr("--faults = 0. Violated constraint: 1 <= --faults <= 1000000"));
+  EXPECT_THAT(
+      test::ErrorMessageOf<std::invalid_argument>(
+          [&] { RunFaultCampaign(DefaultServoConfig(), options); }),
+      HasSubstr("FaultCampaignOptions::runs = 0. Violated constraint: 1 <= runs <= 1000000"));
 }
 
 }  // namespace

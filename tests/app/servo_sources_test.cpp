@@ -538,15 +538,18 @@ TEST(ServoAccuracy, BadOptionsNameTheOption) {
   };
   ServoAccuracyOptions options;
   options.starts = 0;
-  EXPECT_THAT(error(options), HasSubstr("--starts = 0. Violated constraint: 1 <= --starts"));
+  EXPECT_THAT(error(options),
+              HasSubstr("ServoAccuracyOptions::starts = 0. Violated constraint: 1 <= starts"));
   options = ServoAccuracyOptions();
   options.max_distance_m = 0.2;  // below min_distance_m = 0.3
   EXPECT_THAT(error(options),
-              HasSubstr("--max-distance = 0.2. Violated constraint: --max-distance >= "
-                        "--min-distance"));
+              HasSubstr("max_distance_m = 0.2. Violated constraint: max_distance_m >= "
+                        "min_distance_m"));
   options = ServoAccuracyOptions();
   options.modes.clear();
-  EXPECT_THAT(error(options), HasSubstr("--laws: no law to run"));
+  EXPECT_THAT(
+      error(options),
+      HasSubstr("ServoAccuracyOptions::modes = none. Violated constraint: at least one law"));
 }
 
 TEST(ServoLoopTable3, PointAndGoReachesTheGoalWithinThreeMoves) {

@@ -548,8 +548,8 @@ TEST(ServoLoop, AStepAboveTheMaximumStopsBeforeTheRobotMoves) {
     const char* text;
   };
   for (const Limits& limits :
-       {Limits{0.1, 60.0, "servo.max_step_m = 0.1 m or max_step_deg = 60 deg"},
-        Limits{0.5, 10.0, "servo.max_step_m = 0.5 m or max_step_deg = 10 deg"}}) {
+       {Limits{0.1, 60.0, "servo.max_step_m = 0.1 m or servo.max_step_deg = 60 deg"},
+        Limits{0.5, 10.0, "servo.max_step_m = 0.5 m or servo.max_step_deg = 10 deg"}}) {
     ServoAppConfig config = Small(DefaultServoConfig());
     config.servo.law.mode = ServoMode::kPointAndGo;
     config.servo.max_step_m = limits.m;

@@ -13,6 +13,7 @@
 #include <functional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -377,6 +378,90 @@ TEST(RecordedFrames, ASourcesTimestampIsHandedOnWithItsFrame) {
   EXPECT_EQ(frames.TakenAt(), 12.5);
   ASSERT_TRUE(frames.Grab(Capture{}, &gray));
   EXPECT_EQ(frames.TakenAt(), 13.5);
+}
+
+// A step longer than max_step_m is refused before the robot moves: the run stops (limit) and
+// names the limit in the caller's words when it gave them, else as the setup's field.
+TEST(RunServoLoop, AStepBeyondTheLimitStopsTheRunBeforeTheRobotMoves) {
+  for (const bool named : {false, true}) {
+    ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
+    setup.loop.max_step_m = 0.01;
+    if (named) setup.names = {{"loop.max_step_m", "servo.max_step_m"}};
+    const SimulatedCameraOptions start = StartingAt(kStartcMo, setup.wMo);
+    SimulatedCamera robot(start);
+    RenderedFrames frames(setup.target, RenderOptions());
+    std::ostringstream log;
+    const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+    EXPECT_EQ(report.status, ServoRunStatus::kLimit) << report.message;
+    EXPECT_THAT(report.message, HasSubstr(std::string(named ? "exceeds servo.max_step_m = 0.01"
+                                                            : "exceeds loop.max_step_m = 0.01")));
+    EXPECT_THAT(report.message, HasSubstr("the robot did not move"));
+    EXPECT_EQ(report.moves, 0);
+    EXPECT_TRUE(report.robot_stopped);
+    const vpHomogeneousMatrix end = robot.GetPosition(RobotFrame::kCamera).pose;
+    EXPECT_LT((end.getTranslationVector() - start.wMc.getTranslationVector()).frobeniusNorm(),
+              1e-12);
+  }
+}
+
+// The iteration limit ends a run that has not converged, and says which limit it was.
+TEST(RunServoLoop, TheIterationLimitEndsTheRunAndSaysSo) {
+  ServoSetup setup = SheetSetup(ServoMode::kExponential);
+  setup.loop.max_iterations = 2;
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  RenderedFrames frames(setup.target, RenderOptions());
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log);
+  EXPECT_EQ(report.status, ServoRunStatus::kIterationLimit) << report.message;
+  EXPECT_THAT(report.message, HasSubstr("loop.max_iterations = 2"));
+  EXPECT_TRUE(report.robot_stopped);
+}
+
+// A frame rolled by 15 degrees, the robot still: the pose disagrees with the motion, so the
+// loop holds rather than act on it, then finds the target where it was and carries on.
+TEST(RunServoLoop, APoseJumpIsHeldPastNotActedOn) {
+  ServoSetup setup = SheetSetup(ServoMode::kVelocity);
+  setup.loop.law.gain = 2.0;
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  RenderedFrames frames(setup.target, RenderOptions());
+  constexpr int kRolled = 4;
+  ServoLoopHooks hooks;
+  hooks.on_grab = [](int iteration, cv::Mat* gray) {
+    if (iteration != kRolled) return;
+    const cv::Point2f centre(0.5f * (gray->cols - 1), 0.5f * (gray->rows - 1));
+    cv::Mat rolled;
+    cv::warpAffine(*gray, rolled, cv::getRotationMatrix2D(centre, 15.0, 1.0), gray->size(),
+                   cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    *gray = rolled;
+  };
+  std::vector<int> moved_at;
+  hooks.on_move = [&](int iteration) { moved_at.push_back(iteration); };
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log, hooks);
+  ASSERT_EQ(report.status, ServoRunStatus::kConverged) << report.message;
+  const ServoIteration& rolled = report.iterations.at(kRolled);
+  EXPECT_EQ(rolled.status, "held");
+  EXPECT_THAT(rolled.held, HasSubstr("pose jump"));
+  EXPECT_EQ(std::count(moved_at.begin(), moved_at.end(), kRolled), 0);
+  EXPECT_GE(report.holds, 1);
+  EXPECT_LT(report.iterations.back().true_translation_error_mm, 2.0);
+}
+
+// Frames of another size than the camera's stop the run before anything moves, and the
+// message names the setup's size in the caller's words.
+TEST(RunServoLoop, AFrameOfAnotherSizeStopsTheRun) {
+  ServoSetup setup = SheetSetup(ServoMode::kPointAndGo);
+  setup.names = {{"width", "camera.width"}, {"height", "camera.height"}};
+  SimulatedCamera robot(StartingAt(kStartcMo, setup.wMo));
+  RenderedFrames frames(setup.target, RenderOptions());
+  ServoLoopHooks hooks;
+  hooks.on_grab = [](int, cv::Mat* gray) { cv::resize(cv::Mat(*gray), *gray, cv::Size(320, 240)); };
+  std::ostringstream log;
+  const ServoRunReport report = RunServoLoop(setup, frames, robot, log, hooks);
+  EXPECT_EQ(report.status, ServoRunStatus::kError) << report.message;
+  EXPECT_THAT(report.message,
+              HasSubstr("320x240 frames but camera.width x camera.height is 640x480"));
+  EXPECT_EQ(report.moves, 0);
 }
 
 // A hand over the view for three frames in the middle of a velocity run: the loop holds (a

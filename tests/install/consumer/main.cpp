@@ -11,7 +11,7 @@
 
 #include "detector/detector.h"
 #include "detector/lens.h"
-#include "eval/line_scoring.h"
+#include "eval/lines/line_scoring.h"
 #include "loop/frame_source.h"
 #include "loop/servo_loop.h"
 #include "robots/simulated_camera.h"
