@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian (bookworm) packages oalservo needs, only those that are missing,
-# without prompts. Uses sudo when not run as root.
+# without prompts. Uses sudo when not run as root. With package names as arguments, those
+# instead (scripts/slurm-check.sh: slurm-wlm munge).
 set -euo pipefail
 
 packages=(
@@ -14,6 +15,7 @@ packages=(
   libcairo2-dev fonts-dejavu-core librsvg2-bin imagemagick gsfonts poppler-utils xvfb
   pybind11-dev python3-pybind11 python3-numpy python3-pytest
 )
+if [ $# -gt 0 ]; then packages=("$@"); fi
 
 missing=()
 for package in "${packages[@]}"; do
