@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -212,24 +213,24 @@ TEST(Display, AKeyInTheWindowStopsKeepingWhatWasWritten) {
   ASSERT_TRUE(display.Ready());
   const std::string out = dir / "poses.jsonl";
   // 100 frames at 5 a second: 20 s unless the key stops it.
-  const auto start = std::chrono::steady_clock::now();
+  std::atomic<bool> ended{false};
   std::thread run([&] {
     EXPECT_EQ(
         ExitCodeOf("DISPLAY=" + display.name() + " " + Oalservo() + " pose '" + dir / "frames" +
                    "' --display --display-fps 5 --out '" + out + "' 2>'" + dir / "err.txt" + "'"),
         0)
         << test::ReadText(dir / "err.txt");
+    ended = true;
   });
+  // The key is pressed again until the command ends: a window that is up may not listen to
+  // keys yet (a loaded machine), and a user would press again too.
   bool pressed = false;
-  for (int attempt = 0; attempt < 40 && !pressed; ++attempt) {
+  while (!ended) {
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
-    pressed = PressKeyIn(display.name(), "oalservo pose");
+    pressed = PressKeyIn(display.name(), "oalservo pose") || pressed;
   }
   run.join();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(pressed) << "no window titled 'oalservo pose' on " << display.name();
-  EXPECT_LT(seconds, 15.0);
   const std::size_t written = test::ReadLines(out).size();
   EXPECT_GT(written, 0u);
   EXPECT_LT(written, 100u);
