@@ -89,7 +89,19 @@ int RunEvaluate(int argc, char** argv) {
   options.names = {{"target_lines", "--lines"},
                    {"video_codec", "--video-codec"},
                    {"camera_path", "--camera"},
+                   {"truth_path", "--truth"},
                    {"calibrate", "oalservo calibrate"}};
+  // Before the evaluation, whose own messages name options through options.names: translating
+  // every message it throws would also turn plain words ("2 inputs", "jobs") into flags.
+  CheckInOptionWords([&] { options.Check(); }, {{"EvaluateOptions::inputs", "INPUT"},
+                                                {"EvaluateOptions::out_dir", "--out"},
+                                                {"EvaluateOptions::jobs", "--jobs"},
+                                                {"EvaluateOptions::shard", "--shard"},
+                                                {"EvaluateOptions::max_frames", "--max-frames"},
+                                                {"EvaluateOptions::video_scale", "--video-scale"},
+                                                {"EvaluateOptions::video_codec", "--video-codec"},
+                                                {"EvaluateOptions::thumbnails", "--thumbnails"},
+                                                {"EvaluateOptions::target_lines", "--lines"}});
   options.write_video = !no_video;
   options.setup = TrackerSetupOf(config_path, options.inputs);
   std::unique_ptr<LiveView> view;
@@ -104,21 +116,8 @@ int RunEvaluate(int argc, char** argv) {
   const FrameViewer viewer = [&view](const cv::Mat& annotated, const std::string& caption) {
     return view->Show(annotated, caption, false);
   };
-  EvaluateResult result;
-  CheckInOptionWords(
-      [&] {
-        result = Evaluate(options, FrameProgress("evaluate: frame"), view ? viewer : FrameViewer());
-      },
-      {{"EvaluateOptions::inputs", "INPUT"},
-       {"EvaluateOptions::out_dir", "--out"},
-       {"EvaluateOptions::jobs", "--jobs"},
-       {"EvaluateOptions::shard", "--shard"},
-       {"EvaluateOptions::max_frames", "--max-frames"},
-       {"EvaluateOptions::video_scale", "--video-scale"},
-       {"EvaluateOptions::video_codec", "--video-codec"},
-       {"EvaluateOptions::thumbnails", "--thumbnails"},
-       {"EvaluateOptions::target_lines", "--lines"},
-       {"EvaluateOptions::truth_path", "--truth"}});
+  const EvaluateResult result =
+      Evaluate(options, FrameProgress("evaluate: frame"), view ? viewer : FrameViewer());
   int failed = 0, resumed = 0;
   for (const InputOutcome& input : result.inputs) {
     if (input.status == "failed") {

@@ -796,9 +796,9 @@ EvaluateResult Evaluate(const EvaluateOptions& options,
                                 std::to_string(options.jobs) + " jobs");
   }
   if (!options.truth_path.empty() && plan.inputs.size() != 1) {
-    throw std::invalid_argument("truth_path applies to one input, but there are " +
-                                std::to_string(plan.inputs.size()) +
-                                " (give each video a <video>.truth.csv instead)");
+    throw std::invalid_argument(
+        options.names("truth_path") + " applies to one input, but there are " +
+        std::to_string(plan.inputs.size()) + " (give each video a <video>.truth.csv instead)");
   }
   const fs::path out(options.out_dir);
   fs::create_directories(out);

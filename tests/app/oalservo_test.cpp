@@ -146,6 +146,8 @@ TEST(Oalservo, ANumberOutOfRangeGetsOneStyleOfError) {
       {"detect-accuracy --frames 1 --max-tilt-deg 100",
        "--max-tilt-deg = 100. Violated constraint: 0 <= --max-tilt-deg <= 80"},
       {"detect x.png --max-frames -1", "--max-frames = -1. Violated constraint: --max-frames >= 0"},
+      {"evaluate x.avi --out '" + dir / "e" + "' --jobs 0",
+       "--jobs = 0. Violated constraint: 1 <= --jobs <= 64"},
       {"scorbot-sim --speed 0", "--speed = 0. Violated constraint: 1 <= --speed <= 100"},
       {"scorbot-sim --time-scale 0", "--time-scale = 0. Violated constraint: 0.01 <="},
       {"compare '" + dir.path().string() + "' --me-range 0",
@@ -161,6 +163,16 @@ TEST(Oalservo, ANumberOutOfRangeGetsOneStyleOfError) {
     EXPECT_THAT(run.err, Not(HasSubstr("Options::"))) << command;
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "r"));
+}
+
+// evaluate's own message names its option, and leaves plain words plain.
+TEST(Oalservo, ATruthForTwoInputsNamesTheOption) {
+  test::TestDir dir;
+  const test::OalservoRun run =
+      test::RunOalservo(dir, "evaluate a.avi b.avi --truth t.csv --out '" + dir / "e" + "'");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_THAT(run.err, HasSubstr("error: --truth applies to one input, but there are 2"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "e"));
 }
 
 TEST(Oalservo, CameraNameWithoutCameraIsAUsageError) {
