@@ -181,6 +181,41 @@ Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contr
   return Verdict::kContradicts;
 }
 
+// Paper where the ink should be, next to a sample that agrees (through samples that tell
+// nothing): something as light as the paper lying over the stripe (a pale hand, a sheet, a
+// glove), not a wrong pose. A pose whose stripe agrees to a pixel at one sample is off by at
+// most a few pixels at the next, its ink still inside the profile (a displaced dark run, which
+// contradicts); the ink wholly out of the profile there would take a turn of the stripe by tens
+// of degrees between two samples. Other flat light samples (between contradicting ones, or a
+// whole stripe of them) contradict.
+void ExcuseLightCover(const std::vector<std::pair<int, Profile>>& profiles,
+                      std::vector<Verdict>* verdicts) {
+  std::vector<Verdict>& v = *verdicts;
+  const auto same_line = [&](std::size_t a, std::size_t b) {
+    return profiles[a].first == profiles[b].first;
+  };
+  for (std::size_t first = 0; first < v.size();) {
+    if (v[first] != Verdict::kFlatLight && v[first] != Verdict::kUnknown) {
+      ++first;
+      continue;
+    }
+    std::size_t end = first;
+    while (end < v.size() && same_line(first, end) &&
+           (v[end] == Verdict::kFlatLight || v[end] == Verdict::kUnknown)) {
+      ++end;
+    }
+    const bool agrees_before =
+        first > 0 && same_line(first - 1, first) && v[first - 1] == Verdict::kAgrees;
+    const bool agrees_after = end < v.size() && same_line(end, first) && v[end] == Verdict::kAgrees;
+    for (std::size_t i = first; i < end; ++i) {
+      if (v[i] == Verdict::kFlatLight) {
+        v[i] = agrees_before || agrees_after ? Verdict::kUnknown : Verdict::kContradicts;
+      }
+    }
+    first = end;
+  }
+}
+
 }  // namespace
 
 void StripeCheckOptions::Check() const {
@@ -302,8 +337,9 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
     if (verdicts[i] != Verdict::kFlatLight) continue;
     const bool as_paper =
         !paper.empty() && !under_glare(i) && lights[i] >= paper_level - min_contrast / 2;
-    verdicts[i] = as_paper ? Verdict::kContradicts : Verdict::kUnknown;
+    if (!as_paper) verdicts[i] = Verdict::kUnknown;
   }
+  ExcuseLightCover(profiles, &verdicts);
   // A short run of contradicting samples that ends at a covered one, or at an end of the
   // stripe's samples, lies at the rim of something covering the stripe (a finger's edge across
   // the profile leaves a partial dark run; a pale hand over the stripe's end passes for paper):

@@ -12,9 +12,12 @@
 //   - contradicts: the stripe is visible but not there (a dark run with paper on both sides,
 //     off by more than the tolerance, or as wide as no stripe and neither edge in place), or
 //     there is only paper where the ink should be (the profile light and flat, as light as the
-//     paper of the samples that agree);
+//     paper of the samples that agree) and no sample next to it along the stripe agrees;
 //   - tells nothing: something covers the place (a hand, a tool, a cable, a dark shadow: no
-//     paper on one side; a flat profile darker than the paper; a dark run narrower than the
+//     paper on one side; a flat profile darker than the paper; paper where the ink should be
+//     next to a sample that agrees, through samples that tell nothing: something as light as
+//     the paper over the stripe, as a pose that agrees to a pixel at one sample is a few
+//     pixels off at the next, its ink still in the profile; a dark run narrower than the
 //     stripe, inside it, one of its edges where the stripe's is: a pen or a cable lighter than
 //     ink across the rest of it), a glare washes it out (the
 //     profile saturates where the sheet's paper does not, or is lit well above that paper), or

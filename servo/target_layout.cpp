@@ -282,6 +282,34 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
   polygons.resize(used);
 }
 
+void AddMiddleBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
+                      const Lens& camera, int per_pair, ScanBorders* out) {
+  const PlaneProjector projector(plane_to_image, camera);
+  const auto& s = layout.stripes;
+  const Interval cell_a = BetweenPair(s[0], s[2]), cell_b = BetweenPair(s[1], s[3]);
+  for (int pair = 0; pair < 2; ++pair) {
+    // Across lines 1 and 3 (pair 0): the outer rectangle's extent along a, a band of b inside
+    // the middle cell; across lines 2 and 4 the same turned.
+    const Interval& across = pair == 0 ? cell_b : cell_a;
+    const double middle = 0.5 * (across.lo + across.hi), half = 0.5 * (across.hi - across.lo);
+    for (int k = 0; k < per_pair; ++k) {
+      // From near the crossing stripes' edges to near the cell's middle line.
+      const double f = 0.85 - 0.6 * (per_pair > 1 ? static_cast<double>(k) / (per_pair - 1) : 0.0);
+      const Interval band{middle - f * half, middle + f * half};
+      const Interval a = pair == 0 ? layout.outer_a : band;
+      const Interval b = pair == 0 ? band : layout.outer_b;
+      const Point2d corners[4] = {layout.ToPlane(a.lo, b.lo), layout.ToPlane(a.hi, b.lo),
+                                  layout.ToPlane(a.hi, b.hi), layout.ToPlane(a.lo, b.hi)};
+      std::vector<Point2d> polygon(4);
+      bool ok = true;
+      for (int c = 0; c < 4 && ok; ++c) {
+        ok = projector.Project(corners[c], &polygon[static_cast<std::size_t>(c)]);
+      }
+      if (ok && IsConvexQuadrilateral(polygon)) out->polygons.push_back(std::move(polygon));
+    }
+  }
+}
+
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
                                                  const Lens& camera) {
   std::array<Point2d, 4> image;
@@ -358,6 +386,13 @@ std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCel
   if (cell.ClosedSideCount() != 3) return std::nullopt;
   int open = 0;
   while ((cell.closed_sides >> open) & 1) ++open;
+  return PlaneToImageFromEdgeCell(edge, cell, camera, open);
+}
+
+std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
+                                                     const LightQuad& cell, const Lens& camera,
+                                                     int outer) {
+  const int open = outer;
   std::array<Point2d, 4> image, plane;
   Point2d centre{0.0, 0.0};
   for (int k = 0; k < 4; ++k) {

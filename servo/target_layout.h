@@ -116,6 +116,15 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
 /// on the quadrilateral's (a turn by 180 degrees maps the middle cell nearly onto itself and
 /// changes no border), the one whose homography is nearer a rotation's first two columns.
 /// Nothing when the corners cannot be undistorted or the homography is degenerate.
+/// Appends `per_pair` borders across each pair of parallel stripes between the crossings,
+/// where the concentric borders never look: rectangles as long as the outer border across the
+/// pair, as wide as bands of the middle cell along it (from near its sides to near its middle
+/// line), each crossed twice by each of the two stripes. A stripe whose arms beyond the
+/// crossings are hidden (a hand over one, the image's edge cutting the other) still gives
+/// points along its middle. Rectangles mapped and left out as TargetBorders' are.
+void AddMiddleBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
+                      const Lens& camera, int per_pair, ScanBorders* out);
+
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
                                                  const Lens& camera);
 
@@ -125,6 +134,13 @@ std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, con
 /// the corners cannot be undistorted or the homography is degenerate.
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
                                                      const LightQuad& cell, const Lens& camera);
+/// The same with the cell's side `outer` (0-3, from corner outer to outer + 1) on the board's
+/// edge, whatever was found beyond it: a cell closed in on four sides may be one beyond a
+/// stripe whose fourth side is the sheet's edge with something dark and then light beyond (a
+/// tool, the bench's edge, a lit surface).
+std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
+                                                     const LightQuad& cell, const Lens& camera,
+                                                     int outer);
 
 /// The middle cell `cell` would be if its side `cut` (from corner cut to cut + 1) were the edge
 /// of something lying across the cell (a hand, a tool, a cable) rather than a stripe's: the

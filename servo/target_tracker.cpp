@@ -32,6 +32,9 @@ constexpr double kMaxFittedWidthLog = 0.22;
 constexpr double kMinFittedExtent = 0.12;
 // ... and its fits take points in corridors these many times the fit's, in turn.
 constexpr std::array<double, 3> kExpectedCorridorScales = {6.0, 2.5, 1.0};
+// Borders across each pair of stripes between the crossings, when a candidate's concentric
+// borders gave no pose.
+constexpr int kMiddleBordersPerPair = 4;
 
 double Microseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
@@ -406,10 +409,11 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
       frame_.pose.message = message.str();
     } else if (frame_.fit.ok) {
       ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
-    } else if (frame_.fit.starved_line >= 0 && source != ScanSource::kImage) {
-      // The lines' pose puts a stripe where too few runs as wide as it lie (a line drawn
-      // through runs merged with fingers or a pen beside the stripe): not taken. (A whole
-      // image's pose is scanned again on the target's plane, where this applies.)
+    } else if (source != ScanSource::kImage) {
+      // The lines' pose puts a stripe where too few runs as wide as it lie, or where its runs
+      // cannot hold the pose (a line drawn through runs merged with fingers or a pen beside
+      // the stripe): not taken. (A whole image's pose is scanned again on the target's plane,
+      // where this applies.)
       frame_.pose.status = PoseStatus::kDegenerate;
       frame_.pose.message =
           "the stripes' points do not hold the lines' pose: " + frame_.fit.message;
@@ -648,7 +652,14 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
     if (scan == 0 && source == ScanSource::kMiddleCell) ++frame_.candidates;
     // Each candidate on its own: a prior that failed above says nothing about it.
     const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source, expected);
-    if (count >= options_.borders) return accepted;
+    if (count >= options_.borders) {
+      if (accepted) return true;
+      // A stripe seen only between the crossings (its arms under a hand or out of view)
+      // gives the concentric borders no points: scanned again with borders across the
+      // stripes' middles.
+      AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
+      return Attempt(image, borders_, seeds, std::nullopt, source, expected);
+    }
     if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
       return true;
     }
@@ -676,13 +687,31 @@ bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
       const std::optional<vpHomography> beyond = PlaneToImageFromEdgeCell(edge, cell, camera_);
       if (beyond && AttemptCandidate(image, *beyond, ScanSource::kEdgeCell)) return true;
     }
-    // Closed in on four sides, yet not the target's middle cell as it is: one side may be the
-    // edge of a hand, a tool or a cable lying across the cell (the first such cell only).
-    if (cell.ClosedSideCount() == 4 && !uncut_tried) {
+    // Closed in on four sides, yet not the middle cell: a cell beyond a stripe, the sheet's
+    // edge among its sides (something dark and light again beyond it).
+    if (cell.ClosedSideCount() == 4 && AttemptEdgeCellGuesses(image, cell)) return true;
+    // Not the target's middle cell as it is: one side may be the edge of a hand, a tool or a
+    // cable lying across the cell (the first such cell only).
+    if (!uncut_tried) {
       uncut_tried = true;
       if (AttemptUncut(image, cell)) return true;
     }
   }
+  return false;
+}
+
+bool TargetPoseTracker::AttemptEdgeCellGuesses(const GrayImageView& image, const LightQuad& cell) {
+  // Guesses: when none gives a pose, the frame says what the cell as the middle one gave.
+  const TargetFrame as_found = frame_;
+  const std::vector<DetectedLine> lines_as_found = lines_;
+  for (int outer = 0; outer < 4; ++outer) {
+    for (const TargetLayout::EdgeCell& edge : layout_.edge_cells) {
+      const std::optional<vpHomography> beyond =
+          PlaneToImageFromEdgeCell(edge, cell, camera_, outer);
+      if (beyond && AttemptCandidate(image, *beyond, ScanSource::kEdgeCell)) return true;
+    }
+  }
+  RestoreFrame(as_found, lines_as_found);
   return false;
 }
 

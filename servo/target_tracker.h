@@ -258,8 +258,12 @@ class TargetPoseTracker {
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,
   /// at most max_candidates of them, best first; true when a pose is accepted.
   bool AttemptCells(const GrayImageView& image, const std::vector<LightQuad>& cells);
-  /// A candidate closed in on four sides that gave no pose, taken as the middle cell cut by
-  /// something lying across it (UncutCells, each side in turn); when none gives a pose, the
+  /// A candidate closed in on four sides that gave no pose, taken as a cell beyond a stripe
+  /// with each of its sides in turn on the sheet's edge; when none gives a pose, the frame is
+  /// left as the candidate itself left it, with the time spent added.
+  bool AttemptEdgeCellGuesses(const GrayImageView& image, const LightQuad& cell);
+  /// A candidate closed in on three sides or more that gave no pose, taken as the middle cell cut
+  /// by something lying across it (UncutCells, each side in turn); when none gives a pose, the
   /// frame is left as the candidate itself left it (its message, lines and region), with the
   /// time spent added.
   bool AttemptUncut(const GrayImageView& image, const LightQuad& cell);

@@ -279,6 +279,39 @@ TEST(StripeCheck, AHandOrAGlareHidesWithoutContradicting) {
   EXPECT_EQ(agreement.Worst(), 1.0);
 }
 
+// Something as light as the paper (a pale hand, a sheet, a glove) over the middle of line 1
+// between the crossings: its profiles there are paper where the ink should be, next to samples
+// that agree to a pixel. A wrong pose could not put them there (its stripe would be a few
+// pixels off its ink at the next sample, not wholly beside it): they tell nothing.
+TEST(StripeCheck, SomethingAsLightAsThePaperOverAStripeHidesWithoutContradicting) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  FrameEffects effects;
+  PlaneOccluder pale;
+  pale.capsules.push_back({-0.09, -0.035, -0.09, 0.035, 0.025});
+  pale.grey = FourLineA3Target().board_grey;
+  effects.plane_occluders.push_back(pale);
+  const RenderedFrame rendered = renderer.Render(Tilted(), 11, effects);
+  const StripeAgreement agreement =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera);
+  EXPECT_LE(agreement.dark[0] + 3, agreement.samples[0]);  // it hides line 1's middle
+  EXPECT_EQ(agreement.contradict[0], 0);
+  EXPECT_EQ(agreement.Worst(), 1.0);
+}
+
+// A pose 70 mm off across lines 1 and 3 puts both on bare paper along their whole length:
+// paper where the ink should be, with no sample of theirs agreeing, contradicts.
+TEST(StripeCheck, StripesWhollyOnBarePaperContradictThePose) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 12);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const vpHomogeneousMatrix off = rendered.cMo * vpHomogeneousMatrix(0.07, 0.0, 0.0, 0.0, 0.0, 0.0);
+  const StripeAgreement agreement = CheckStripes(ViewOf(rendered.image), layout, off, kCamera);
+  EXPECT_GE(agreement.contradict[0], agreement.samples[0] / 2);
+  EXPECT_GE(agreement.contradict[2], agreement.samples[2] / 2);
+  EXPECT_LT(agreement.Worst(), 0.75);
+}
+
 // A grey pen lying along line 1 over part of its width leaves a narrower dark run there, one
 // edge the stripe's: it hides that part of the stripe and contradicts nothing (samples between
 // agreeing ones are not excused as an occluder's rim).

@@ -152,5 +152,41 @@ TEST(TargetLayout, AMiddleCellCutByAToolIsLengthenedBackToItsShape) {
   }
 }
 
+// Whether the segment a-b crosses the segment c-d.
+bool Crosses(const Point2d& a, const Point2d& b, const Point2d& c, const Point2d& d) {
+  const auto side = [](const Point2d& p, const Point2d& q, const Point2d& r) {
+    return (q.u - p.u) * (r.v - p.v) - (q.v - p.v) * (r.u - p.u);
+  };
+  return side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0;
+}
+
+// The borders across the stripes' middles, seen straight on (1000 px a metre): four across
+// lines 1 and 3, four across lines 2 and 4, each crossed twice by each stripe of its pair
+// between the crossings and never by the other pair.
+TEST(TargetLayout, MiddleBordersCrossOnePairOfStripesBetweenTheCrossings) {
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const Lens camera = Lens::Pinhole(1000.0, 1000.0, 0.0, 0.0);
+  const vpHomography plane_to_image = PlaneToImage(vpHomogeneousMatrix(0, 0, 1, 0, 0, 0));
+  ScanBorders borders;
+  AddMiddleBorders(layout, plane_to_image, camera, 4, &borders);
+  ASSERT_EQ(borders.polygons.size(), 8u);
+  for (std::size_t i = 0; i < borders.polygons.size(); ++i) {
+    const std::vector<Point2d>& polygon = borders.polygons[i];
+    ASSERT_EQ(polygon.size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+      const StripeSpan& stripe = layout.stripes[static_cast<std::size_t>(k)];
+      const Point2d from = layout.OnStripe(k, stripe.along.lo, 0.0);
+      const Point2d to = layout.OnStripe(k, stripe.along.hi, 0.0);
+      const Point2d a{1000.0 * from.u, 1000.0 * from.v}, b{1000.0 * to.u, 1000.0 * to.v};
+      int crossings = 0;
+      for (std::size_t c = 0; c < 4; ++c) {
+        crossings += Crosses(a, b, polygon[c], polygon[(c + 1) % 4]);
+      }
+      const bool of_pair = (k % 2 == 0) == (i < 4);
+      EXPECT_EQ(crossings, of_pair ? 2 : 0) << "border " << i << ", line " << k + 1;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace oal

@@ -308,6 +308,33 @@ TEST(TargetPoseTracker, AStripeHiddenOnOneSideIsFittedFromTheOther) {
   EXPECT_LT(found.fit.extent[3], 0.76);
 }
 
+// Line 4 hidden on both sides beyond the crossings (an arm over one side, a tool over the
+// other): the concentric borders meet it only there and give it no points. The borders across
+// the stripes' middles do: right, line 4 fitted on its stretch between the crossings.
+TEST(TargetPoseTracker, AStripeSeenOnlyBetweenTheCrossingsIsFittedThere) {
+  const LineTarget target = FourLineA3Target();
+  const SceneRenderer renderer(target, BenchRender(5));
+  FrameEffects effects;
+  PlaneOccluder arm, tool;  // over line 4 (y = +0.062) beyond x = +-0.1
+  arm.capsules.push_back({0.127, 0.062, 0.30, 0.062, 0.025});
+  arm.grey = 120;
+  arm.texture_grey = 10.0;
+  tool.capsules.push_back({-0.127, 0.062, -0.30, 0.062, 0.025});
+  tool.grey = 90;
+  effects.plane_occluders = {arm, tool};
+  for (const double roll : {0.3, 1.9}) {
+    const vpHomogeneousMatrix cMo(0.01, -0.02, 0.55, 0.2, -0.15, roll);
+    const RenderedFrame frame = renderer.Render(cMo, 4, effects);
+    ASSERT_GT(frame.truth[3].occluded_fraction, 0.4);
+    TargetPoseTracker tracker = TrackerFor(renderer);
+    const TargetFrame& found = tracker.Track(ViewOf(frame.image));
+    ExpectRightPose(found, cMo, "line 4 seen between the crossings, roll " + std::to_string(roll));
+    EXPECT_EQ(found.pose.method, PoseMethod::kStripes);
+    EXPECT_GT(found.fit.points[3], 0);
+    EXPECT_LT(found.fit.extent[3], 0.5);  // x from -0.1 to 0.1 of the stripe's 0.4 m
+  }
+}
+
 // A lamp's glare across a stripe between two crossings joins the middle cell to the paper
 // beyond it: no cell is closed in on four sides, and the cells closed in on three are taken
 // for the cells beyond a stripe, out to the sheet's edge.
@@ -364,6 +391,27 @@ TEST(TargetPoseTracker, AToolAcrossTheMiddleCellIsSeenPast) {
     ExpectRightPose(found, cMo, "a tool across the middle cell, roll " + std::to_string(roll));
     // Read as the middle cell it is (not as a cell beyond a stripe, which it is not).
     EXPECT_EQ(found.source, ScanSource::kMiddleCell);
+  }
+}
+
+// A forearm lying across the sheet over half the middle cell and beyond both sides of it:
+// the light cell left is closed in on three sides by stripes and on the fourth by the arm,
+// which nothing light follows within reach. The sheet is found past it (the cell lengthened
+// back to the middle cell's shape, or a cell beyond a stripe), at either roll.
+TEST(TargetPoseTracker, AnArmAcrossHalfTheMiddleCellIsSeenPast) {
+  const LineTarget target = FourLineA3Target();
+  const SceneRenderer renderer(target, BenchRender(12));
+  FrameEffects effects;
+  PlaneOccluder arm;
+  arm.capsules.push_back({-0.35, 0.01, 0.35, 0.01, 0.03});
+  arm.grey = 120;
+  arm.texture_grey = 8.0;
+  effects.plane_occluders.push_back(arm);
+  for (const double roll : {0.4, 2.2}) {
+    const vpHomogeneousMatrix cMo(0.0, 0.0, 0.5, 0.1, -0.12, roll);
+    TargetPoseTracker tracker = TrackerFor(renderer);
+    const TargetFrame& found = tracker.Track(ViewOf(renderer.Render(cMo, 13, effects).image));
+    ExpectRightPose(found, cMo, "an arm across the middle cell, roll " + std::to_string(roll));
   }
 }
 
