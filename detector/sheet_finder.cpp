@@ -23,6 +23,9 @@ constexpr double kEdgeTolerancePx = 1.5;
 // within this many cells (a stripe under a glare stays darker than the paper beside it).
 constexpr int kLocalRadiusCells = 3;
 constexpr double kLocalLightRatio = 0.8;
+// ... and FindFaintlyDark's: a pale hand or sleeve is a tenth darker than the paper beside it
+// (paper's texture, noise and fall-off over a few cells change a cell's mean by a few per cent).
+constexpr double kFaintLightRatio = 0.9;
 constexpr int kSaturatedGrey = 250;
 constexpr int kLocalSaturationMargin = 15;
 
@@ -434,9 +437,9 @@ bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
   return quad->refined;
 }
 
-void SheetFinder::MarkLocallyDark() {
+void SheetFinder::MarkLocallyDark(double light_ratio) {
   // A separable maximum over (2 kLocalRadiusCells + 1)^2 cells, then the cells darker than
-  // kLocalLightRatio of it set to 0.
+  // light_ratio of it set to 0.
   const int w = grid_width_, h = grid_height_, r = kLocalRadiusCells;
   // Where the paper itself is not saturated, a saturated cell is a glare's core, over ink and
   // paper alike: it tells nothing, and taken as light it would join the cells around it.
@@ -458,8 +461,8 @@ void SheetFinder::MarkLocallyDark() {
         brightest = std::max(brightest, row_max_[static_cast<std::size_t>(k) * w + x]);
       }
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      const bool light = cells_[i] >= kLocalLightRatio * brightest &&
-                         !(glare_saturates && cells_[i] >= kSaturatedGrey);
+      const bool light =
+          cells_[i] >= light_ratio * brightest && !(glare_saturates && cells_[i] >= kSaturatedGrey);
       local_[i] = light ? cells_[i] : 0;
     }
   }
@@ -621,7 +624,7 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
     closed = std::any_of(candidates_.begin(), candidates_.end(),
                          [](const LightQuad& quad) { return quad.ClosedSideCount() == 4; });
   }
-  if (!closed) AddLocallyLight(image);
+  if (!closed) AddLocallyLight(image, kLocalLightRatio);
   KeepBest();
   return candidates_;
 }
@@ -630,16 +633,26 @@ const std::vector<LightQuad>& SheetFinder::FindLocallyLight(const GrayImageView&
   candidates_.clear();
   if (!local_done_ && image.width / options_.cell_px == grid_width_ &&
       image.height / options_.cell_px == grid_height_) {
-    AddLocallyLight(image);
+    AddLocallyLight(image, kLocalLightRatio);
     KeepBest();
   }
   return candidates_;
 }
 
-void SheetFinder::AddLocallyLight(const GrayImageView& image) {
+const std::vector<LightQuad>& SheetFinder::FindFaintlyDark(const GrayImageView& image) {
+  candidates_.clear();
+  if (image.width / options_.cell_px == grid_width_ &&
+      image.height / options_.cell_px == grid_height_) {
+    AddLocallyLight(image, kFaintLightRatio);
+    KeepBest();
+  }
+  return candidates_;
+}
+
+void SheetFinder::AddLocallyLight(const GrayImageView& image, double light_ratio) {
   local_done_ = true;
   if (first_threshold_ < 0) return;
-  MarkLocallyDark();
+  MarkLocallyDark(light_ratio);
   AddComponents(image, local_.data(), first_threshold_);
 }
 

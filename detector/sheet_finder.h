@@ -100,6 +100,12 @@ class SheetFinder {
   /// paper), quadrilaterals Find returned left out. Empty when Find made this pass itself (it
   /// does when it finds no quadrilateral closed in on four sides). Same validity as Find's.
   const std::vector<LightQuad>& FindLocallyLight(const GrayImageView& image);
+  /// More candidates of the image last given to Find, for when neither Find's nor
+  /// FindLocallyLight's were the target: the same last pass with the cells darker than 0.9
+  /// times the brightest within three cells taken as dark (a pale hand, a sleeve or a sheet
+  /// of paper a little darker than the target's paper, lying across the middle cell and its
+  /// neighbours, which it joins at the coarser ratio). Same validity as Find's.
+  const std::vector<LightQuad>& FindFaintlyDark(const GrayImageView& image);
   /// Step 4 for one candidate of the same image (done on demand: a caller usually needs the
   /// first only): its sides moved onto the light/dark edges, sub-pixel. True when quad is
   /// (now) refined; its corners are unchanged otherwise.
@@ -127,9 +133,9 @@ class SheetFinder {
   /// Adds the candidates of the light cells at `threshold` to candidates_.
   void AddComponents(const GrayImageView& image, const std::uint8_t* grid, int threshold);
   /// local_: the cells, those much darker than the brightest near them set to 0.
-  void MarkLocallyDark();
+  void MarkLocallyDark(double light_ratio);
   /// Candidates of local_ at first_threshold_ (the last pass).
-  void AddLocallyLight(const GrayImageView& image);
+  void AddLocallyLight(const GrayImageView& image, double light_ratio);
   /// candidates_ best first, at most max_candidates.
   void KeepBest();
   int Root(int run);

@@ -772,6 +772,13 @@ const TargetFrame& TargetPoseTracker::Track(
         frame_.find_us += Microseconds(start);
         found = AttemptCells(image, more);
       }
+      if (!found) {
+        // ... and those a little darker than the paper near them (a pale hand across it).
+        start = std::chrono::steady_clock::now();
+        const std::vector<LightQuad>& faint = finder_.FindFaintlyDark(image);
+        frame_.find_us += Microseconds(start);
+        found = AttemptCells(image, faint);
+      }
     }
     if (!found && options_.image_fallback) {
       found = Attempt(image, ScanBorders{}, {}, std::nullopt, ScanSource::kImage) &&

@@ -111,6 +111,22 @@ bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target, co
   });
 }
 
+// ... and with FindFaintlyDark's last.
+bool FindsTheMiddleCellAtLast(const RenderedFrame& frame, const LineTarget& target,
+                              const Lens& camera) {
+  SheetFinder finder;
+  const GrayImageView view = ViewOf(frame.image);
+  std::vector<LightQuad> candidates = finder.Find(view);
+  const std::vector<LightQuad> more = finder.FindLocallyLight(view);
+  candidates.insert(candidates.end(), more.begin(), more.end());
+  const std::vector<LightQuad>& faint = finder.FindFaintlyDark(view);
+  candidates.insert(candidates.end(), faint.begin(), faint.end());
+  return std::any_of(candidates.begin(), candidates.end(), [&](LightQuad quad) {
+    return quad.ClosedSideCount() >= 3 && finder.Refine(view, &quad) &&
+           CornerError(quad, target, frame.cMo, camera) < 2.0;
+  });
+}
+
 class SheetFinderInALivedInScene : public ::testing::Test {
  protected:
   SheetFinderInALivedInScene() : target_(TargetByName("four-line-a3")) {
@@ -154,6 +170,22 @@ TEST_F(SheetFinderInALivedInScene, AGreyHandOverACrossingStillLeavesTheMiddleCel
   hand.grey = 150;
   hand.ellipses.push_back({Crossing12().u + 0.015, Crossing12().v + 0.01, 0.03, 0.02, 0.0});
   EXPECT_TRUE(FindsTheMiddleCellPast(hand));
+}
+
+TEST_F(SheetFinderInALivedInScene, APaleHandAcrossAStripeIsTakenAsDarkAtLast) {
+  // A pale forearm a tenth darker than the paper, from the middle cell across line 2 and off
+  // the sheet: light at every threshold and at 0.8 of the paper near it, it joins the middle
+  // cell to the cell beyond and to itself on the bench; FindFaintlyDark's 0.9 takes it as
+  // dark, and the middle cell is closed in again, on three sides at least.
+  PlaneOccluder arm;
+  arm.grey = 190;
+  arm.capsules.push_back({0.0, -0.02, 0.04, -0.3, 0.022});
+  FrameEffects effects;
+  effects.plane_occluders.push_back(arm);
+  const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
+  const RenderedFrame frame = SceneRenderer(target_, render_).Render(cMo, 5, effects);
+  EXPECT_FALSE(FindsTheMiddleCell(frame, target_, render_.camera));
+  EXPECT_TRUE(FindsTheMiddleCellAtLast(frame, target_, render_.camera));
 }
 
 TEST_F(SheetFinderInALivedInScene, APenAlongASideLeavesItWhereTheStripeIs) {

@@ -415,6 +415,26 @@ TEST(TargetPoseTracker, AnArmAcrossHalfTheMiddleCellIsSeenPast) {
   }
 }
 
+// A pale forearm, a tenth darker than the paper, from the middle cell across line 2 and off the
+// sheet: the middle cell, joined to the arm and the cell beyond, is found again with the arm
+// taken as dark (the finder's last pass), at either roll.
+TEST(TargetPoseTracker, APaleArmAcrossTheMiddleCellIsSeenPast) {
+  const LineTarget target = FourLineA3Target();
+  const SceneRenderer renderer(target, BenchRender(14));
+  FrameEffects effects;
+  PlaneOccluder arm;
+  arm.capsules.push_back({0.0, -0.02, 0.04, -0.3, 0.022});
+  arm.grey = static_cast<int>(0.9 * target.board_grey);
+  arm.texture_grey = 5.0;
+  effects.plane_occluders.push_back(arm);
+  for (const double roll : {0.5, 2.5}) {
+    const vpHomogeneousMatrix cMo(0.01, 0.0, 0.5, 0.12, -0.1, roll);
+    TargetPoseTracker tracker = TrackerFor(renderer);
+    const TargetFrame& found = tracker.Track(ViewOf(renderer.Render(cMo, 15, effects).image));
+    ExpectRightPose(found, cMo, "a pale arm across the middle cell, roll " + std::to_string(roll));
+  }
+}
+
 // The settings in pixels follow the camera: a 1920x1080 webcam 70 degrees across (1371 px)
 // gets the detector's and the sheet finder's settings of a 600 px camera 2.285 times; with
 // reference_focal_px 0 they are used as given.
