@@ -17,7 +17,8 @@
 //      and saturated ones too where the paper is not (a stripe under a glare stays darker
 //      than the paper beside it, a glare's core is no paper, a grey hand is darker than the
 //      paper): this last pass is also FindLocallyLight's, for a caller none of whose
-//      candidates was the target;
+//      candidates was the target, and FindFaintlyDark's with 0.9 instead of 0.8 (a pale hand
+//      or sleeve);
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
