@@ -35,6 +35,8 @@ constexpr std::array<double, 3> kExpectedCorridorScales = {6.0, 2.5, 1.0};
 // Borders across each pair of stripes between the crossings, when a candidate's concentric
 // borders gave no pose.
 constexpr int kMiddleBordersPerPair = 4;
+// ... and, after a pose, when a stripe's points span less than this fraction of it.
+constexpr double kWeakStripeExtent = 0.3;
 
 double Microseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
@@ -653,7 +655,7 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
     // Each candidate on its own: a prior that failed above says nothing about it.
     const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source, expected);
     if (count >= options_.borders) {
-      if (accepted) return true;
+      if (accepted) return RescanWeakStripe(image, source);
       // A stripe seen only between the crossings (its arms under a hand or out of view)
       // gives the concentric borders no points: scanned again with borders across the
       // stripes' middles.
@@ -661,10 +663,31 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
       return Attempt(image, borders_, seeds, std::nullopt, source, expected);
     }
     if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
-      return true;
+      return RescanWeakStripe(image, source);
     }
   }
   return false;
+}
+
+bool TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource source) {
+  if (!frame_.fit.ok ||
+      *std::min_element(frame_.fit.extent.begin(), frame_.fit.extent.end()) >= kWeakStripeExtent) {
+    return true;
+  }
+  // A stripe whose points span a short stretch of it leaves the pose's tilt about it loosely
+  // told (a glare's slope, a blur across it, tilts it by degrees): its middle between the
+  // crossings, scanned from the pose found, tells more.
+  const TargetFrame first = frame_;
+  const std::vector<DetectedLine> first_lines = lines_;
+  const vpHomography plane_to_image = PlaneToImage(first.pose.cMo);
+  TargetBorders(layout_, plane_to_image, camera_, options_.borders, &borders_);
+  AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
+  if (!borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt, source,
+                                   Expected{first.pose.cMo, false})) {
+    return true;
+  }
+  RestoreFrame(first, first_lines);
+  return true;
 }
 
 bool TargetPoseTracker::AttemptCells(const GrayImageView& image,

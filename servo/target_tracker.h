@@ -275,6 +275,10 @@ class TargetPoseTracker {
   /// than quick_max_identification_cost; true when a pose is accepted.
   bool AttemptCandidate(const GrayImageView& image, const vpHomography& plane_to_image,
                         ScanSource source);
+  /// After a candidate's accepted pose whose stripe fit keeps one stripe's points over a short
+  /// stretch of it: the target's borders and those across the stripes' middles scanned again
+  /// from that pose, the new pose kept when it passes the checks, else the first. True.
+  bool RescanWeakStripe(const GrayImageView& image, ScanSource source);
   /// The whole image's accepted pose scanned again on the target's plane (step 3): false when
   /// the two poses disagree; the frame keeps the better fitting one.
   bool ConfirmOnTarget(const GrayImageView& image);

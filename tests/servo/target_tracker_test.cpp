@@ -304,8 +304,11 @@ TEST(TargetPoseTracker, AStripeHiddenOnOneSideIsFittedFromTheOther) {
   ExpectRightPose(found, cMo, "line 4 half hidden");
   EXPECT_EQ(found.pose.method, PoseMethod::kStripes);
   EXPECT_GT(found.fit.points[3], 0);
-  // Only the stretch the arm leaves: x from -0.2 to 0.101 of the stripe's 0.4 m (0.75).
+  // Only the stretch the arm leaves: x from -0.2 to 0.101 of the stripe's 0.4 m (0.75). The
+  // concentric borders give line 4's left arm only (a quarter of it): the pose is scanned
+  // again with borders across the stripes' middles, which give the rest of that stretch.
   EXPECT_LT(found.fit.extent[3], 0.76);
+  EXPECT_GT(found.fit.extent[3], 0.5);
 }
 
 // Line 4 hidden on both sides beyond the crossings (an arm over one side, a tool over the
@@ -333,6 +336,33 @@ TEST(TargetPoseTracker, AStripeSeenOnlyBetweenTheCrossingsIsFittedThere) {
     EXPECT_GT(found.fit.points[3], 0);
     EXPECT_LT(found.fit.extent[3], 0.5);  // x from -0.1 to 0.1 of the stripe's 0.4 m
   }
+}
+
+// An A4 sheet turned upside down, smeared by 10 px of motion across lines 2 and 4, a lamp's
+// glare washing out line 4's arm beyond line 1: the concentric borders leave line 4 a few
+// points on its other arm, a fifth of it, and their pose tilts about it by two degrees. Scanned
+// again from that pose with the borders across the stripes' middles, it is right.
+TEST(TargetPoseTracker, AStripeSeenOverAShortStretchIsScannedAgainAcrossItsMiddle) {
+  const LineTarget target = FourLineA4Target();
+  const SceneRenderer renderer(target, BenchRender(16));
+  FrameEffects effects;
+  effects.glares.push_back({-0.110, 0.047, 0.0237, 249.0});
+  effects.motion_blur_px = 10.1;
+  effects.motion_blur_angle_rad = 1.306;
+  vpHomogeneousMatrix cMo;
+  const double m[3][4] = {{-0.9978, 0.0619, 0.0225, -0.0987},
+                          {-0.062, -0.9981, -0.0025, -0.0056},
+                          {0.0223, -0.0039, 0.9997, 0.547}};
+  vpRotationMatrix rotation;
+  for (unsigned r = 0; r < 3; ++r) {
+    for (unsigned c = 0; c < 3; ++c) rotation[r][c] = m[r][c];
+  }
+  cMo.buildFrom(vpTranslationVector(m[0][3], m[1][3], m[2][3]),
+                vpRotationMatrix(vpThetaUVector(rotation)));
+  TargetPoseTracker tracker = TrackerFor(renderer);
+  const TargetFrame& found = tracker.Track(ViewOf(renderer.Render(cMo, 17, effects).image));
+  ExpectRightPose(found, cMo, "line 4 washed out on one arm");
+  EXPECT_GT(found.fit.extent[3], 0.3);
 }
 
 // A lamp's glare across a stripe between two crossings joins the middle cell to the paper
