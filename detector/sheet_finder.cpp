@@ -630,20 +630,23 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
 }
 
 const std::vector<LightQuad>& SheetFinder::FindLocallyLight(const GrayImageView& image) {
-  candidates_.clear();
-  if (!local_done_ && image.width / options_.cell_px == grid_width_ &&
-      image.height / options_.cell_px == grid_height_) {
-    AddLocallyLight(image, kLocalLightRatio);
-    KeepBest();
+  if (local_done_) {
+    candidates_.clear();
+    return candidates_;
   }
-  return candidates_;
+  return LookAgainLocally(image, kLocalLightRatio);
 }
 
 const std::vector<LightQuad>& SheetFinder::FindFaintlyDark(const GrayImageView& image) {
+  return LookAgainLocally(image, kFaintLightRatio);
+}
+
+const std::vector<LightQuad>& SheetFinder::LookAgainLocally(const GrayImageView& image,
+                                                            double light_ratio) {
   candidates_.clear();
   if (image.width / options_.cell_px == grid_width_ &&
       image.height / options_.cell_px == grid_height_) {
-    AddLocallyLight(image, kFaintLightRatio);
+    AddLocallyLight(image, light_ratio);
     KeepBest();
   }
   return candidates_;

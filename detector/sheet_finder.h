@@ -137,6 +137,9 @@ class SheetFinder {
   void MarkLocallyDark(double light_ratio);
   /// Candidates of local_ at first_threshold_ (the last pass).
   void AddLocallyLight(const GrayImageView& image, double light_ratio);
+  /// The last pass again for the image last given to Find (nothing for another size), best
+  /// first: FindLocallyLight's and FindFaintlyDark's.
+  const std::vector<LightQuad>& LookAgainLocally(const GrayImageView& image, double light_ratio);
   /// candidates_ best first, at most max_candidates.
   void KeepBest();
   int Root(int run);

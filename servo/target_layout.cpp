@@ -254,6 +254,24 @@ ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_
   return borders;
 }
 
+namespace {
+
+// The rectangle a x b of the '#' frame mapped into the image as *polygon (its memory reused);
+// false when a corner does not project or the lens folds it (a quadrilateral seen near the edge
+// of the lens's reach): only convex ones are kept.
+bool ProjectRectangle(const TargetLayout& layout, const PlaneProjector& projector,
+                      const Interval& a, const Interval& b, std::vector<Point2d>* polygon) {
+  const Point2d corners[4] = {layout.ToPlane(a.lo, b.lo), layout.ToPlane(a.hi, b.lo),
+                              layout.ToPlane(a.hi, b.hi), layout.ToPlane(a.lo, b.hi)};
+  polygon->resize(4);
+  for (int c = 0; c < 4; ++c) {
+    if (!projector.Project(corners[c], &(*polygon)[static_cast<std::size_t>(c)])) return false;
+  }
+  return IsConvexQuadrilateral(*polygon);
+}
+
+}  // namespace
+
 void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
                    const Lens& camera, int count, ScanBorders* out) {
   std::vector<std::vector<Point2d>>& polygons = out->polygons;
@@ -266,18 +284,8 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
     const double f = count > 1 ? static_cast<double>(k) / (count - 1) : 0.0;
     const Interval a = lerp(layout.outer_a, layout.inner_a, f);
     const Interval b = lerp(layout.outer_b, layout.inner_b, f);
-    const Point2d corners[4] = {layout.ToPlane(a.lo, b.lo), layout.ToPlane(a.hi, b.lo),
-                                layout.ToPlane(a.hi, b.hi), layout.ToPlane(a.lo, b.hi)};
     if (polygons.size() <= used) polygons.emplace_back();
-    std::vector<Point2d>& polygon = polygons[used];
-    polygon.resize(4);
-    bool ok = true;
-    for (int c = 0; c < 4 && ok; ++c) {
-      ok = projector.Project(corners[c], &polygon[static_cast<std::size_t>(c)]);
-    }
-    // The lens can fold a quadrilateral seen near the edge of its reach: keep convex ones.
-    if (!ok || !IsConvexQuadrilateral(polygon)) continue;
-    ++used;
+    if (ProjectRectangle(layout, projector, a, b, &polygons[used])) ++used;
   }
   polygons.resize(used);
 }
@@ -298,14 +306,10 @@ void AddMiddleBorders(const TargetLayout& layout, const vpHomography& plane_to_i
       const Interval band{middle - f * half, middle + f * half};
       const Interval a = pair == 0 ? layout.outer_a : band;
       const Interval b = pair == 0 ? band : layout.outer_b;
-      const Point2d corners[4] = {layout.ToPlane(a.lo, b.lo), layout.ToPlane(a.hi, b.lo),
-                                  layout.ToPlane(a.hi, b.hi), layout.ToPlane(a.lo, b.hi)};
-      std::vector<Point2d> polygon(4);
-      bool ok = true;
-      for (int c = 0; c < 4 && ok; ++c) {
-        ok = projector.Project(corners[c], &polygon[static_cast<std::size_t>(c)]);
+      std::vector<Point2d> polygon;
+      if (ProjectRectangle(layout, projector, a, b, &polygon)) {
+        out->polygons.push_back(std::move(polygon));
       }
-      if (ok && IsConvexQuadrilateral(polygon)) out->polygons.push_back(std::move(polygon));
     }
   }
 }
@@ -392,12 +396,11 @@ std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCel
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
                                                      const LightQuad& cell, const Lens& camera,
                                                      int outer) {
-  const int open = outer;
   std::array<Point2d, 4> image, plane;
   Point2d centre{0.0, 0.0};
   for (int k = 0; k < 4; ++k) {
-    // The cell's outer side onto the quadrilateral's open one.
-    const std::size_t i = static_cast<std::size_t>((k + open - edge.outer + 4) % 4);
+    // The cell's outer side onto the quadrilateral's side `outer`.
+    const std::size_t i = static_cast<std::size_t>((k + outer - edge.outer + 4) % 4);
     const Point2d& corner = cell.corners[i];
     Point2d& normalised = image[static_cast<std::size_t>(k)];
     normalised = camera.Normalised(corner.u, corner.v);

@@ -110,12 +110,6 @@ ScanBorders TargetBorders(const TargetLayout& layout, const vpHomography& plane_
 /// The same into *borders, reusing the memory it holds (for a loop).
 void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
                    const Lens& camera, int count, ScanBorders* borders);
-
-/// The plane-to-image homography (normalised coordinates) that maps the layout's middle cell
-/// onto `cell`, a light quadrilateral of the frame: of the two ways to lay the cell's sides
-/// on the quadrilateral's (a turn by 180 degrees maps the middle cell nearly onto itself and
-/// changes no border), the one whose homography is nearer a rotation's first two columns.
-/// Nothing when the corners cannot be undistorted or the homography is degenerate.
 /// Appends `per_pair` borders across each pair of parallel stripes between the crossings,
 /// where the concentric borders never look: rectangles as long as the outer border across the
 /// pair, as wide as bands of the middle cell along it (from near its sides to near its middle
@@ -125,6 +119,11 @@ void TargetBorders(const TargetLayout& layout, const vpHomography& plane_to_imag
 void AddMiddleBorders(const TargetLayout& layout, const vpHomography& plane_to_image,
                       const Lens& camera, int per_pair, ScanBorders* out);
 
+/// The plane-to-image homography (normalised coordinates) that maps the layout's middle cell
+/// onto `cell`, a light quadrilateral of the frame: of the two ways to lay the cell's sides
+/// on the quadrilateral's (a turn by 180 degrees maps the middle cell nearly onto itself and
+/// changes no border), the one whose homography is nearer a rotation's first two columns.
+/// Nothing when the corners cannot be undistorted or the homography is degenerate.
 std::optional<vpHomography> PlaneToImageFromCell(const TargetLayout& layout, const LightQuad& cell,
                                                  const Lens& camera);
 

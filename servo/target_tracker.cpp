@@ -655,7 +655,10 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
     // Each candidate on its own: a prior that failed above says nothing about it.
     const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source, expected);
     if (count >= options_.borders) {
-      if (accepted) return RescanWeakStripe(image, source);
+      if (accepted) {
+        RescanWeakStripe(image, source);
+        return true;
+      }
       // A stripe seen only between the crossings (its arms under a hand or out of view)
       // gives the concentric borders no points: scanned again with borders across the
       // stripes' middles.
@@ -663,16 +666,17 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
       return Attempt(image, borders_, seeds, std::nullopt, source, expected);
     }
     if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
-      return RescanWeakStripe(image, source);
+      RescanWeakStripe(image, source);
+      return true;
     }
   }
   return false;
 }
 
-bool TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource source) {
+void TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource source) {
   if (!frame_.fit.ok ||
       *std::min_element(frame_.fit.extent.begin(), frame_.fit.extent.end()) >= kWeakStripeExtent) {
-    return true;
+    return;
   }
   // A stripe whose points span a short stretch of it leaves the pose's tilt about it loosely
   // told (a glare's slope, a blur across it, tilts it by degrees): its middle between the
@@ -684,10 +688,9 @@ bool TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource 
   AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
   if (!borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt, source,
                                    Expected{first.pose.cMo, false})) {
-    return true;
+    return;
   }
   RestoreFrame(first, first_lines);
-  return true;
 }
 
 bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
