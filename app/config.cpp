@@ -946,6 +946,7 @@ const std::vector<Field<TargetTrackerOptions>>& TrackingFields() {
       IntField("tracked_borders", &O::tracked_borders),
       DoubleField("quick_max_identification_cost", &O::quick_max_identification_cost),
       IntField("max_candidates", &O::max_candidates),
+      BoolField("corner_cells", &O::corner_cells),
       BoolField("image_fallback", &O::image_fallback),
       IntField("min_line_support", &O::min_line_support),
       DoubleField("min_stripe_agreement", &O::min_stripe_agreement),

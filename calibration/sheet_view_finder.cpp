@@ -29,6 +29,9 @@ TargetTrackerOptions ForAGuessedCamera(TargetTrackerOptions tracking) {
   tracking.stripe_tolerance_fraction = std::max(tracking.stripe_tolerance_fraction, 0.25);
   tracking.stripe_width_tolerance = std::max(tracking.stripe_width_tolerance, 0.5);
   tracking.borders = std::max(tracking.borders, kCalibrationBorders);
+  // The corner cells' guesses are left out: each is tried four ways, and the loose check above
+  // let one pass that threw a calibration off.
+  tracking.corner_cells = false;
   return tracking;
 }
 

@@ -211,6 +211,24 @@ TargetLayout TargetLayout::Of(const LineTarget& target) {
       edge.outer = 0;
     }
   }
+  const StripeSpan& high_b = line2.at <= line4.at ? line4 : line2;
+  const StripeSpan& high_a = line1.at <= line3.at ? line3 : line1;
+  for (std::size_t c = 0; c < 4; ++c) {
+    const bool low_side_a = c < 2, low_side_b = c % 2 == 0;
+    const double a = low_side_a ? out_a : high_a.at + high_a.half;
+    const double b = low_side_b ? out_b : high_b.at + high_b.half;
+    const Point2d meet = layout.ToPlane(a, b);
+    const Point2d along_a = to_edge(meet, low_side_a ? minus_a : layout.axis_a);
+    const Point2d along_b = to_edge(meet, low_side_b ? minus_b : layout.axis_b);
+    TargetLayout::CornerCell& corner = layout.corner_cells[c];
+    corner.corners = {meet, along_a, to_edge(along_a, low_side_b ? minus_b : layout.axis_b),
+                      along_b};
+    corner.inner = 0;
+    if (SignedArea({corner.corners.begin(), corner.corners.end()}) < 0.0) {
+      std::reverse(corner.corners.begin(), corner.corners.end());
+      corner.inner = 3;
+    }
+  }
   return layout;
 }
 
@@ -396,16 +414,22 @@ std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCel
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
                                                      const LightQuad& cell, const Lens& camera,
                                                      int outer) {
+  // The cell's outer side onto the quadrilateral's side `outer`.
+  return PlaneToImageFromCorners(edge.corners, edge.outer, cell, outer, camera);
+}
+
+std::optional<vpHomography> PlaneToImageFromCorners(const std::array<Point2d, 4>& plane_corners,
+                                                    int plane_first, const LightQuad& quad,
+                                                    int quad_first, const Lens& camera) {
   std::array<Point2d, 4> image, plane;
   Point2d centre{0.0, 0.0};
   for (int k = 0; k < 4; ++k) {
-    // The cell's outer side onto the quadrilateral's side `outer`.
-    const std::size_t i = static_cast<std::size_t>((k + outer - edge.outer + 4) % 4);
-    const Point2d& corner = cell.corners[i];
+    const std::size_t i = static_cast<std::size_t>((k + quad_first - plane_first + 4) % 4);
+    const Point2d& corner = quad.corners[i];
     Point2d& normalised = image[static_cast<std::size_t>(k)];
     normalised = camera.Normalised(corner.u, corner.v);
     if (!std::isfinite(normalised.u) || !std::isfinite(normalised.v)) return std::nullopt;
-    plane[static_cast<std::size_t>(k)] = edge.corners[static_cast<std::size_t>(k)];
+    plane[static_cast<std::size_t>(k)] = plane_corners[static_cast<std::size_t>(k)];
     centre = Point2d{centre.u + 0.25 * plane[static_cast<std::size_t>(k)].u,
                      centre.v + 0.25 * plane[static_cast<std::size_t>(k)].v};
   }

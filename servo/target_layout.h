@@ -71,6 +71,16 @@ struct TargetLayout {
     int outer = 0;
   };
   std::array<EdgeCell, 2> edge_cells{};
+  /// The paper beyond one stripe of each pair, out to the board's corner: a cell a sheet
+  /// finder sees closed in on two adjacent sides (the two stripes) when the margin beyond the
+  /// stripes' ends is narrower than its cells and the middle and edge cells are broken or
+  /// hidden. All four, corners as middle_cell's; `inner` is the corner where the two stripes'
+  /// outer edges meet.
+  struct CornerCell {
+    std::array<Point2d, 4> corners{};
+    int inner = 0;
+  };
+  std::array<CornerCell, 4> corner_cells{};
 
   /// Object-plane point of '#' coordinates (a, b).
   Point2d ToPlane(double a, double b) const;
@@ -140,6 +150,14 @@ std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCel
 std::optional<vpHomography> PlaneToImageFromEdgeCell(const TargetLayout::EdgeCell& edge,
                                                      const LightQuad& cell, const Lens& camera,
                                                      int outer);
+
+/// The plane-to-image homography (normalised coordinates) that lays `plane` (a cell's corners
+/// on the target plane, in middle_cell's turning sense) onto `quad`'s corners, the cell's
+/// corner `plane_first` on the quadrilateral's corner `quad_first` (both 0-3). Nothing when the
+/// corners cannot be undistorted or the homography is degenerate.
+std::optional<vpHomography> PlaneToImageFromCorners(const std::array<Point2d, 4>& plane,
+                                                    int plane_first, const LightQuad& quad,
+                                                    int quad_first, const Lens& camera);
 
 /// The middle cell `cell` would be if its side `cut` (from corner cut to cut + 1) were the edge
 /// of something lying across the cell (a hand, a tool, a cable) rather than a stripe's: the

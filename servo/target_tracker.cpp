@@ -38,6 +38,9 @@ constexpr int kMiddleBordersPerPair = 4;
 // ... and, after a pose, when a stripe's points span less than this fraction of it.
 constexpr double kWeakStripeExtent = 0.3;
 
+// Candidates closed in on two sides set aside as corner cells, at most.
+constexpr std::size_t kMaxCornerGuesses = 3;
+
 double Microseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
       .count();
@@ -59,6 +62,8 @@ std::string ToString(ScanSource source) {
       return "middle-cell";
     case ScanSource::kEdgeCell:
       return "edge-cell";
+    case ScanSource::kCornerCell:
+      return "corner-cell";
     case ScanSource::kImage:
       return "image";
   }
@@ -253,6 +258,17 @@ bool RunsAsWideAsStripe(const StripeFit& fit, std::size_t k) {
 int MergedStripe(const StripeFit& fit) {
   for (std::size_t k = 0; k < 4; ++k) {
     if (!RunsAsWideAsStripe(fit, k)) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+// The corner where a quadrilateral's only two closed sides meet (side k runs from corner k to
+// corner k + 1); -1 unless exactly two sides that meet are closed.
+int ClosedCorner(const LightQuad& quad) {
+  if (quad.ClosedSideCount() != 2) return -1;
+  for (int k = 0; k < 4; ++k) {
+    const int next = (k + 1) % 4;
+    if (((quad.closed_sides >> k) & 1) && ((quad.closed_sides >> next) & 1)) return next;
   }
   return -1;
 }
@@ -698,6 +714,9 @@ bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
   int tried = 0;
   bool uncut_tried = false;
   for (LightQuad cell : cells) {
+    if (ClosedCorner(cell) >= 0 && corner_guesses_.size() < kMaxCornerGuesses) {
+      corner_guesses_.push_back(cell);
+    }
     if (cell.ClosedSideCount() < 3 || tried >= options_.max_candidates) continue;
     ++tried;
     const auto refine_start = std::chrono::steady_clock::now();
@@ -755,6 +774,24 @@ bool TargetPoseTracker::AttemptUncut(const GrayImageView& image, const LightQuad
   return false;
 }
 
+bool TargetPoseTracker::AttemptCornerCells(const GrayImageView& image) {
+  const TargetFrame as_found = frame_;
+  const std::vector<DetectedLine> lines_as_found = lines_;
+  for (LightQuad quad : corner_guesses_) {
+    const int inner = ClosedCorner(quad);
+    const auto refine_start = std::chrono::steady_clock::now();
+    finder_.Refine(image, &quad);
+    frame_.find_us += Microseconds(refine_start);
+    for (const TargetLayout::CornerCell& cell : layout_.corner_cells) {
+      const std::optional<vpHomography> h =
+          PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner, camera_);
+      if (h && AttemptCandidate(image, *h, ScanSource::kCornerCell)) return true;
+    }
+  }
+  RestoreFrame(as_found, lines_as_found);
+  return false;
+}
+
 void TargetPoseTracker::RestoreFrame(const TargetFrame& saved,
                                      const std::vector<DetectedLine>& saved_lines) {
   // The work done since stays counted: its time and the candidates it scanned.
@@ -770,6 +807,7 @@ void TargetPoseTracker::RestoreFrame(const TargetFrame& saved,
 const TargetFrame& TargetPoseTracker::Track(
     const GrayImageView& image, const std::optional<vpHomogeneousMatrix>& predicted_cMo) {
   frame_ = TargetFrame{};
+  corner_guesses_.clear();
   pose_options_.image_width = image.width;
   pose_options_.image_height = image.height;
   const std::optional<vpHomogeneousMatrix> prior = predicted_cMo ? predicted_cMo : last_cMo_;
@@ -805,6 +843,7 @@ const TargetFrame& TargetPoseTracker::Track(
         frame_.find_us += Microseconds(start);
         found = AttemptCells(image, faint);
       }
+      if (!found && options_.corner_cells) found = AttemptCornerCells(image);
     }
     if (!found && options_.image_fallback) {
       found = Attempt(image, ScanBorders{}, {}, std::nullopt, ScanSource::kImage) &&

@@ -10,11 +10,16 @@
 //      (detector/sheet_finder.h); for each candidate closed in on three sides or more, best
 //      first (at most max_candidates), the borders its homography gives are scanned: as few
 //      as a tracked frame's first (its lines are seeded as a prior's are), all `borders` when
-//      those give no pose or lines whose widths barely identify them. When none gives a pose,
-//      the same for the finder's second look (SheetFinder::FindLocallyLight: a hand or a
-//      glare joining the middle cell to its neighbour). The first candidate closed in on four
-//      sides that gives no pose is also tried as the middle cell cut short by something lying
-//      across it (target_layout.h: UncutCells).
+//      those give no pose or lines whose widths barely identify them. A candidate that gives
+//      no pose as the middle cell is also tried as a cell beyond a stripe, out to the sheet's
+//      edge (closed in on three sides: its open side there; on four: each side in turn), and
+//      the first one as the middle cell cut short by something lying across it
+//      (target_layout.h: UncutCells). When none gives a pose, the same for the finder's later
+//      looks (SheetFinder::FindLocallyLight: a hand or a glare joining the middle cell to its
+//      neighbour; FindFaintlyDark: a pale hand); then the candidates closed in on two sides
+//      that meet, set aside on the way, as each of the sheet's corner cells (the paper beyond
+//      one stripe of each pair, out to the sheet's corner: a glare over the middle of the
+//      sheet joins the middle cell to the cells beyond all four stripes).
 //   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
 //      with the paper's concentric image borders. A line of the bench can stand in for a
 //      stripe's edge there and tilt the pose by degrees yet pass the checks below, so the
@@ -70,6 +75,7 @@ enum class ScanSource {
   kPrior,       ///< borders from the prior pose
   kMiddleCell,  ///< borders from a middle-cell candidate of the sheet finder
   kEdgeCell,    ///< ... from a candidate closed in on three sides taken as an edge cell
+  kCornerCell,  ///< ... from a candidate closed in on two adjacent sides taken as a corner cell
   kImage,       ///< the whole image
 };
 
@@ -115,6 +121,10 @@ struct TargetTrackerOptions {
   /// Middle-cell candidates scanned at most per pass of the sheet finder (two passes: its
   /// candidates, then those with locally dark cells). Range [1, 16].
   int max_candidates = 3;
+  /// When no candidate gives a pose, take the candidates closed in on two sides that meet as
+  /// the sheet's corner cells (guesses, each tried four ways: for a camera whose model check
+  /// is strict).
+  bool corner_cells = true;
   /// When no candidate gives a pose, scan the whole image as the paper does.
   bool image_fallback = true;
   /// Each of the four lines the pose uses needs at least this many feature points on it
@@ -267,6 +277,9 @@ class TargetPoseTracker {
   /// frame is left as the candidate itself left it (its message, lines and region), with the
   /// time spent added.
   bool AttemptUncut(const GrayImageView& image, const LightQuad& cell);
+  /// The candidates closed in on two adjacent sides that AttemptCells set aside, each taken
+  /// as each of the layout's corner cells.
+  bool AttemptCornerCells(const GrayImageView& image);
   /// frame_ and lines_ back to `saved` and `saved_lines`, an attempt since then undone but for
   /// its time and the candidates it scanned.
   void RestoreFrame(const TargetFrame& saved, const std::vector<DetectedLine>& saved_lines);
@@ -308,6 +321,8 @@ class TargetPoseTracker {
   OalDetector detector_;
   SheetFinder finder_;
   std::vector<DetectedLine> lines_;
+  /// This frame's candidates closed in on two sides, for AttemptCornerCells.
+  std::vector<LightQuad> corner_guesses_;
   ScanBorders borders_;  ///< working memory for each attempt's borders
   TargetFrame frame_;
   GrayImageView image_{};

@@ -228,6 +228,17 @@ TEST(ConfigTracking, TheStripeFitAndTheModelCheckKeys) {
               HasSubstr("cfg.yaml:2: 'tracking.fit_stripes' must be true or false"));
 }
 
+// Where the tracker looks when no middle or edge cell gives a pose.
+TEST(ConfigTracking, TheCornerCellsAndTheImageFallbackKeys) {
+  EXPECT_TRUE(ParseConfig("tracking:\n  max_candidates: 3\n", "cfg.yaml").tracking.corner_cells);
+  const AppConfig config =
+      ParseConfig("tracking:\n  corner_cells: false\n  image_fallback: false\n", "cfg.yaml");
+  EXPECT_FALSE(config.tracking.corner_cells);
+  EXPECT_FALSE(config.tracking.image_fallback);
+  EXPECT_THAT(ErrorOf("tracking:\n  corner_cells: 2\n"),
+              HasSubstr("cfg.yaml:2: 'tracking.corner_cells' must be true or false"));
+}
+
 // The settings in pixels and the focal length they are given for; a region's sample step.
 TEST(ConfigTracking, TheReferenceFocalLengthAndTheRegionSampleStep) {
   const AppConfig config = ParseConfig(

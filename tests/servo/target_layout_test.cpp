@@ -1,7 +1,7 @@
 // Points of the target's plane projected through a lens (servo/target_layout.h): the pixel
 // PlaneProjector gives maps back, through ViSP's own pixel-to-metre conversion, to the ideal
 // point the homography gives, for barrel and pincushion lenses, near and far from the centre;
-// the edge cells of an A3 sheet and the homography from one seen through its open side.
+// the edge and corner cells of an A3 sheet and the homographies from them as a finder sees them.
 #include "servo/target_layout.h"
 
 #include <gtest/gtest.h>
@@ -13,7 +13,8 @@
 #include <optional>
 #include <vector>
 
-#include "detector/lens.h"  // CameraWithKdu
+#include "detector/lens.h"    // CameraWithKdu
+#include "detector/region.h"  // SignedArea
 
 namespace oal {
 namespace {
@@ -104,6 +105,60 @@ TEST(TargetLayout, EdgeCellsReachTheSheetsEdgeAndMapBackThroughTheirOpenSide) {
   LightQuad closed;
   closed.closed_sides = 0xF;
   EXPECT_FALSE(PlaneToImageFromEdgeCell(above, closed, camera).has_value());
+}
+
+// An A3 sheet's corner cells: each from the outer edges of one stripe of each pair, where they
+// meet, out to one of the sheet's corners, clear of every stripe; a quadrilateral seen at a
+// cell's corners, starting anywhere, maps the plane as the pose does when its corner where the
+// closed sides meet is laid on the cell's inner one.
+TEST(TargetLayout, CornerCellsReachTheSheetsCornersAndMapBackFromTheirClosedCorner) {
+  const LineTarget target = FourLineA3Target();
+  const TargetLayout layout = TargetLayout::Of(target);
+  std::vector<std::pair<double, double>> sheet_corners;
+  for (const TargetLayout::CornerCell& cell : layout.corner_cells) {
+    const Point2d& inner = cell.corners[static_cast<std::size_t>(cell.inner)];
+    // Lines 1 (x = -0.09, 24 mm) and 3 (x = 0.09, 16 mm); 2 (y = -0.062, 12 mm), 4 (y = 0.062,
+    // 14 mm): the inner corner at the outer edges of one of each.
+    EXPECT_NEAR(std::fabs(inner.u), inner.u < 0.0 ? 0.102 : 0.098, 1e-9);
+    EXPECT_NEAR(std::fabs(inner.v), inner.v < 0.0 ? 0.068 : 0.069, 1e-9);
+    const Point2d& far = cell.corners[static_cast<std::size_t>((cell.inner + 2) % 4)];
+    EXPECT_NEAR(std::fabs(far.u), 0.21, 1e-9);
+    EXPECT_NEAR(std::fabs(far.v), 0.1485, 1e-9);
+    EXPECT_GT(far.u * inner.u, 0.0);
+    EXPECT_GT(far.v * inner.v, 0.0);
+    sheet_corners.emplace_back(far.u, far.v);
+    // In the middle cell's turning sense.
+    EXPECT_GT(SignedArea({cell.corners.begin(), cell.corners.end()}) *
+                  SignedArea({layout.middle_cell.begin(), layout.middle_cell.end()}),
+              0.0);
+  }
+  std::sort(sheet_corners.begin(), sheet_corners.end());
+  EXPECT_EQ(std::unique(sheet_corners.begin(), sheet_corners.end()), sheet_corners.end());
+
+  const vpCameraParameters camera(600.0, 600.0, 319.5, 239.5);
+  const vpHomogeneousMatrix cMo(0.01, 0.02, 0.5, 0.2, -0.1, 0.7);
+  const vpHomography truth = PlaneToImage(cMo);
+  for (const TargetLayout::CornerCell& cell : layout.corner_cells) {
+    for (int inner_at = 0; inner_at < 4; ++inner_at) {
+      LightQuad quad;
+      for (int k = 0; k < 4; ++k) {
+        const Point2d& plane =
+            cell.corners[static_cast<std::size_t>((k + cell.inner - inner_at + 4) % 4)];
+        ASSERT_TRUE(
+            ProjectPlanePoint(truth, camera, plane, &quad.corners[static_cast<std::size_t>(k)]));
+      }
+      const std::optional<vpHomography> found =
+          PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner_at, camera);
+      ASSERT_TRUE(found.has_value());
+      for (const Point2d& plane : layout.middle_cell) {
+        Point2d a, b;
+        ASSERT_TRUE(ProjectPlanePoint(*found, camera, plane, &a));
+        ASSERT_TRUE(ProjectPlanePoint(truth, camera, plane, &b));
+        EXPECT_NEAR(a.u, b.u, 1e-6);
+        EXPECT_NEAR(a.v, b.v, 1e-6);
+      }
+    }
+  }
 }
 
 // The A3 sheet's middle cell seen face on (its image an exact scaling of it), a tool lying

@@ -381,6 +381,41 @@ TEST(TargetPoseTracker, AGlareAcrossTheMiddleCellsSideFindsTheSheetFromAnEdgeCel
   EXPECT_EQ(found.source, ScanSource::kEdgeCell);
 }
 
+// A lamp's broad glare over the middle of the sheet, at 1280x720 (a 720p webcam, 70 degrees
+// across): the stripes washed out between the crossings join the middle cell to the four cells
+// beyond the stripes. A corner's paper, closed in by two stripes alone (the margin beyond the
+// stripes' ends is narrower than the finder's cells), is taken for each of the sheet's corner
+// cells in turn: the right pose, from a corner cell, at two rolls.
+TEST(TargetPoseTracker, ABroadGlareOverTheMiddleAt720pFindsTheSheetFromACornerCell) {
+  const LineTarget target = FourLineA3Target();
+  RenderOptions render = BenchRender(4);
+  render.camera = Lens::WithKdu(914.0, 914.0, 639.5, 359.5, 0.15, 1280, 720);
+  render.width = 1280;
+  render.height = 720;
+  const SceneRenderer renderer(target, render);
+  FrameEffects effects;
+  effects.glares.push_back({0.0, 0.0, 0.05, 700.0});
+  effects.motion_blur_px = 5.0;
+  effects.motion_blur_angle_rad = 2.3;
+  effects.jpeg_quality = 62;
+  for (const double roll : {2.95, 1.0}) {
+    const vpHomogeneousMatrix cMo(0.02, -0.05, 0.45, 0.09, -0.28, roll);
+    const RenderedFrame frame = renderer.Render(cMo, 9, effects);
+    TargetPoseTracker tracker = TrackerFor(renderer);
+    const TargetFrame& found = tracker.Track(ViewOf(frame.image));
+    const std::string what = "a broad glare at 720p, roll " + std::to_string(roll);
+    ExpectRightPose(found, cMo, what);
+    EXPECT_EQ(found.source, ScanSource::kCornerCell) << what;
+    // Without the corner cells, nothing else finds it.
+    TargetTrackerOptions options;
+    options.corner_cells = false;
+    PoseOptions pose;
+    pose.camera = render.camera;
+    TargetPoseTracker without(target, render.camera, DetectorOptions(), pose, options);
+    EXPECT_NE(without.Track(ViewOf(frame.image)).status, TargetStatus::kOk) << what;
+  }
+}
+
 // A dark cable lying against line 3 along its length: its runs there are half as wide again
 // as the stripe and their middles off its centre line. No pose, or a right one, at any roll.
 TEST(TargetPoseTracker, ACableAgainstAStripeGivesNoWrongPose) {
