@@ -468,6 +468,29 @@ void SheetFinder::MarkLocallyDark(double light_ratio) {
   }
 }
 
+void SheetFinder::Narrow() {
+  // A separable minimum over 3 x 3 cells of the last pass's grid.
+  const int w = grid_width_, h = grid_height_;
+  row_max_.resize(local_.size());  // here: each row's minimum over three cells
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* in = local_.data() + static_cast<std::size_t>(y) * w;
+    std::uint8_t* out = row_max_.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      out[x] = *std::min_element(in + std::max(0, x - 1), in + std::min(w, x + 2));
+    }
+  }
+  narrowed_.resize(local_.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t darkest = 255;
+      for (int k = std::max(0, y - 1); k <= std::min(h - 1, y + 1); ++k) {
+        darkest = std::min(darkest, row_max_[static_cast<std::size_t>(k) * w + x]);
+      }
+      narrowed_[static_cast<std::size_t>(y) * w + x] = darkest;
+    }
+  }
+}
+
 int SheetFinder::Root(int run) {
   while (runs_[static_cast<std::size_t>(run)].parent != run) {
     CellRun& r = runs_[static_cast<std::size_t>(run)];
@@ -639,6 +662,18 @@ const std::vector<LightQuad>& SheetFinder::FindLocallyLight(const GrayImageView&
 
 const std::vector<LightQuad>& SheetFinder::FindFaintlyDark(const GrayImageView& image) {
   return LookAgainLocally(image, kFaintLightRatio);
+}
+
+const std::vector<LightQuad>& SheetFinder::FindNarrowed(const GrayImageView& image) {
+  candidates_.clear();
+  if (first_threshold_ >= 0 && image.width / options_.cell_px == grid_width_ &&
+      image.height / options_.cell_px == grid_height_) {
+    MarkLocallyDark(kLocalLightRatio);
+    Narrow();
+    AddComponents(image, narrowed_.data(), first_threshold_);
+    KeepBest();
+  }
+  return candidates_;
 }
 
 const std::vector<LightQuad>& SheetFinder::LookAgainLocally(const GrayImageView& image,

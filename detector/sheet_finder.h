@@ -18,7 +18,8 @@
 //      than the paper beside it, a glare's core is no paper, a grey hand is darker than the
 //      paper): this last pass is also FindLocallyLight's, for a caller none of whose
 //      candidates was the target, and FindFaintlyDark's with 0.9 instead of 0.8 (a pale hand
-//      or sleeve);
+//      or sleeve), and FindNarrowed's with each cell then the darkest of the 3 x 3 around it
+//      (a bridge of light cells a cell or two wide, a stripe washed out over a short stretch);
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
@@ -107,6 +108,14 @@ class SheetFinder {
   /// of paper a little darker than the target's paper, lying across the middle cell and its
   /// neighbours, which it joins at the coarser ratio). Same validity as Find's.
   const std::vector<LightQuad>& FindFaintlyDark(const GrayImageView& image);
+  /// More candidates of the image last given to Find, for when none of the looks above found
+  /// the target: the first last pass's cells (0.8 of the brightest near them), each made the
+  /// darkest of itself and its eight neighbours, at the first threshold. A bridge of light
+  /// cells one or two cells wide (a stripe washed out over a short stretch, a gap a blur
+  /// leaves at a crossing) no longer joins the middle cell to its neighbour; the cells shrink
+  /// by one on each side, which Refine takes back. Quadrilaterals found before are left out.
+  /// Same validity as Find's.
+  const std::vector<LightQuad>& FindNarrowed(const GrayImageView& image);
   /// Step 4 for one candidate of the same image (done on demand: a caller usually needs the
   /// first only): its sides moved onto the light/dark edges, sub-pixel. True when quad is
   /// (now) refined; its corners are unchanged otherwise.
@@ -135,6 +144,8 @@ class SheetFinder {
   void AddComponents(const GrayImageView& image, const std::uint8_t* grid, int threshold);
   /// local_: the cells, those much darker than the brightest near them set to 0.
   void MarkLocallyDark(double light_ratio);
+  /// narrowed_: local_'s minimum over 3 x 3 cells.
+  void Narrow();
   /// Candidates of local_ at first_threshold_ (the last pass).
   void AddLocallyLight(const GrayImageView& image, double light_ratio);
   /// The last pass again for the image last given to Find (nothing for another size), best
@@ -151,7 +162,7 @@ class SheetFinder {
   SheetFinderOptions options_;
   int grid_width_ = 0, grid_height_ = 0;
   std::vector<std::uint8_t> cells_;
-  std::vector<std::uint8_t> local_, row_max_;
+  std::vector<std::uint8_t> local_, row_max_, narrowed_;
   int first_threshold_ = -1;             ///< the first pass's threshold of the last frame; -1: none
   double first_light_ = 0.0;             ///< the mean of the cells at or above it
   bool local_done_ = false;              ///< the last pass made for the last frame

@@ -843,6 +843,13 @@ const TargetFrame& TargetPoseTracker::Track(
         frame_.find_us += Microseconds(start);
         found = AttemptCells(image, faint);
       }
+      if (!found) {
+        // ... and the light cells narrowed by one (a stripe washed out over a short stretch).
+        start = std::chrono::steady_clock::now();
+        const std::vector<LightQuad>& narrowed = finder_.FindNarrowed(image);
+        frame_.find_us += Microseconds(start);
+        found = AttemptCells(image, narrowed);
+      }
       if (!found && options_.corner_cells) found = AttemptCornerCells(image);
     }
     if (!found && options_.image_fallback) {

@@ -16,7 +16,8 @@
 //      the first one as the middle cell cut short by something lying across it
 //      (target_layout.h: UncutCells). When none gives a pose, the same for the finder's later
 //      looks (SheetFinder::FindLocallyLight: a hand or a glare joining the middle cell to its
-//      neighbour; FindFaintlyDark: a pale hand); then the candidates closed in on two sides
+//      neighbour; FindFaintlyDark: a pale hand; FindNarrowed: a stripe washed out over a short
+//      stretch, a bridge a cell or two wide); then the candidates closed in on two sides
 //      that meet, set aside on the way, as each of the sheet's corner cells (the paper beyond
 //      one stripe of each pair, out to the sheet's corner: a glare over the middle of the
 //      sheet joins the middle cell to the cells beyond all four stripes).

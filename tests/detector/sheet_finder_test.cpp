@@ -200,6 +200,49 @@ TEST_F(SheetFinderInALivedInScene, APenAlongASideLeavesItWhereTheStripeIs) {
   EXPECT_TRUE(FindsTheMiddleCellPast(pen));
 }
 
+// A '#' drawn on a sheet, its upper stripe broken by a gap of paper 16 px long (a stripe washed
+// out over a short stretch): the middle cell joins the cell beyond through a bridge two cells
+// wide at every threshold and ratio; narrowed by one cell it stands alone again, closed in on
+// four sides, and refines back onto the stripes' edges.
+TEST(SheetFinder, AGapOfACellInAStripeIsClosedWhenTheCellsAreNarrowed) {
+  vpImage<unsigned char> image(480, 640, 70);
+  const auto fill = [&](int left, int top, int right, int bottom, unsigned char grey) {
+    for (int v = top; v < bottom; ++v) {
+      for (int u = left; u < right; ++u) image[v][u] = grey;
+    }
+  };
+  fill(100, 60, 540, 420, 215);   // the sheet
+  fill(230, 70, 250, 410, 30);    // line 1
+  fill(392, 70, 408, 410, 30);    // line 3
+  fill(110, 163, 530, 177, 30);   // line 2
+  fill(110, 302, 530, 318, 30);   // line 4
+  fill(296, 163, 312, 177, 215);  // the gap
+  const std::array<Point2d, 4> middle = {Point2d{249.5, 176.5}, Point2d{391.5, 176.5},
+                                         Point2d{391.5, 301.5}, Point2d{249.5, 301.5}};
+  const auto is_middle = [&](LightQuad quad, const SheetFinder& finder) {
+    if (quad.ClosedSideCount() < 4 || !finder.Refine(ViewOf(image), &quad)) return false;
+    for (const Point2d& corner : quad.corners) {
+      const bool near = std::any_of(middle.begin(), middle.end(), [&](const Point2d& m) {
+        return std::hypot(corner.u - m.u, corner.v - m.v) < 1.5;
+      });
+      if (!near) return false;
+    }
+    return true;
+  };
+  SheetFinder finder;
+  const GrayImageView view = ViewOf(image);
+  const auto holds_middle = [&](const std::vector<LightQuad>& found) {
+    return std::any_of(found.begin(), found.end(),
+                       [&](const LightQuad& quad) { return is_middle(quad, finder); });
+  };
+  EXPECT_FALSE(holds_middle(finder.Find(view)));
+  EXPECT_FALSE(holds_middle(finder.FindLocallyLight(view)));
+  EXPECT_FALSE(holds_middle(finder.FindFaintlyDark(view)));
+  const std::vector<LightQuad>& narrowed = finder.FindNarrowed(view);
+  EXPECT_TRUE(std::any_of(narrowed.begin(), narrowed.end(),
+                          [&](const LightQuad& quad) { return is_middle(quad, finder); }));
+}
+
 TEST(SheetFinder, FindLocallyLightAddsNothingAfterFindMadeThatPass) {
   RenderOptions render;
   render.noise_sigma = 3.0;
