@@ -184,6 +184,39 @@ bool RefineSide(const GrayImageView& image, const Side& side, double light, doub
   return true;
 }
 
+// out[i]: the brightest (take_brightest) or the darkest of `in` over the (2 radius + 1)^2
+// cells around cell i of a w x h grid, clipped to the grid (separable: rows, then columns);
+// *rows is working memory.
+void ExtremeAround(const std::vector<std::uint8_t>& in, int w, int h, int radius,
+                   bool take_brightest, std::vector<std::uint8_t>* rows,
+                   std::vector<std::uint8_t>* out) {
+  const auto extreme = [take_brightest](std::uint8_t a, std::uint8_t b) {
+    return take_brightest ? std::max(a, b) : std::min(a, b);
+  };
+  rows->resize(in.size());
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* row = in.data() + static_cast<std::size_t>(y) * w;
+    std::uint8_t* row_out = rows->data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t value = row[x];
+      for (int k = std::max(0, x - radius); k <= std::min(w - 1, x + radius); ++k) {
+        value = extreme(value, row[k]);
+      }
+      row_out[x] = value;
+    }
+  }
+  out->resize(in.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t value = (*rows)[static_cast<std::size_t>(y) * w + x];
+      for (int k = std::max(0, y - radius); k <= std::min(h - 1, y + radius); ++k) {
+        value = extreme(value, (*rows)[static_cast<std::size_t>(k) * w + x]);
+      }
+      (*out)[static_cast<std::size_t>(y) * w + x] = value;
+    }
+  }
+}
+
 // Bit i of words (64 cells a word) set when cells[i] >= threshold, i < n; the bits past n are 0.
 void LightMask(const std::uint8_t* cells, int n, int threshold, std::uint64_t* words) {
   const int word_count = (n + 63) / 64;
@@ -438,56 +471,17 @@ bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
 }
 
 void SheetFinder::MarkLocallyDark(double light_ratio) {
-  // A separable maximum over (2 kLocalRadiusCells + 1)^2 cells, then the cells darker than
+  // The brightest over (2 kLocalRadiusCells + 1)^2 cells, then the cells darker than
   // light_ratio of it set to 0.
-  const int w = grid_width_, h = grid_height_, r = kLocalRadiusCells;
   // Where the paper itself is not saturated, a saturated cell is a glare's core, over ink and
   // paper alike: it tells nothing, and taken as light it would join the cells around it.
   const bool glare_saturates = first_light_ < kSaturatedGrey - kLocalSaturationMargin;
-  row_max_.resize(cells_.size());
-  for (int y = 0; y < h; ++y) {
-    const std::uint8_t* in = cells_.data() + static_cast<std::size_t>(y) * w;
-    std::uint8_t* out = row_max_.data() + static_cast<std::size_t>(y) * w;
-    for (int x = 0; x < w; ++x) {
-      out[x] = *std::max_element(in + std::max(0, x - r), in + std::min(w, x + r + 1));
-    }
-  }
+  ExtremeAround(cells_, grid_width_, grid_height_, kLocalRadiusCells, true, &rows_, &brightest_);
   local_.resize(cells_.size());
-  for (int y = 0; y < h; ++y) {
-    const int top = std::max(0, y - r), bottom = std::min(h - 1, y + r);
-    for (int x = 0; x < w; ++x) {
-      std::uint8_t brightest = 0;
-      for (int k = top; k <= bottom; ++k) {
-        brightest = std::max(brightest, row_max_[static_cast<std::size_t>(k) * w + x]);
-      }
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      const bool light =
-          cells_[i] >= light_ratio * brightest && !(glare_saturates && cells_[i] >= kSaturatedGrey);
-      local_[i] = light ? cells_[i] : 0;
-    }
-  }
-}
-
-void SheetFinder::Narrow() {
-  // A separable minimum over 3 x 3 cells of the last pass's grid.
-  const int w = grid_width_, h = grid_height_;
-  row_max_.resize(local_.size());  // here: each row's minimum over three cells
-  for (int y = 0; y < h; ++y) {
-    const std::uint8_t* in = local_.data() + static_cast<std::size_t>(y) * w;
-    std::uint8_t* out = row_max_.data() + static_cast<std::size_t>(y) * w;
-    for (int x = 0; x < w; ++x) {
-      out[x] = *std::min_element(in + std::max(0, x - 1), in + std::min(w, x + 2));
-    }
-  }
-  narrowed_.resize(local_.size());
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      std::uint8_t darkest = 255;
-      for (int k = std::max(0, y - 1); k <= std::min(h - 1, y + 1); ++k) {
-        darkest = std::min(darkest, row_max_[static_cast<std::size_t>(k) * w + x]);
-      }
-      narrowed_[static_cast<std::size_t>(y) * w + x] = darkest;
-    }
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    const bool light = cells_[i] >= light_ratio * brightest_[i] &&
+                       !(glare_saturates && cells_[i] >= kSaturatedGrey);
+    local_[i] = light ? cells_[i] : 0;
   }
 }
 
@@ -666,21 +660,24 @@ const std::vector<LightQuad>& SheetFinder::FindFaintlyDark(const GrayImageView& 
 
 const std::vector<LightQuad>& SheetFinder::FindNarrowed(const GrayImageView& image) {
   candidates_.clear();
-  if (first_threshold_ >= 0 && image.width / options_.cell_px == grid_width_ &&
-      image.height / options_.cell_px == grid_height_) {
+  if (first_threshold_ >= 0 && OnTheLastGrid(image)) {
     MarkLocallyDark(kLocalLightRatio);
-    Narrow();
+    ExtremeAround(local_, grid_width_, grid_height_, 1, false, &rows_, &narrowed_);
     AddComponents(image, narrowed_.data(), first_threshold_);
     KeepBest();
   }
   return candidates_;
 }
 
+bool SheetFinder::OnTheLastGrid(const GrayImageView& image) const {
+  return image.width / options_.cell_px == grid_width_ &&
+         image.height / options_.cell_px == grid_height_;
+}
+
 const std::vector<LightQuad>& SheetFinder::LookAgainLocally(const GrayImageView& image,
                                                             double light_ratio) {
   candidates_.clear();
-  if (image.width / options_.cell_px == grid_width_ &&
-      image.height / options_.cell_px == grid_height_) {
+  if (OnTheLastGrid(image)) {
     AddLocallyLight(image, light_ratio);
     KeepBest();
   }

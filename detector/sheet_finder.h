@@ -144,13 +144,13 @@ class SheetFinder {
   void AddComponents(const GrayImageView& image, const std::uint8_t* grid, int threshold);
   /// local_: the cells, those much darker than the brightest near them set to 0.
   void MarkLocallyDark(double light_ratio);
-  /// narrowed_: local_'s minimum over 3 x 3 cells.
-  void Narrow();
   /// Candidates of local_ at first_threshold_ (the last pass).
   void AddLocallyLight(const GrayImageView& image, double light_ratio);
   /// The last pass again for the image last given to Find (nothing for another size), best
   /// first: FindLocallyLight's and FindFaintlyDark's.
   const std::vector<LightQuad>& LookAgainLocally(const GrayImageView& image, double light_ratio);
+  /// Whether `image` has the grid of the image last given to Find (a later look's condition).
+  bool OnTheLastGrid(const GrayImageView& image) const;
   /// candidates_ best first, at most max_candidates.
   void KeepBest();
   int Root(int run);
@@ -162,7 +162,8 @@ class SheetFinder {
   SheetFinderOptions options_;
   int grid_width_ = 0, grid_height_ = 0;
   std::vector<std::uint8_t> cells_;
-  std::vector<std::uint8_t> local_, row_max_, narrowed_;
+  std::vector<std::uint8_t> local_, narrowed_;
+  std::vector<std::uint8_t> rows_, brightest_;  ///< working memory of the cells' filters
   int first_threshold_ = -1;             ///< the first pass's threshold of the last frame; -1: none
   double first_light_ = 0.0;             ///< the mean of the cells at or above it
   bool local_done_ = false;              ///< the last pass made for the last frame

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 
@@ -696,17 +697,16 @@ void TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource 
   }
   // A stripe whose points span a short stretch of it leaves the pose's tilt about it loosely
   // told (a glare's slope, a blur across it, tilts it by degrees): its middle between the
-  // crossings, scanned from the pose found, tells more.
-  const TargetFrame first = frame_;
-  const std::vector<DetectedLine> first_lines = lines_;
-  const vpHomography plane_to_image = PlaneToImage(first.pose.cMo);
+  // crossings, scanned from the pose found, tells more. When that gives no pose, the first
+  // stands.
+  const vpHomogeneousMatrix first = frame_.pose.cMo;
+  const vpHomography plane_to_image = PlaneToImage(first);
   TargetBorders(layout_, plane_to_image, camera_, options_.borders, &borders_);
   AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
-  if (!borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt, source,
-                                   Expected{first.pose.cMo, false})) {
-    return;
-  }
-  RestoreFrame(first, first_lines);
+  AsGuesses([&] {
+    return !borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt,
+                                        source, Expected{first, false});
+  });
 }
 
 bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
@@ -745,51 +745,56 @@ bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
   return false;
 }
 
-bool TargetPoseTracker::AttemptEdgeCellGuesses(const GrayImageView& image, const LightQuad& cell) {
-  // Guesses: when none gives a pose, the frame says what the cell as the middle one gave.
+bool TargetPoseTracker::AsGuesses(const std::function<bool()>& attempts) {
   const TargetFrame as_found = frame_;
   const std::vector<DetectedLine> lines_as_found = lines_;
-  for (int outer = 0; outer < 4; ++outer) {
-    for (const TargetLayout::EdgeCell& edge : layout_.edge_cells) {
-      const std::optional<vpHomography> beyond =
-          PlaneToImageFromEdgeCell(edge, cell, camera_, outer);
-      if (beyond && AttemptCandidate(image, *beyond, ScanSource::kEdgeCell)) return true;
-    }
-  }
+  if (attempts()) return true;
   RestoreFrame(as_found, lines_as_found);
   return false;
+}
+
+bool TargetPoseTracker::AttemptEdgeCellGuesses(const GrayImageView& image, const LightQuad& cell) {
+  // When none gives a pose, the frame says what the cell as the middle one gave.
+  return AsGuesses([&] {
+    for (int outer = 0; outer < 4; ++outer) {
+      for (const TargetLayout::EdgeCell& edge : layout_.edge_cells) {
+        const std::optional<vpHomography> beyond =
+            PlaneToImageFromEdgeCell(edge, cell, camera_, outer);
+        if (beyond && AttemptCandidate(image, *beyond, ScanSource::kEdgeCell)) return true;
+      }
+    }
+    return false;
+  });
 }
 
 bool TargetPoseTracker::AttemptUncut(const GrayImageView& image, const LightQuad& cell) {
-  // These are guesses: when none gives a pose, the frame says what the cell as found gave.
-  const TargetFrame as_found = frame_;
-  const std::vector<DetectedLine> lines_as_found = lines_;
-  for (int cut = 0; cut < 4; ++cut) {
-    for (const LightQuad& uncut : UncutCells(layout_, cell, cut)) {
-      const std::optional<vpHomography> h = PlaneToImageFromCell(layout_, uncut, camera_);
-      if (h && AttemptCandidate(image, *h, ScanSource::kMiddleCell)) return true;
+  // When none gives a pose, the frame says what the cell as found gave.
+  return AsGuesses([&] {
+    for (int cut = 0; cut < 4; ++cut) {
+      for (const LightQuad& uncut : UncutCells(layout_, cell, cut)) {
+        const std::optional<vpHomography> h = PlaneToImageFromCell(layout_, uncut, camera_);
+        if (h && AttemptCandidate(image, *h, ScanSource::kMiddleCell)) return true;
+      }
     }
-  }
-  RestoreFrame(as_found, lines_as_found);
-  return false;
+    return false;
+  });
 }
 
 bool TargetPoseTracker::AttemptCornerCells(const GrayImageView& image) {
-  const TargetFrame as_found = frame_;
-  const std::vector<DetectedLine> lines_as_found = lines_;
-  for (LightQuad quad : corner_guesses_) {
-    const int inner = ClosedCorner(quad);
-    const auto refine_start = std::chrono::steady_clock::now();
-    finder_.Refine(image, &quad);
-    frame_.find_us += Microseconds(refine_start);
-    for (const TargetLayout::CornerCell& cell : layout_.corner_cells) {
-      const std::optional<vpHomography> h =
-          PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner, camera_);
-      if (h && AttemptCandidate(image, *h, ScanSource::kCornerCell)) return true;
+  return AsGuesses([&] {
+    for (LightQuad quad : corner_guesses_) {
+      const int inner = ClosedCorner(quad);
+      const auto refine_start = std::chrono::steady_clock::now();
+      finder_.Refine(image, &quad);
+      frame_.find_us += Microseconds(refine_start);
+      for (const TargetLayout::CornerCell& cell : layout_.corner_cells) {
+        const std::optional<vpHomography> h =
+            PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner, camera_);
+        if (h && AttemptCandidate(image, *h, ScanSource::kCornerCell)) return true;
+      }
     }
-  }
-  RestoreFrame(as_found, lines_as_found);
-  return false;
+    return false;
+  });
 }
 
 void TargetPoseTracker::RestoreFrame(const TargetFrame& saved,
@@ -823,35 +828,21 @@ const TargetFrame& TargetPoseTracker::Track(
                         Expected{*prior, false});
       }
     }
-    if (!found) {
-      auto start = std::chrono::steady_clock::now();
-      const std::vector<LightQuad>& cells = finder_.Find(image);
-      frame_.find_us = Microseconds(start);
+    // The finder's looks in turn, each only when none of the one before was the target's:
+    // its candidates; the cells again, those much darker than the paper near them taken as
+    // dark (a hand or a glare joining the middle cell to its neighbour); those a little darker
+    // (a pale hand across it); the light cells narrowed by one (a stripe washed out over a
+    // short stretch).
+    using Look = const std::vector<LightQuad>& (SheetFinder::*)(const GrayImageView&);
+    for (const Look look : {&SheetFinder::Find, &SheetFinder::FindLocallyLight,
+                            &SheetFinder::FindFaintlyDark, &SheetFinder::FindNarrowed}) {
+      if (found) break;
+      const auto start = std::chrono::steady_clock::now();
+      const std::vector<LightQuad>& cells = (finder_.*look)(image);
+      frame_.find_us += Microseconds(start);
       found = AttemptCells(image, cells);
-      if (!found) {
-        // None was the target's: the cells again, those much darker than the paper near them
-        // taken as dark (a hand or a glare joining the middle cell to its neighbour).
-        start = std::chrono::steady_clock::now();
-        const std::vector<LightQuad>& more = finder_.FindLocallyLight(image);
-        frame_.find_us += Microseconds(start);
-        found = AttemptCells(image, more);
-      }
-      if (!found) {
-        // ... and those a little darker than the paper near them (a pale hand across it).
-        start = std::chrono::steady_clock::now();
-        const std::vector<LightQuad>& faint = finder_.FindFaintlyDark(image);
-        frame_.find_us += Microseconds(start);
-        found = AttemptCells(image, faint);
-      }
-      if (!found) {
-        // ... and the light cells narrowed by one (a stripe washed out over a short stretch).
-        start = std::chrono::steady_clock::now();
-        const std::vector<LightQuad>& narrowed = finder_.FindNarrowed(image);
-        frame_.find_us += Microseconds(start);
-        found = AttemptCells(image, narrowed);
-      }
-      if (!found && options_.corner_cells) found = AttemptCornerCells(image);
     }
+    if (!found && options_.corner_cells) found = AttemptCornerCells(image);
     if (!found && options_.image_fallback) {
       found = Attempt(image, ScanBorders{}, {}, std::nullopt, ScanSource::kImage) &&
               ConfirmOnTarget(image);

@@ -48,6 +48,7 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -284,6 +285,9 @@ class TargetPoseTracker {
   /// frame_ and lines_ back to `saved` and `saved_lines`, an attempt since then undone but for
   /// its time and the candidates it scanned.
   void RestoreFrame(const TargetFrame& saved, const std::vector<DetectedLine>& saved_lines);
+  /// `attempts`, guesses: true when they accept a pose; otherwise frame_ and lines_ are as
+  /// before them (RestoreFrame), with the time they spent added.
+  bool AsGuesses(const std::function<bool()>& attempts);
   /// A sheet finder's candidate: its borders scanned, first as few as a tracked frame's
   /// (tracked_borders), then `borders` when those give no pose or one identified at more
   /// than quick_max_identification_cost; true when a pose is accepted.

@@ -58,6 +58,33 @@ TEST(PlaneProjector, ItsPixelsAreViSPsDistortedProjection) {
 namespace oal {
 namespace {
 
+// The quadrilateral a sheet finder sees at a cell's corners (`cell`, on the target plane)
+// through `truth`, its corners turned so that the cell's corner `plane_first` is its corner
+// `quad_first`.
+LightQuad QuadSeenAt(const std::array<Point2d, 4>& cell, int plane_first, int quad_first,
+                     const vpHomography& truth, const Lens& camera) {
+  LightQuad quad;
+  for (int k = 0; k < 4; ++k) {
+    const Point2d& plane = cell[static_cast<std::size_t>((k + plane_first - quad_first + 4) % 4)];
+    EXPECT_TRUE(
+        ProjectPlanePoint(truth, camera, plane, &quad.corners[static_cast<std::size_t>(k)]));
+  }
+  return quad;
+}
+
+// `found` puts the middle cell's corners where the pose's homography `truth` does.
+void ExpectMapsAsThePose(const std::optional<vpHomography>& found, const vpHomography& truth,
+                         const TargetLayout& layout, const Lens& camera) {
+  ASSERT_TRUE(found.has_value());
+  for (const Point2d& plane : layout.middle_cell) {
+    Point2d a, b;
+    ASSERT_TRUE(ProjectPlanePoint(*found, camera, plane, &a));
+    ASSERT_TRUE(ProjectPlanePoint(truth, camera, plane, &b));
+    EXPECT_NEAR(a.u, b.u, 1e-6);
+    EXPECT_NEAR(a.v, b.v, 1e-6);
+  }
+}
+
 // An A3 sheet's edge cells: between two stripes' inner edges, from the stripe they cross out to
 // the sheet's edge; a quadrilateral seen at their corners, its open side on the sheet's edge,
 // maps the plane as the pose does.
@@ -83,23 +110,9 @@ TEST(TargetLayout, EdgeCellsReachTheSheetsEdgeAndMapBackThroughTheirOpenSide) {
   for (const TargetLayout::EdgeCell& edge : layout.edge_cells) {
     for (int open_at = 0; open_at < 4; ++open_at) {
       // The quadrilateral as a finder would give it, its corners turned to start anywhere.
-      LightQuad quad;
-      for (int k = 0; k < 4; ++k) {
-        const Point2d& plane =
-            edge.corners[static_cast<std::size_t>((k + edge.outer - open_at + 4) % 4)];
-        ASSERT_TRUE(
-            ProjectPlanePoint(truth, camera, plane, &quad.corners[static_cast<std::size_t>(k)]));
-      }
+      LightQuad quad = QuadSeenAt(edge.corners, edge.outer, open_at, truth, camera);
       quad.closed_sides = static_cast<std::uint8_t>(0xF & ~(1u << open_at));
-      const std::optional<vpHomography> found = PlaneToImageFromEdgeCell(edge, quad, camera);
-      ASSERT_TRUE(found.has_value());
-      for (const Point2d& plane : layout.middle_cell) {
-        Point2d a, b;
-        ASSERT_TRUE(ProjectPlanePoint(*found, camera, plane, &a));
-        ASSERT_TRUE(ProjectPlanePoint(truth, camera, plane, &b));
-        EXPECT_NEAR(a.u, b.u, 1e-6);
-        EXPECT_NEAR(a.v, b.v, 1e-6);
-      }
+      ExpectMapsAsThePose(PlaneToImageFromEdgeCell(edge, quad, camera), truth, layout, camera);
     }
   }
   LightQuad closed;
@@ -140,23 +153,9 @@ TEST(TargetLayout, CornerCellsReachTheSheetsCornersAndMapBackFromTheirClosedCorn
   const vpHomography truth = PlaneToImage(cMo);
   for (const TargetLayout::CornerCell& cell : layout.corner_cells) {
     for (int inner_at = 0; inner_at < 4; ++inner_at) {
-      LightQuad quad;
-      for (int k = 0; k < 4; ++k) {
-        const Point2d& plane =
-            cell.corners[static_cast<std::size_t>((k + cell.inner - inner_at + 4) % 4)];
-        ASSERT_TRUE(
-            ProjectPlanePoint(truth, camera, plane, &quad.corners[static_cast<std::size_t>(k)]));
-      }
-      const std::optional<vpHomography> found =
-          PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner_at, camera);
-      ASSERT_TRUE(found.has_value());
-      for (const Point2d& plane : layout.middle_cell) {
-        Point2d a, b;
-        ASSERT_TRUE(ProjectPlanePoint(*found, camera, plane, &a));
-        ASSERT_TRUE(ProjectPlanePoint(truth, camera, plane, &b));
-        EXPECT_NEAR(a.u, b.u, 1e-6);
-        EXPECT_NEAR(a.v, b.v, 1e-6);
-      }
+      const LightQuad quad = QuadSeenAt(cell.corners, cell.inner, inner_at, truth, camera);
+      ExpectMapsAsThePose(PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner_at, camera),
+                          truth, layout, camera);
     }
   }
 }
