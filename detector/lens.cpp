@@ -376,13 +376,21 @@ double CornerRadius2(const Lens& lens, int width, int height) {
 }
 
 void CheckPerspectiveCamera(const Lens& lens, const std::string& field) {
+  // A lens that passes builds none of the field names (the pose checks its camera every frame).
+  const auto coefficients = lens.distortion().ToArray();
+  bool finite = std::isfinite(lens.u0()) && std::isfinite(lens.v0()) && std::isfinite(lens.kdu()) &&
+                std::isfinite(lens.kud());
+  for (const double c : coefficients) finite = finite && std::isfinite(c);
+  if (finite && lens.px() > 0.0 && std::isfinite(lens.px()) && lens.py() > 0.0 &&
+      std::isfinite(lens.py())) {
+    return;
+  }
   RequireOption(lens.px() > 0.0 && std::isfinite(lens.px()), field + ".px", lens.px(), "px > 0");
   RequireOption(lens.py() > 0.0 && std::isfinite(lens.py()), field + ".py", lens.py(), "py > 0");
   RequireOption(std::isfinite(lens.u0()), field + ".u0", lens.u0(), "u0 is finite");
   RequireOption(std::isfinite(lens.v0()), field + ".v0", lens.v0(), "v0 is finite");
   RequireOption(std::isfinite(lens.kdu()), field + ".kdu", lens.kdu(), "kdu is finite");
   RequireOption(std::isfinite(lens.kud()), field + ".kud", lens.kud(), "kud is finite");
-  const auto coefficients = lens.distortion().ToArray();
   for (std::size_t i = 0; i < coefficients.size(); ++i) {
     RequireOption(std::isfinite(coefficients[i]), field + "." + Distortion::kNames[i],
                   coefficients[i], std::string(Distortion::kNames[i]) + " is finite");

@@ -155,29 +155,35 @@ bool RefineSide(const GrayImageView& image, const Side& side, double light, doub
   if (points.size() < kMinEdgePoints) return false;
   // The line through two of the points that most of the others lie on (a hand or a pen over
   // part of the side puts its own edge in a few of them); distances by the cross product, no
-  // angles, as this runs for every pair.
-  auto on_line = [&](std::size_t i, std::size_t j, const Point2d& p) {
-    const double du = points[j].u - points[i].u, dv = points[j].v - points[i].v;
-    const double length = std::hypot(du, dv);
-    return length > 0.0 && std::fabs((p.u - points[i].u) * dv - (p.v - points[i].v) * du) <=
-                               kEdgeTolerancePx * length;
+  // angles, as this runs for every pair (the pair's length once, not once a point).
+  struct Pair {
+    Point2d from;
+    double du = 0.0, dv = 0.0, tolerance = 0.0;
+    bool Holds(const Point2d& p) const {
+      return tolerance > 0.0 && std::fabs((p.u - from.u) * dv - (p.v - from.v) * du) <= tolerance;
+    }
   };
-  std::size_t most = 0, best_i = 0, best_j = 0;
+  const auto pair_of = [&points](std::size_t i, std::size_t j) {
+    const double du = points[j].u - points[i].u, dv = points[j].v - points[i].v;
+    return Pair{points[i], du, dv, kEdgeTolerancePx * std::hypot(du, dv)};
+  };
+  std::size_t most = 0;
+  Pair best;
   for (std::size_t i = 0; i < points.size(); ++i) {
     for (std::size_t j = i + 1; j < points.size(); ++j) {
+      const Pair pair = pair_of(i, j);
       const auto on = static_cast<std::size_t>(std::count_if(
-          points.begin(), points.end(), [&](const Point2d& p) { return on_line(i, j, p); }));
+          points.begin(), points.end(), [&pair](const Point2d& p) { return pair.Holds(p); }));
       if (on > most) {
         most = on;
-        best_i = i;
-        best_j = j;
+        best = pair;
       }
     }
   }
   if (most < kMinEdgePoints) return false;
   std::vector<Point2d> kept;
   for (const Point2d& p : points) {
-    if (on_line(best_i, best_j, p)) kept.push_back(p);
+    if (best.Holds(p)) kept.push_back(p);
   }
   points.swap(kept);
   *line = FitLine(points);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "base/check.h"
@@ -29,12 +30,10 @@ constexpr int kMinAgreeing = 3;
 // this long, or a third of the stripe's samples.
 constexpr std::size_t kExcusedRun = 2;
 
-// The grey level nearest to the image point p; false outside the image (a pixel's margin kept).
-bool GreyAt(const GrayImageView& image, const Point2d& p, int* grey) {
+// Whether the pixel nearest to the image point p is inside the image, a pixel's margin kept.
+bool InImage(const GrayImageView& image, const Point2d& p) {
   const double u = p.u + 0.5, v = p.v + 0.5;
-  if (!(u >= 1.0 && v >= 1.0 && u < image.width - 1.0 && v < image.height - 1.0)) return false;
-  *grey = image.at(static_cast<int>(u), static_cast<int>(v));
-  return true;
+  return u >= 1.0 && v >= 1.0 && u < image.width - 1.0 && v < image.height - 1.0;
 }
 
 // The part of stripe k's span whose centre line is in view, to kCoarseSteps of the span (the
@@ -46,8 +45,7 @@ Interval StripeInView(const GrayImageView& image, const TargetLayout& layout,
   const Interval span = layout.stripes[static_cast<std::size_t>(k)].along;
   const auto seen = [&](double along) {
     Point2d pixel;
-    int grey = 0;
-    return projector.Project(layout.OnStripe(k, along, 0.0), &pixel) && GreyAt(image, pixel, &grey);
+    return projector.Project(layout.OnStripe(k, along, 0.0), &pixel) && InImage(image, pixel);
   };
   if (seen(span.lo) && seen(span.hi) && seen(0.5 * (span.lo + span.hi))) return span;
   const double step = (span.hi - span.lo) / kCoarseSteps;
@@ -63,13 +61,15 @@ Interval StripeInView(const GrayImageView& image, const TargetLayout& layout,
 
 enum class Verdict { kAgrees, kContradicts, kUnknown, kFlatLight };
 
-// One profile across a stripe and where the pose puts the stripe's edges and middle on it
-// (indices, fractional).
+// One profile across a stripe, where the pose puts the stripe's edges and middle on it
+// (indices, fractional), and its darkest and lightest points (read with it: each profile is
+// judged on them, and they cost nothing more there).
 struct Profile {
-  std::array<int, kMaxProfile> grey{};
+  std::array<std::uint8_t, kMaxProfile> grey{};
   int n = 0;
   double spacing_px = 1.0;
   double low_edge = 0.0, centre = 0.0, high_edge = 0.0;
+  int darkest = 255, darkest_at = 0, lightest = 0;
 };
 
 // Reads the profile from `from` to `to` (pixels) whose plane ends lie at depths z_from, z_to;
@@ -78,16 +78,28 @@ struct Profile {
 // s) z_from + s z_to) of the image segment). False when part of it is out of the image.
 bool ReadProfile(const GrayImageView& image, const Point2d& from, const Point2d& to, double z_from,
                  double z_to, double half, double reach, Profile* profile) {
+  // The segment lies inside the image when both its ends do.
+  if (!InImage(image, from) || !InImage(image, to)) return false;
   const double length = std::hypot(to.u - from.u, to.v - from.v);
-  profile->n = std::clamp(static_cast<int>(std::ceil(length)) + 1, kMinProfile, kMaxProfile);
-  profile->spacing_px = length / (profile->n - 1);
-  for (int i = 0; i < profile->n; ++i) {
-    const double t = static_cast<double>(i) / (profile->n - 1);
-    if (!GreyAt(image, {from.u + t * (to.u - from.u), from.v + t * (to.v - from.v)},
-                &profile->grey[static_cast<std::size_t>(i)])) {
-      return false;
-    }
+  const int n = std::clamp(static_cast<int>(std::ceil(length)) + 1, kMinProfile, kMaxProfile);
+  profile->n = n;
+  profile->spacing_px = length / (n - 1);
+  // Nearest pixels along the segment, its coordinates in 16.16 fixed point.
+  constexpr double kOne = 65536.0;
+  const auto fixed = [](double x) { return static_cast<std::int64_t>(std::llround(x * kOne)); };
+  const std::int64_t step_u = fixed((to.u - from.u) / (n - 1)),
+                     step_v = fixed((to.v - from.v) / (n - 1));
+  std::int64_t u = fixed(from.u + 0.5), v = fixed(from.v + 0.5);
+  int darkest = 256, darkest_at = 0, lightest = -1;
+  for (int i = 0; i < n; ++i, u += step_u, v += step_v) {
+    const int grey = image.at(static_cast<int>(u >> 16), static_cast<int>(v >> 16));
+    profile->grey[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(grey);
+    if (grey < darkest) darkest = grey, darkest_at = i;
+    lightest = std::max(lightest, grey);
   }
+  profile->darkest = darkest;
+  profile->darkest_at = darkest_at;
+  profile->lightest = lightest;
   const auto index = [&](double offset) {
     const double s = (offset + reach) / (2.0 * reach);
     const double t = s * z_to / ((1.0 - s) * z_from + s * z_to);
@@ -111,7 +123,7 @@ int Contrast(const Profile& p) {
   const int n = p.n;
   const int light =
       std::min(std::max({at(0), at(1), at(2)}), std::max({at(n - 1), at(n - 2), at(n - 3)}));
-  return light - *std::min_element(p.grey.begin(), p.grey.begin() + n);
+  return light - p.darkest;
 }
 
 int MedianOf(std::vector<int>* values) {
@@ -130,13 +142,7 @@ Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contr
   const int light_a = std::max({at(0), at(1), at(2)});
   const int light_b = std::max({at(n - 1), at(n - 2), at(n - 3)});
   const int light = std::min(light_a, light_b);
-  int darkest = 255, darkest_at = 0;
-  for (int i = 0; i < n; ++i) {
-    if (at(i) < darkest) {
-      darkest = at(i);
-      darkest_at = i;
-    }
-  }
+  const int darkest = p.darkest, darkest_at = p.darkest_at;
   *light_level = light;
   if (darkest >= kSaturated) return Verdict::kUnknown;  // a glare over it all
   if (light - darkest < min_contrast) return Verdict::kFlatLight;
@@ -329,8 +335,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
     const Profile& p = profiles[i].second;
     return !paper.empty() &&
            (lights[i] > paper_level + min_contrast ||
-            (paper_level < kSaturated - kGlareMargin &&
-             *std::max_element(p.grey.begin(), p.grey.begin() + p.n) >= kSaturated));
+            (paper_level < kSaturated - kGlareMargin && p.lightest >= kSaturated));
   };
   for (std::size_t i = 0; i < verdicts.size(); ++i) {
     if (verdicts[i] == Verdict::kContradicts && under_glare(i)) verdicts[i] = Verdict::kUnknown;

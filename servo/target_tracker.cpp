@@ -38,6 +38,10 @@ constexpr std::array<double, 3> kExpectedCorridorScales = {6.0, 2.5, 1.0};
 constexpr int kMiddleBordersPerPair = 4;
 // ... and, after a pose, when a stripe's points span less than this fraction of it.
 constexpr double kWeakStripeExtent = 0.3;
+// A fit from the other tilt this close to the first one's pose (radians, and metres over the
+// target's distance) has come back to it, however wide its corridor: on the bench frames such
+// fits land within 3e-3 rad of it, those settling on the other tilt 0.5 rad or more away.
+constexpr double kSameFitRad = 2e-3;
 
 // Candidates closed in on two sides set aside as corner cells, at most.
 constexpr std::size_t kMaxCornerGuesses = 3;
@@ -255,6 +259,14 @@ bool RunsAsWideAsStripe(const StripeFit& fit, std::size_t k) {
   return !(std::fabs(std::log(fit.width_ratio[k])) > kMaxFittedWidthLog);
 }
 
+// Whether two fits' poses are one: kSameFitRad apart at most, the translation over the
+// target's distance.
+bool SameFit(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
+  const PoseDistance d = Distance(a, b);
+  const double depth = std::max(std::fabs(b[2][3]), 1e-3);
+  return d.rotation_rad < kSameFitRad && d.translation_m < kSameFitRad * depth;
+}
+
 // The first stripe (0-3) whose kept runs are not as wide as it; -1 when none.
 int MergedStripe(const StripeFit& fit) {
   for (std::size_t k = 0; k < 4; ++k) {
@@ -448,7 +460,8 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
 }
 
 StripeFit TargetPoseTracker::FitNarrowing(const vpHomogeneousMatrix& start,
-                                          const StripeGuides* guides) const {
+                                          const StripeGuides* guides,
+                                          const vpHomogeneousMatrix* known) const {
   StripeFit fit;
   fit.cMo = start;
   for (const double scale : kExpectedCorridorScales) {
@@ -457,6 +470,11 @@ StripeFit TargetPoseTracker::FitNarrowing(const vpHomogeneousMatrix& start,
     fit = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_, detector_.Undistorts(),
                      corridor, scale == kExpectedCorridorScales[0] ? guides : nullptr);
     if (!fit.ok) break;
+    if (known != nullptr && SameFit(fit.cMo, *known)) {
+      fit.ok = false;
+      fit.message = "the fit came back to the known pose";
+      break;
+    }
   }
   return fit;
 }
@@ -465,7 +483,7 @@ StripeFit TargetPoseTracker::OtherTiltIfBetter(const StripeFit& fit) const {
   // Tried wherever the other tilt puts the stripes: from tens of pixels off, its fit in the
   // narrowing corridors still settles where it explains the points best.
   const vpHomogeneousMatrix mirrored = MirroredTilt(fit.cMo);
-  StripeFit other = FitNarrowing(mirrored, nullptr);
+  StripeFit other = FitNarrowing(mirrored, nullptr, &fit.cMo);
   if (!other.ok) return fit;
   const int kept = fit.TotalPoints(), other_kept = other.TotalPoints();
   return other_kept > kept || (other_kept == kept && other.rms_px < fit.rms_px) ? other : fit;

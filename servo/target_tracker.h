@@ -260,7 +260,10 @@ class TargetPoseTracker {
   /// fit's own, each fit from the last (the first guided by `guides`, when given): `start`
   /// may be pixels, or tens of pixels, off at the stripes' ends (a candidate's corners, a
   /// prediction).
-  StripeFit FitNarrowing(const vpHomogeneousMatrix& start, const StripeGuides* guides) const;
+  /// With `known`, it stops, not ok, as soon as a fit lands on that pose (a hair's breadth
+  /// from it): the narrower corridors would end there too.
+  StripeFit FitNarrowing(const vpHomogeneousMatrix& start, const StripeGuides* guides,
+                         const vpHomogeneousMatrix* known = nullptr) const;
   /// `fit`, or the fit from the pose tilted the other way (MirroredTilt) when it keeps more of
   /// the stripes' points, or as many closer: without a prior, the planar ambiguity.
   StripeFit OtherTiltIfBetter(const StripeFit& fit) const;
