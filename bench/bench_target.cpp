@@ -22,6 +22,7 @@
 #include "scene/bench_scene.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
+#include "servo/stripe_check.h"
 #include "servo/target_tracker.h"
 
 namespace oal {
@@ -266,6 +267,32 @@ void StripeFitAlone(benchmark::State& state) {
   state.counters["iterations"] = iterations;
 }
 
+// The model check (servo/stripe_check.h) of a tracked frame's pose: its share of a tracked
+// frame, the image as delivered (see TargetTrackedFromGrabber: copied in before each check).
+void StripeCheckAlone(benchmark::State& state) {
+  const TargetInputs& inputs = Inputs(state);
+  TargetPoseTracker tracker = MakeTracker(inputs, state);
+  tracker.Track(ViewOf(inputs.moving.front().image));
+  const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
+  const vpHomogeneousMatrix cMo = tracked.pose.cMo;
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const vpImage<unsigned char>& frame = inputs.moving[1].image;
+  vpImage<unsigned char> delivered = frame;
+  int samples = 0, agreeing = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::copy(frame.bitmap, frame.bitmap + frame.getSize(), delivered.bitmap);
+    state.ResumeTiming();
+    const StripeAgreement agreement = CheckStripes(ViewOf(delivered), layout, cMo, inputs.camera);
+    samples =
+        agreement.samples[0] + agreement.samples[1] + agreement.samples[2] + agreement.samples[3];
+    agreeing = agreement.dark[0] + agreement.dark[1] + agreement.dark[2] + agreement.dark[3];
+    benchmark::DoNotOptimize(agreement);
+  }
+  state.counters["samples"] = samples;
+  state.counters["agreeing"] = agreeing;
+}
+
 // Arguments: the image width, and the lens model the tracker is told (0: ViSP's, 1: OpenCV's).
 BENCHMARK(TargetFirstFrame)
     ->Args({640, 0})
@@ -285,6 +312,7 @@ BENCHMARK(TargetTracked)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(TargetTrackedFromGrabber)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
 BENCHMARK(StripeFitAlone)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
+BENCHMARK(StripeCheckAlone)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace oal

@@ -80,22 +80,29 @@ bool ReadProfile(const GrayImageView& image, const Point2d& from, const Point2d&
                  double z_to, double half, double reach, Profile* profile) {
   // The segment lies inside the image when both its ends do.
   if (!InImage(image, from) || !InImage(image, to)) return false;
-  const double length = std::hypot(to.u - from.u, to.v - from.v);
+  const double du = to.u - from.u, dv = to.v - from.v;
+  const double length = std::sqrt(du * du + dv * dv);  // a few pixels: hypot's care not needed
   const int n = std::clamp(static_cast<int>(std::ceil(length)) + 1, kMinProfile, kMaxProfile);
   profile->n = n;
   profile->spacing_px = length / (n - 1);
   // Nearest pixels along the segment, its coordinates in 16.16 fixed point.
   constexpr double kOne = 65536.0;
-  const auto fixed = [](double x) { return static_cast<std::int64_t>(std::llround(x * kOne)); };
-  const std::int64_t step_u = fixed((to.u - from.u) / (n - 1)),
-                     step_v = fixed((to.v - from.v) / (n - 1));
+  const auto fixed = [](double x) {  // rounded half away from zero, as llround, inline
+    const double scaled = x * kOne;
+    return static_cast<std::int64_t>(scaled + (scaled >= 0.0 ? 0.5 : -0.5));
+  };
+  const std::int64_t step_u = fixed(du / (n - 1)), step_v = fixed(dv / (n - 1));
   std::int64_t u = fixed(from.u + 0.5), v = fixed(from.v + 0.5);
+  // The image's view in locals: the profile's bytes could alias it.
+  const std::uint8_t* const data = image.data;
+  const std::ptrdiff_t stride = image.stride;
+  std::uint8_t* const grey = profile->grey.data();
   int darkest = 256, darkest_at = 0, lightest = -1;
   for (int i = 0; i < n; ++i, u += step_u, v += step_v) {
-    const int grey = image.at(static_cast<int>(u >> 16), static_cast<int>(v >> 16));
-    profile->grey[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(grey);
-    if (grey < darkest) darkest = grey, darkest_at = i;
-    lightest = std::max(lightest, grey);
+    const int value = data[(v >> 16) * stride + (u >> 16)];
+    grey[i] = static_cast<std::uint8_t>(value);
+    if (value < darkest) darkest = value, darkest_at = i;
+    lightest = std::max(lightest, value);
   }
   profile->darkest = darkest;
   profile->darkest_at = darkest_at;
