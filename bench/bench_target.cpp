@@ -276,6 +276,10 @@ void StripeCheckAlone(benchmark::State& state) {
   const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
   const vpHomogeneousMatrix cMo = tracked.pose.cMo;
   const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  // As the tracker checks: its settings in pixels scaled with the camera's focal length.
+  const TargetTrackerOptions defaults;
+  const StripeCheckOptions check =
+      defaults.ScaledBy(defaults.PixelScale(inputs.camera)).StripeCheck();
   const vpImage<unsigned char>& frame = inputs.moving[1].image;
   vpImage<unsigned char> delivered = frame;
   int samples = 0, agreeing = 0;
@@ -283,7 +287,8 @@ void StripeCheckAlone(benchmark::State& state) {
     state.PauseTiming();
     std::copy(frame.bitmap, frame.bitmap + frame.getSize(), delivered.bitmap);
     state.ResumeTiming();
-    const StripeAgreement agreement = CheckStripes(ViewOf(delivered), layout, cMo, inputs.camera);
+    const StripeAgreement agreement =
+        CheckStripes(ViewOf(delivered), layout, cMo, inputs.camera, check);
     samples =
         agreement.samples[0] + agreement.samples[1] + agreement.samples[2] + agreement.samples[3];
     agreeing = agreement.dark[0] + agreement.dark[1] + agreement.dark[2] + agreement.dark[3];

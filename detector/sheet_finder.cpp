@@ -83,6 +83,18 @@ void ReduceTo(std::vector<Point2d>* polygon, std::size_t count) {
   }
 }
 
+// The grey level at (u, v): the mean of the pixel and its neighbours one pixel away along
+// (du, dv) on both sides, nearest pixels; -1 when one of them lies outside the image.
+double Probe(const GrayImageView& image, double u, double v, double du, double dv) {
+  int sum = 0;
+  for (int k = -1; k <= 1; ++k) {
+    const double x = u + k * du + 0.5, y = v + k * dv + 0.5;
+    if (!(x >= 0.0 && y >= 0.0 && x < image.width && y < image.height)) return -1.0;
+    sum += image.at(static_cast<int>(x), static_cast<int>(y));
+  }
+  return sum / 3.0;
+}
+
 // A side from a to b of a quadrilateral turning like the image borders: its unit direction
 // and outward unit normal.
 struct Side {
@@ -107,30 +119,12 @@ bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light
   const int n = static_cast<int>(2.0 * search) + 1;
   std::array<double, 512> profile;
   if (n > static_cast<int>(profile.size())) return false;
-  // Probe i at side.At(t, i - search): the mean of the nearest pixel and its neighbours one
-  // pixel away along the side on both sides. The probes' pixels fill a parallelogram, all
-  // inside the image when its four corners are (16.16 fixed point: exactly linear).
-  constexpr double kOne = 65536.0;
-  const auto fixed = [](double x) { return static_cast<std::int64_t>(std::floor(x * kOne + 0.5)); };
-  const Point2d first = side.At(t, -search);
-  const std::int64_t u0 = fixed(first.u + 0.5), v0 = fixed(first.v + 0.5);
-  const std::int64_t step_u = fixed(side.outward.u), step_v = fixed(side.outward.v);
-  const std::int64_t beside_u = fixed(side.direction.u), beside_v = fixed(side.direction.v);
-  for (const int i : {0, n - 1}) {
-    for (const int k : {-1, 1}) {
-      const std::int64_t u = (u0 + i * step_u + k * beside_u) >> 16;
-      const std::int64_t v = (v0 + i * step_v + k * beside_v) >> 16;
-      if (u < 0 || v < 0 || u >= image.width || v >= image.height) return false;
-    }
-  }
   double darkest = 255.0;
   for (int i = 0; i < n; ++i) {
-    const std::int64_t u = u0 + i * step_u, v = v0 + i * step_v;
-    int sum = 0;
-    for (int k = -1; k <= 1; ++k) {
-      sum += image.data[((v + k * beside_v) >> 16) * image.stride + ((u + k * beside_u) >> 16)];
-    }
-    profile[static_cast<std::size_t>(i)] = sum / 3.0;
+    const Point2d p = side.At(t, i - search);
+    profile[static_cast<std::size_t>(i)] =
+        Probe(image, p.u, p.v, side.direction.u, side.direction.v);
+    if (profile[static_cast<std::size_t>(i)] < 0.0) return false;
     darkest = std::min(darkest, profile[static_cast<std::size_t>(i)]);
   }
   if (light - darkest < min_contrast) return false;

@@ -77,12 +77,13 @@ struct Profile {
 // segment's perspective (the image of the plane segment's point at s is at t = s z_to / ((1 -
 // s) z_from + s z_to) of the image segment). False when part of it is out of the image.
 bool ReadProfile(const GrayImageView& image, const Point2d& from, const Point2d& to, double z_from,
-                 double z_to, double half, double reach, Profile* profile) {
+                 double z_to, double half, double reach, double step_px, Profile* profile) {
   // The segment lies inside the image when both its ends do.
   if (!InImage(image, from) || !InImage(image, to)) return false;
   const double du = to.u - from.u, dv = to.v - from.v;
   const double length = std::sqrt(du * du + dv * dv);  // a few pixels: hypot's care not needed
-  const int n = std::clamp(static_cast<int>(std::ceil(length)) + 1, kMinProfile, kMaxProfile);
+  const int n =
+      std::clamp(static_cast<int>(std::ceil(length / step_px)) + 1, kMinProfile, kMaxProfile);
   profile->n = n;
   profile->spacing_px = length / (n - 1);
   // Nearest pixels along the segment, its coordinates in 16.16 fixed point.
@@ -245,6 +246,9 @@ void StripeCheckOptions::Check() const {
   RequireOption(width_tolerance > 0.0 && width_tolerance <= 10.0,
                 "StripeCheckOptions::width_tolerance", width_tolerance,
                 "0 < width_tolerance <= 10");
+  RequireOption(profile_step_px >= 0.25 && profile_step_px <= 16.0,
+                "StripeCheckOptions::profile_step_px", profile_step_px,
+                "0.25 <= profile_step_px <= 16");
 }
 
 double StripeAgreement::Worst() const {
@@ -305,7 +309,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
         Point2d from, to;
         return projector.Project(from_plane, &from) && projector.Project(to_plane, &to) &&
                ReadProfile(image, from, to, depth(from_plane), depth(to_plane), stripe.half, across,
-                           &profile);
+                           options.profile_step_px, &profile);
       };
       if (!read(reach) && !(options.short_profiles_at_edge &&
                             read(stripe.half + std::max(0.5 * stripe.half, kMinBesideM / 2.0)))) {

@@ -64,6 +64,11 @@ struct StripeCheckOptions {
   /// edge is read too. false: such a sample is not read (a pose that rests on fewer
   /// measurements, fitted to the stripes alone, is held to the full profiles).
   bool short_profiles_at_edge = true;
+  /// A profile's points lie about this far apart along it, pixels: one at the focal length the
+  /// settings were set for, more for a camera whose stripes are as many more pixels wide (the
+  /// tolerances in pixels grow with them; a profile's cost stays that of its paper and ink, not
+  /// of the image's size). Range [0.25, 16].
+  double profile_step_px = 1.0;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;

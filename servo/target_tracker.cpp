@@ -136,6 +136,9 @@ void TargetTrackerOptions::Check() const {
   RequireOption(stripe_width_tolerance > 0.0 && stripe_width_tolerance <= 10.0,
                 "TargetTrackerOptions::stripe_width_tolerance", stripe_width_tolerance,
                 "0 < stripe_width_tolerance <= 10");
+  RequireOption(stripe_profile_step_px >= 0.25 && stripe_profile_step_px <= 16.0,
+                "TargetTrackerOptions::stripe_profile_step_px", stripe_profile_step_px,
+                "0.25 <= stripe_profile_step_px <= 16");
   stripe_fit.Check();
 }
 
@@ -150,6 +153,8 @@ TargetTrackerOptions TargetTrackerOptions::ScaledBy(double scale) const {
   TargetTrackerOptions scaled = *this;
   scaled.finder = finder.ScaledBy(scale);
   scaled.stripe_tolerance_px = stripe_tolerance_px * scale;
+  // A smaller image's profile is read a pixel apart still: closer points repeat its pixels.
+  scaled.stripe_profile_step_px = std::min(16.0, stripe_profile_step_px * std::max(1.0, scale));
   scaled.stripe_fit.corridor_px = stripe_fit.corridor_px * scale;
   scaled.stripe_fit.guide_tolerance_px = stripe_fit.guide_tolerance_px * scale;
   return scaled;
@@ -161,6 +166,7 @@ StripeCheckOptions TargetTrackerOptions::StripeCheck() const {
   check.centre_tolerance_px = stripe_tolerance_px;
   check.centre_tolerance_fraction = stripe_tolerance_fraction;
   check.width_tolerance = stripe_width_tolerance;
+  check.profile_step_px = stripe_profile_step_px;
   return check;
 }
 

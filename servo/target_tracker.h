@@ -152,6 +152,10 @@ struct TargetTrackerOptions {
   double stripe_tolerance_px = 1.0;
   double stripe_tolerance_fraction = 0.1;
   double stripe_width_tolerance = 0.35;
+  /// The check's profiles read a point about every this many pixels (stripe_check.h's
+  /// profile_step_px), scaled with the image as the tolerance is (never below it). Range
+  /// [0.25, 16].
+  double stripe_profile_step_px = 1.0;
   /// Largest move of the pose between consecutive frames without a prediction, metres and
   /// degrees; 0 turns the check off. Ranges [0, 100], [0, 180].
   double max_jump_m = 0.05;

@@ -260,6 +260,36 @@ TEST(StripeCheck, APoseADegreeAndAHalfOffIsContradicted) {
   EXPECT_LT(agreement.Worst(), 0.75);
 }
 
+// At 1920x1080 (a 1371 px lens) the stripes are 2.285 times as many pixels wide: profiles read
+// a point every 2.285 px, with the tolerance scaled alike, judge as at 640x480. The truth
+// agrees along every stripe, a pose a degree and a half off is contradicted.
+TEST(StripeCheck, ProfilesReadAPointEveryScaledPixelJudgeAsAtTheReferenceSize) {
+  const Lens camera = Lens::WithKdu(1371.0, 1371.0, 959.5, 539.5, 0.15, 1920, 1080);
+  RenderOptions render = Render();
+  render.camera = camera;
+  render.width = 1920;
+  render.height = 1080;
+  const SceneRenderer renderer(FourLineA3Target(), render);
+  const RenderedFrame rendered = renderer.Render(Tilted(), 6);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  StripeCheckOptions scaled;
+  scaled.profile_step_px = 2.285;
+  scaled.centre_tolerance_px = 2.285;
+  const StripeAgreement truth =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, camera, scaled);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_GE(truth.samples[static_cast<std::size_t>(k)], 8) << "line " << k + 1;
+    EXPECT_EQ(truth.dark[static_cast<std::size_t>(k)], truth.samples[static_cast<std::size_t>(k)])
+        << "line " << k + 1;
+  }
+  const vpHomogeneousMatrix off =
+      vpHomogeneousMatrix(0.0, 0.0, 0.0, 0.0, vpMath::rad(1.5), 0.0) * rendered.cMo;
+  EXPECT_LT(CheckStripes(ViewOf(rendered.image), layout, off, camera, scaled).Worst(), 0.75);
+  StripeCheckOptions bad;
+  bad.profile_step_px = 0.1;
+  EXPECT_THROW(bad.Check(), std::invalid_argument);
+}
+
 // A hand over part of a stripe tells nothing there; a glare saturating ink and paper neither.
 TEST(StripeCheck, AHandOrAGlareHidesWithoutContradicting) {
   const SceneRenderer renderer(FourLineA3Target(), Render());

@@ -517,6 +517,10 @@ TEST(TargetPoseTracker, ItsSettingsInPixelsFollowTheCamerasFocalLength) {
   EXPECT_EQ(unscaled.detector().options().step_px, DetectorOptions().step_px);
   EXPECT_DOUBLE_EQ(as_given.PixelScale(camera), 1.0);
   EXPECT_DOUBLE_EQ(TargetTrackerOptions().ScaledBy(2.0).finder.cell_px, 16);
+  // The model check's profiles: a point every 2 px at twice the focal length, every pixel
+  // still at half of it.
+  EXPECT_DOUBLE_EQ(TargetTrackerOptions().ScaledBy(2.0).stripe_profile_step_px, 2.0);
+  EXPECT_DOUBLE_EQ(TargetTrackerOptions().ScaledBy(0.5).stripe_profile_step_px, 1.0);
   TargetTrackerOptions bad;
   bad.reference_focal_px = 0.5;
   EXPECT_THROW(bad.Check(), std::invalid_argument);
