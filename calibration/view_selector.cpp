@@ -22,7 +22,118 @@ std::array<double, 4> CornerDistances(const std::array<Point2d, 4>& a,
   return distances;
 }
 
+// The signed distance from q to the chord through the two points of `seen` nearest to it, the
+// chord turned along `tangent`; false when the nearest lies farther than reach_px (a stretch
+// `seen` does not cover).
+bool OffsetFromSeen(const std::vector<Point2d>& seen, const Point2d& tangent, const Point2d& q,
+                    double reach_px, double* offset) {
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::size_t first = kNone, second = kNone;
+  double d_first = HUGE_VAL, d_second = HUGE_VAL;
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    const double d = std::hypot(seen[i].u - q.u, seen[i].v - q.v);
+    if (d < d_first) {
+      second = first, d_second = d_first;
+      first = i, d_first = d;
+    } else if (d < d_second) {
+      second = i, d_second = d;
+    }
+  }
+  if (second == kNone || !(d_first <= reach_px)) return false;
+  const Point2d& a = seen[first];
+  double du = seen[second].u - a.u, dv = seen[second].v - a.v;
+  const double length = std::hypot(du, dv);
+  if (!(length > 1e-9)) {
+    du = tangent.u, dv = tangent.v;
+  } else {
+    const double sign = du * tangent.u + dv * tangent.v < 0.0 ? -1.0 : 1.0;
+    du *= sign / length, dv *= sign / length;
+  }
+  *offset = du * (q.v - a.v) - dv * (q.u - a.u);
+  return true;
+}
+
+// The median distance from one of `seen`'s points to its nearest other, pixels.
+double MedianSpacing(const std::vector<Point2d>& seen) {
+  std::vector<double> nearest;
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    double d = HUGE_VAL;
+    for (std::size_t j = 0; j < seen.size(); ++j) {
+      if (j != i) d = std::min(d, std::hypot(seen[i].u - seen[j].u, seen[i].v - seen[j].v));
+    }
+    nearest.push_back(d);
+  }
+  const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
+  std::nth_element(nearest.begin(), middle, nearest.end());
+  return *middle;
+}
+
+// A line's points near those seen before needed to say how it moved.
+constexpr double kMinMeasured = 3.0;
+
+// How far a line seen as `before` moved to `after`: the offsets of after's points from the
+// curve before's points trace, as a straight trend along the line, at the ends of the stretch
+// measured; infinite when fewer than a quarter of after's points lie within reach of before's.
+double LineMotion(const std::vector<Point2d>& before, const std::vector<Point2d>& after,
+                  double reach_px) {
+  // The line's direction: the principal axis of the points seen before.
+  double mu = 0.0, mv = 0.0;
+  for (const Point2d& p : before) mu += p.u, mv += p.v;
+  mu /= static_cast<double>(before.size());
+  mv /= static_cast<double>(before.size());
+  double suu = 0.0, suv = 0.0, svv = 0.0;
+  for (const Point2d& p : before) {
+    suu += (p.u - mu) * (p.u - mu), suv += (p.u - mu) * (p.v - mv), svv += (p.v - mv) * (p.v - mv);
+  }
+  const double angle = 0.5 * std::atan2(2.0 * suv, suu - svv);
+  const Point2d tangent{std::cos(angle), std::sin(angle)};
+  const double reach = reach_px + MedianSpacing(before);
+  // Least squares of offset = a + b s, s along the line.
+  double n = 0.0, ss = 0.0, sd = 0.0, sss = 0.0, ssd = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (const Point2d& q : after) {
+    double offset = 0.0;
+    if (!OffsetFromSeen(before, tangent, q, reach, &offset)) continue;
+    const double s = (q.u - mu) * tangent.u + (q.v - mv) * tangent.v;
+    n += 1.0, ss += s, sd += offset, sss += s * s, ssd += s * offset;
+    lo = std::min(lo, s), hi = std::max(hi, s);
+  }
+  // A stripe moved by more than the reach leaves none of its points near those seen before; one
+  // seen over another stretch, some (sliding along it shows on the lines across it).
+  if (n < kMinMeasured || 4.0 * n < static_cast<double>(after.size())) return HUGE_VAL;
+  const double spread = sss - ss * ss / n;
+  const double slope = spread > 1e-9 ? (ssd - ss * sd / n) / spread : 0.0;
+  const double at_mean = sd / n, mean_s = ss / n;
+  return std::max(std::fabs(at_mean + slope * (lo - mean_s)),
+                  std::fabs(at_mean + slope * (hi - mean_s)));
+}
+
 }  // namespace
+
+std::optional<double> TargetMotion(const CalibrationView& from, const CalibrationView& to,
+                                   double reach_px) {
+  // A line needs this many points in both views to say how it moved.
+  constexpr std::size_t kMinLinePoints = 3;
+  bool measured = false;
+  double motion = 0.0;
+  for (const CalibrationPoint& p : to.points) {
+    for (const CalibrationPoint& q : from.points) {
+      if (std::fabs(p.x - q.x) > 1e-9 || std::fabs(p.y - q.y) > 1e-9) continue;
+      motion = std::max(motion, std::hypot(p.u - q.u, p.v - q.v));
+      measured = true;
+      break;
+    }
+  }
+  const std::size_t lines = std::min(from.lines.size(), to.lines.size());
+  for (std::size_t k = 0; k < lines; ++k) {
+    const std::vector<Point2d>& before = from.lines[k].seen;
+    const std::vector<Point2d>& after = to.lines[k].seen;
+    if (before.size() < kMinLinePoints || after.size() < kMinLinePoints) continue;
+    measured = true;
+    motion = std::max(motion, LineMotion(before, after, reach_px));
+  }
+  if (!measured) return std::nullopt;
+  return motion;
+}
 
 void ViewSelectorOptions::Check() const {
   RequireOption(still_frames >= 1 && still_frames <= 1000, "ViewSelectorOptions::still_frames",
@@ -72,13 +183,13 @@ ViewSelector::Verdict ViewSelector::Offer(const CalibrationView& view) {
     still_for_ = 0;
     return Verdict::kNoTarget;
   }
-  const auto largest_motion = [&] {
-    const std::array<double, 4> moved = CornerDistances(*last_, *outline);
-    return *std::max_element(moved.begin(), moved.end());
-  };
-  const bool still = last_ && largest_motion() <= options_.still_px;
+  // A line's point farther than a few times the stillness from what the last frame saw
+  // along it lies on a stretch that frame did not see.
+  const std::optional<double> motion =
+      last_ ? TargetMotion(*last_, view, 4.0 * options_.still_px) : std::nullopt;
+  const bool still = motion && *motion <= options_.still_px;
   still_for_ = still ? still_for_ + 1 : 0;
-  last_ = outline;
+  last_ = view;
   // still_frames frames in a row means still_frames - 1 steps without motion.
   if (still_for_ + 1 < options_.still_frames) return Verdict::kMoving;
   for (std::size_t k = 0; k < taken_.size(); ++k) {

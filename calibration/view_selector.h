@@ -15,8 +15,12 @@ namespace oal {
 struct ViewSelectorOptions {
   /// Frames in a row the target must hold still before a view is taken. Range [1, 1000].
   int still_frames = 5;
-  /// The most a corner of the target's outline may move between two frames that count as
-  /// still, pixels. Range (0, 100].
+  /// The most the target may move between two frames that count as still, pixels: each known
+  /// point (the same point of the plane), and each line across the stretch seen in both (its
+  /// points' offsets from the curve the last frame's points trace, a straight trend along
+  /// it, at its two ends). Frames see different stretches of a stripe and a lens bends it: a
+  /// straight fit through its points, or the outline it gives, moves when the stripe does
+  /// not. Range (0, 100].
   double still_px = 1.5;
   /// A view is taken only when the corners of its outline lie, on average, at least this far
   /// from those of every view taken, as a fraction of the image's diagonal. Range [0, 1].
@@ -31,6 +35,13 @@ struct ViewSelectorOptions {
 /// tell motion). Empty when the view does not place the target (fewer than four points and
 /// crossings).
 std::optional<std::array<Point2d, 4>> TargetOutline(const CalibrationView& view);
+
+/// How far the target moved from view `from` to view `to`, pixels (ViewSelectorOptions::
+/// still_px says how); infinite when fewer than a quarter of a line's points lie within
+/// `reach_px` (plus the spacing of its points) of the points `from` saw along it; empty when the
+/// two views share no known point and no line seen in both.
+std::optional<double> TargetMotion(const CalibrationView& from, const CalibrationView& to,
+                                   double reach_px);
 
 class ViewSelector {
  public:
@@ -54,7 +65,7 @@ class ViewSelector {
  private:
   double diagonal_;
   ViewSelectorOptions options_;
-  std::optional<std::array<Point2d, 4>> last_;
+  std::optional<CalibrationView> last_;
   int still_for_ = 0;  // frames in a row that moved no more than still_px
   int similar_to_ = -1;
   std::vector<std::array<Point2d, 4>> taken_;

@@ -5,8 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <optional>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 #include "calibration/sheet_view.h"
 #include "target/line_target.h"
@@ -73,6 +77,82 @@ TEST_F(ViewSelectorTest, ANewPoseIsTakenAndALostTargetStartsOver) {
   selector.Offer(ViewFrom(first));
   EXPECT_EQ(selector.Offer(ViewFrom(first)), Verdict::kTooLike);
   EXPECT_EQ(selector.similar_to(), 0);
+}
+
+// The view with each line's points kept only over the middle `fraction` of the stretch seen.
+CalibrationView MiddleOfEachLine(CalibrationView view, double fraction) {
+  for (CalibrationLine& line : view.lines) {
+    if (line.seen.size() < 2) continue;
+    double u0 = HUGE_VAL, u1 = -HUGE_VAL, v0 = HUGE_VAL, v1 = -HUGE_VAL;
+    for (const Point2d& p : line.seen) {
+      u0 = std::min(u0, p.u), u1 = std::max(u1, p.u), v0 = std::min(v0, p.v),
+      v1 = std::max(v1, p.v);
+    }
+    const bool along_u = u1 - u0 >= v1 - v0;
+    const double lo = along_u ? u0 : v0, hi = along_u ? u1 : v1;
+    const double keep_lo = lo + 0.5 * (1.0 - fraction) * (hi - lo);
+    const double keep_hi = hi - 0.5 * (1.0 - fraction) * (hi - lo);
+    std::vector<Point2d> kept, kept_runs;
+    for (std::size_t i = 0; i < line.seen.size(); ++i) {
+      const double at = along_u ? line.seen[i].u : line.seen[i].v;
+      if (at < keep_lo || at > keep_hi) continue;
+      kept.push_back(line.seen[i]);
+      if (i < line.runs.size()) kept_runs.push_back(line.runs[i]);
+    }
+    line.seen = std::move(kept);
+    if (!line.runs.empty()) line.runs = std::move(kept_runs);
+  }
+  return view;
+}
+
+// Through a lens that bends the stripes (kdu 0.25), a still sheet seen over all of its stripes
+// in one frame and over their middle halves in the next: the straight lines through the
+// points, and the outline they give, move by pixels; the stripes do not, and the target counts
+// as still. Turned by half a degree, or moved by two pixels, it has moved.
+TEST(TargetMotion, IsTheStripesNotTheStretchesSeen) {
+  const LineTarget target = FourLineA3Target();
+  const Lens bending = Lens::WithKdu(690.0, 694.0, 331.0, 232.0, 0.25, 640, 480);
+  std::mt19937 random(5);
+  const vpHomogeneousMatrix pose = LookingAtTheSheet(0.45, 25.0, -10.0, 20.0);
+  const auto view_at = [&](const vpHomogeneousMatrix& cMo) {
+    return SheetView(target, SeenAlongStripes(target, bending, cMo, 0.05, &random), "frame");
+  };
+  const CalibrationView whole = view_at(pose);
+  const CalibrationView middle = MiddleOfEachLine(view_at(pose), 0.5);
+  const auto outline_whole = TargetOutline(whole), outline_middle = TargetOutline(middle);
+  ASSERT_TRUE(outline_whole && outline_middle);
+  double outline_moved = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    outline_moved =
+        std::max(outline_moved, std::hypot((*outline_whole)[k].u - (*outline_middle)[k].u,
+                                           (*outline_whole)[k].v - (*outline_middle)[k].v));
+  }
+  EXPECT_GT(outline_moved, 1.5);  // what made a still sheet look moving
+  for (const auto& [from, to] : {std::pair{whole, middle}, std::pair{middle, whole}}) {
+    const std::optional<double> still = TargetMotion(from, to, 6.0);
+    ASSERT_TRUE(still);
+    EXPECT_LT(*still, 0.5);
+  }
+  const vpHomogeneousMatrix turned =
+      pose * vpHomogeneousMatrix(0.0, 0.0, 0.0, 0.0, 0.0, vpMath::rad(0.5));
+  const vpHomogeneousMatrix shifted = vpHomogeneousMatrix(0.0013, 0.0, 0.0, 0.0, 0.0, 0.0) * pose;
+  for (const vpHomogeneousMatrix& moved_pose : {turned, shifted}) {
+    const std::optional<double> moved = TargetMotion(whole, view_at(moved_pose), 6.0);
+    ASSERT_TRUE(moved);
+    EXPECT_GT(*moved, 1.5);
+  }
+  EXPECT_FALSE(TargetMotion(whole, CalibrationView{"blank", {}, {}}, 6.0));
+}
+
+TEST_F(ViewSelectorTest, AStillTargetSeenOverChangingStretchesIsTaken) {
+  ViewSelectorOptions options;
+  options.still_frames = 4;
+  ViewSelector selector(640, 480, options);
+  const vpHomogeneousMatrix pose = LookingAtTheSheet(0.45, 25.0, -10.0, 20.0);
+  EXPECT_EQ(selector.Offer(ViewFrom(pose)), Verdict::kMoving);
+  EXPECT_EQ(selector.Offer(MiddleOfEachLine(ViewFrom(pose), 0.6)), Verdict::kMoving);
+  EXPECT_EQ(selector.Offer(ViewFrom(pose)), Verdict::kMoving);
+  EXPECT_EQ(selector.Offer(MiddleOfEachLine(ViewFrom(pose), 0.5)), Verdict::kTaken);
 }
 
 TEST(TargetOutline, IsTheSheetsInkSeenThroughTheView) {
