@@ -245,15 +245,26 @@ void TargetTrackedFromGrabber(benchmark::State& state) {
   tally.Report(state);
 }
 
+// The moving sequence's second frame tracked from its first: its pose and the detector's
+// feature points, what the *Alone benchmarks take one step of a tracked frame from.
+struct TrackedFrame {
+  vpHomogeneousMatrix cMo;
+  std::vector<FramePoint> points;
+};
+TrackedFrame TrackSecondFrame(const TargetInputs& inputs, const benchmark::State& state) {
+  TargetPoseTracker tracker = MakeTracker(inputs, state);
+  tracker.Track(ViewOf(inputs.moving.front().image));
+  const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
+  return TrackedFrame{tracked.pose.cMo, tracker.detector().feature_points()};
+}
+
 // The pose refined on the stripes' points alone (servo/stripe_fit.h), from a tracked frame's
 // intersections' pose and feature points: its share of a tracked frame.
 void StripeFitAlone(benchmark::State& state) {
   const TargetInputs& inputs = Inputs(state);
-  TargetPoseTracker tracker = MakeTracker(inputs, state);
-  tracker.Track(ViewOf(inputs.moving.front().image));
-  const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
-  const vpHomogeneousMatrix start = tracked.pose.cMo;
-  const std::vector<FramePoint> points = tracker.detector().feature_points();
+  const TrackedFrame tracked = TrackSecondFrame(inputs, state);
+  const vpHomogeneousMatrix& start = tracked.cMo;
+  const std::vector<FramePoint>& points = tracked.points;
   const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
   int ok = 0, iterations = 0;
   for (auto _ : state) {
@@ -271,10 +282,7 @@ void StripeFitAlone(benchmark::State& state) {
 // frame, the image as delivered (see TargetTrackedFromGrabber: copied in before each check).
 void StripeCheckAlone(benchmark::State& state) {
   const TargetInputs& inputs = Inputs(state);
-  TargetPoseTracker tracker = MakeTracker(inputs, state);
-  tracker.Track(ViewOf(inputs.moving.front().image));
-  const TargetFrame& tracked = tracker.Track(ViewOf(inputs.moving[1].image));
-  const vpHomogeneousMatrix cMo = tracked.pose.cMo;
+  const vpHomogeneousMatrix cMo = TrackSecondFrame(inputs, state).cMo;
   const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
   // As the tracker checks: its settings in pixels scaled with the camera's focal length.
   const TargetTrackerOptions defaults;

@@ -76,24 +76,19 @@ constexpr double kMinMeasured = 3.0;
 // measured; infinite when fewer than a quarter of after's points lie within reach of before's.
 double LineMotion(const std::vector<Point2d>& before, const std::vector<Point2d>& after,
                   double reach_px) {
-  // The line's direction: the principal axis of the points seen before.
-  double mu = 0.0, mv = 0.0;
-  for (const Point2d& p : before) mu += p.u, mv += p.v;
-  mu /= static_cast<double>(before.size());
-  mv /= static_cast<double>(before.size());
-  double suu = 0.0, suv = 0.0, svv = 0.0;
-  for (const Point2d& p : before) {
-    suu += (p.u - mu) * (p.u - mu), suv += (p.u - mu) * (p.v - mv), svv += (p.v - mv) * (p.v - mv);
-  }
-  const double angle = 0.5 * std::atan2(2.0 * suv, suu - svv);
-  const Point2d tangent{std::cos(angle), std::sin(angle)};
+  // The line's direction: that of the straight line through the points seen before (s below
+  // runs along it from that line's foot; where it starts does not change the trend's ends).
+  const LineParams line = FitLine(before);
+  const Point2d tangent{-std::sin(line.theta_rad), std::cos(line.theta_rad)};
+  const Point2d foot{line.rho_px * std::cos(line.theta_rad),
+                     line.rho_px * std::sin(line.theta_rad)};
   const double reach = reach_px + MedianSpacing(before);
   // Least squares of offset = a + b s, s along the line.
   double n = 0.0, ss = 0.0, sd = 0.0, sss = 0.0, ssd = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
   for (const Point2d& q : after) {
     double offset = 0.0;
     if (!OffsetFromSeen(before, tangent, q, reach, &offset)) continue;
-    const double s = (q.u - mu) * tangent.u + (q.v - mv) * tangent.v;
+    const double s = (q.u - foot.u) * tangent.u + (q.v - foot.v) * tangent.v;
     n += 1.0, ss += s, sd += offset, sss += s * s, ssd += s * offset;
     lo = std::min(lo, s), hi = std::max(hi, s);
   }
