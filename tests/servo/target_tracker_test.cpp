@@ -521,6 +521,9 @@ TEST(TargetPoseTracker, ItsSettingsInPixelsFollowTheCamerasFocalLength) {
   // still at half of it.
   EXPECT_DOUBLE_EQ(TargetTrackerOptions().ScaledBy(2.0).stripe_profile_step_px, 2.0);
   EXPECT_DOUBLE_EQ(TargetTrackerOptions().ScaledBy(0.5).stripe_profile_step_px, 1.0);
+  TargetTrackerOptions bad_step;
+  bad_step.stripe_profile_step_px = 0.1;
+  EXPECT_THROW(bad_step.Check(), std::invalid_argument);
   TargetTrackerOptions bad;
   bad.reference_focal_px = 0.5;
   EXPECT_THROW(bad.Check(), std::invalid_argument);
