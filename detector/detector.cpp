@@ -269,10 +269,16 @@ void OalDetector::AddBorderPoints(int border) {
   for (const BorderPoint& point : border_points_) {
     // Built in place: copying in a just-built local stalled on store forwarding.
     FramePoint& frame_point = frame_points_.emplace_back();
-    frame_point.p = ToWorking(point.pixel);
     const double run = point.straight ? point.run_px : 0.0;
-    frame_point.across_u = static_cast<float>(run * point.along.u);
-    frame_point.across_v = static_cast<float>(run * point.along.v);
+    Point2d across{run * point.along.u, run * point.along.v};
+    if (undistorter_) {
+      frame_point.p = undistorter_->Undistort(point.pixel);
+      if (run > 0.0) across = undistorter_->UndistortVector(point.pixel, frame_point.p, across);
+    } else {
+      frame_point.p = point.pixel;
+    }
+    frame_point.across_u = static_cast<float>(across.u);
+    frame_point.across_v = static_cast<float>(across.v);
     frame_point.sides = point.sides;
     frame_point.straight = point.straight;
     frame_point.border = static_cast<std::int16_t>(border);

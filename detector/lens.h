@@ -156,6 +156,16 @@ class PointUndistorter {
     const Point2d x = lens_.Normalised(pixel.u, pixel.v);
     return Point2d{lens_.u0() + lens_.px() * x.u, lens_.v0() + lens_.py() * x.v};
   }
+  /// A short vector at the distorted `pixel` (whose Undistort is `ideal`), as the undistortion
+  /// maps it: a run across a stripe in ideal pixels. Near the corners of a wide lens a run is
+  /// a third shorter in the image than on the ideal one.
+  Point2d UndistortVector(const Point2d& pixel, const Point2d& ideal, const Point2d& vector) const {
+    if (lens_.model() == Lens::Model::kPinhole) return vector;
+    const Point2d x{(ideal.u - lens_.u0()) / lens_.px(), (ideal.v - lens_.v0()) / lens_.py()};
+    const auto [xu, xv, yu, yv] = lens_.NormalisedDerivative(pixel.u, pixel.v, x);
+    return Point2d{lens_.px() * (xu * vector.u + xv * vector.v),
+                   lens_.py() * (yu * vector.u + yv * vector.v)};
+  }
 
  private:
   Lens lens_;

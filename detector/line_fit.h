@@ -16,8 +16,9 @@ namespace oal {
 /// A feature point of the whole frame, in the detector's working coordinates.
 struct FramePoint {
   Point2d p;  ///< undistorted when the detector corrects distortion
-  /// The run along its border side: its length times the side's unit direction, pixels;
-  /// (0, 0) when its width is unknown (edges, runs around a corner of the border).
+  /// The run along its border side: its length times the side's unit direction, pixels, in
+  /// the working coordinates as `p` (undistorted with it); (0, 0) when its width is unknown
+  /// (edges, runs around a corner of the border).
   float across_u = 0.0f, across_v = 0.0f;
   std::uint16_t sides = 0;  ///< sides of the border the point is on (BorderPoint::sides)
   bool straight = true;     ///< the run lay on one side of the border

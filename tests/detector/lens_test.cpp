@@ -128,6 +128,28 @@ TEST(Lens, UndistorterMapsToTheIdealPixel) {
   }
 }
 
+// A short run at a distorted pixel maps as the undistortion moves its two ends: near the
+// corners of a strong lens the run is longer on the ideal image than in the distorted one.
+TEST(Lens, UndistorterMapsAShortVectorAsItMapsItsEnds) {
+  std::vector<NamedLens> lenses = OpenCvLenses();
+  lenses.push_back({"visp", Lens::WithKdu(600.0, 590.0, 322.0, 241.0, 0.33, 640, 480), 640, 480});
+  lenses.push_back({"pinhole", Lens::Pinhole(600.0, 590.0, 322.0, 241.0), 640, 480});
+  for (const NamedLens& c : lenses) {
+    const PointUndistorter undistorter(c.lens);
+    for (const Point2d& p : {Point2d{13.0, 17.0}, Point2d{0.5 * c.width, 0.5 * c.height},
+                             Point2d{c.width - 5.0, c.height - 9.0}}) {
+      for (const Point2d& run : {Point2d{0.02, 0.0}, Point2d{-0.012, 0.016}}) {
+        const Point2d ideal = undistorter.Undistort(p);
+        const Point2d mapped = undistorter.UndistortVector(p, ideal, run);
+        const Point2d a = undistorter.Undistort({p.u - 0.5 * run.u, p.v - 0.5 * run.v});
+        const Point2d b = undistorter.Undistort({p.u + 0.5 * run.u, p.v + 0.5 * run.v});
+        EXPECT_NEAR(mapped.u, b.u - a.u, 1e-7) << c.name << " at " << p.u << ", " << p.v;
+        EXPECT_NEAR(mapped.v, b.v - a.v, 1e-7) << c.name << " at " << p.u << ", " << p.v;
+      }
+    }
+  }
+}
+
 TEST(Lens, ViSPCameraIsTheBestOneTermApproximation) {
   for (const NamedLens& c : OpenCvLenses()) {
     ASSERT_TRUE(c.lens.IsViSPApproximation());

@@ -529,6 +529,25 @@ TEST(TargetPoseTracker, ItsSettingsInPixelsFollowTheCamerasFocalLength) {
   EXPECT_THROW(bad.Check(), std::invalid_argument);
 }
 
+// A lens about 100 degrees across (OpenCV's model, strong barrel), the sheet in the image's
+// bottom-right corner and running out of it: there a run across a stripe is a third shorter in
+// the image than on the ideal one, and the runs' widths are held against the stripes' in ideal
+// pixels.
+TEST(TargetPoseTracker, FindsTheSheetInTheCornerOfAWideLens) {
+  Distortion barrel;
+  barrel.k1 = -0.28, barrel.k2 = 0.08, barrel.p1 = 0.0006, barrel.p2 = -0.0004, barrel.k3 = -0.01;
+  RenderOptions render;
+  render.camera = Lens::WithDistortion(730.0, 730.0, 642.5, 357.5, barrel);
+  render.width = 1280;
+  render.height = 720;
+  render.noise_sigma = 3.0;
+  render.blur_sigma_px = 0.8;
+  const SceneRenderer renderer(FourLineA3Target(), render);
+  const vpHomogeneousMatrix cMo(0.199, 0.117, 0.408, 0.527, -0.272, 2.945);
+  TargetPoseTracker tracker = TrackerFor(renderer);
+  ExpectRightPose(tracker.Track(ViewOf(renderer.Render(cMo, 1).image)), cMo, "in the corner");
+}
+
 TEST(TargetPoseTracker, LosesTheSheetOutOfViewAndFindsItAgain) {
   const SceneRenderer renderer(FourLineA3Target(), BenchRender(7));
   TargetPoseTracker tracker = TrackerFor(renderer);
