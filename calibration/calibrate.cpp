@@ -247,6 +247,34 @@ double PairThroughCamera(const CalibrationView& view, const cv::Mat& camera_matr
   return moved;
 }
 
+// A view's pairing settled through the camera the other views have solved: its pose from its
+// points (cv::solvePnP), its runs centred and its points paired again, until they stay.
+LinePairing SettledPairing(const CalibrationView& view, LinePairing pairing,
+                           const cv::Mat& camera_matrix, const cv::Mat& distortion) {
+  std::fill(pairing.outlier.begin(), pairing.outlier.end(), 0);
+  for (int round = 0; round < kMaxPairingRounds; ++round) {
+    std::vector<cv::Point3d> object;
+    std::vector<cv::Point2d> image;
+    for (const CalibrationPoint& point : view.points) {
+      object.emplace_back(point.x, point.y, 0.0);
+      image.emplace_back(point.u, point.v);
+    }
+    for (std::size_t k = 0; k < pairing.seen.size(); ++k) {
+      if (!pairing.used(k)) continue;
+      object.emplace_back(pairing.paired[k].x, pairing.paired[k].y, 0.0);
+      image.push_back(pairing.seen[k]);
+    }
+    cv::Mat rvec, tvec;
+    if (object.size() < 4 || !cv::solvePnP(object, image, camera_matrix, distortion, rvec, tvec)) {
+      break;
+    }
+    const double centred = CentreRuns(view, camera_matrix, distortion, rvec, tvec, &pairing);
+    const double moved = PairThroughCamera(view, camera_matrix, distortion, rvec, tvec, &pairing);
+    if (moved < kPairingSettledM && centred < kCentringSettledPx) break;
+  }
+  return pairing;
+}
+
 // The distortion terms a solve's flags leave free, as indices in the distortion vector.
 std::vector<int> FreeDistortionTerms(int flags, int terms) {
   std::vector<int> free;
@@ -676,7 +704,10 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
       }
     }
   };
-  const auto solve = [&](int solve_flags, bool from_previous) {
+  // Views left out as disagreeing with the others, by index in `views`, and those let back in
+  // once (see solve).
+  std::vector<char> left_out_views(views.size(), 0), readmitted(views.size(), 0);
+  const auto settle = [&](int solve_flags, bool from_previous) {
     for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
       // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
       // not flat or printed stretched) is left out: the outlier cut has left it too few
@@ -690,6 +721,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
           rejected = "its points disagree with the other views' (" + std::to_string(points) +
                      " of " + std::to_string(result.views[used[i]].points) + " kept)";
         }
+        left_out_views[used[i]] = 1;
         used_views.erase(used_views.begin() + static_cast<std::ptrdiff_t>(i));
         used.erase(used.begin() + static_cast<std::ptrdiff_t>(i));
         left_out = true;
@@ -736,6 +768,30 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
     view_errors = solution.view_errors;
     result.rms_px = solution.rms_px;
     gather();
+  };
+  // A view is judged against the others before the lens has settled: one that reaches far
+  // towards the image's corners, where the lens is not yet right, can fit worse then than it
+  // does in the end. Each view left out so is let back in once, from the settled camera, and
+  // judged again; one that disagrees still is left out for good.
+  const auto solve = [&](int solve_flags, bool from_previous) {
+    settle(solve_flags, from_previous);
+    bool readmit = false;
+    for (std::size_t k = 0; k < views.size(); ++k) {
+      if (!left_out_views[k] || readmitted[k]) continue;
+      readmitted[k] = 1;
+      left_out_views[k] = 0;
+      result.views[k].rejected.clear();
+      const auto at = std::upper_bound(used.begin(), used.end(), k);
+      const std::ptrdiff_t i = at - used.begin();
+      used.insert(at, k);
+      used_views.insert(used_views.begin() + i, &views[k]);
+      // Its homography's pairing is far off where the lens bends most: it starts from the
+      // pairing the settled camera gives it, as the others go on from theirs.
+      first_pairings[k] = SettledPairing(views[k], first_pairings[k], camera_matrix, distortion);
+      pairings.insert(pairings.begin() + i, first_pairings[k]);
+      readmit = true;
+    }
+    if (readmit) settle(solve_flags, true);
   };
   solve(flags, false);
   if (options.estimate_distortion) {

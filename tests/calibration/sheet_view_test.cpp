@@ -181,6 +181,38 @@ TEST(CalibrateFromTheSheet, AViewWhosePointsDisagreeWithTheOthersIsLeftOut) {
   EXPECT_LT(WorstIdealPixelDifference(result.camera, truth, 640, 480, 200.0), 0.3);
 }
 
+// A lens about 100 degrees across and views of the sheet in the image's corners, as the
+// calibration's advice asks: before the lens has settled, a corner view fits worse than the
+// others; once it has, it fits as well, and it is kept.
+TEST(CalibrateFromTheSheet, ViewsInTheCornersOfAWideLensAreKept) {
+  const LineTarget target = FourLineA3Target();
+  Distortion barrel;
+  barrel.k1 = -0.28, barrel.k2 = 0.08, barrel.p1 = 0.0006, barrel.p2 = -0.0004, barrel.k3 = -0.01;
+  const Lens truth = Lens::WithDistortion(730.0, 730.0, 642.5, 357.5, barrel);
+  std::mt19937 random(5);
+  std::vector<CalibrationView> views;
+  std::vector<vpHomogeneousMatrix> poses = VariedSheetPoses();
+  for (int corner = 0; corner < 4; ++corner) {
+    const double x = corner % 2 == 0 ? 0.19 : -0.19, y = corner < 2 ? 0.11 : -0.11;
+    poses.push_back(vpHomogeneousMatrix(x, y, 0.0, 0.0, 0.0, 0.0) *
+                    LookingAtTheSheet(0.41, 15.0 + 8.0 * corner, -10.0 * corner, 40.0 * corner));
+  }
+  for (const vpHomogeneousMatrix& cMo : poses) {
+    views.push_back(SheetView(target, SeenAlongStripes(target, truth, cMo, 0.1, &random, 1280, 720),
+                              "view" + std::to_string(views.size())));
+  }
+  CalibrationOptions options;
+  options.width = 1280;
+  options.height = 720;
+  const CalibrationResult result = Calibrate(views, options);
+  for (const CalibrationViewReport& view : result.views) {
+    EXPECT_TRUE(view.used) << view.name << ": " << view.rejected;
+  }
+  EXPECT_NEAR(result.camera.px(), truth.px(), 0.001 * truth.px());
+  EXPECT_NEAR(result.camera.u0(), truth.u0(), 0.5);
+  EXPECT_NEAR(result.camera.v0(), truth.v0(), 0.5);
+}
+
 TEST(CalibrateFromTheSheet, AViewWhoseLinesCannotBePlacedIsRefusedWithTheReason) {
   const LineTarget target = FourLineA3Target();
   CalibrationView view{"two-stripes.png", {}, {}};

@@ -37,11 +37,12 @@ inline std::vector<vpHomogeneousMatrix> VariedSheetPoses() {
 }
 
 // Points every 6 mm along each stripe's centre line, through `camera` from `cMo`, with pixel
-// noise of `sigma_px`; those outside the image are not seen.
+// noise of `sigma_px`; those outside the width x height image are not seen.
 inline std::vector<std::vector<Point2d>> SeenAlongStripes(const LineTarget& target,
                                                           const Lens& camera,
                                                           const vpHomogeneousMatrix& cMo,
-                                                          double sigma_px, std::mt19937* random) {
+                                                          double sigma_px, std::mt19937* random,
+                                                          int width = 640, int height = 480) {
   std::normal_distribution<double> noise(0.0, sigma_px);
   std::vector<std::vector<Point2d>> seen(target.lines.size());
   for (std::size_t k = 0; k < target.lines.size(); ++k) {
@@ -55,7 +56,7 @@ inline std::vector<std::vector<Point2d>> SeenAlongStripes(const LineTarget& targ
       // Through ViSP's kdu model exactly, as the renderer draws and the detector undistorts.
       const Point2d pixel = camera.Pixel(c[0] / c[2], c[1] / c[2]);
       const double u = pixel.u + noise(*random), v = pixel.v + noise(*random);
-      if (u >= 0.0 && u < 640.0 && v >= 0.0 && v < 480.0) seen[k].push_back(Point2d{u, v});
+      if (u >= 0.0 && u < width && v >= 0.0 && v < height) seen[k].push_back(Point2d{u, v});
     }
   }
   return seen;
