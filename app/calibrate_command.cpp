@@ -1,10 +1,12 @@
 #include "app/calibrate_command.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -125,12 +127,37 @@ class ViewFinder {
     return sheet_->Find(frame.view(), frame.source);
   }
 
+  /// Whether LookThrough can help: the line target, once a frame has been seen.
+  bool CanLookThrough() const { return !chessboard_ && sheet_.has_value(); }
+  /// Looks through `camera` first from now on (SheetViewFinder::LookThrough).
+  void LookThrough(const Lens& camera) { sheet_->LookThrough(camera); }
+
  private:
   std::optional<ChessboardOptions> chessboard_;
   LineTarget target_;
   AppConfig config_;
   std::optional<SheetViewFinder> sheet_;
 };
+
+// The frames of `inputs` again, in the same order: each view of `views` (one per frame) that
+// has no target is looked for again by `finder`. Returns how many were found.
+int FindAgain(const std::vector<std::string>& inputs, ViewFinder* finder,
+              std::vector<CalibrationView>* views) {
+  int found = 0;
+  std::size_t index = 0;
+  for (const std::string& input : inputs) {
+    std::vector<std::string> warnings;  // said on the first reading
+    const std::unique_ptr<ImageSource> source = OpenImageSource(input, &warnings);
+    Frame frame;
+    while (index < views->size() && source->Next(&frame)) {
+      CalibrationView& view = (*views)[index++];
+      if (!view.points.empty() || !view.lines.empty()) continue;
+      view = finder->Find(frame);
+      found += !view.points.empty() || !view.lines.empty();
+    }
+  }
+  return found;
+}
 
 // What the user is told when the live selection's verdict changes.
 std::string LiveStatus(ViewSelector::Verdict verdict, const ViewSelector& selector) {
@@ -319,32 +346,52 @@ int RunCalibrate(int argc, char** argv) {
   options.estimate_distortion = !no_distortion;
   options.rational = rational;
   if (use_chessboard) options.min_points_per_view = chessboard.columns * chessboard.rows;
-  std::vector<CalibrationView> found;
-  for (CalibrationView& view : views) {
-    if (view.points.empty() && view.lines.empty()) {
-      std::cout << view.name << ": not used: " << what << " was not found\n";
-    } else {
-      found.push_back(std::move(view));
+  const auto has_target = [](const CalibrationView& view) {
+    return !view.points.empty() || !view.lines.empty();
+  };
+  const auto say_not_found = [&]() {
+    for (const CalibrationView& view : views) {
+      if (!has_target(view)) std::cout << view.name << ": not used: " << what << " was not found\n";
+    }
+  };
+  const auto calibrate = [&]() {
+    std::vector<CalibrationView> found;
+    std::copy_if(views.begin(), views.end(), std::back_inserter(found), has_target);
+    if (static_cast<int>(found.size()) < options.min_views) {
+      say_not_found();
+      throw std::runtime_error(std::to_string(found.size()) + " of " +
+                               std::to_string(views.size()) + " images show " + what +
+                               ", at least " + std::to_string(options.min_views) +
+                               " needed: nothing written to " + out_path);
+    }
+    try {
+      return Calibrate(found, options);
+    } catch (const std::runtime_error& error) {
+      say_not_found();
+      throw std::runtime_error(std::string(error.what()) + "\nnothing written to " + out_path);
+    }
+  };
+  CalibrationResult result = calibrate();
+  // Near the image's corners a wide lens bends the stripes past what the finder's pinhole
+  // guesses identify: the frames where it found no target are looked at again through the
+  // lens the others gave. (Live views are taken only where the target was found.)
+  if (!live && finder.CanLookThrough() && !std::all_of(views.begin(), views.end(), has_target)) {
+    finder.LookThrough(result.camera);
+    if (const int again = FindAgain(inputs, &finder, &views); again > 0) {
+      std::cout << "found the target in " << again << " more view" << (again == 1 ? "" : "s")
+                << " through the lens the others gave; calibrating again\n";
+      result = calibrate();
     }
   }
-  if (static_cast<int>(found.size()) < options.min_views) {
-    throw std::runtime_error(std::to_string(found.size()) + " of " + std::to_string(views.size()) +
-                             " images show " + what + ", at least " +
-                             std::to_string(options.min_views) + " needed: nothing written to " +
-                             out_path);
-  }
-  CalibrationResult result;
-  try {
-    result = Calibrate(found, options);
-  } catch (const std::runtime_error& error) {
-    throw std::runtime_error(std::string(error.what()) + "\nnothing written to " + out_path);
-  }
+  say_not_found();
+  const auto found =
+      static_cast<std::size_t>(std::count_if(views.begin(), views.end(), has_target));
   PrintReport(result, use_chessboard ? "corners" : "stripe points");
   const std::optional<std::string> note =
       SaveCameraFile(out_path, result.camera, name, static_cast<unsigned>(width),
                      static_cast<unsigned>(height), format, FileComments(result, format));
   std::cout << "wrote " << out_path << " (" << CameraFileFormatName(format) << ", camera '" << name
-            << "', " << width << "x" << height << ", " << found.size() << " of " << views.size()
+            << "', " << width << "x" << height << ", " << found << " of " << views.size()
             << " views)\n";
   if (note) {
     Warn("calibrate", *note + "; reprojection RMS " + Fixed(result.visp_rms_px, 3) +

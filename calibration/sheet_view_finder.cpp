@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <utility>
 
 #include "calibration/sheet_view.h"
 #include "detector/lens.h"
@@ -35,12 +37,25 @@ TargetTrackerOptions ForAGuessedCamera(TargetTrackerOptions tracking) {
   return tracking;
 }
 
+// A camera calibrated from other views: the tracker's own checks, every view on
+// kCalibrationBorders borders.
+TargetTrackerOptions ForACalibratedCamera(TargetTrackerOptions tracking) {
+  tracking.borders = std::max(tracking.borders, kCalibrationBorders);
+  tracking.corner_cells = false;
+  return tracking;
+}
+
+// The distorted pixel of an ideal pixel of `camera`.
+Point2d Distorted(const Lens& camera, double u, double v) {
+  return camera.Pixel((u - camera.u0()) / camera.px(), (v - camera.v0()) / camera.py());
+}
+
 }  // namespace
 
 SheetViewFinder::SheetViewFinder(const LineTarget& target, int width, int height,
                                  const DetectorOptions& detector, const PoseOptions& pose,
                                  const TargetTrackerOptions& tracking)
-    : target_(target) {
+    : target_(target), detector_(detector), pose_(pose), tracking_(tracking) {
   for (const double focal_per_width : kGuessedFocalPerWidth) {
     Lens guess = Lens::Pinhole(focal_per_width * width, focal_per_width * width, 0.5 * (width - 1),
                                0.5 * (height - 1));
@@ -50,24 +65,53 @@ SheetViewFinder::SheetViewFinder(const LineTarget& target, int width, int height
   }
 }
 
+void SheetViewFinder::LookThrough(const Lens& camera) {
+  calibrated_camera_ = camera;
+  calibrated_.emplace(target_, camera, detector_, pose_, ForACalibratedCamera(tracking_));
+  calibrated_->set_quick_scan(false);
+}
+
 CalibrationView SheetViewFinder::Find(const GrayImageView& image, const std::string& name) {
+  if (calibrated_) {
+    calibrated_->Reset();
+    calibrated_->Track(image);
+    std::optional<CalibrationView> view = ViewOf(*calibrated_, name);
+    if (view && !view->lines.empty()) return std::move(*view);
+  }
   for (TargetPoseTracker& tracker : trackers_) {
     tracker.Reset();
     tracker.Track(image);
-    // The runs' middles as seen, with their runs: the calibration moves each onto the centre
-    // line through the lens it solves (the guess knows no lens to do it with).
-    const std::array<std::vector<FramePoint>, 4> stripes = tracker.StripeRuns(kStripeTolerancePx);
-    if (stripes[0].empty()) continue;
-    std::vector<std::vector<Point2d>> seen(4), runs(4);
-    for (std::size_t k = 0; k < 4; ++k) {
-      for (const FramePoint& point : stripes[k]) {
-        seen[k].push_back(point.p);
-        runs[k].push_back(Point2d{point.across_u, point.across_v});
-      }
-    }
-    return SheetView(target_, seen, name, SheetViewOptions(), runs);
+    if (std::optional<CalibrationView> view = ViewOf(tracker, name)) return std::move(*view);
   }
   return CalibrationView{name, {}, {}};
+}
+
+std::optional<CalibrationView> SheetViewFinder::ViewOf(const TargetPoseTracker& tracker,
+                                                       const std::string& name) const {
+  // The runs' middles as seen, with their runs: the calibration moves each onto the centre
+  // line through the lens it solves. A tracker that corrects a lens gives them on the ideal
+  // image: they are taken back to the image's pixels.
+  const std::array<std::vector<FramePoint>, 4> stripes = tracker.StripeRuns(kStripeTolerancePx);
+  if (stripes[0].empty()) return std::nullopt;
+  const bool ideal = calibrated_ && &tracker == &*calibrated_ && calibrated_camera_.distorted();
+  std::vector<std::vector<Point2d>> seen(4), runs(4);
+  for (std::size_t k = 0; k < 4; ++k) {
+    for (const FramePoint& point : stripes[k]) {
+      if (!ideal) {
+        seen[k].push_back(point.p);
+        runs[k].push_back(Point2d{point.across_u, point.across_v});
+        continue;
+      }
+      const double half_u = 0.5 * point.across_u, half_v = 0.5 * point.across_v;
+      const Point2d middle = Distorted(calibrated_camera_, point.p.u, point.p.v);
+      const Point2d a = Distorted(calibrated_camera_, point.p.u - half_u, point.p.v - half_v);
+      const Point2d b = Distorted(calibrated_camera_, point.p.u + half_u, point.p.v + half_v);
+      if (!std::isfinite(middle.u + middle.v + a.u + a.v + b.u + b.v)) continue;
+      seen[k].push_back(middle);
+      runs[k].push_back(Point2d{b.u - a.u, b.v - a.v});
+    }
+  }
+  return SheetView(target_, seen, name, SheetViewOptions(), runs);
 }
 
 }  // namespace oal

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,9 +26,23 @@ class SheetViewFinder {
   /// found the target (Calibrate then leaves it out and says why).
   CalibrationView Find(const GrayImageView& image, const std::string& name);
 
+  /// From now on looks through `camera` first: a camera calibrated from the views found so far.
+  /// Near the image's corners a wide lens bends a stripe past what a pinhole guess identifies;
+  /// through its lens the stripes are straight. The points are the image's all the same.
+  void LookThrough(const Lens& camera);
+
  private:
+  /// The view `tracker` found in the frame it last tracked; nullopt when it found none.
+  std::optional<CalibrationView> ViewOf(const TargetPoseTracker& tracker,
+                                        const std::string& name) const;
+
   LineTarget target_;
+  DetectorOptions detector_;
+  PoseOptions pose_;
+  TargetTrackerOptions tracking_;
   std::vector<TargetPoseTracker> trackers_;  // one per guessed focal length, likeliest first
+  std::optional<TargetPoseTracker> calibrated_;
+  Lens calibrated_camera_;
 };
 
 }  // namespace oal

@@ -148,6 +148,31 @@ TEST(CalibrateCommand, CalibratesFromThePrintedSheetOnABench) {
   EXPECT_NEAR(file.camera.kdu(), 0.2, 0.02);
 }
 
+// Views of the sheet in the corners of a lens about 100 degrees across: the finder's pinhole
+// guesses miss the sheet where the lens bends its stripes most; through the lens the other
+// views give, it is found there, and every view is used.
+TEST(CalibrateCommand, FindsTheSheetInAWideLensCornersThroughTheLensTheOthersGave) {
+  const TestDir dir;
+  const std::string lens = std::string(OAL_SOURCE_DIR) + "/config/lenses/wide-100.yaml";
+  const std::string views = dir / "views";
+  const OalservoRun render = RunOalservo(
+      dir, "render --camera '" + lens + "' --count 10 --seed 21 --max-tilt-deg 45 --noise 3 " +
+               "--blur 0.8 --max-offset 0.3 --min-distance 0.4 --max-distance 0.75 --out '" +
+               views + "'");
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const OalservoRun run =
+      RunOalservo(dir, "calibrate '" + views + "' --out '" + (dir / "camera.yaml") + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.out.find("more views through the lens the others gave"), std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("not used"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("10 of 10 views)"), std::string::npos) << run.out;
+  const CameraFile file = LoadCameraFile(dir / "camera.yaml");
+  const CameraFile truth = LoadCameraFile(lens);
+  EXPECT_NEAR(file.camera.px(), truth.camera.px(), 0.002 * truth.camera.px());
+  EXPECT_NEAR(file.camera.distortion().k1, truth.camera.distortion().k1, 0.002);
+}
+
 // A video of the sheet moved from pose to pose and held still at each: --live takes one view
 // per pose held, and calibrates with them when the video ends.
 TEST(CalibrateCommand, LiveTakesAViewWhereTheSheetIsHeldStill) {
