@@ -15,6 +15,11 @@ namespace {
 // points counted as kept, in robust scales.
 constexpr double kTukey = 4.685;
 constexpr double kKeptScales = 2.5;
+// A stripe's extent counts the stretches of its kept points that hold this many points at
+// least, each within this fraction of the stripe's length of the next: one or two points far
+// from the rest (runs cut by a hand's edge, a speck) would tell the stripe's angle alone.
+constexpr std::size_t kMinStretchPoints = 3;
+constexpr double kMaxStretchGap = 0.05;
 // Points this close to a crossing's stripe (beyond its half width), metres, are left out: a
 // run there may have merged with the crossing stripe.
 constexpr double kCrossingMarginM = 0.002;
@@ -434,6 +439,22 @@ vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo) {
   return turned.Matrix();
 }
 
+double SupportedExtent(std::vector<double>* along, double length) {
+  std::sort(along->begin(), along->end());
+  const double max_gap = kMaxStretchGap * length;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (std::size_t first = 0; first < along->size();) {
+    std::size_t last = first;
+    while (last + 1 < along->size() && (*along)[last + 1] - (*along)[last] <= max_gap) ++last;
+    if (last - first + 1 >= kMinStretchPoints) {
+      lo = std::min(lo, (*along)[first]);
+      hi = std::max(hi, (*along)[last]);
+    }
+    first = last + 1;
+  }
+  return hi > lo ? std::min(1.0, (hi - lo) / length) : 0.0;
+}
+
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options,
@@ -529,23 +550,22 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   look();
   double sum2 = 0.0;
   int kept = 0;
+  std::vector<double> along;
   for (std::size_t k = 0; k < 4; ++k) {
-    double lo = HUGE_VAL, hi = -HUGE_VAL;
     magnitudes.clear();  // the kept points' width ratios
+    along.clear();
     for (std::size_t i = 0; i < stripes[k].p.size(); ++i) {
       const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
       if (!(std::fabs(r) <= kKeptScales * scale)) continue;
       ++fit.points[k];
       magnitudes.push_back(stripes[k].width_ratio[i]);
-      lo = std::min(lo, stripes[k].along[i]);
-      hi = std::max(hi, stripes[k].along[i]);
+      along.push_back(stripes[k].along[i]);
       sum2 += r * r;
       ++kept;
     }
     fit.width_ratio[k] = Median(&magnitudes);
     const StripeSpan& span = layout.stripes[k];
-    fit.extent[k] =
-        fit.points[k] > 1 ? std::min(1.0, (hi - lo) / (span.along.hi - span.along.lo)) : 0.0;
+    fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }
   fit.scale_px = scale;
   fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;

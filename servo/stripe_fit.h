@@ -73,7 +73,9 @@ struct StripeFit {
   std::array<int, 4> points{};  ///< points kept on lines 1-4 (within 2.5 robust scales)
   int TotalPoints() const { return points[0] + points[1] + points[2] + points[3]; }
   /// The fraction of each stripe's printed length (between the crossings and its ends, both
-  /// arms) that its kept points span: a stripe half hidden under a hand shows about 0.5.
+  /// arms) that its kept points span: a stripe half hidden under a hand shows about 0.5. Only
+  /// stretches of three points or more count (SupportedExtent): two runs cut by a hand's
+  /// edge far from the rest do not make a stripe seen over its length.
   std::array<double, 4> extent{};
   /// The median, over each stripe's kept points, of its run's width across over the stripe's
   /// width there where the pose puts it: about 1 for the right pose, the ratio of two stripes'
@@ -90,6 +92,11 @@ struct StripeFit {
 /// Lines known to be lines 1-4 (a detected line identified with a stripe), in the points'
 /// pixels; a stripe without one is found by the corridor alone.
 using StripeGuides = std::array<std::optional<LineParams>, 4>;
+
+/// The fraction of a stripe `length` long (its ends in `along`'s units) that the points at
+/// `along` (sorted in place) span, counting only stretches of three points or more, each
+/// within 5 % of the length of the next; 0 when there is none.
+double SupportedExtent(std::vector<double>* along, double length);
 
 /// The other pose a plane's view is nearly as well explained by (the planar ambiguity: the
 /// plane tilted the other way about the line of sight to its origin, its origin where it is):

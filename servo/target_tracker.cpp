@@ -696,41 +696,50 @@ bool TargetPoseTracker::AttemptCandidate(const GrayImageView& image,
     // Each candidate on its own: a prior that failed above says nothing about it.
     const bool accepted = Attempt(image, borders_, seeds, std::nullopt, source, expected);
     if (count >= options_.borders) {
-      if (accepted) {
-        RescanWeakStripe(image, source);
-        return true;
-      }
+      if (accepted && RescanWeakStripe(image, source)) return true;
       // A stripe seen only between the crossings (its arms under a hand or out of view)
       // gives the concentric borders no points: scanned again with borders across the
       // stripes' middles.
       AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
       return Attempt(image, borders_, seeds, std::nullopt, source, expected);
     }
-    if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost) {
-      RescanWeakStripe(image, source);
+    if (accepted && frame_.pose.identification_cost < options_.quick_max_identification_cost &&
+        RescanWeakStripe(image, source)) {
       return true;
     }
   }
   return false;
 }
 
-void TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource source) {
-  if (!frame_.fit.ok ||
-      *std::min_element(frame_.fit.extent.begin(), frame_.fit.extent.end()) >= kWeakStripeExtent) {
-    return;
-  }
+bool TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource source) {
+  const double weakest =
+      frame_.fit.ok ? *std::min_element(frame_.fit.extent.begin(), frame_.fit.extent.end()) : 1.0;
+  if (weakest >= kWeakStripeExtent) return true;
   // A stripe whose points span a short stretch of it leaves the pose's tilt about it loosely
   // told (a glare's slope, a blur across it, tilts it by degrees): its middle between the
   // crossings, scanned from the pose found, tells more. When that gives no pose, the first
-  // stands.
+  // stands if its stripes are seen over kMinFittedExtent each at least (as a pose fitted
+  // without four lines must be); one seen over less leaves the tilt about it to a few runs
+  // (a hand's edge across a stripe tilted a sheet by 10 degrees so).
+  const TargetFrame first_frame = frame_;
+  const std::vector<DetectedLine> first_lines = lines_;
   const vpHomogeneousMatrix first = frame_.pose.cMo;
   const vpHomography plane_to_image = PlaneToImage(first);
   TargetBorders(layout_, plane_to_image, camera_, options_.borders, &borders_);
   AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
-  AsGuesses([&] {
-    return !borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt,
-                                        source, Expected{first, false});
-  });
+  if (!borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt, source,
+                                   Expected{first, false})) {
+    return true;
+  }
+  RestoreFrame(first_frame, first_lines);
+  if (weakest >= kMinFittedExtent) return true;
+  std::ostringstream message;
+  message << "a stripe's points span " << weakest << " of it (at least " << kMinFittedExtent
+          << " needed): too little to tell the pose's tilt, and its middle scanned again gave no "
+             "pose";
+  frame_.status = TargetStatus::kNotFound;
+  frame_.message = message.str();
+  return false;
 }
 
 bool TargetPoseTracker::AttemptCells(const GrayImageView& image,

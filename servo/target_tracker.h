@@ -302,8 +302,9 @@ class TargetPoseTracker {
                         ScanSource source);
   /// After a candidate's accepted pose whose stripe fit keeps one stripe's points over a short
   /// stretch of it: the target's borders and those across the stripes' middles scanned again
-  /// from that pose, the new pose kept when it passes the checks, else the first.
-  void RescanWeakStripe(const GrayImageView& image, ScanSource source);
+  /// from that pose, the new pose kept when it passes the checks, else the first unless a
+  /// stripe of it is seen over less than kMinFittedExtent. False when no pose is kept.
+  bool RescanWeakStripe(const GrayImageView& image, ScanSource source);
   /// The whole image's accepted pose scanned again on the target's plane (step 3): false when
   /// the two poses disagree; the frame keeps the better fitting one.
   bool ConfirmOnTarget(const GrayImageView& image);

@@ -194,6 +194,23 @@ TEST(StripeFit, AStripeWithoutPointsIsNamed) {
       << fit.message;
 }
 
+// What a stripe's points span counts only stretches of three points or more: a few runs
+// at a hand's edge far from the rest do not make a stripe seen over its length.
+TEST(StripeFit, AStripesExtentCountsOnlyStretchesOfThreePointsOrMore) {
+  // Both arms of a 0.4 m stripe, a point every 5 mm: the stretch between them counts too.
+  std::vector<double> arms;
+  for (double a = 0.0; a <= 0.0701; a += 0.005) arms.push_back(a), arms.push_back(0.4 - a);
+  EXPECT_DOUBLE_EQ(SupportedExtent(&arms, 0.4), 1.0);
+  // Seven runs over 3 cm near one end, two at a hand's edge 10 cm away.
+  std::vector<double> cut = {0.30, 0.305, 0.31, 0.315, 0.32, 0.325, 0.33, 0.20, 0.21};
+  EXPECT_NEAR(SupportedExtent(&cut, 0.4), 0.03 / 0.4, 1e-12);
+  // Two such pairs and nothing else: no stretch at all.
+  std::vector<double> pairs = {0.05, 0.06, 0.30, 0.31};
+  EXPECT_EQ(SupportedExtent(&pairs, 0.4), 0.0);
+  std::vector<double> none;
+  EXPECT_EQ(SupportedExtent(&none, 0.4), 0.0);
+}
+
 TEST(StripeFit, BadOptionsNameTheField) {
   StripeFitOptions options;
   options.corridor_px = 0.0;
