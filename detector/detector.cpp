@@ -140,7 +140,24 @@ void OalDetector::PrepareFor(int width, int height) {
   }
   // The image border, where read-off lines end (undistorted when correcting).
   RectangleOutline(BorderAt(width, height, 0), 8, &image_outline_);
-  for (Point2d& p : image_outline_) p = ToWorking(p);
+  // Runs are at most max_width_px wide in the image; undistorted with their points, one near
+  // the image's edge is wider on the ideal image by as much as the lens stretches it there.
+  double stretch = 1.0;
+  for (Point2d& p : image_outline_) {
+    const Point2d working = ToWorking(p);
+    if (undistorter_) {
+      const Point2d a = undistorter_->UndistortVector(p, working, {1.0, 0.0});
+      const Point2d b = undistorter_->UndistortVector(p, working, {0.0, 1.0});
+      // The larger singular value of the 2 x 2 derivative [a b].
+      const double t = a.u * a.u + a.v * a.v + b.u * b.u + b.v * b.v;
+      const double det = a.u * b.v - a.v * b.u;
+      const double largest =
+          std::sqrt(0.5 * (t + std::sqrt(std::max(0.0, t * t - 4.0 * det * det))));
+      if (std::isfinite(largest)) stretch = std::max(stretch, largest);
+    }
+    p = working;
+  }
+  pair_max_width_px_ = options_.max_width_px * stretch;
   candidates_.reserve(static_cast<std::size_t>(oal_.capacity()));
   lines_.reserve(static_cast<std::size_t>(options_.max_output_lines));
 }
@@ -359,7 +376,7 @@ bool OalDetector::WidthsAgree(const FramePoint& a, const FramePoint& b, double d
   const double width_b = WidthAcross(b, -dv, du);
   if (width_a <= 0.0 || width_b <= 0.0) return true;  // a corner run: width unknown
   const double wider = std::max(width_a, width_b), narrower = std::min(width_a, width_b);
-  const double max_width = options_.max_width_px, slack = options_.min_width_px;
+  const double max_width = pair_max_width_px_, slack = options_.min_width_px;
   if (wider * wider > max_width * max_width * length_sq) return false;
   // The min_width_px slack keeps thin lines, whose widths are a pixel or two, comparable:
   // wider <= ratio * narrower + slack, that is excess <= slack (times the length).

@@ -170,6 +170,8 @@ class OalDetector {
   std::vector<FramePoint> frame_points_;
   std::vector<BorderOutline<8>> outlines_;  ///< per border
   std::vector<Point2d> image_outline_;      ///< the image border in working coordinates
+  /// max_width_px as a pair's widths are measured (on the ideal image when correcting).
+  double pair_max_width_px_ = 0.0;
   // A region's borders (the last region's; rebuilt for each frame with a region).
   bool in_region_ = false;       ///< the next DetectInRegion scans region_borders_
   bool scanned_region_ = false;  ///< the last frame was scanned in a region

@@ -75,6 +75,21 @@ LineError ErrorOf(const LineParams& detected, const LineParams& truth, const Poi
   return error;
 }
 
+// A stripe 72 px wide across the image's corner, through a strong lens the detector corrects:
+// its runs, undistorted with their points, are wider than max_width_px (80) on the ideal
+// image, as wide as the lens stretches them there; the pair test holds them against the
+// limit stretched so.
+TEST(OalDetector, AWideStripeNearTheCornerOfAStrongLensIsFound) {
+  testing::TestImage image(640, 480, 210);
+  const LineParams stripe = LineThrough(Point2d{0.0, 190.0}, Point2d{190.0, 0.0});
+  testing::PaintStripe(&image, stripe, 72.0, 40);
+  OalDetector detector(DetectorOptions(),
+                       Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.33, 640, 480));
+  const std::vector<DetectedLine>& lines = detector.Detect(image.View());
+  ASSERT_FALSE(lines.empty());
+  EXPECT_GT(lines.front().width_px, 80.0);
+}
+
 TEST(OalDetector, EmptyViewThrows) {
   OalDetector detector;
   EXPECT_THROW(detector.Detect(GrayImageView{}), std::invalid_argument);
