@@ -139,6 +139,11 @@ class ViewFinder {
   std::optional<SheetViewFinder> sheet_;
 };
 
+// Whether the finder found the target in the view.
+bool ShowsTarget(const CalibrationView& view) {
+  return !view.points.empty() || !view.lines.empty();
+}
+
 // The frames of `inputs` again, in the same order: each view of `views` (one per frame) that
 // has no target is looked for again by `finder`. Returns how many were found.
 int FindAgain(const std::vector<std::string>& inputs, ViewFinder* finder,
@@ -151,9 +156,9 @@ int FindAgain(const std::vector<std::string>& inputs, ViewFinder* finder,
     Frame frame;
     while (index < views->size() && source->Next(&frame)) {
       CalibrationView& view = (*views)[index++];
-      if (!view.points.empty() || !view.lines.empty()) continue;
+      if (ShowsTarget(view)) continue;
       view = finder->Find(frame);
-      found += !view.points.empty() || !view.lines.empty();
+      found += ShowsTarget(view);
     }
   }
   return found;
@@ -346,17 +351,15 @@ int RunCalibrate(int argc, char** argv) {
   options.estimate_distortion = !no_distortion;
   options.rational = rational;
   if (use_chessboard) options.min_points_per_view = chessboard.columns * chessboard.rows;
-  const auto has_target = [](const CalibrationView& view) {
-    return !view.points.empty() || !view.lines.empty();
-  };
   const auto say_not_found = [&]() {
     for (const CalibrationView& view : views) {
-      if (!has_target(view)) std::cout << view.name << ": not used: " << what << " was not found\n";
+      if (!ShowsTarget(view))
+        std::cout << view.name << ": not used: " << what << " was not found\n";
     }
   };
   const auto calibrate = [&]() {
     std::vector<CalibrationView> found;
-    std::copy_if(views.begin(), views.end(), std::back_inserter(found), has_target);
+    std::copy_if(views.begin(), views.end(), std::back_inserter(found), ShowsTarget);
     if (static_cast<int>(found.size()) < options.min_views) {
       say_not_found();
       throw std::runtime_error(std::to_string(found.size()) + " of " +
@@ -375,7 +378,7 @@ int RunCalibrate(int argc, char** argv) {
   // Near the image's corners a wide lens bends the stripes past what the finder's pinhole
   // guesses identify: the frames where it found no target are looked at again through the
   // lens the others gave. (Live views are taken only where the target was found.)
-  if (!live && finder.CanLookThrough() && !std::all_of(views.begin(), views.end(), has_target)) {
+  if (!live && finder.CanLookThrough() && !std::all_of(views.begin(), views.end(), ShowsTarget)) {
     finder.LookThrough(result.camera);
     if (const int again = FindAgain(inputs, &finder, &views); again > 0) {
       std::cout << "found the target in " << again << " more view" << (again == 1 ? "" : "s")
@@ -385,7 +388,7 @@ int RunCalibrate(int argc, char** argv) {
   }
   say_not_found();
   const auto found =
-      static_cast<std::size_t>(std::count_if(views.begin(), views.end(), has_target));
+      static_cast<std::size_t>(std::count_if(views.begin(), views.end(), ShowsTarget));
   PrintReport(result, use_chessboard ? "corners" : "stripe points");
   const std::optional<std::string> note =
       SaveCameraFile(out_path, result.camera, name, static_cast<unsigned>(width),

@@ -721,17 +721,16 @@ bool TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource 
   // stands if its stripes are seen over kMinFittedExtent each at least (as a pose fitted
   // without four lines must be); one seen over less leaves the tilt about it to a few runs
   // (a hand's edge across a stripe tilted a sheet by 10 degrees so).
-  const TargetFrame first_frame = frame_;
-  const std::vector<DetectedLine> first_lines = lines_;
   const vpHomogeneousMatrix first = frame_.pose.cMo;
   const vpHomography plane_to_image = PlaneToImage(first);
   TargetBorders(layout_, plane_to_image, camera_, options_.borders, &borders_);
   AddMiddleBorders(layout_, plane_to_image, camera_, kMiddleBordersPerPair, &borders_);
-  if (!borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image), std::nullopt, source,
-                                   Expected{first, false})) {
+  if (AsGuesses([&] {
+        return !borders_.empty() && Attempt(image, borders_, SeedsFrom(plane_to_image),
+                                            std::nullopt, source, Expected{first, false});
+      })) {
     return true;
   }
-  RestoreFrame(first_frame, first_lines);
   if (weakest >= kMinFittedExtent) return true;
   std::ostringstream message;
   message << "a stripe's points span " << weakest << " of it (at least " << kMinFittedExtent
