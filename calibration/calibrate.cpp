@@ -69,10 +69,9 @@ constexpr double kOutlierFloorPx = 0.3;
 // floor (pixels), is left out.
 constexpr double kViewOutlierRatio = 2.0;
 constexpr double kViewOutlierFloorPx = 0.3;
-// Outliers are sought once no point moves by more than this (metres) between two solves, or
-// from this round on: a pairing that still creeps then is kept moving by the outliers.
-constexpr double kOutliersAfterM = 5e-5;
-constexpr int kOutliersByRound = 10;
+// Rounds of solving, polishing and judging the points, at most, until none changes sides (a
+// view left out as a whole always gets its round).
+constexpr int kMaxJudgingRounds = 10;
 
 // The view's plane tilt from its rotation vector: the angle between the plane's normal (its z
 // axis) and the optical axis.
@@ -371,14 +370,7 @@ ViewRows RowsOf(const CalibrationView& view, const LinePairing& pairing, const S
   return rows;
 }
 
-// Polishes the camera and the view poses on what the line points tell: their distances across
-// their lines, each point free to slide along its line (Levenberg-Marquardt on the distances,
-// each point paired again with its line after each step). calibrateCamera measures a line
-// point's distance to a paired plane point fixed during each solve, so the pairing creeps
-// along the lines over dozens of solves and stops short, the focal length a few tenths of a
-// percent off under a strong lens; here it follows each step. Known points keep their two
-// rows. The deviations come from this fit's normal equations.
-// The unknowns of the polish: fx, fy, cx, cy, the free distortion terms, then each view's
+// The unknowns of the polish (PolishAcrossLines): fx, fy, cx, cy, the free distortion terms, then each view's
 // rvec and tvec.
 class PolishUnknowns {
  public:
@@ -707,8 +699,12 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   // Views left out as disagreeing with the others, by index in `views`, and those let back in
   // once (see solve).
   std::vector<char> left_out_views(views.size(), 0), readmitted(views.size(), 0);
+  // Each round solves the camera on the points as paired (calibrateCamera), polishes it with
+  // the pairing following each step (PolishAcrossLines), then judges the views and points on
+  // the polished camera: the lens is right there, so the points it bends most, near the
+  // image's edges, are not taken for outliers (they would go first and bias k1 low).
   const auto settle = [&](int solve_flags, bool from_previous) {
-    for (int pairing_round = 0; pairing_round < kMaxPairingRounds; ++pairing_round) {
+    for (int round = 0;; ++round) {
       // A view that disagrees with the others as a whole (a stripe taken for another, a sheet
       // not flat or printed stretched) is left out: the outlier cut has left it too few
       // points, or its points fit far worse than the other views'.
@@ -730,49 +726,41 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
       if (left_out) {
         pairings.clear();
         for (const std::size_t k : used) pairings.push_back(first_pairings[k]);
-        pairing_round = 0;
       }
       gather();
-      const bool guess = pairing_round > 0 || from_previous;
+      const bool guess = (round > 0 && !left_out) || from_previous;
       result.rms_px = cv::calibrateCamera(
           object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
           distortion, rvecs, tvecs, sd_intrinsics, sd_extrinsics, view_errors,
           guess ? solve_flags | cv::CALIB_USE_INTRINSIC_GUESS : solve_flags, stop);
-      double moved = 0.0, centred = 0.0;
-      for (std::size_t i = 0; i < used_views.size() && any_lines; ++i) {
-        centred = std::max(centred, CentreRuns(*used_views[i], camera_matrix, distortion, rvecs[i],
-                                               tvecs[i], &pairings[i]));
-        moved = std::max(moved, PairThroughCamera(*used_views[i], camera_matrix, distortion,
-                                                  rvecs[i], tvecs[i], &pairings[i]));
+      if (!any_lines) {
+        if (MarkDisagreeingView(view_errors, used, &result)) continue;
+        break;
       }
-      // Only once the pairing has nearly settled are the views and points that fit badly
-      // outliers: before, the lens is not yet right, and the points it bends most, near the
-      // image's edges, would go first and bias k1 low. A view that disagrees as a whole goes
-      // first, before the point cut could whittle it down to its points that happen to fit.
-      if (moved >= kOutliersAfterM && pairing_round < kOutliersByRound) continue;
+      Solution solution{camera_matrix, distortion,  rvecs,        tvecs,
+                        sd_intrinsics, view_errors, result.rms_px};
+      PolishAcrossLines(used_views, solve_flags, &pairings, &solution);
+      camera_matrix = solution.camera_matrix;
+      distortion = solution.distortion;
+      rvecs = solution.rvecs;
+      tvecs = solution.tvecs;
+      sd_intrinsics = solution.sd_intrinsics;
+      view_errors = solution.view_errors;
+      result.rms_px = solution.rms_px;
+      gather();
+      // A view that disagrees as a whole goes first, before the point cut could whittle it
+      // down to its points that happen to fit.
       if (MarkDisagreeingView(view_errors, used, &result)) continue;
       const int changed =
-          any_lines ? MarkOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings)
-                    : 0;
-      if (moved < kPairingSettledM && centred < kCentringSettledPx && changed == 0) break;
+          MarkOutliers(used_views, camera_matrix, distortion, rvecs, tvecs, &pairings);
+      if (changed == 0 || round + 1 >= kMaxJudgingRounds) break;
     }
-    if (!any_lines) return;
-    Solution solution{camera_matrix, distortion,  rvecs,        tvecs,
-                      sd_intrinsics, view_errors, result.rms_px};
-    PolishAcrossLines(used_views, solve_flags, &pairings, &solution);
-    camera_matrix = solution.camera_matrix;
-    distortion = solution.distortion;
-    rvecs = solution.rvecs;
-    tvecs = solution.tvecs;
-    sd_intrinsics = solution.sd_intrinsics;
-    view_errors = solution.view_errors;
-    result.rms_px = solution.rms_px;
-    gather();
   };
-  // A view is judged against the others before the lens has settled: one that reaches far
-  // towards the image's corners, where the lens is not yet right, can fit worse then than it
-  // does in the end. Each view left out so is let back in once, from the settled camera, and
-  // judged again; one that disagrees still is left out for good.
+  // A view is judged against the others from the first round, while points still to be cut
+  // and views still to be left out pull the lens: one that reaches far towards the image's
+  // corners, where the lens is least sure, can fit worse then than it does in the end. Each view
+  // left out so is let back in once, from the settled camera, and judged again; one that disagrees
+  // still is left out for good.
   const auto solve = [&](int solve_flags, bool from_previous) {
     settle(solve_flags, from_previous);
     bool readmit = false;
