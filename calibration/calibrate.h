@@ -4,7 +4,11 @@
 //
 // The solver is OpenCV's calibrateCamera (Zhang's initialisation, then Levenberg-Marquardt on
 // the reprojection error, with each parameter's standard deviation and each view's RMS, which
-// vpCalibration does not give). Every term the views determine is kept: one whose value lies
+// vpCalibration does not give). Points seen along lines are paired with points of their lines;
+// each round's solution is then polished on their distances across the lines, each point
+// sliding along its line (Levenberg-Marquardt, its own deviations), before the views and points
+// that disagree are left out, round after round until none changes. Every term the views
+// determine is kept: one whose value lies
 // within `min_term_significance` standard deviations of zero is fixed at zero, with the
 // reason, and the camera solved again (k3 first, then the tangential pair). ViSP's one-term
 // model (kud, kdu), for ViSP's own camera XML, is the lens's best approximation over the
