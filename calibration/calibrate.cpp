@@ -370,8 +370,8 @@ ViewRows RowsOf(const CalibrationView& view, const LinePairing& pairing, const S
   return rows;
 }
 
-// The unknowns of the polish (PolishAcrossLines): fx, fy, cx, cy, the free distortion terms, then each view's
-// rvec and tvec.
+// The unknowns of the polish (PolishAcrossLines): fx, fy, cx, cy, the free distortion terms,
+// then each view's rvec and tvec.
 class PolishUnknowns {
  public:
   PolishUnknowns(int flags, int terms, std::size_t views)

@@ -8,12 +8,11 @@
 // each round's solution is then polished on their distances across the lines, each point
 // sliding along its line (Levenberg-Marquardt, its own deviations), before the views and points
 // that disagree are left out, round after round until none changes. Every term the views
-// determine is kept: one whose value lies
-// within `min_term_significance` standard deviations of zero is fixed at zero, with the
-// reason, and the camera solved again (k3 first, then the tangential pair). ViSP's one-term
-// model (kud, kdu), for ViSP's own camera XML, is the lens's best approximation over the
-// image (Lens::ViSPCamera); its reprojection RMS on the same points is given beside the full
-// model's.
+// determine is kept: one whose value lies within `min_term_significance` standard deviations
+// of zero is fixed at zero, with the reason, and the camera solved again (k3 first, then the
+// tangential pair). ViSP's one-term model (kud, kdu), for ViSP's own camera XML, is the lens's
+// best approximation over the image (Lens::ViSPCamera); its reprojection RMS on the same
+// points is given beside the full model's.
 #pragma once
 
 #include <string>
