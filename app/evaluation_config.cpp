@@ -35,6 +35,11 @@ void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
                              const std::string& kdu_help) {
   cli.add_option("--frames", options->frames, "number of rendered frames, [1, 1000000]")
       ->capture_default_str();
+  cli.add_option("--first-frame", options->first_frame,
+                 "start at this frame of the seed's sequence, [0, 1000000]: the frames before it "
+                 "are drawn, not rendered, so one frame of a long run is replayed exactly as it "
+                 "was (--first-frame 730 --frames 1)")
+      ->capture_default_str();
   AddSeedOption(cli, &options->seed, "seed of poses and noise, >= 0");
   // The defaults depend on the target (ApplySheetDefaults): said in words, not shown.
   cli.add_option("--kdu", options->kdu,
@@ -57,6 +62,7 @@ void AddRenderedFrameOptions(CLI::App& cli, RenderedFrameOptions* options,
 
 std::vector<std::pair<std::string, std::string>> RenderedFrameOptionWords() {
   return {{"RenderedFrameOptions::frames", "--frames"},
+          {"RenderedFrameOptions::first_frame", "--first-frame"},
           {"RenderedFrameOptions::kdu", "--kdu"},
           {"RenderedFrameOptions::noise_sigma", "--noise"},
           {"RenderedFrameOptions::blur_sigma_px", "--blur"},

@@ -26,6 +26,14 @@
 namespace oal {
 namespace {
 
+// "1000", or "1 (from frame 730)" for a run that starts later in the seed's sequence.
+std::string FramesCell(const PoseAccuracyReport& r) {
+  const std::string count = std::to_string(r.frames);
+  return r.options.first_frame > 0
+             ? count + " (from frame " + std::to_string(r.options.first_frame) + ")"
+             : count;
+}
+
 std::string Table(const PoseAccuracyReport& r) {
   std::ostringstream out;
   const auto count = [](const std::map<std::string, int>& counts, const std::string& key) {
@@ -35,7 +43,7 @@ std::string Table(const PoseAccuracyReport& r) {
   const double frames = std::max(1, r.frames);
   out << std::fixed << std::setprecision(2) << "| measure | value |\n|---|---:|\n"
       << "| target | " << r.options.target.name << " |\n"
-      << "| frames | " << r.frames << " |\n"
+      << "| frames | " << FramesCell(r) << " |\n"
       << "| frames with a pose | " << r.posed() << " (" << 100.0 * r.posed() / frames << " %) |\n"
       << "| wrong poses (> " << r.options.wrong_translation_pct << " % or > "
       << r.options.wrong_rotation_deg << " deg) | " << r.wrong_frames.size() << " |\n";
@@ -93,7 +101,7 @@ std::string MarkerTable(const PoseAccuracyReport& r) {
   out << std::fixed << std::setprecision(2) << "| measure | value |\n|---|---:|\n"
       << "| marker | " << ToString(r.options.marker) << ": " << r.marker_description << " |\n"
       << "| sheet | " << r.options.target.name << "'s board, without its stripes |\n"
-      << "| frames | " << r.frames << " |\n"
+      << "| frames | " << FramesCell(r) << " |\n"
       << "| frames with a pose | " << r.posed() << " (" << 100.0 * r.posed() / frames << " %) |\n"
       << "| wrong poses (> " << r.options.wrong_translation_pct << " % or > "
       << r.options.wrong_rotation_deg << " deg) | " << r.wrong_frames.size() << " |\n"

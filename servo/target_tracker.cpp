@@ -896,9 +896,21 @@ bool TargetPoseTracker::ConfirmOnTarget(const GrayImageView& image) {
     RestoreFrame(whole_image, whole_image_lines);
     return true;
   };
-  // The target's plane gave nothing (a board seen from near fills the view, its borders' lines
-  // too short): the whole image's pose stands as the paper's scan gives it.
   if (!AttemptCandidate(image, PlaneToImage(whole_image.pose.cMo), ScanSource::kImage)) {
+    // The target's plane gave a pose of its own that the image contradicts, and the whole
+    // image's pose puts a stripe where too few of its points lie (a hand's edge along a
+    // blurred stripe tilted it by degrees, yet its samples agreed just enough): the stripes
+    // are there and neither pose is sure where. (A board seen from near leaves too few stripe
+    // points to fit a pose at all: nothing said against its pose.)
+    const bool stripe_without_points = whole_image.fit.starved_line >= 0;
+    if (frame_.status == TargetStatus::kModelMismatch && stripe_without_points) {
+      frame_.message =
+          "the whole image's pose is not confirmed on the target's plane seen from it: " +
+          frame_.message;
+      return false;
+    }
+    // The target's plane gave nothing (a board seen from near fills the view, its borders'
+    // lines too short): the whole image's pose stands as the paper's scan gives it.
     return keep_whole_image();
   }
   double metres = 0.0, degrees = 0.0;

@@ -27,8 +27,11 @@
 //      borders on the target's plane seen from that pose are scanned as a candidate's (step
 //      2): when both poses pass, they must lie within max_jump_m / max_jump_deg of each other
 //      (else the frame is kModelMismatch), and the one whose corners fit the target better
-//      (the lower residual) is the frame's; when only the whole image's does (a board seen from
-//      near, whose lines traverse the view), it stands.
+//      (the lower residual) is the frame's; when the target's plane gives no pose at all (a
+//      board seen from near, whose lines traverse the view), the whole image's stands; when it
+//      gives one the image contradicts and the whole image's pose puts a stripe where too few
+//      of its points lie (its stripe fit starved), the stripes are there and neither pose is
+//      sure where (kModelMismatch).
 // A pose is refined on the stripes' own feature points, the target held rigid (stripe_fit.h),
 // and accepted only when the image shows the target where it says (stripe_check.h): across
 // each stripe, between the crossings and the printed ends, its dark run where the pose puts it

@@ -147,9 +147,11 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
 
   std::uint64_t state = options.seed;
   std::vector<LineParams> lines;
-  for (int frame = 0; frame < options.frames; ++frame) {
+  const int end = options.first_frame + options.frames;
+  for (int frame = 0; frame < end; ++frame) {
     const SceneRenderer& renderer = scenes.For(frame);
     const vpHomogeneousMatrix cMo = SamplePose(renderer, options.sampling, &state);
+    if (frame < options.first_frame) continue;
     const RenderedFrame rendered =
         renderer.Render(cMo, options.seed * 1000003ULL + frame, scenes.EffectsFor(frame));
     for (OalMethod& method : ours) {
@@ -178,7 +180,7 @@ AccuracyReport EvaluateDetectorAccuracy(const AccuracyOptions& options,
       for (const DetectedLine& line : tracker->lines()) lines.push_back(line.line);
       Score(lines, rendered, true, undistorter, options, frame, &tracked);
     }
-    if (progress) progress(frame + 1, options.frames);
+    if (progress) progress(frame + 1 - options.first_frame, options.frames);
   }
 
   AccuracyReport report;

@@ -191,8 +191,10 @@ PoseAccuracyReport EvaluateMarkerPoseAccuracy(const PoseAccuracyOptions& options
     report.status_counts[ToString(status)] = 0;
   }
   std::uint64_t state = options.seed;
-  for (int frame = 0; frame < options.frames; ++frame) {
+  const int end = options.first_frame + options.frames;
+  for (int frame = 0; frame < end; ++frame) {
     const vpHomogeneousMatrix cMo_true = SamplePose(scenes.For(frame), options.sampling, &state);
+    if (frame < options.first_frame) continue;
     const std::uint64_t noise_seed = options.seed * 7919ULL + frame;
     const FrameEffects effects = scenes.EffectsFor(frame);
     const SceneRenderer& renderer = printed.For(frame);
@@ -214,7 +216,7 @@ PoseAccuracyReport EvaluateMarkerPoseAccuracy(const PoseAccuracyOptions& options
       report.posed_in_view += in_view;
       RecordPose(cMo_true, found.cMo, frame, options, &report);
     }
-    if (progress) progress(frame + 1, options.frames);
+    if (progress) progress(frame + 1 - options.first_frame, options.frames);
   }
   return report;
 }
@@ -243,9 +245,11 @@ PoseAccuracyReport EvaluatePoseAccuracy(
     report.status_counts[ToString(status)] = 0;
   }
   std::uint64_t state = options.seed;
-  for (int frame = 0; frame < options.frames; ++frame) {
+  const int end = options.first_frame + options.frames;
+  for (int frame = 0; frame < end; ++frame) {
     const SceneRenderer& renderer = scenes.For(frame);
     const vpHomogeneousMatrix cMo_true = SamplePose(renderer, options.sampling, &state);
+    if (frame < options.first_frame) continue;
     const std::uint64_t noise_seed = options.seed * 7919ULL + frame;
     const FrameEffects effects = scenes.EffectsFor(frame);
     const RenderedFrame rendered = renderer.Render(cMo_true, noise_seed, effects);
@@ -276,7 +280,7 @@ PoseAccuracyReport EvaluatePoseAccuracy(
       const PoseErrors errors = RecordPose(cMo_true, result.pose.cMo, frame, options, &report);
       if (errors.wrong) missed(true, errors.translation_pct, errors.rotation_deg);
     }
-    if (progress) progress(frame + 1, options.frames);
+    if (progress) progress(frame + 1 - options.first_frame, options.frames);
   }
   return report;
 }

@@ -26,6 +26,8 @@ double Uniform01(std::uint64_t seed, int frame, std::uint64_t stream) {
 void RenderedFrameOptions::Check() const {
   RequireOption(frames >= 1 && frames <= 1000000, "RenderedFrameOptions::frames", frames,
                 "1 <= frames <= 1000000");
+  RequireOption(first_frame >= 0 && first_frame <= 1000000, "RenderedFrameOptions::first_frame",
+                first_frame, "0 <= first_frame <= 1000000");
   RequireOption(kdu > -1.0 && kdu < 1.0, "RenderedFrameOptions::kdu", kdu, "-1 < kdu < 1");
   RequireOption(noise_sigma >= 0.0 && noise_sigma <= 100.0, "RenderedFrameOptions::noise_sigma",
                 noise_sigma, "0 <= noise_sigma <= 100");
@@ -136,6 +138,7 @@ std::vector<std::string> DefaultBenchPhotos() {
 
 nlohmann::json RenderedFrameJson(const RenderedFrameOptions& options) {
   nlohmann::json json{{"frames", options.frames},
+                      {"first_frame", options.first_frame},
                       {"seed", options.seed},
                       {"width", options.width},
                       {"height", options.height},

@@ -18,7 +18,11 @@ namespace oal {
 
 /// The rendered frames of an accuracy evaluation: how many, their seed, camera and degradations.
 struct RenderedFrameOptions {
-  int frames = 1000;       ///< rendered frames, [1, 1000000]
+  int frames = 1000;  ///< rendered frames, [1, 1000000]
+  /// The first of them in the seed's sequence, [0, 1000000]: the poses before it are drawn
+  /// (each frame's pose follows from the one before) but not rendered, so frame N of a long
+  /// run is replayed on its own, exactly as it was.
+  int first_frame = 0;
   std::uint64_t seed = 1;  ///< poses and noise
   int width = 640, height = 480;
   double focal_px = 600.0;
@@ -41,8 +45,8 @@ struct RenderedFrameOptions {
   SceneOptions scene;
 
   /// Throws std::invalid_argument naming the command-line option and its range: --frames
-  /// [1, 1000000], --kdu (-1, 1) (as `oalservo render`), --noise [0, 100], --blur [0, 20],
-  /// --gradient [0, 0.9]; and width, height >= 16, focal_px > 0.
+  /// [1, 1000000], --first-frame [0, 1000000], --kdu (-1, 1) (as `oalservo render`), --noise
+  /// [0, 100], --blur [0, 20], --gradient [0, 0.9]; and width, height >= 16, focal_px > 0.
   void Check() const;
 };
 

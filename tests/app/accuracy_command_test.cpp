@@ -94,6 +94,52 @@ TEST(PoseAccuracy, MissedFramesAreSavedForAReplay) {
   EXPECT_EQ(replaced.exit_code, 0) << replaced.err;
 }
 
+// --first-frame N: frame N of the seed's sequence on its own, exactly as in the longer run (its
+// pose, bench, effects and noise), the report's frame numbers those of the sequence.
+TEST(PoseAccuracy, AFrameOfALongerRunIsReplayedOnItsOwn) {
+  PoseAccuracyOptions options;
+  options.frames = 4;
+  options.seed = 5;
+  const PoseAccuracyReport run = EvaluatePoseAccuracy(options);
+  ASSERT_EQ(run.posed(), 4);
+  options.first_frame = 2;
+  options.frames = 1;
+  const PoseAccuracyReport replay = EvaluatePoseAccuracy(options);
+  ASSERT_EQ(replay.frames, 1);
+  ASSERT_EQ(replay.translation_error_pct.size(), 1u);
+  EXPECT_DOUBLE_EQ(replay.translation_error_pct[0], run.translation_error_pct[2]);
+  EXPECT_DOUBLE_EQ(replay.rotation_error_deg[0], run.rotation_error_deg[2]);
+
+  test::TestDir dir;
+  test::WriteText(dir / "strict.yaml", "pose:\n  max_residual_px: 0.0001\n");
+  const test::OalservoRun strict =
+      test::RunOalservo(dir, "pose-accuracy --frames 2 --first-frame 7 --config '" +
+                                 dir / "strict.yaml" + "' --out '" + dir / "report.json" + "'");
+  ASSERT_EQ(strict.exit_code, 0) << strict.err;
+  const json report = json::parse(test::ReadText(dir / "report.json"));
+  EXPECT_EQ(report.at("frames_without_pose"), json({7, 8}));
+  EXPECT_EQ(report.at("options").at("first_frame"), 7);
+  EXPECT_THAT(strict.out, HasSubstr("| frames | 2 (from frame 7) |"));
+}
+
+// Frames of the lived-in evaluation that once got a wrong pose give a right one or none: a hand
+// over the crossing of a blurred stripe, no light cell found, the whole image's pose 3.7
+// degrees off (seed 91, frame 730); a hand's edge across a short stripe (seed 41, frame 931).
+TEST(PoseAccuracy, TheLivedInFramesThatOnceGaveWrongPosesGiveARightOneOrNone) {
+  test::TestDir dir;
+  const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
+  for (const auto& [seed, frame] : {std::pair{91, 730}, std::pair{41, 931}}) {
+    const std::string what = "seed " + std::to_string(seed) + ", frame " + std::to_string(frame);
+    const test::OalservoRun run = test::RunOalservo(
+        dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(seed) +
+                 " --first-frame " + std::to_string(frame) + " --frames 1 --out '" +
+                 dir / "report.json" + "'");
+    ASSERT_EQ(run.exit_code, 0) << what << ": " << run.err;
+    const json report = json::parse(test::ReadText(dir / "report.json"));
+    EXPECT_EQ(report.at("wrong_poses"), json::array()) << what;
+  }
+}
+
 // The report: status_counts keyed by status name, and the roll median the table shows.
 TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
   test::TestDir dir;
@@ -257,6 +303,10 @@ TEST(AccuracyCommands, OptionRanges) {
                 }),
                 HasSubstr("--noise = 200"));
     EXPECT_THROW(test::RunWithArgs(run, {"x", "--frames", "1", "--seed", "-1"}), UsageError);
+    EXPECT_THAT(test::ErrorMessageOf<std::invalid_argument>([&] {
+                  test::RunWithArgs(run, {"x", "--frames", "1", "--first-frame", "-3"});
+                }),
+                HasSubstr("--first-frame = -3"));
   }
 }
 
