@@ -31,11 +31,11 @@ TEST(Demo, WritesThePicturesTheJsonAndATable) {
   for (const char* name : {"demo.png", "frame.png", "lines.json"}) {
     EXPECT_TRUE(fs::is_regular_file(fs::path(options.out_dir) / name)) << name;
   }
-  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
-  EXPECT_EQ(json.at("truth").size(), 4u);
-  EXPECT_EQ(json.at("detected").size(), static_cast<std::size_t>(report.detected));
-  EXPECT_EQ(json.at("camera").at("kdu"), 0.15);
-  EXPECT_EQ(json.at("target"), "four-line-a3");
+  const auto lines = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(lines.at("truth").size(), 4u);
+  EXPECT_EQ(lines.at("detected").size(), static_cast<std::size_t>(report.detected));
+  EXPECT_EQ(lines.at("camera").at("kdu"), 0.15);
+  EXPECT_EQ(lines.at("target"), "four-line-a3");
   EXPECT_THAT(out.str(), HasSubstr("angle err(deg)"));
   EXPECT_THAT(out.str(), HasSubstr("target lines found"));
   EXPECT_TRUE(test::TempFilesIn(dir.path()).empty());
@@ -51,9 +51,9 @@ TEST(Demo, FindsTheSheetAndItsPose) {
   const DemoReport report = RunDemoScene(options, out);
   EXPECT_EQ(report.pose_status, "ok") << out.str();
   for (const DemoMatch& match : report.matches) EXPECT_GE(match.detected_index, 0);
-  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
-  EXPECT_EQ(json.at("scan").at("mode"), "target");
-  EXPECT_EQ(json.at("scan").at("region").size() >= 4, true);
+  const auto lines = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(lines.at("scan").at("mode"), "target");
+  EXPECT_EQ(lines.at("scan").at("region").size() >= 4, true);
   EXPECT_THAT(out.str(), HasSubstr("from the truth"));
 }
 
@@ -66,9 +66,9 @@ TEST(Demo, TheBoardThroughACheapLens) {
   std::ostringstream out;
   const DemoReport report = RunDemoScene(options, out);
   EXPECT_EQ(report.matches.size(), 4u);
-  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
-  EXPECT_EQ(json.at("camera").at("kdu"), 0.33);
-  EXPECT_EQ(json.at("target"), "four-line-board");
+  const auto lines = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(lines.at("camera").at("kdu"), 0.33);
+  EXPECT_EQ(lines.at("target"), "four-line-board");
 }
 
 TEST(Demo, AnUnknownTargetIsAnErrorNamingTheOption) {
@@ -97,9 +97,9 @@ TEST(Demo, NumbersTheTargetLinesOneToFour) {
     if (line.rfind("     ", 0) == 0 && words >> number) numbers.push_back(number);
   }
   EXPECT_EQ(numbers, (std::vector<int>{1, 2, 3, 4})) << out.str();
-  const auto json = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
-  EXPECT_EQ(json.at("matches")[0].at("target_line"), 1);
-  EXPECT_EQ(json.at("matches")[0].at("truth_index"), 0);
+  const auto lines = nlohmann::json::parse(test::ReadText(dir / "demo/lines.json"));
+  EXPECT_EQ(lines.at("matches")[0].at("target_line"), 1);
+  EXPECT_EQ(lines.at("matches")[0].at("truth_index"), 0);
 }
 
 // A failed output stream (stdout on a full disk) is an error, not a silent success.

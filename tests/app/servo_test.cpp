@@ -48,7 +48,7 @@ std::string ReadText(const std::string& path) {
   return text.str();
 }
 
-std::string ErrorOf(const std::string& yaml) {
+std::string ServoConfigErrorOf(const std::string& yaml) {
   return test::ConfigErrorOf(yaml, "servo.yaml");
 }
 
@@ -132,78 +132,78 @@ TEST(ServoConfig, Table3ColumnsReadBackTheConfigsAngles) {
 }
 
 TEST(ServoConfig, ErrorsNameFileLineAndKey) {
-  EXPECT_EQ(ErrorOf("servo:\n  delta: 0.5\n  deltaa: 0.3\n").substr(0, 43),
+  EXPECT_EQ(ServoConfigErrorOf("servo:\n  delta: 0.5\n  deltaa: 0.3\n").substr(0, 43),
             "servo.yaml:3: key 'servo.deltaa' is unknown");
-  EXPECT_THAT(ErrorOf("servo:\n  mode: exponential\n  delta: 1.5\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  mode: exponential\n  delta: 1.5\n"),
               HasSubstr("servo.yaml:3: 'servo.delta' is invalid"));
   // The camera's kdu: the range every command line's --kdu has.
-  EXPECT_THAT(ErrorOf("camera:\n  kdu: 1.5\n"),
+  EXPECT_THAT(ServoConfigErrorOf("camera:\n  kdu: 1.5\n"),
               HasSubstr("servo.yaml:2: 'camera.kdu' is invalid: 1.5 (needs -1 < kdu < 1)"));
-  EXPECT_THAT(ErrorOf("servo:\n  max_iterations: -1\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  max_iterations: -1\n"),
               HasSubstr("servo.yaml:2: 'servo.max_iterations' is invalid"));
-  EXPECT_THAT(ErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  delta: 0.5\n  max_step_m: 0\n"),
               HasSubstr("servo.yaml:3: 'servo.max_step_m' is invalid: 0 (needs max_step_m > 0)"));
-  EXPECT_THAT(ErrorOf("servo:\n  max_step_deg: 200\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  max_step_deg: 200\n"),
               HasSubstr("servo.yaml:2: 'servo.max_step_deg' is invalid"));
-  EXPECT_THAT(ErrorOf("servo:\n  max_step_m: fast\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  max_step_m: fast\n"),
               HasSubstr("servo.yaml:2: 'servo.max_step_m'"));
-  EXPECT_THAT(ErrorOf("servo:\n  delta: 0.5\n  max_lost_s: -2\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  delta: 0.5\n  max_lost_s: -2\n"),
               HasSubstr("servo.yaml:3: 'servo.max_lost_s' is invalid: -2 (needs 0 <= max_lost_s "
                         "<= 3600)"));
-  EXPECT_THAT(ErrorOf("servo:\n  max_lost_frames: 1.5\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  max_lost_frames: 1.5\n"),
               HasSubstr("servo.yaml:2: 'servo.max_lost_frames'"));
-  EXPECT_THAT(ErrorOf("camera:\n  latency_s: -0.1\n"),
+  EXPECT_THAT(ServoConfigErrorOf("camera:\n  latency_s: -0.1\n"),
               HasSubstr("servo.yaml:2: 'camera.latency_s' is invalid: -0.1"));
-  EXPECT_THAT(ErrorOf("scene:\n  episode_s: [0.5, 0.2]\n"),
+  EXPECT_THAT(ServoConfigErrorOf("scene:\n  episode_s: [0.5, 0.2]\n"),
               HasSubstr("servo.yaml:2: 'scene.episode_s' is invalid"));
-  EXPECT_THAT(ErrorOf("scene:\n  episode_seed: -3\n"),
+  EXPECT_THAT(ServoConfigErrorOf("scene:\n  episode_seed: -3\n"),
               HasSubstr("servo.yaml:2: 'scene.episode_seed' is invalid: -3"));
-  EXPECT_THAT(ErrorOf("camera:\n  px: 600\n  exposure_s: 2\n"),
+  EXPECT_THAT(ServoConfigErrorOf("camera:\n  px: 600\n  exposure_s: 2\n"),
               HasSubstr("servo.yaml:3: 'camera.exposure_s' is invalid: 2 (needs 0 <= exposure_s "
                         "<= 1)"));
-  EXPECT_THAT(ErrorOf("servo:\n  mode: sideways\n"),
+  EXPECT_THAT(ServoConfigErrorOf("servo:\n  mode: sideways\n"),
               HasSubstr("servo.yaml:2: 'servo.mode' must be one of point-and-go, exponential"));
-  EXPECT_THAT(ErrorOf("camera:\n  px: 600\n  width: 8\n"),
+  EXPECT_THAT(ServoConfigErrorOf("camera:\n  px: 600\n  width: 8\n"),
               HasSubstr("servo.yaml:3: 'camera.width' is invalid"));
-  EXPECT_THAT(ErrorOf("camera:\n  noise: -1\n"),
+  EXPECT_THAT(ServoConfigErrorOf("camera:\n  noise: -1\n"),
               HasSubstr("servo.yaml:2: 'camera.noise' is invalid"));
-  EXPECT_THAT(ErrorOf("robot:\n  max_translation_mps: -0.1\n"),
+  EXPECT_THAT(ServoConfigErrorOf("robot:\n  max_translation_mps: -0.1\n"),
               HasSubstr("servo.yaml:2: 'robot.max_translation_mps' is invalid"));
-  EXPECT_THAT(ErrorOf("robot:\n  start: {translation_m: [0, 0], rxyz_deg: [0, 0, 0]}\n"),
+  EXPECT_THAT(ServoConfigErrorOf("robot:\n  start: {translation_m: [0, 0], rxyz_deg: [0, 0, 0]}\n"),
               HasSubstr("servo.yaml:2: 'robot.start.translation_m' must be [x, y, z]"));
-  EXPECT_THAT(ErrorOf("goal:\n  cdMo:\n    translation: [0, 0, 1]\n"),
+  EXPECT_THAT(ServoConfigErrorOf("goal:\n  cdMo:\n    translation: [0, 0, 1]\n"),
               HasSubstr("servo.yaml:3: key 'goal.cdMo.translation' is unknown"));
   EXPECT_THAT(
-      ErrorOf("goal:\n  taught_from_pose: x.png\n"),
+      ServoConfigErrorOf("goal:\n  taught_from_pose: x.png\n"),
       HasSubstr("servo.yaml:2: key 'goal.taught_from_pose' is unknown (known: cdMo, image)"));
-  EXPECT_THAT(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5], rxyz_deg: [0, 0, 0]}\n"),
+  EXPECT_THAT(ServoConfigErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5], rxyz_deg: [0, 0, 0]}\n"),
               HasSubstr("servo.yaml:2: 'goal.cdMo' puts the target at z = -0.5"));
-  EXPECT_THAT(ErrorOf("target_pose: {translation_m: [0, 0, 0], rxyz: [0, 0, 0]}\n"),
+  EXPECT_THAT(ServoConfigErrorOf("target_pose: {translation_m: [0, 0, 0], rxyz: [0, 0, 0]}\n"),
               HasSubstr("servo.yaml:1: key 'target_pose.rxyz' is unknown"));
 }
 
 // Half a pose was read as zeros for the other half: the robot would start (or servo to)
 // somewhere else than the user wrote.
 TEST(ServoConfig, APoseWithOnlyOneOfItsKeysIsAnErrorNamingTheMissingKey) {
-  EXPECT_THAT(ErrorOf("robot:\n  start: {translation_m: [0.5, 0, 0.6]}\n"),
+  EXPECT_THAT(ServoConfigErrorOf("robot:\n  start: {translation_m: [0.5, 0, 0.6]}\n"),
               HasSubstr("servo.yaml:2: 'robot.start' has no 'rxyz_deg'"));
-  EXPECT_THAT(ErrorOf("goal:\n  cdMo:\n    rxyz_deg: [0, 0, 10]\n"),
+  EXPECT_THAT(ServoConfigErrorOf("goal:\n  cdMo:\n    rxyz_deg: [0, 0, 10]\n"),
               HasSubstr("servo.yaml:3: 'goal.cdMo' has no 'translation_m'"));
-  EXPECT_THAT(ErrorOf("target_pose: {rxyz_deg: [180, 0, 0]}\n"),
+  EXPECT_THAT(ServoConfigErrorOf("target_pose: {rxyz_deg: [180, 0, 0]}\n"),
               HasSubstr("servo.yaml:1: 'target_pose' has no 'translation_m'"));
-  EXPECT_THAT(ErrorOf("camera:\n  eMc: {rxyz_deg: [0, 0, 90]}\n"),
+  EXPECT_THAT(ServoConfigErrorOf("camera:\n  eMc: {rxyz_deg: [0, 0, 90]}\n"),
               HasSubstr("servo.yaml:2: 'camera.eMc' has no 'translation_m'"));
-  EXPECT_EQ(ErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.4], rxyz_deg: [0, 0, 0]}\n"), "");
+  EXPECT_EQ(ServoConfigErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.4], rxyz_deg: [0, 0, 0]}\n"), "");
 }
 
 TEST(ServoConfig, AWorkspaceBoxWithMinAboveMaxNamesTheKeyAndLine) {
-  EXPECT_THAT(ErrorOf("robot:\n  workspace_enabled: true\n  workspace_min_m: [1, -1, -1]\n"
+  EXPECT_THAT(ServoConfigErrorOf("robot:\n  workspace_enabled: true\n  workspace_min_m: [1, -1, -1]\n"
                       "  workspace_max_m: [0, 1, 1]\n"),
               HasSubstr("servo.yaml:3: 'robot.workspace_min_m' is invalid: "
                         "robot.workspace_min_m/workspace_max_m [x] = 1 / 0 (needs finite and min < "
                         "max)"));
   // Only the max in this file: its line.
-  EXPECT_THAT(ErrorOf("robot:\n  workspace_max_m: [1, 1, -2]\n"),
+  EXPECT_THAT(ServoConfigErrorOf("robot:\n  workspace_max_m: [1, 1, -2]\n"),
               HasSubstr("servo.yaml:2: 'robot.workspace_max_m' is invalid"));
 }
 
