@@ -8,8 +8,10 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
 # Line tables: the reports name file and line. -O0 for the app and the tests (half the build
 # time of -O1); the libraries keep -O1 (OAL_SANITIZE_HOT_FLAGS), the suite's running time.
+# Each test executable runs as four shards, not a process per case (tests/CMakeLists.txt:
+# OAL_TEST_SHARDS): a process's start and end under the sanitizers cost half a second.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O0 -g1" \
-  -DOAL_SANITIZE=address,undefined -DOAL_BUILD_BENCH=OFF
+  -DOAL_SANITIZE=address,undefined -DOAL_BUILD_BENCH=OFF -DOAL_TEST_SHARDS=4
 cmake --build build-asan -j "$jobs"
 here=$(pwd)
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_init_order=1:detect_stack_use_after_return=1"
