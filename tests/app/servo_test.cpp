@@ -176,8 +176,9 @@ TEST(ServoConfig, ErrorsNameFileLineAndKey) {
   EXPECT_THAT(
       ServoConfigErrorOf("goal:\n  taught_from_pose: x.png\n"),
       HasSubstr("servo.yaml:2: key 'goal.taught_from_pose' is unknown (known: cdMo, image)"));
-  EXPECT_THAT(ServoConfigErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5], rxyz_deg: [0, 0, 0]}\n"),
-              HasSubstr("servo.yaml:2: 'goal.cdMo' puts the target at z = -0.5"));
+  EXPECT_THAT(
+      ServoConfigErrorOf("goal:\n  cdMo: {translation_m: [0, 0, -0.5], rxyz_deg: [0, 0, 0]}\n"),
+      HasSubstr("servo.yaml:2: 'goal.cdMo' puts the target at z = -0.5"));
   EXPECT_THAT(ServoConfigErrorOf("target_pose: {translation_m: [0, 0, 0], rxyz: [0, 0, 0]}\n"),
               HasSubstr("servo.yaml:1: key 'target_pose.rxyz' is unknown"));
 }
@@ -193,15 +194,17 @@ TEST(ServoConfig, APoseWithOnlyOneOfItsKeysIsAnErrorNamingTheMissingKey) {
               HasSubstr("servo.yaml:1: 'target_pose' has no 'translation_m'"));
   EXPECT_THAT(ServoConfigErrorOf("camera:\n  eMc: {rxyz_deg: [0, 0, 90]}\n"),
               HasSubstr("servo.yaml:2: 'camera.eMc' has no 'translation_m'"));
-  EXPECT_EQ(ServoConfigErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.4], rxyz_deg: [0, 0, 0]}\n"), "");
+  EXPECT_EQ(
+      ServoConfigErrorOf("goal:\n  cdMo: {translation_m: [0, 0, 0.4], rxyz_deg: [0, 0, 0]}\n"), "");
 }
 
 TEST(ServoConfig, AWorkspaceBoxWithMinAboveMaxNamesTheKeyAndLine) {
-  EXPECT_THAT(ServoConfigErrorOf("robot:\n  workspace_enabled: true\n  workspace_min_m: [1, -1, -1]\n"
-                      "  workspace_max_m: [0, 1, 1]\n"),
-              HasSubstr("servo.yaml:3: 'robot.workspace_min_m' is invalid: "
-                        "robot.workspace_min_m/workspace_max_m [x] = 1 / 0 (needs finite and min < "
-                        "max)"));
+  EXPECT_THAT(
+      ServoConfigErrorOf("robot:\n  workspace_enabled: true\n  workspace_min_m: [1, -1, -1]\n"
+                         "  workspace_max_m: [0, 1, 1]\n"),
+      HasSubstr("servo.yaml:3: 'robot.workspace_min_m' is invalid: "
+                "robot.workspace_min_m/workspace_max_m [x] = 1 / 0 (needs finite and min < "
+                "max)"));
   // Only the max in this file: its line.
   EXPECT_THAT(ServoConfigErrorOf("robot:\n  workspace_max_m: [1, 1, -2]\n"),
               HasSubstr("servo.yaml:2: 'robot.workspace_max_m' is invalid"));
