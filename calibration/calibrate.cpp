@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "base/check.h"
 #include "base/format.h"
 #include "calibration/plane_lines.h"
@@ -19,8 +20,6 @@ namespace {
 using plane_lines::OnPlane;
 using plane_lines::PlaneLine;
 using plane_lines::Snap;
-
-constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 
 // How far a relative standard deviation (or a pixel one for the principal point) may go
 // before the result says which parameter the views leave loose.

@@ -9,15 +9,15 @@
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "base/check.h"
 #include "base/format.h"
-#include "robots/robot.h"  // Distance
+#include "detector/line.h"  // kPi
+#include "robots/robot.h"   // Distance
 
 namespace oal {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegPerRad = 180.0 / kPi;
 // Two stations closer than this are one: the arm did not move between them.
 constexpr double kSameStationM = 1e-4;
 constexpr double kSameStationRad = 1e-3;

@@ -3,12 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/angles.h"
+
 namespace oal {
-namespace {
-
-constexpr double kRadToDeg = 180.0 / kPi;
-
-}  // namespace
 
 Point2d Foot(const LineParams& line, const Point2d& p) {
   const double distance = line.SignedDistance(p.u, p.v);
@@ -37,7 +34,7 @@ LineParams Midline(const LineParams& a, const LineParams& b, const Point2d& cent
 std::pair<double, double> ErrorOf(const LineParams& line, const LineParams& truth, const Point2d& a,
                                   const Point2d& b) {
   return {
-      AngleBetween(line, truth) * kRadToDeg,
+      AngleBetween(line, truth) * kDegPerRad,
       std::max(std::fabs(line.SignedDistance(a.u, a.v)), std::fabs(line.SignedDistance(b.u, b.v)))};
 }
 

@@ -6,10 +6,10 @@
 #include <opencv2/ximgproc/fast_line_detector.hpp>
 #include <vector>
 
+#include "base/angles.h"
+
 namespace oal {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / kPi;
 
 // Drops lines within `angle_deg` and `distance_px` of a better (earlier) line.
 std::vector<LineParams> Deduplicated(const std::vector<LineParams>& lines, double angle_deg,
@@ -17,7 +17,7 @@ std::vector<LineParams> Deduplicated(const std::vector<LineParams>& lines, doubl
   std::vector<LineParams> kept;
   for (const LineParams& line : lines) {
     const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const LineParams& k) {
-      return AngleBetween(k, line) * kRadToDeg <= angle_deg &&
+      return AngleBetween(k, line) * kDegPerRad <= angle_deg &&
              DistanceAt(k, line, centre) <= distance_px;
     });
     if (!duplicate) kept.push_back(line);
@@ -37,7 +37,7 @@ std::vector<LineParams> PairedEdges(const std::vector<LineParams>& lines, double
     std::size_t best = lines.size();
     double best_distance = max_width_px;
     for (std::size_t j = i + 1; j < lines.size(); ++j) {
-      if (used[j] || AngleBetween(lines[i], lines[j]) * kRadToDeg > kPairAngleDeg) continue;
+      if (used[j] || AngleBetween(lines[i], lines[j]) * kDegPerRad > kPairAngleDeg) continue;
       const double distance = DistanceAt(lines[i], lines[j], centre);
       if (distance >= kMinWidthPx && distance <= best_distance) {
         best = j;
@@ -92,7 +92,7 @@ std::vector<LineParams> MergedSegments(const std::vector<cv::Vec4f>& segments) {
     const LineParams own = LineThrough(a, b);
     Cluster* home = nullptr;
     for (Cluster& cluster : clusters) {
-      if (AngleBetween(cluster.line, own) * kRadToDeg <= kAngleDeg &&
+      if (AngleBetween(cluster.line, own) * kDegPerRad <= kAngleDeg &&
           std::fabs(cluster.line.SignedDistance(a.u, a.v)) <= kDistancePx &&
           std::fabs(cluster.line.SignedDistance(b.u, b.v)) <= kDistancePx) {
         home = &cluster;

@@ -7,12 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "base/angles.h"
 #include "base/check.h"
 
 namespace oal {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / kPi;
 
 // vpMeLine's a·i + b·j + c = 0 (i = row, j = column) in our convention. vpMeLine::getRho()
 // takes |c| and picks the sign from the grey levels on both sides (its theta spans
@@ -83,7 +82,7 @@ class VpMeLineMethod : public LineMethod {
         double best = 1e300;
         for (std::size_t i = 0; i < targets.size(); ++i) {
           if (taken[i]) continue;
-          const double cost = AngleBetween(targets[i].image_line, track.line) * kRadToDeg / 5.0 +
+          const double cost = AngleBetween(targets[i].image_line, track.line) * kDegPerRad / 5.0 +
                               DistanceAt(track.line, targets[i].image_line, centre) / 10.0;
           if (cost < best) {
             best = cost;

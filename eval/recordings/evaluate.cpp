@@ -21,6 +21,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "base/angles.h"
 #include "base/check.h"
 #include "base/format.h"
 #include "base/statistics.h"
@@ -52,7 +53,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kRadToDeg = 180.0 / kPi;
 constexpr std::size_t kQueueFrames = 8;         // decoded frames waiting for the tracker
 constexpr std::size_t kListedUnreadable = 100;  // unreadable frames named in the summary
 constexpr std::size_t kListedJumps = 100;       // jump frames named in the summary
@@ -540,7 +540,7 @@ class InputEvaluation {
     if (pose_error) row.pose_t_mm = pose_error->first, row.pose_r_deg = pose_error->second;
     for (const TrackedLine* track : held) {
       row.tracks.push_back(
-          {track->id, track->line.line.rho_px, track->line.line.theta_rad * kRadToDeg});
+          {track->id, track->line.line.rho_px, track->line.line.theta_rad * kDegPerRad});
     }
     row.decode_us = frame.decode_us;
     row.track_us = track_us;

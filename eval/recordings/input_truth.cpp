@@ -2,14 +2,10 @@
 
 #include <cmath>
 
+#include "base/angles.h"
 #include "base/pose_distance.h"
 
 namespace oal {
-namespace {
-
-constexpr double kRadToDeg = 180.0 / kPi;
-
-}  // namespace
 
 std::vector<LineError> MatchTruth(const std::vector<TargetLineTruth>& truth,
                                   const std::vector<DetectedLine>& held,
@@ -42,7 +38,7 @@ std::vector<LineError> MatchTruth(const std::vector<TargetLineTruth>& truth,
 std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
                                     const vpHomogeneousMatrix& truth) {
   const PoseDistance d = Distance(truth, cMo);
-  return {1000.0 * d.translation_m, kRadToDeg * d.rotation_rad};
+  return {1000.0 * d.translation_m, kDegPerRad * d.rotation_rad};
 }
 
 }  // namespace oal

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/angles.h"
 #include "base/check.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
@@ -16,13 +17,11 @@
 namespace oal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / kPi;
-
 // Angle and largest offset of the truth chord's ends from `line`.
 std::pair<double, double> ErrorOf(const LineParams& line, const LineParams& truth, const Point2d& a,
                                   const Point2d& b) {
   return {
-      AngleBetween(line, truth) * kRadToDeg,
+      AngleBetween(line, truth) * kDegPerRad,
       std::max(std::fabs(line.SignedDistance(a.u, a.v)), std::fabs(line.SignedDistance(b.u, b.v)))};
 }
 
@@ -82,7 +81,7 @@ std::vector<LineParams> OpenCvHough(const vpImage<unsigned char>& image,
   for (const cv::Vec3f& line : found) {
     const LineParams candidate = Normalized(line[0], line[1]);
     const bool duplicate = std::any_of(lines.begin(), lines.end(), [&](const LineParams& kept) {
-      return AngleBetween(kept, candidate) * kRadToDeg <= detector.duplicate_angle_deg &&
+      return AngleBetween(kept, candidate) * kDegPerRad <= detector.duplicate_angle_deg &&
              std::fabs(RhoAlignedTo(kept, candidate) - kept.rho_px) <= detector.duplicate_r_px;
     });
     if (!duplicate) lines.push_back(candidate);
