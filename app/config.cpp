@@ -929,6 +929,7 @@ const std::vector<Field<SheetFinderOptions>>& FinderFields() {
       IntField("cell_px", &O::cell_px),
       DoubleField("min_area_fraction", &O::min_area_fraction),
       IntField("min_contrast", &O::min_contrast),
+      DoubleField("min_relative_contrast", &O::min_relative_contrast),
       IntField("max_candidates", &O::max_candidates),
   };
   return fields;

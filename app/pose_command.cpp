@@ -222,6 +222,7 @@ void EstimateLens(const PoseCommandOptions& options, FrameFeed* feed, PoseRun* r
   run->camera.camera = WithLens(pinhole, lens);
   run->tracker = TargetPoseTracker(run->config.target, run->camera.camera, run->config.detector,
                                    run->config.pose, run->config.tracking);
+  run->tracker.set_measure_lens(true);
   run->undistorted_by = run->camera.camera;
   said << "kdu " << lens.kdu << " +- " << lens.kdu_sd << " (kud " << lens.kud << ")"
        << " from the stripes of " << told.frames << " frames (they bend " << std::setprecision(2)
@@ -316,6 +317,7 @@ PoseSummary EstimatePoses(const PoseCommandOptions& options, std::ostream& out) 
   // The target and the options with the camera, before any frame: a bad one fails here.
   TargetPoseTracker tracker(config.target, camera.camera, config.detector, config.pose,
                             config.tracking);
+  tracker.set_measure_lens(true);  // every pose's lines feed the lens check
   PoseRun run{std::move(config), std::move(camera), std::move(tracker), {}, {}, {}};
   if (run.tracker.detector().Undistorts()) run.undistorted_by = run.camera.camera;
   run.sources = OpenInputs(options, &summary.warnings);

@@ -19,6 +19,10 @@ constexpr int kEdgePoints = 9;
 constexpr std::size_t kMinEdgePoints = 4;
 constexpr double kEdgeSearchCells = 2.5;
 constexpr double kEdgeTolerancePx = 1.5;
+// A side's edge is a stripe's ink against the cell's paper, a tenth of its grey level or
+// less: it differs by min_contrast, or by half the paper's level in a frame too dim for that
+// (a grey hand's edge, a fifth darker than the paper, is no stripe's at any exposure).
+constexpr double kEdgeContrastOfLight = 0.5;
 // The last pass: a cell is light only when it is at least this fraction of the brightest cell
 // within this many cells (a stripe under a glare stays darker than the paper beside it).
 constexpr int kLocalRadiusCells = 3;
@@ -115,7 +119,7 @@ struct Side {
 // The light/dark edge nearest to the side at t along its normal, within +-search px: false
 // when there is none with enough contrast.
 bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light, double search,
-            int min_contrast, Point2d* edge) {
+            double min_contrast, Point2d* edge) {
   const int n = static_cast<int>(2.0 * search) + 1;
   std::array<double, 512> profile;
   if (n > static_cast<int>(profile.size())) return false;
@@ -145,7 +149,7 @@ bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light
 // The side moved onto the light/dark edge: a line through the edge points found along it
 // (at least 4 of kEdgePoints, those more than 1.5 px off the first fit dropped).
 bool RefineSide(const GrayImageView& image, const Side& side, double light, double search,
-                int min_contrast, LineParams* line) {
+                double min_contrast, LineParams* line) {
   std::vector<Point2d> points;
   for (int k = 0; k < kEdgePoints; ++k) {
     const double t = 0.1 + 0.8 * k / (kEdgePoints - 1.0);
@@ -274,8 +278,15 @@ void SheetFinderOptions::Check() const {
                 "0 < min_area_fraction <= 1");
   RequireOption(min_contrast >= 0 && min_contrast <= 255, "SheetFinderOptions::min_contrast",
                 min_contrast, "0 <= min_contrast <= 255");
+  RequireOption(min_relative_contrast >= 0.0 && min_relative_contrast <= 1.0,
+                "SheetFinderOptions::min_relative_contrast", min_relative_contrast,
+                "0 <= min_relative_contrast <= 1");
   RequireOption(max_candidates >= 1 && max_candidates <= 16, "SheetFinderOptions::max_candidates",
                 max_candidates, "1 <= max_candidates <= 16");
+}
+
+double SheetFinderOptions::ContrastNeededAt(double light) const {
+  return std::min(static_cast<double>(min_contrast), min_relative_contrast * light);
 }
 
 SheetFinderOptions SheetFinderOptions::ScaledBy(double scale) const {
@@ -449,9 +460,10 @@ bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
   // three still place the corners better than the cells do.
   std::array<LineParams, 4> lines;
   int unmoved = 0;
+  const double edge_contrast =
+      std::min(static_cast<double>(options_.min_contrast), kEdgeContrastOfLight * quad->light);
   for (std::size_t k = 0; k < 4; ++k) {
-    if (!RefineSide(image, sides[k], quad->light, kEdgeSearchCells * c, options_.min_contrast,
-                    &lines[k])) {
+    if (!RefineSide(image, sides[k], quad->light, kEdgeSearchCells * c, edge_contrast, &lines[k])) {
       lines[k] = LineThrough(sides[k].a, sides[k].b);
       if (++unmoved > 1) return false;
     }
@@ -592,21 +604,30 @@ void SheetFinder::AddComponents(const GrayImageView& image, const std::uint8_t* 
                          component_.back().row == grid_height_ - 1;
     if (at_edge || 2.2 * cells < static_cast<double>(rows) * (right - left + 1)) continue;
     // The same component found at another threshold (its cell box within a cell) is kept
-    // once, as first found.
+    // once: as first found, unless it is found again closed in on more sides (a hand over a
+    // crossing leaves a side open at one threshold and closed at the last pass's).
     const std::array<int, 4> box{left, component_.front().row, right, component_.back().row};
-    const bool seen = std::any_of(boxes_.begin(), boxes_.end(), [&](const std::array<int, 4>& b) {
-      for (int k = 0; k < 4; ++k) {
-        if (std::abs(b[static_cast<std::size_t>(k)] - box[static_cast<std::size_t>(k)]) > 1) {
-          return false;
-        }
+    const auto seen = std::find_if(seen_.begin(), seen_.end(), [&](const SeenComponent& s) {
+      for (std::size_t k = 0; k < 4; ++k) {
+        if (std::abs(s.box[k] - box[k]) > 1) return false;
       }
       return true;
     });
-    if (seen) continue;
+    if (seen != seen_.end() && seen->closed_sides == 4) continue;
     LightQuad quad;
     if (!Describe(image, grid, threshold, component_, &quad)) continue;
-    boxes_.push_back(box);
-    candidates_.push_back(quad);
+    if (seen == seen_.end()) {
+      seen_.push_back({box, quad.ClosedSideCount(), static_cast<int>(candidates_.size())});
+      candidates_.push_back(quad);
+    } else if (quad.ClosedSideCount() > seen->closed_sides) {
+      seen->closed_sides = quad.ClosedSideCount();
+      if (seen->candidate >= 0) {  // returned by this call: replaced
+        candidates_[static_cast<std::size_t>(seen->candidate)] = quad;
+      } else {
+        seen->candidate = static_cast<int>(candidates_.size());
+        candidates_.push_back(quad);
+      }
+    }
   }
 }
 
@@ -615,7 +636,7 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
     throw std::invalid_argument("SheetFinder::Find: empty image or stride < width");
   }
   candidates_.clear();
-  boxes_.clear();
+  seen_.clear();
   ComputeCells(image);
   if (grid_width_ < 2 || grid_height_ < 2) return candidates_;
   std::array<int, 256> histogram{};
@@ -637,7 +658,7 @@ const std::vector<LightQuad>& SheetFinder::Find(const GrayImageView& image) {
   for (int level = 0; level < 3 && !closed; ++level) {
     double contrast = 0.0, light = 0.0;
     const int threshold = OtsuOfHistogram(histogram, lo, &contrast, &light);
-    if (threshold > 255 || contrast < options_.min_contrast) break;
+    if (threshold > 255 || contrast < options_.ContrastNeededAt(light)) break;
     AddComponents(image, cells_.data(), threshold);
     lo = threshold;
     if (first_threshold_ < 0) {
@@ -698,6 +719,7 @@ void SheetFinder::AddLocallyLight(const GrayImageView& image, double light_ratio
 }
 
 void SheetFinder::KeepBest() {
+  for (SeenComponent& seen : seen_) seen.candidate = -1;  // candidates_ reordered, then cleared
   std::stable_sort(candidates_.begin(), candidates_.end(),
                    [](const LightQuad& a, const LightQuad& b) { return a.score > b.score; });
   if (static_cast<int>(candidates_.size()) > options_.max_candidates) {

@@ -11,10 +11,10 @@
 // cells costs what a small one does):
 //   1. cell means and thresholds between light and dark cells: Otsu's over the cells, then
 //      Otsu's over the light class again (a light bench, a bright photo), while the classes
-//      differ by at least min_contrast and no quadrilateral closed in on all four sides has
-//      been found at the thresholds before; when none is, a last pass at the first threshold
-//      with the cells darker than 0.8 times the brightest within three cells taken as dark,
-//      and saturated ones too where the paper is not (a stripe under a glare stays darker
+//      differ by at least min_contrast (less in a dim frame) and no quadrilateral closed in on all
+//      four sides has been found at the thresholds before; when none is, a last pass at the first
+//      threshold with the cells darker than 0.8 times the brightest within three cells taken as
+//      dark, and saturated ones too where the paper is not (a stripe under a glare stays darker
 //      than the paper beside it, a glare's core is no paper, a grey hand is darker than the
 //      paper): this last pass is also FindLocallyLight's, for a caller none of whose
 //      candidates was the target, and FindFaintlyDark's with 0.9 instead of 0.8 (a pale hand
@@ -23,19 +23,20 @@
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
-//      its neighbours is smallest (the quadrilateral stays inside the hull);
+//      its neighbours is smallest (the quadrilateral stays inside the hull); a component
+//      found at several thresholds is kept once, as found closed in on most sides;
 //   3. each side of the quadrilateral is probed in the image at three points along the
 //      outward normal, up to 3/4 of the quadrilateral's shorter side: a side is closed in
 //      when dark pixels (a band of at least 2 px, min_contrast below the cell) and light ones
 //      again follow;
 //   4. a quadrilateral closed in on at least three sides is refined at pixel level: every
-//      side is moved onto the light/dark edge found along its normal at nine points
-//      (sub-pixel; the line through two of them that most others lie within 1.5 px of, then
-//      fitted to those: a hand or a pen over part of a side), one side whose edge is not found
-//      left where the cells put it, and the corners are the sides' crossings;
+//      side is moved onto the light/dark edge found along its normal at nine points (ink
+//      against paper: min_contrast, or half the paper's grey level in a frame too dim; sub-pixel;
+//      the line through two of them that most others lie within 1.5 px of, then fitted to those: a
+//      hand or a pen over part of a side), one side whose edge is not found left where the cells
+//      put it, and the corners are the sides' crossings;
 //   5. candidates are ranked by the sides closed in, how well the cells fill the
-//      quadrilateral, and its area; the same quadrilateral found at another threshold is
-//      kept once.
+//      quadrilateral, and its area.
 // The finder knows nothing of any target: which candidate is the middle cell of which target,
 // and where that puts the target, is the caller's to decide (servo/target_tracker.h).
 #pragma once
@@ -54,13 +55,19 @@ struct SheetFinderOptions {
   int cell_px = 8;
   /// Smallest light region, as a fraction of the image's area. Range (0, 1].
   double min_area_fraction = 0.006;
-  /// Light and dark must differ by at least this, grey levels. Range [0, 255].
+  /// Light and dark must differ by at least this, grey levels, Range [0, 255] ...
   int min_contrast = 30;
+  /// ... or by this fraction of the light's grey level where that is less: a frame exposed
+  /// at a third of the right level keeps a third of its contrast, and the cells are means of
+  /// dozens of pixels, so their noise does not grow as the frame dims. Range [0, 1].
+  double min_relative_contrast = 0.14;
   /// Candidates returned at most. Range [1, 16].
   int max_candidates = 4;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
   void Check() const;
+  /// The least difference between `light` (grey level) and dark that counts as contrast.
+  double ContrastNeededAt(double light) const;
   /// These options for an image `scale` times as many pixels across (DetectorOptions::
   /// ScaledBy): the cells `scale` times as wide, as many of them over the sheet. `scale` in
   /// (0, 100].
@@ -173,7 +180,14 @@ class SheetFinder {
   std::vector<CellRun> component_;
   std::vector<int> order_, starts_;
   std::vector<LightQuad> candidates_;
-  std::vector<std::array<int, 4>> boxes_;  ///< candidates' cell boxes (left, top, right, bottom)
+  /// The components described since the last Find: their cell box (left, top, right, bottom),
+  /// the most sides found closed, and where the candidate is in candidates_ (-1: not there).
+  struct SeenComponent {
+    std::array<int, 4> box;
+    int closed_sides;
+    int candidate;
+  };
+  std::vector<SeenComponent> seen_;
 };
 
 }  // namespace oal

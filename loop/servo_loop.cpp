@@ -684,6 +684,7 @@ class ServoRun {
     // nearer a 90-deg-turned assignment of a near-square target's lines than the right one).
     const bool confirming = candidate_cMo_.has_value();
     if (confirming) tracker_.Reset();
+    tracker_.set_measure_lens(lens_frames_.size() < kLensCheckFrames);
     const TargetFrame& tracked =
         tracker_.Track(ViewOf(gray_), confirming ? std::nullopt : predicted_cMo);
     const PoseResult& pose = tracked.pose;
@@ -876,7 +877,6 @@ class ServoRun {
   // The lens check over the first frames with a pose, said once: a camera file that misses
   // the lens biases every pose, which the loop cannot see otherwise.
   void CheckLensOnce(const TargetFrame& tracked) {
-    constexpr std::size_t kLensCheckFrames = 5;
     if (tracked.status != TargetStatus::kOk || lens_frames_.size() >= kLensCheckFrames) return;
     lens_frames_.push_back(tracked.lens);
     const LensCheck lens = CheckLens(lens_frames_, static_cast<int>(kLensCheckFrames));
@@ -996,6 +996,8 @@ class ServoRun {
   /// The last confirmed pose and where the camera was: the odometry's prediction starts here.
   std::optional<vpHomogeneousMatrix> previous_cMo_;
   vpHomogeneousMatrix previous_wMc_;
+  /// The lens check's frames: the first ones with a pose (their lines measured, no others).
+  static constexpr std::size_t kLensCheckFrames = 5;
   std::vector<RadialBend> lens_frames_;
   cv::Mat gray_;
 };

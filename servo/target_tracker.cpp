@@ -612,7 +612,7 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
   return true;
 }
 
-bool TargetPoseTracker::Verify(const GrayImageView& image) {
+void TargetPoseTracker::MeasureLens() {
   std::array<LineParams, 4> identified;
   for (std::size_t k = 0; k < identified.size(); ++k) {
     identified[k] = lines_[static_cast<std::size_t>(frame_.pose.line_index[k])].line;
@@ -622,6 +622,10 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
       identified, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px,
       StripeEnds(PlaneToImage(frame_.pose.cMo)), Point2d{camera_.u0(), camera_.v0()},
       std::sqrt(camera_.px() * camera_.py()));
+}
+
+bool TargetPoseTracker::Verify(const GrayImageView& image) {
+  if (measure_lens_) MeasureLens();
   if (frame_.pose.method == PoseMethod::kStripes) {
     // The four stripes held together: their points in all (each stripe has its fit's minimum).
     const int points = frame_.fit.TotalPoints();
@@ -661,6 +665,7 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
     }
     message << " (min_stripe_agreement = " << options_.min_stripe_agreement
             << ", min_stripe_seen = " << options_.min_stripe_seen << ")";
+    if (!measure_lens_) MeasureLens();
     if (ContradictsLens(frame_.lens)) {
       message << "; the stripes bend as a lens the camera model misses would (its kdu off by "
               << -frame_.lens.kdu_error << ")";

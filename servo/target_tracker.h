@@ -196,7 +196,8 @@ struct TargetFrame {
   /// pose): the kdu error they show and the bend it puts on them (bend_px, the frame's
   /// straightness), over their feature points between the stripes' printed ends. Stripes bent
   /// by a lens the camera file does not describe (a distortion-free model on a wide lens, the
-  /// wrong resolution) raise it.
+  /// wrong resolution) raise it. Measured for every pose with set_measure_lens(true), else
+  /// only for one the model check refuses.
   RadialBend lens;
   double find_us = 0.0, detect_us = 0.0, pose_us = 0.0;  ///< time spent in each step
 };
@@ -247,6 +248,10 @@ class TargetPoseTracker {
   /// for those who use them (the lens told from the stripes).
   void set_quick_scan(bool allowed) { quick_scan_ = allowed; }
   bool quick_scan() const { return quick_scan_; }
+  /// Whether each pose's lines are measured for the lens (TargetFrame::lens, what CheckLens
+  /// judges; about 3 us a frame at 640x480); off (the default), only a pose the model check
+  /// refuses is, to say whether the lens is why.
+  void set_measure_lens(bool measure) { measure_lens_ = measure; }
 
  private:
   /// Detects in `borders` (the whole image when empty) and estimates the pose from `prior`;
@@ -275,8 +280,10 @@ class TargetPoseTracker {
   /// the stripes' points, or as many closer: without a prior, the planar ambiguity.
   StripeFit OtherTiltIfBetter(const StripeFit& fit) const;
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
-  /// told from the lines.
+  /// told from the lines (set_measure_lens, or a pose the check refuses).
   bool Verify(const GrayImageView& image);
+  /// frame_.lens from the frame's pose and its lines 1-4.
+  void MeasureLens();
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,
   /// at most max_candidates of them, best first; true when a pose is accepted.
   bool AttemptCells(const GrayImageView& image, const std::vector<LightQuad>& cells);
@@ -334,6 +341,7 @@ class TargetPoseTracker {
   PoseOptions pose_options_;
   TargetTrackerOptions options_;
   bool quick_scan_ = true;
+  bool measure_lens_ = false;
   OalDetector detector_;
   SheetFinder finder_;
   std::vector<DetectedLine> lines_;
@@ -352,9 +360,9 @@ class TargetPoseTracker {
 /// leaves (0.1 and more), where a matching model's frames stay under 0.01 (docs/BENCHMARKS.md).
 inline constexpr double kLensMismatchKdu = 0.03;
 
-/// Whether a frame's lines 1-4 were measured for the lens: those of a pose, kept or refused by
-/// the model check (a camera model that misses the lens bends the stripes off the lines the
-/// check expects; the frame then says why).
+/// Whether a frame's lines 1-4 were measured for the lens (set_measure_lens for a kept pose): those
+/// of a pose, kept or refused by the model check (a camera model that misses the lens bends the
+/// stripes off the lines the check expects; the frame then says why).
 inline bool MeasuresLens(const TargetFrame& frame) {
   return frame.status == TargetStatus::kOk ||
          (frame.status == TargetStatus::kModelMismatch && std::isfinite(frame.lens.kdu_error_sd));

@@ -210,6 +210,7 @@ class InputEvaluation {
       target_pose.compute_covariance = false;
       target_tracker_.emplace(run_.target, camera_->camera, run_.setup.detector, target_pose,
                               run_.setup.tracking);
+      target_tracker_->set_measure_lens(true);  // every pose's lines feed the lens check
     }
 
     AtomicFile frames_file(dir_ / "frames.jsonl");

@@ -228,6 +228,16 @@ TEST(ConfigTracking, TheStripeFitAndTheModelCheckKeys) {
               HasSubstr("cfg.yaml:2: 'tracking.fit_stripes' must be true or false"));
 }
 
+// The sheet finder's contrast, in grey levels and in proportion to a dim frame's paper.
+TEST(ConfigTracking, TheSheetFindersContrastKeys) {
+  const AppConfig config = ParseConfig(
+      "tracking:\n  finder:\n    min_contrast: 25\n    min_relative_contrast: 0.1\n", "cfg.yaml");
+  EXPECT_EQ(config.tracking.finder.min_contrast, 25);
+  EXPECT_EQ(config.tracking.finder.min_relative_contrast, 0.1);
+  EXPECT_THAT(ErrorOf("tracking:\n  finder:\n    min_relative_contrast: 1.5\n"),
+              HasSubstr("cfg.yaml:3: 'tracking.finder.min_relative_contrast' is invalid: 1.5"));
+}
+
 // Where the tracker looks when no middle or edge cell gives a pose.
 TEST(ConfigTracking, TheCornerCellsAndTheImageFallbackKeys) {
   EXPECT_TRUE(ParseConfig("tracking:\n  max_candidates: 3\n", "cfg.yaml").tracking.corner_cells);

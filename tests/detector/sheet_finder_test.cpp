@@ -99,8 +99,9 @@ INSTANTIATE_TEST_SUITE_P(Sheets, SheetFinderOnRenderedSheets,
 // Whether the finder's candidates (its first pass, then FindLocallyLight's) hold the middle
 // cell closed in on three sides or more (what the target tracker scans), refined within 2 px
 // of it.
-bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target, const Lens& camera) {
-  SheetFinder finder;
+bool FindsTheMiddleCell(const RenderedFrame& frame, const LineTarget& target, const Lens& camera,
+                        const SheetFinderOptions& options = {}) {
+  SheetFinder finder(options);
   const GrayImageView view = ViewOf(frame.image);
   std::vector<LightQuad> candidates = finder.Find(view);
   const std::vector<LightQuad>& more = finder.FindLocallyLight(view);
@@ -268,12 +269,38 @@ TEST(SheetFinder, AFrameWithoutAGridHasNoCandidateClosedIn) {
   }
 }
 
+TEST_F(SheetFinderInALivedInScene, ADimFrameNeedsLessContrastInProportionToItsPaper) {
+  // Exposed at a fifth of the right level on a grey bench (an auto-exposure lagging behind a
+  // lamp switched off): paper, bench and ink at a fifth of their grey levels, and so is the
+  // contrast between them, under the 30 grey levels of a rightly exposed frame.
+  render_.background_grey = 120;
+  FrameEffects dim;
+  dim.gain = 0.2;
+  const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
+  const RenderedFrame frame = SceneRenderer(target_, render_).Render(cMo, 5, dim);
+  EXPECT_TRUE(FindsTheMiddleCell(frame, target_, render_.camera));
+  SheetFinderOptions absolute;
+  absolute.min_relative_contrast = 1.0;  // never less than min_contrast
+  EXPECT_FALSE(FindsTheMiddleCell(frame, target_, render_.camera, absolute));
+}
+
+TEST(SheetFinder, TheContrastNeededFollowsADimLightButNeverExceedsMinContrast) {
+  SheetFinderOptions options;
+  EXPECT_DOUBLE_EQ(options.ContrastNeededAt(230.0), options.min_contrast);
+  EXPECT_NEAR(options.ContrastNeededAt(100.0), 100.0 * options.min_relative_contrast, 1e-12);
+  options.min_relative_contrast = 0.0;
+  EXPECT_DOUBLE_EQ(options.ContrastNeededAt(100.0), 0.0);
+}
+
 TEST(SheetFinder, OptionsAreChecked) {
   SheetFinderOptions options;
   options.cell_px = 1;
   EXPECT_THROW(SheetFinder{options}, std::invalid_argument);
   options = SheetFinderOptions();
   options.min_area_fraction = 0.0;
+  EXPECT_THROW(SheetFinder{options}, std::invalid_argument);
+  options = SheetFinderOptions();
+  options.min_relative_contrast = 1.5;
   EXPECT_THROW(SheetFinder{options}, std::invalid_argument);
   SheetFinder finder;
   EXPECT_THROW(finder.Find(GrayImageView{}), std::invalid_argument);

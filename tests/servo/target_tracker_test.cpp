@@ -203,6 +203,7 @@ TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
     pose.image_width = 640;
     pose.image_height = 480;
     TargetPoseTracker tracker(renderer.target(), camera, DetectorOptions(), pose);
+    tracker.set_measure_lens(true);
     std::vector<RadialBend> values;
     for (const vpImage<unsigned char>& frame : frames) {
       tracker.Reset();
@@ -237,6 +238,26 @@ TEST(TargetPoseTracker, StraightnessTellsARightCameraFileFromAWrongOne) {
   EXPECT_TRUE(CheckLens({bent, bent, RadialBend{}}).mismatch);
   EXPECT_FALSE(CheckLens({bent, RadialBend{}, RadialBend{}}).mismatch) << "one frame of three";
   EXPECT_EQ(CheckLens({}).frames, 0);
+}
+
+// The lens is measured on every pose only when asked (the pose command's lens check); by
+// default only a pose the model check refuses is, to say whether the lens is why.
+TEST(TargetPoseTracker, MeasuresEachPosesLensOnlyWhenAsked) {
+  const SceneRenderer renderer(FourLineA3Target(), BenchRender(13));
+  std::uint64_t random = 5;
+  const vpImage<unsigned char> image =
+      renderer.Render(SamplePose(renderer, SheetSampling(renderer.target()), &random), 7).image;
+  const Lens camera = Lens::WithKdu(600.0, 600.0, 319.5, 239.5, 0.15, 640, 480);
+  PoseOptions pose;
+  pose.camera = camera;
+  TargetPoseTracker tracker(renderer.target(), camera, DetectorOptions(), pose);
+  ASSERT_EQ(tracker.Track(ViewOf(image)).status, TargetStatus::kOk);
+  EXPECT_EQ(tracker.Track(ViewOf(image)).lens.lines, 0);
+  tracker.set_measure_lens(true);
+  const TargetFrame& frame = tracker.Track(ViewOf(image));
+  ASSERT_EQ(frame.status, TargetStatus::kOk);
+  EXPECT_GE(frame.lens.lines, 3);
+  EXPECT_TRUE(std::isfinite(frame.lens.kdu_error_sd));
 }
 
 // The stripes' points lie on their centre lines' images: on a sheet tilted 45 degrees, a run's
