@@ -16,6 +16,7 @@
 #include "app/command_line.h"
 #include "app/evaluation_config.h"
 #include "app/render_command.h"
+#include "base/angles.h"
 #include "base/pose_distance.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
@@ -32,7 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kRadToDeg = 180.0 / kPi;
 // A detected line further than this from a true line (in angle) is not its match.
 constexpr double kMaxMatchAngleDeg = 10.0;
 
@@ -128,13 +128,13 @@ void PrintTable(const DemoReport& report, const std::vector<TruthLine>& truth,
     const LineParams& ideal = truth[static_cast<std::size_t>(match.truth_index)].ideal;
     if (match.detected_index < 0) {
       std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5s\n", match.truth_index + 1,
-                    ideal.rho_px, ideal.theta_rad * kRadToDeg, "-");
+                    ideal.rho_px, ideal.theta_rad * kDegPerRad, "-");
     } else {
       ++found;
       const LineParams& line = lines[static_cast<std::size_t>(match.detected_index)].line;
       std::snprintf(row, sizeof(row), "%6d  %12.1f %10.2f  %5d  %7.1f %10.2f  %14.3f  %15.2f\n",
-                    match.truth_index + 1, ideal.rho_px, ideal.theta_rad * kRadToDeg,
-                    match.detected_index, line.rho_px, line.theta_rad * kRadToDeg,
+                    match.truth_index + 1, ideal.rho_px, ideal.theta_rad * kDegPerRad,
+                    match.detected_index, line.rho_px, line.theta_rad * kDegPerRad,
                     match.angle_error_deg, match.max_offset_px);
     }
     out << row;

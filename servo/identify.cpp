@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/angles.h"
 #include "detector/lens.h"
 #include "servo/pose.h"
 #include "servo/pose_internal.h"
@@ -18,7 +19,6 @@ namespace {
 using pose_internal::HashTarget;
 using pose_internal::Vec2;
 
-constexpr double kDegPerRad = 180.0 / kPi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool InRange(double value, double lo, double hi) {

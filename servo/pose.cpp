@@ -14,6 +14,7 @@
 #include <sstream>
 #include <utility>
 
+#include "base/angles.h"
 #include "detector/lens.h"
 #include "servo/pose_internal.h"
 #include "servo/target_layout.h"
@@ -22,8 +23,6 @@ namespace oal {
 namespace {
 
 using pose_internal::HashTarget;
-
-constexpr double kDegPerRad = 180.0 / kPi;
 
 double Wrap360(double deg) {
   double wrapped = std::fmod(deg, 360.0);

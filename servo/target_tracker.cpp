@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "base/pose_distance.h"
 #include "detector/lens.h"  // DistortedPixel
 #include "detector/options.h"
@@ -16,7 +17,6 @@
 namespace oal {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / kPi;
 // A fit from an expected pose that may be turned by 180 degrees: the other way round must fit
 // the runs' widths worse by this (FitExpected's score).
 constexpr double kWaysRoundMargin = 0.1;
