@@ -429,6 +429,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
   frame_.pose_us += Microseconds(start);
   frame_.agreement = StripeAgreement{};
   frame_.lens = RadialBend{};
+  frame_.lens_measured = false;
   frame_.fit = StripeFit{};
   if (frame_.pose.status == PoseStatus::kOk && options_.fit_stripes) {
     frame_.fit = FitStripes(frame_.pose.cMo, layout_, detector_.feature_points(), camera_,
@@ -622,6 +623,7 @@ void TargetPoseTracker::MeasureLens() {
       identified, detector_.feature_points(), 2.0 * detector_.options().support_tolerance_px,
       StripeEnds(PlaneToImage(frame_.pose.cMo)), Point2d{camera_.u0(), camera_.v0()},
       std::sqrt(camera_.px() * camera_.py()));
+  frame_.lens_measured = true;
 }
 
 bool TargetPoseTracker::Verify(const GrayImageView& image) {

@@ -199,6 +199,7 @@ struct TargetFrame {
   /// wrong resolution) raise it. Measured for every pose with set_measure_lens(true), else
   /// only for one the model check refuses.
   RadialBend lens;
+  bool lens_measured = false;  ///< whether `lens` was measured on this frame's lines
   double find_us = 0.0, detect_us = 0.0, pose_us = 0.0;  ///< time spent in each step
 };
 
@@ -364,8 +365,9 @@ inline constexpr double kLensMismatchKdu = 0.03;
 /// of a pose, kept or refused by the model check (a camera model that misses the lens bends the
 /// stripes off the lines the check expects; the frame then says why).
 inline bool MeasuresLens(const TargetFrame& frame) {
-  return frame.status == TargetStatus::kOk ||
-         (frame.status == TargetStatus::kModelMismatch && std::isfinite(frame.lens.kdu_error_sd));
+  return frame.lens_measured &&
+         (frame.status == TargetStatus::kOk ||
+          (frame.status == TargetStatus::kModelMismatch && std::isfinite(frame.lens.kdu_error_sd)));
 }
 
 /// Whether one frame's lines say the camera model misses the lens.

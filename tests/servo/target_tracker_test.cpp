@@ -252,10 +252,13 @@ TEST(TargetPoseTracker, MeasuresEachPosesLensOnlyWhenAsked) {
   pose.camera = camera;
   TargetPoseTracker tracker(renderer.target(), camera, DetectorOptions(), pose);
   ASSERT_EQ(tracker.Track(ViewOf(image)).status, TargetStatus::kOk);
-  EXPECT_EQ(tracker.Track(ViewOf(image)).lens.lines, 0);
+  const TargetFrame& unasked = tracker.Track(ViewOf(image));
+  EXPECT_EQ(unasked.lens.lines, 0);
+  EXPECT_FALSE(MeasuresLens(unasked));
   tracker.set_measure_lens(true);
   const TargetFrame& frame = tracker.Track(ViewOf(image));
   ASSERT_EQ(frame.status, TargetStatus::kOk);
+  EXPECT_TRUE(MeasuresLens(frame));
   EXPECT_GE(frame.lens.lines, 3);
   EXPECT_TRUE(std::isfinite(frame.lens.kdu_error_sd));
 }
