@@ -32,6 +32,13 @@ constexpr double kLocalLightRatio = 0.8;
 constexpr double kFaintLightRatio = 0.9;
 constexpr int kSaturatedGrey = 250;
 constexpr int kLocalSaturationMargin = 15;
+// FindSplitAtNecks: two rooms of light cells that meet where the cells lie less than this
+// fraction of the shallower room's depth from dark are split there. A washed-out crossing
+// joining the middle cell to its neighbour is a third to a half as deep as the cells; along a
+// room's middle the depth varies by a step or two, so one room is never split.
+constexpr double kNeckDepthRatio = 0.7;
+// Depths are chamfer distances to dark, in these units per step across and diagonally.
+constexpr int kChamferStep = 3, kChamferDiagonal = 4;
 
 // Otsu's threshold over the values of histogram[lo, 256): values >= the result are the
 // light class; *contrast gets the two classes' mean difference and *light the light class's
@@ -223,6 +230,39 @@ void ExtremeAround(const std::vector<std::uint8_t>& in, int w, int h, int radius
         value = extreme(value, (*rows)[static_cast<std::size_t>(k) * w + x]);
       }
       (*out)[static_cast<std::size_t>(y) * w + x] = value;
+    }
+  }
+}
+
+// Each light cell's chamfer distance (3 a step, 4 a diagonal one) to the nearest dark cell
+// of the grid; beyond the grid counts as light (a sheet running out of view is not narrowed
+// at the image's edge). Dark cells get 0.
+void DistanceToDark(const std::vector<std::uint8_t>& grid, int w, int h, int threshold,
+                    std::vector<int>* distance) {
+  constexpr int kFar = 1 << 20;
+  distance->resize(grid.size());
+  std::vector<int>& d = *distance;
+  for (std::size_t i = 0; i < grid.size(); ++i) d[i] = grid[i] >= threshold ? kFar : 0;
+  const auto relax = [&](int x, int y, int dx, int dy, int step) {
+    const int nx = x + dx, ny = y + dy;
+    if (nx < 0 || ny < 0 || nx >= w || ny >= h) return;
+    int& here = d[static_cast<std::size_t>(y) * w + x];
+    here = std::min(here, d[static_cast<std::size_t>(ny) * w + nx] + step);
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      relax(x, y, -1, 0, kChamferStep);
+      relax(x, y, 0, -1, kChamferStep);
+      relax(x, y, -1, -1, kChamferDiagonal);
+      relax(x, y, 1, -1, kChamferDiagonal);
+    }
+  }
+  for (int y = h - 1; y >= 0; --y) {
+    for (int x = w - 1; x >= 0; --x) {
+      relax(x, y, 1, 0, kChamferStep);
+      relax(x, y, 0, 1, kChamferStep);
+      relax(x, y, 1, 1, kChamferDiagonal);
+      relax(x, y, -1, 1, kChamferDiagonal);
     }
   }
 }
@@ -694,6 +734,82 @@ const std::vector<LightQuad>& SheetFinder::FindNarrowed(const GrayImageView& ima
     KeepBest();
   }
   return candidates_;
+}
+
+const std::vector<LightQuad>& SheetFinder::FindSplitAtNecks(const GrayImageView& image) {
+  candidates_.clear();
+  if (first_threshold_ >= 0 && OnTheLastGrid(image)) {
+    MarkLocallyDark(kLocalLightRatio);
+    SplitAtNecks(local_, first_threshold_, &split_);
+    AddComponents(image, split_.data(), first_threshold_);
+    KeepBest();
+  }
+  return candidates_;
+}
+
+void SheetFinder::SplitAtNecks(const std::vector<std::uint8_t>& grid, int threshold,
+                               std::vector<std::uint8_t>* out) {
+  // A watershed of the distances to dark: the light cells taken from the deepest up, each
+  // joining the room of its neighbours; where two rooms meet, they are one when the meeting
+  // cell is nearly as deep as the shallower room's deepest, else the cell is their neck, set
+  // dark.
+  DistanceToDark(grid, grid_width_, grid_height_, threshold, &depth_);
+  order_.clear();
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (depth_[i] > 0) order_.push_back(static_cast<int>(i));
+  }
+  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) {
+    return depth_[static_cast<std::size_t>(a)] > depth_[static_cast<std::size_t>(b)];
+  });
+  room_.assign(grid.size(), -1);
+  room_parent_.clear();
+  room_peak_.clear();
+  const auto parent = [&](int r) -> int& { return room_parent_[static_cast<std::size_t>(r)]; };
+  const auto root = [&](int r) {
+    while (parent(r) != r) {
+      parent(r) = parent(parent(r));  // path halving
+      r = parent(r);
+    }
+    return r;
+  };
+  *out = grid;
+  for (const int cell : order_) {
+    const std::size_t i = static_cast<std::size_t>(cell);
+    const int x = cell % grid_width_, y = cell / grid_width_;
+    const int depth = depth_[i];
+    int joined = -1;
+    bool neck = false;
+    const std::array<std::array<int, 2>, 4> steps{{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};
+    for (const auto& step : steps) {
+      const int nx = x + step[0], ny = y + step[1];
+      if (nx < 0 || ny < 0 || nx >= grid_width_ || ny >= grid_height_) continue;
+      const int other = room_[static_cast<std::size_t>(ny) * grid_width_ + nx];
+      if (other < 0) continue;
+      const int r = root(other);
+      if (joined < 0 || r == joined) {
+        joined = r;
+        continue;
+      }
+      const int shallower = std::min(room_peak_[static_cast<std::size_t>(r)],
+                                     room_peak_[static_cast<std::size_t>(joined)]);
+      if (depth >= kNeckDepthRatio * shallower) {
+        parent(r) = joined;
+        room_peak_[static_cast<std::size_t>(joined)] = std::max(
+            room_peak_[static_cast<std::size_t>(joined)], room_peak_[static_cast<std::size_t>(r)]);
+      } else {
+        neck = true;
+      }
+    }
+    if (neck) {
+      (*out)[i] = 0;
+    } else if (joined >= 0) {
+      room_[i] = joined;
+    } else {
+      room_[i] = static_cast<int>(room_parent_.size());
+      room_parent_.push_back(room_[i]);
+      room_peak_.push_back(depth);
+    }
+  }
 }
 
 bool SheetFinder::OnTheLastGrid(const GrayImageView& image) const {

@@ -19,7 +19,9 @@
 //      paper): this last pass is also FindLocallyLight's, for a caller none of whose
 //      candidates was the target, and FindFaintlyDark's with 0.9 instead of 0.8 (a pale hand
 //      or sleeve), and FindNarrowed's with each cell then the darkest of the 3 x 3 around it
-//      (a bridge of light cells a cell or two wide, a stripe washed out over a short stretch);
+//      (a bridge of light cells a cell or two wide, a stripe washed out over a short stretch),
+//      and FindSplitAtNecks' with the light cells split where two rooms of them meet at a
+//      neck much narrower than either (a crossing washed out over several cells);
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
@@ -123,6 +125,14 @@ class SheetFinder {
   /// by one on each side, which Refine takes back. Quadrilaterals found before are left out.
   /// Same validity as Find's.
   const std::vector<LightQuad>& FindNarrowed(const GrayImageView& image);
+  /// More candidates of the image last given to Find, for when none of the looks above found
+  /// the target: the first last pass's cells split where two rooms of light cells meet at a
+  /// neck much narrower than either (a watershed of each cell's distance to dark: a glare or
+  /// a blur washing out a crossing over several cells, through which the middle cell joins its
+  /// neighbour or the paper beyond the sheet's edge, out of view). A room that runs out of
+  /// the image is left out as in Find, the rooms inside it are not. Quadrilaterals found
+  /// before are left out. Same validity as Find's.
+  const std::vector<LightQuad>& FindSplitAtNecks(const GrayImageView& image);
   /// Step 4 for one candidate of the same image (done on demand: a caller usually needs the
   /// first only): its sides moved onto the light/dark edges, sub-pixel. True when quad is
   /// (now) refined; its corners are unchanged otherwise.
@@ -151,6 +161,10 @@ class SheetFinder {
   void AddComponents(const GrayImageView& image, const std::uint8_t* grid, int threshold);
   /// local_: the cells, those much darker than the brightest near them set to 0.
   void MarkLocallyDark(double light_ratio);
+  /// `grid`'s light cells (>= threshold) set to 0 where two rooms meet at a neck (see
+  /// FindSplitAtNecks), into *out.
+  void SplitAtNecks(const std::vector<std::uint8_t>& grid, int threshold,
+                    std::vector<std::uint8_t>* out);
   /// Candidates of local_ at first_threshold_ (the last pass).
   void AddLocallyLight(const GrayImageView& image, double light_ratio);
   /// The last pass again for the image last given to Find (nothing for another size), best
@@ -169,7 +183,8 @@ class SheetFinder {
   SheetFinderOptions options_;
   int grid_width_ = 0, grid_height_ = 0;
   std::vector<std::uint8_t> cells_;
-  std::vector<std::uint8_t> local_, narrowed_;
+  std::vector<std::uint8_t> local_, narrowed_, split_;
+  std::vector<int> depth_, room_, room_parent_, room_peak_;  ///< SplitAtNecks' working memory
   std::vector<std::uint8_t> rows_, brightest_;  ///< working memory of the cells' filters
   int first_threshold_ = -1;             ///< the first pass's threshold of the last frame; -1: none
   double first_light_ = 0.0;             ///< the mean of the cells at or above it

@@ -458,7 +458,7 @@ double SupportedExtent(std::vector<double>* along, double length) {
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options,
-                     const StripeGuides* guides) {
+                     const StripeGuides* guides, int left_out_line) {
   options.Check();
   StripeFit fit;
   fit.cMo = start;
@@ -468,6 +468,9 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   // fraction of the corridor at most, and points must not hop between stripes as it goes.
   std::array<StripePoints, 4> stripes;
   fitter.Assign(pose, points, points_undistorted, guides, &stripes);
+  if (left_out_line >= 0 && left_out_line < 4) {
+    stripes[static_cast<std::size_t>(left_out_line)] = StripePoints{};
+  }
   for (StripePoints& stripe : stripes) KeepCollinear(camera.px(), camera.py(), &stripe);
 
   std::vector<double> magnitudes;
@@ -554,6 +557,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   for (std::size_t k = 0; k < 4; ++k) {
     magnitudes.clear();  // the kept points' width ratios
     along.clear();
+    double line_sum2 = 0.0;
     for (std::size_t i = 0; i < stripes[k].p.size(); ++i) {
       const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
       if (!(std::fabs(r) <= kKeptScales * scale)) continue;
@@ -561,8 +565,10 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       magnitudes.push_back(stripes[k].width_ratio[i]);
       along.push_back(stripes[k].along[i]);
       sum2 += r * r;
+      line_sum2 += r * r;
       ++kept;
     }
+    fit.line_rms_px[k] = fit.points[k] > 0 ? std::sqrt(line_sum2 / fit.points[k]) : 0.0;
     fit.width_ratio[k] = Median(&magnitudes);
     const StripeSpan& span = layout.stripes[k];
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
@@ -571,7 +577,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;
   fit.cMo = pose.Matrix();
   for (int k = 0; k < 4; ++k) {
-    if (fit.points[static_cast<std::size_t>(k)] < options.min_points) {
+    if (k != left_out_line && fit.points[static_cast<std::size_t>(k)] < options.min_points) {
       std::ostringstream message;
       message << "line " << k + 1 << " keeps " << fit.points[static_cast<std::size_t>(k)]
               << " of its stripe's points (min_points = " << options.min_points << ")";

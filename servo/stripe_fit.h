@@ -81,8 +81,9 @@ struct StripeFit {
   /// width there where the pose puts it: about 1 for the right pose, the ratio of two stripes'
   /// widths for one that takes a stripe for another (turned by 180 degrees).
   std::array<double, 4> width_ratio{};
-  double rms_px = 0.0;    ///< of the kept points' distances to their lines, pixels
-  double scale_px = 0.0;  ///< the residuals' robust scale at the end, pixels
+  double rms_px = 0.0;                  ///< of the kept points' distances to their lines, pixels
+  std::array<double, 4> line_rms_px{};  ///< the same for each line's kept points
+  double scale_px = 0.0;                ///< the residuals' robust scale at the end, pixels
   /// The line (0-3) that kept fewer than min_points, when that is why the fit is not ok; -1
   /// otherwise.
   int starved_line = -1;
@@ -112,9 +113,11 @@ vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo);
 /// `guides`, when given, take each stripe's points near its guide line (guide_tolerance_px,
 /// between its printed ends as `start` puts them, wide enough) however far `start` puts the
 /// stripe: a start tens of pixels off still converges when the stripes' lines were told.
+/// `left_out_line` (0-3), when given, keeps none of that stripe's points: the pose the other
+/// three hold (three lines fix a plane's pose), that line needing no min_points.
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options = {},
-                     const StripeGuides* guides = nullptr);
+                     const StripeGuides* guides = nullptr, int left_out_line = -1);
 
 }  // namespace oal

@@ -42,6 +42,18 @@ constexpr double kWeakStripeExtent = 0.3;
 // target's distance) has come back to it, however wide its corridor: on the bench frames such
 // fits land within 3e-3 rad of it, those settling on the other tilt 0.5 rad or more away.
 constexpr double kSameFitRad = 2e-3;
+// A stripe keeping fewer than this fraction of the median of the others' points is checked
+// against the pose the other three hold. Its points are not its stripe's when they move the pose
+// by more than kMaxPullRad or kMaxPullFraction of the distance at a cost to the others: their RMS
+// over kMaxOthersRmsGrowth times theirs without it, and kOthersRmsMarginPx more (a finger's
+// shadow where a hidden stripe should be tilted a sheet by 2.3 degrees, the others' RMS 0.38 px
+// against 0.09). Three stripes alone tell the tilt loosely (their pose may lie degrees away, the
+// RMS the same): a move alone says nothing.
+constexpr double kFewPointsRatio = 0.5;
+constexpr double kMaxPullRad = 1.0 * kPi / 180.0;
+constexpr double kMaxPullFraction = 0.01;
+constexpr double kMaxOthersRmsGrowth = 2.0;
+constexpr double kOthersRmsMarginPx = 0.05;
 
 // Candidates closed in on two sides set aside as corner cells, at most.
 constexpr std::size_t kMaxCornerGuesses = 3;
@@ -626,8 +638,51 @@ void TargetPoseTracker::MeasureLens() {
   frame_.lens_measured = true;
 }
 
+std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
+  const StripeFit& fit = frame_.fit;
+  if (!fit.ok) return std::nullopt;
+  const auto weakest = std::min_element(fit.points.begin(), fit.points.end());
+  const int line = static_cast<int>(weakest - fit.points.begin());
+  std::array<int, 3> others{};
+  for (int k = 0, i = 0; k < 4; ++k) {
+    if (k != line) others[static_cast<std::size_t>(i++)] = fit.points[static_cast<std::size_t>(k)];
+  }
+  std::sort(others.begin(), others.end());
+  if (*weakest >= kFewPointsRatio * others[1]) return std::nullopt;
+  const StripeFit without = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
+                                       detector_.Undistorts(), options_.stripe_fit, nullptr, line);
+  if (!without.ok) return std::nullopt;  // the other three do not fix the pose: nothing to tell
+  const vpHomogeneousMatrix moved = fit.cMo.inverse() * without.cMo;
+  const double angle = vpThetaUVector(moved.getRotationMatrix()).getTheta();
+  const double distance = std::max(fit.cMo.getTranslationVector().frobeniusNorm(), 1e-6);
+  const double shift = moved.getTranslationVector().frobeniusNorm() / distance;
+  double others_sum2 = 0.0;
+  int others_points = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (static_cast<int>(k) == line) continue;
+    others_sum2 += fit.points[k] * fit.line_rms_px[k] * fit.line_rms_px[k];
+    others_points += fit.points[k];
+  }
+  const double others_rms = others_points > 0 ? std::sqrt(others_sum2 / others_points) : 0.0;
+  if ((angle <= kMaxPullRad && shift <= kMaxPullFraction) ||
+      others_rms <= kMaxOthersRmsGrowth * without.rms_px + kOthersRmsMarginPx) {
+    return std::nullopt;
+  }
+  std::ostringstream message;
+  message << "line " << line + 1 << "'s " << *weakest << " points (the others keep " << others[1]
+          << ") pull the pose " << angle * kDegPerRad << " deg and " << 100.0 * shift
+          << " % of the distance from where the other three stripes put it, their RMS from "
+          << without.rms_px << " to " << others_rms << " px: they are not all its stripe's";
+  return message.str();
+}
+
 bool TargetPoseTracker::Verify(const GrayImageView& image) {
   if (measure_lens_) MeasureLens();
+  if (const std::optional<std::string> pull = WeakStripePull()) {
+    frame_.status = TargetStatus::kNotFound;
+    frame_.message = *pull;
+    return false;
+  }
   if (frame_.pose.method == PoseMethod::kStripes) {
     // The four stripes held together: their points in all (each stripe has its fit's minimum).
     const int points = frame_.fit.TotalPoints();
@@ -871,10 +926,11 @@ const TargetFrame& TargetPoseTracker::Track(
     // its candidates; the cells again, those much darker than the paper near them taken as
     // dark (a hand or a glare joining the middle cell to its neighbour); those a little darker
     // (a pale hand across it); the light cells narrowed by one (a stripe washed out over a
-    // short stretch).
+    // short stretch); split at necks (a crossing washed out over several cells).
     using Look = const std::vector<LightQuad>& (SheetFinder::*)(const GrayImageView&);
-    for (const Look look : {&SheetFinder::Find, &SheetFinder::FindLocallyLight,
-                            &SheetFinder::FindFaintlyDark, &SheetFinder::FindNarrowed}) {
+    for (const Look look :
+         {&SheetFinder::Find, &SheetFinder::FindLocallyLight, &SheetFinder::FindFaintlyDark,
+          &SheetFinder::FindNarrowed, &SheetFinder::FindSplitAtNecks}) {
       if (found) break;
       const auto start = std::chrono::steady_clock::now();
       const std::vector<LightQuad>& cells = (finder_.*look)(image);

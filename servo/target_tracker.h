@@ -17,10 +17,11 @@
 //      (target_layout.h: UncutCells). When none gives a pose, the same for the finder's later
 //      looks (SheetFinder::FindLocallyLight: a hand or a glare joining the middle cell to its
 //      neighbour; FindFaintlyDark: a pale hand; FindNarrowed: a stripe washed out over a short
-//      stretch, a bridge a cell or two wide); then the candidates closed in on two sides
-//      that meet, set aside on the way, as each of the sheet's corner cells (the paper beyond
-//      one stripe of each pair, out to the sheet's corner: a glare over the middle of the
-//      sheet joins the middle cell to the cells beyond all four stripes).
+//      stretch, a bridge a cell or two wide; FindSplitAtNecks: a crossing washed out over
+//      several cells, the middle cell joined through it to paper out of view); then the candidates
+//      closed in on two sides that meet, set aside on the way, as each of the sheet's corner cells
+//      (the paper beyond one stripe of each pair, out to the sheet's corner: a glare over the
+//      middle of the sheet joins the middle cell to the cells beyond all four stripes).
 //   3. When no candidate gives a pose and image_fallback is set, the whole image is scanned
 //      with the paper's concentric image borders. A line of the bench can stand in for a
 //      stripe's edge there and tilt the pose by degrees yet pass the checks below, so the
@@ -32,9 +33,12 @@
 //      gives one the image contradicts and the whole image's pose puts a stripe where too few
 //      of its points lie (its stripe fit starved), the stripes are there and neither pose is
 //      sure where (kModelMismatch).
-// A pose is refined on the stripes' own feature points, the target held rigid (stripe_fit.h),
-// and accepted only when the image shows the target where it says (stripe_check.h): across
-// each stripe, between the crossings and the printed ends, its dark run where the pose puts it
+// A pose is refined on the stripes' own feature points, the target held rigid (stripe_fit.h);
+// a stripe keeping under half the points of the others is fitted without, and when its points
+// pull the pose away from where the other three put it at a cost to theirs (their RMS doubled),
+// they are not its stripe's and the pose is not taken. A pose is accepted only when the image
+// shows the target where it says (stripe_check.h): across each stripe, between the crossings
+// and the printed ends, its dark run where the pose puts it
 // (min_stripe_agreement of the samples that agree or contradict, min_stripe_seen of all the
 // samples in view); otherwise the frame's status is kModelMismatch. Without a caller's prediction,
 // a pose found on the borders of the last accepted one (step 1) that moved more than max_jump_m /
@@ -283,6 +287,9 @@ class TargetPoseTracker {
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
   /// told from the lines (set_measure_lens, or a pose the check refuses).
   bool Verify(const GrayImageView& image);
+  /// Why the frame's stripe fit is not taken, when a stripe keeping few points beside the
+  /// others' pulls the pose away from where the other three stripes alone put it.
+  std::optional<std::string> WeakStripePull() const;
   /// frame_.lens from the frame's pose and its lines 1-4.
   void MeasureLens();
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,

@@ -244,6 +244,63 @@ TEST(SheetFinder, AGapOfACellInAStripeIsClosedWhenTheCellsAreNarrowed) {
                           [&](const LightQuad& quad) { return is_middle(quad, finder); }));
 }
 
+// An over-exposed '#' (paper and a glare clip at 255 alike) whose sheet runs out of the image
+// at the bottom, its lower left crossing washed out by a glare eleven cells across: the middle
+// cell joins through it to the cells beyond lines 1 and 4, which run out of view, at every
+// threshold, ratio and narrowing. Split where the rooms meet at the washed-out crossing, a neck
+// much narrower than the middle cell, it stands alone and refines onto the stripes' edges.
+TEST(SheetFinder, ACrossingWashedOutOverSeveralCellsIsSplitAtTheNeck) {
+  vpImage<unsigned char> image(480, 640, 120);
+  const auto fill = [&](int left, int top, int right, int bottom, unsigned char grey) {
+    for (int v = top; v < bottom; ++v) {
+      for (int u = left; u < right; ++u) image[v][u] = grey;
+    }
+  };
+  fill(100, 60, 540, 480, 255);  // the sheet, out of view at the bottom
+  fill(230, 70, 250, 480, 30);   // line 1
+  fill(392, 70, 408, 480, 30);   // line 3
+  fill(110, 163, 530, 177, 30);  // line 2
+  fill(110, 302, 530, 318, 30);  // line 4
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) {
+      if (std::hypot(u - 240.0, v - 310.0) < 44.0) image[v][u] = 255;  // the glare
+    }
+  }
+  const std::array<Point2d, 4> middle = {Point2d{249.5, 176.5}, Point2d{391.5, 176.5},
+                                         Point2d{391.5, 301.5}, Point2d{249.5, 301.5}};
+  SheetFinder finder;
+  const GrayImageView view = ViewOf(image);
+  const auto holds_middle = [&](const std::vector<LightQuad>& found) {
+    return std::any_of(found.begin(), found.end(), [&](LightQuad quad) {
+      if (quad.ClosedSideCount() < 3 || !finder.Refine(view, &quad)) return false;
+      return std::all_of(quad.corners.begin(), quad.corners.end(), [&](const Point2d& corner) {
+        return std::any_of(middle.begin(), middle.end(), [&](const Point2d& m) {
+          return std::hypot(corner.u - m.u, corner.v - m.v) < 2.0;
+        });
+      });
+    });
+  };
+  EXPECT_FALSE(holds_middle(finder.Find(view)));
+  EXPECT_FALSE(holds_middle(finder.FindLocallyLight(view)));
+  EXPECT_FALSE(holds_middle(finder.FindFaintlyDark(view)));
+  EXPECT_FALSE(holds_middle(finder.FindNarrowed(view)));
+  EXPECT_TRUE(holds_middle(finder.FindSplitAtNecks(view)));
+}
+
+// A room of light cells with no neck (the paper alone, a '#'s intact middle cell) is not split:
+// the split finds nothing Find did not.
+TEST(SheetFinder, ARoomWithoutANeckIsNotSplit) {
+  vpImage<unsigned char> image(480, 640, 70);
+  for (int v = 60; v < 420; ++v) {
+    for (int u = 100; u < 540; ++u) image[v][u] = 215;
+  }
+  SheetFinder finder;
+  const GrayImageView view = ViewOf(image);
+  const std::vector<LightQuad> found = finder.Find(view);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_TRUE(finder.FindSplitAtNecks(view).empty());
+}
+
 TEST(SheetFinder, FindLocallyLightAddsNothingAfterFindMadeThatPass) {
   RenderOptions render;
   render.noise_sigma = 3.0;

@@ -194,6 +194,29 @@ TEST(StripeFit, AStripeWithoutPointsIsNamed) {
       << fit.message;
 }
 
+// Any three stripes fix the sheet's pose: each one left out in turn, the others' points still
+// give the truth (within a third of the 1 degree by which the tracker lets a stripe with few
+// points pull the pose: three stripes tell the tilt less well than four), the one left out
+// keeping none and needing none.
+TEST(StripeFit, TheOtherThreeStripesHoldThePoseWithOneLeftOut) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 6);
+  const Tracked tracked = Track(rendered);
+  ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const vpHomogeneousMatrix start =
+      vpHomogeneousMatrix(0.002, 0.0, 0.0, 0.0, 0.0, vpMath::rad(0.5)) * rendered.cMo;
+  for (int line = 0; line < 4; ++line) {
+    const StripeFit fit =
+        FitStripes(start, layout, tracked.points, kCamera, true, {}, nullptr, line);
+    ASSERT_TRUE(fit.ok) << "line " << line + 1 << " left out: " << fit.message;
+    EXPECT_EQ(fit.points[static_cast<std::size_t>(line)], 0);
+    const auto [t, r] = PoseError(fit.cMo, rendered.cMo);
+    EXPECT_LT(t, 2e-3) << "line " << line + 1 << " left out";
+    EXPECT_LT(r, 0.3) << "line " << line + 1 << " left out";
+  }
+}
+
 // What a stripe's points span counts only stretches of three points or more: a few runs
 // at a hand's edge far from the rest do not make a stripe seen over its length.
 TEST(StripeFit, AStripesExtentCountsOnlyStretchesOfThreePointsOrMore) {

@@ -409,7 +409,9 @@ TEST(TargetPoseTracker, AGlareAcrossTheMiddleCellsSideFindsTheSheetFromAnEdgeCel
 // across): the stripes washed out between the crossings join the middle cell to the four cells
 // beyond the stripes. A corner's paper, closed in by two stripes alone (the margin beyond the
 // stripes' ends is narrower than the finder's cells), is taken for each of the sheet's corner
-// cells in turn: the right pose, from a corner cell, at two rolls.
+// cells in turn: the right pose, from a corner cell. At another roll the cells beyond the
+// stripes meet the middle one through necks the finder splits them at (SheetFinder::
+// FindSplitAtNecks), and a cell beyond a stripe gives the right pose first.
 TEST(TargetPoseTracker, ABroadGlareOverTheMiddleAt720pFindsTheSheetFromACornerCell) {
   const LineTarget target = FourLineA3Target();
   RenderOptions render = BenchRender(4);
@@ -429,6 +431,10 @@ TEST(TargetPoseTracker, ABroadGlareOverTheMiddleAt720pFindsTheSheetFromACornerCe
     const TargetFrame& found = tracker.Track(ViewOf(frame.image));
     const std::string what = "a broad glare at 720p, roll " + std::to_string(roll);
     ExpectRightPose(found, cMo, what);
+    if (roll == 2.95) {
+      EXPECT_EQ(found.source, ScanSource::kEdgeCell) << what;
+      continue;
+    }
     EXPECT_EQ(found.source, ScanSource::kCornerCell) << what;
     // Without the corner cells, nothing else finds it.
     TargetTrackerOptions options;
