@@ -773,14 +773,14 @@ void SheetFinder::SplitAtNecks(const std::vector<std::uint8_t>& grid, int thresh
     return r;
   };
   *out = grid;
+  constexpr std::array<std::array<int, 2>, 4> kSteps{{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};
   for (const int cell : order_) {
     const std::size_t i = static_cast<std::size_t>(cell);
     const int x = cell % grid_width_, y = cell / grid_width_;
     const int depth = depth_[i];
     int joined = -1;
     bool neck = false;
-    const std::array<std::array<int, 2>, 4> steps{{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};
-    for (const auto& step : steps) {
+    for (const auto& step : kSteps) {
       const int nx = x + step[0], ny = y + step[1];
       if (nx < 0 || ny < 0 || nx >= grid_width_ || ny >= grid_height_) continue;
       const int other = room_[static_cast<std::size_t>(ny) * grid_width_ + nx];

@@ -1,7 +1,5 @@
 #include "servo/target_tracker.h"
 
-#include <visp3/core/vpThetaUVector.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -652,10 +650,10 @@ std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
   const StripeFit without = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
                                        detector_.Undistorts(), options_.stripe_fit, nullptr, line);
   if (!without.ok) return std::nullopt;  // the other three do not fix the pose: nothing to tell
-  const vpHomogeneousMatrix moved = fit.cMo.inverse() * without.cMo;
-  const double angle = vpThetaUVector(moved.getRotationMatrix()).getTheta();
+  const PoseDistance moved = Distance(fit.cMo, without.cMo);
+  const double angle = moved.rotation_rad;
   const double distance = std::max(fit.cMo.getTranslationVector().frobeniusNorm(), 1e-6);
-  const double shift = moved.getTranslationVector().frobeniusNorm() / distance;
+  const double shift = moved.translation_m / distance;
   double others_sum2 = 0.0;
   int others_points = 0;
   for (std::size_t k = 0; k < 4; ++k) {

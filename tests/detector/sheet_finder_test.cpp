@@ -201,23 +201,26 @@ TEST_F(SheetFinderInALivedInScene, APenAlongASideLeavesItWhereTheStripeIs) {
   EXPECT_TRUE(FindsTheMiddleCellPast(pen));
 }
 
+// Sets the pixels of [left, right) x [top, bottom) of *image to grey.
+void Fill(vpImage<unsigned char>* image, int left, int top, int right, int bottom,
+          unsigned char grey) {
+  for (int v = top; v < bottom; ++v) {
+    for (int u = left; u < right; ++u) (*image)[v][u] = grey;
+  }
+}
+
 // A '#' drawn on a sheet, its upper stripe broken by a gap of paper 16 px long (a stripe washed
 // out over a short stretch): the middle cell joins the cell beyond through a bridge two cells
 // wide at every threshold and ratio; narrowed by one cell it stands alone again, closed in on
 // four sides, and refines back onto the stripes' edges.
 TEST(SheetFinder, AGapOfACellInAStripeIsClosedWhenTheCellsAreNarrowed) {
   vpImage<unsigned char> image(480, 640, 70);
-  const auto fill = [&](int left, int top, int right, int bottom, unsigned char grey) {
-    for (int v = top; v < bottom; ++v) {
-      for (int u = left; u < right; ++u) image[v][u] = grey;
-    }
-  };
-  fill(100, 60, 540, 420, 215);   // the sheet
-  fill(230, 70, 250, 410, 30);    // line 1
-  fill(392, 70, 408, 410, 30);    // line 3
-  fill(110, 163, 530, 177, 30);   // line 2
-  fill(110, 302, 530, 318, 30);   // line 4
-  fill(296, 163, 312, 177, 215);  // the gap
+  Fill(&image, 100, 60, 540, 420, 215);   // the sheet
+  Fill(&image, 230, 70, 250, 410, 30);    // line 1
+  Fill(&image, 392, 70, 408, 410, 30);    // line 3
+  Fill(&image, 110, 163, 530, 177, 30);   // line 2
+  Fill(&image, 110, 302, 530, 318, 30);   // line 4
+  Fill(&image, 296, 163, 312, 177, 215);  // the gap
   const std::array<Point2d, 4> middle = {Point2d{249.5, 176.5}, Point2d{391.5, 176.5},
                                          Point2d{391.5, 301.5}, Point2d{249.5, 301.5}};
   const auto is_middle = [&](LightQuad quad, const SheetFinder& finder) {
@@ -251,16 +254,11 @@ TEST(SheetFinder, AGapOfACellInAStripeIsClosedWhenTheCellsAreNarrowed) {
 // much narrower than the middle cell, it stands alone and refines onto the stripes' edges.
 TEST(SheetFinder, ACrossingWashedOutOverSeveralCellsIsSplitAtTheNeck) {
   vpImage<unsigned char> image(480, 640, 120);
-  const auto fill = [&](int left, int top, int right, int bottom, unsigned char grey) {
-    for (int v = top; v < bottom; ++v) {
-      for (int u = left; u < right; ++u) image[v][u] = grey;
-    }
-  };
-  fill(100, 60, 540, 480, 255);  // the sheet, out of view at the bottom
-  fill(230, 70, 250, 480, 30);   // line 1
-  fill(392, 70, 408, 480, 30);   // line 3
-  fill(110, 163, 530, 177, 30);  // line 2
-  fill(110, 302, 530, 318, 30);  // line 4
+  Fill(&image, 100, 60, 540, 480, 255);  // the sheet, out of view at the bottom
+  Fill(&image, 230, 70, 250, 480, 30);   // line 1
+  Fill(&image, 392, 70, 408, 480, 30);   // line 3
+  Fill(&image, 110, 163, 530, 177, 30);  // line 2
+  Fill(&image, 110, 302, 530, 318, 30);  // line 4
   for (int v = 0; v < 480; ++v) {
     for (int u = 0; u < 640; ++u) {
       if (std::hypot(u - 240.0, v - 310.0) < 44.0) image[v][u] = 255;  // the glare

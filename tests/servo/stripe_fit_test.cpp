@@ -44,6 +44,12 @@ std::pair<double, double> PoseError(const vpHomogeneousMatrix& cMo,
   return {d.translation_m, vpMath::deg(d.rotation_rad)};
 }
 
+// `cMo` off by half a degree about the optical axis and 2 mm: the stripes' ends a few pixels
+// away, where a fit starts from.
+vpHomogeneousMatrix SlightlyOff(const vpHomogeneousMatrix& cMo) {
+  return vpHomogeneousMatrix(0.002, 0.0, 0.0, 0.0, 0.0, vpMath::rad(0.5)) * cMo;
+}
+
 // The tracker's feature points of `frame` (found with no prior) and its pose.
 struct Tracked {
   std::vector<FramePoint> points;
@@ -65,10 +71,8 @@ TEST(StripeFit, ConvergesToTheTruthFromAPoseADegreeOff) {
   const Tracked tracked = Track(rendered);
   ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
   const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
-  // Off by 1 degree about the optical axis and 2 mm: the stripes' ends a few pixels away.
-  const vpHomogeneousMatrix start =
-      vpHomogeneousMatrix(0.002, 0.0, 0.0, 0.0, 0.0, vpMath::rad(0.5)) * rendered.cMo;
-  const StripeFit fit = FitStripes(start, layout, tracked.points, kCamera, true);
+  const StripeFit fit =
+      FitStripes(SlightlyOff(rendered.cMo), layout, tracked.points, kCamera, true);
   ASSERT_TRUE(fit.ok) << fit.message;
   const auto [t, r] = PoseError(fit.cMo, rendered.cMo);
   EXPECT_LT(t, 0.6e-3);
@@ -204,8 +208,7 @@ TEST(StripeFit, TheOtherThreeStripesHoldThePoseWithOneLeftOut) {
   const Tracked tracked = Track(rendered);
   ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
   const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
-  const vpHomogeneousMatrix start =
-      vpHomogeneousMatrix(0.002, 0.0, 0.0, 0.0, 0.0, vpMath::rad(0.5)) * rendered.cMo;
+  const vpHomogeneousMatrix start = SlightlyOff(rendered.cMo);
   for (int line = 0; line < 4; ++line) {
     const StripeFit fit =
         FitStripes(start, layout, tracked.points, kCamera, true, {}, nullptr, line);
