@@ -141,10 +141,17 @@ int MedianOf(std::vector<int>* values) {
   return *middle;
 }
 
+// How far both edges of a dark run lie off the stripe's the same way: the smaller offset when
+// they agree in sign, else 0 (a run narrowed or widened on one side moves one edge only).
+double SharedShift(double low_offset, double high_offset) {
+  if (!(low_offset * high_offset > 0.0)) return 0.0;
+  return low_offset > 0.0 ? std::min(low_offset, high_offset) : std::max(low_offset, high_offset);
+}
+
 // What one profile says of the pose (see the header). kFlatLight: light and flat, to be judged
 // against the paper of the agreeing samples.
 Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contrast,
-              int* light_level) {
+              int* light_level, double* shared_shift_px) {
   const auto at = [&p](int i) { return p.grey[static_cast<std::size_t>(i)]; };
   const int n = p.n;
   const int light_a = std::max({at(0), at(1), at(2)});
@@ -178,6 +185,7 @@ Verdict Judge(const Profile& p, const StripeCheckOptions& options, int min_contr
   const double ratio = (high - low) / predicted;
   if (std::fabs(0.5 * (low + high) - p.centre) <= tolerance &&
       std::fabs(ratio - 1.0) <= options.width_tolerance) {
+    *shared_shift_px = SharedShift(low - p.low_edge, high - p.high_edge) * p.spacing_px;
     return Verdict::kAgrees;
   }
   // Wider: the stripe and something dark against it, one edge still the stripe's.
@@ -261,6 +269,16 @@ double StripeAgreement::Worst() const {
   return worst;
 }
 
+double StripeAgreement::ShiftRms() const {
+  double sum2 = 0.0;
+  int agreeing = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    sum2 += dark[k] * shift_rms_px[k] * shift_rms_px[k];
+    agreeing += dark[k];
+  }
+  return agreeing > 0 ? std::sqrt(sum2 / agreeing) : 0.0;
+}
+
 double StripeAgreement::Seen() const {
   int in_view = 0, agreeing = 0;
   for (int k = 0; k < 4; ++k) {
@@ -329,11 +347,16 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
   std::vector<int> lights, paper;
   verdicts.reserve(profiles.size());
   lights.reserve(profiles.size());
+  std::array<double, 4> shift_sum2{};
   for (const auto& [k, p] : profiles) {
     int light = 0;
-    verdicts.push_back(Judge(p, options, min_contrast, &light));
+    double shift = 0.0;
+    verdicts.push_back(Judge(p, options, min_contrast, &light, &shift));
     lights.push_back(light);
-    if (verdicts.back() == Verdict::kAgrees) paper.push_back(light);
+    if (verdicts.back() == Verdict::kAgrees) {
+      paper.push_back(light);
+      shift_sum2[static_cast<std::size_t>(k)] += shift * shift;
+    }
   }
   // A light, flat profile as light as the paper beside the agreeing samples: paper where the
   // ink should be; darker, a light object over the stripe; lighter, a glare washing the stripe
@@ -387,6 +410,11 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
       i = j;
     }
     first = end;
+  }
+  // (Agreeing samples stay so through the excuses above.)
+  for (std::size_t k = 0; k < 4; ++k) {
+    agreement.shift_rms_px[k] =
+        agreement.dark[k] > 0 ? std::sqrt(shift_sum2[k] / agreement.dark[k]) : 0.0;
   }
   return agreement;
 }

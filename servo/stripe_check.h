@@ -82,6 +82,13 @@ struct StripeAgreement {
   /// ... that contradict it at the rim of something covering the stripe (a short run next to
   /// a sample that tells nothing, or at an end of its samples), not counted against it.
   std::array<int, 4> excused{};
+  /// ... the RMS, over the agreeing samples, of the shift both edges of their dark run share
+  /// (the smaller of the two edges' offsets from the stripe's where they lie off the same way),
+  /// pixels: a pose a little off moves both of a stripe's edges; something light or dark lying
+  /// along one side of the stripe moves one.
+  std::array<double, 4> shift_rms_px{};
+  /// The same over all agreeing samples.
+  double ShiftRms() const;
   /// The smallest, over lines 1-4, of the samples agreeing among those that agree or
   /// contradict (0 for a line with fewer than 3 agreeing samples): 1 when no sample
   /// contradicts.

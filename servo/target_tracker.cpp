@@ -52,6 +52,16 @@ constexpr double kMaxPullRad = 1.0 * kPi / 180.0;
 constexpr double kMaxPullFraction = 0.01;
 constexpr double kMaxOthersRmsGrowth = 2.0;
 constexpr double kOthersRmsMarginPx = 0.05;
+// A stripe whose runs' median width over its own differs from the others' median by more than
+// this (log of the ratio: 8 %) is lopsided: something light or dark lies along one side of it
+// (a white cable over an edge narrows its runs), their middles off its centre line all the same
+// way. When it pulls the pose as above, the image's stripes decide: its points are not taken
+// when the model check finds the stripes' edges, both shifted the same way, at most
+// kLopsidedShiftRatio as far off at the three's pose as at the four's (a cable along a stripe of
+// an over-exposed far sheet: 0.05 px against 0.46; right poses on the lived-in scenes: 0.47
+// of it at least).
+constexpr double kLopsidedWidthLog = 0.08;
+constexpr double kLopsidedShiftRatio = 1.0 / 3.0;
 
 // Candidates closed in on two sides set aside as corner cells, at most.
 constexpr std::size_t kMaxCornerGuesses = 3;
@@ -269,6 +279,17 @@ std::array<std::vector<FramePoint>, 4> TargetPoseTracker::StripeRuns(double tole
 }
 
 namespace {
+
+// The median of the values of the three lines other than `line`.
+template <typename T>
+T MedianOfOthers(const std::array<T, 4>& values, int line) {
+  std::array<T, 3> others{};
+  for (int k = 0, i = 0; k < 4; ++k) {
+    if (k != line) others[static_cast<std::size_t>(i++)] = values[static_cast<std::size_t>(k)];
+  }
+  std::sort(others.begin(), others.end());
+  return others[1];
+}
 
 // Whether stripe k's kept runs are, at their median, as wide as it.
 bool RunsAsWideAsStripe(const StripeFit& fit, std::size_t k) {
@@ -636,24 +657,39 @@ void TargetPoseTracker::MeasureLens() {
   frame_.lens_measured = true;
 }
 
+TargetPoseTracker::Pull TargetPoseTracker::PullOf(int line) const {
+  const StripeFit& fit = frame_.fit;
+  Pull pull;
+  pull.line = line;
+  pull.without = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
+                            detector_.Undistorts(), options_.stripe_fit, nullptr, line);
+  const PoseDistance moved = Distance(fit.cMo, pull.without.cMo);
+  const double distance = std::max(fit.cMo.getTranslationVector().frobeniusNorm(), 1e-6);
+  pull.angle_rad = moved.rotation_rad;
+  pull.shift = moved.translation_m / distance;
+  return pull;
+}
+
+bool TargetPoseTracker::Pull::Matters() const {
+  return without.ok && (angle_rad > kMaxPullRad || shift > kMaxPullFraction);
+}
+
+std::string TargetPoseTracker::Pull::Describe() const {
+  std::ostringstream text;
+  text << "pull the pose " << angle_rad * kDegPerRad << " deg and " << 100.0 * shift
+       << " % of the distance from where the other three stripes put it";
+  return text.str();
+}
+
 std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
   const StripeFit& fit = frame_.fit;
   if (!fit.ok) return std::nullopt;
   const auto weakest = std::min_element(fit.points.begin(), fit.points.end());
   const int line = static_cast<int>(weakest - fit.points.begin());
-  std::array<int, 3> others{};
-  for (int k = 0, i = 0; k < 4; ++k) {
-    if (k != line) others[static_cast<std::size_t>(i++)] = fit.points[static_cast<std::size_t>(k)];
-  }
-  std::sort(others.begin(), others.end());
-  if (*weakest >= kFewPointsRatio * others[1]) return std::nullopt;
-  const StripeFit without = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
-                                       detector_.Undistorts(), options_.stripe_fit, nullptr, line);
-  if (!without.ok) return std::nullopt;  // the other three do not fix the pose: nothing to tell
-  const PoseDistance moved = Distance(fit.cMo, without.cMo);
-  const double angle = moved.rotation_rad;
-  const double distance = std::max(fit.cMo.getTranslationVector().frobeniusNorm(), 1e-6);
-  const double shift = moved.translation_m / distance;
+  const int others = MedianOfOthers(fit.points, line);
+  if (*weakest >= kFewPointsRatio * others) return std::nullopt;
+  const Pull pull = PullOf(line);  // without.ok: the other three fix the pose
+  if (!pull.Matters()) return std::nullopt;
   double others_sum2 = 0.0;
   int others_points = 0;
   for (std::size_t k = 0; k < 4; ++k) {
@@ -662,21 +698,57 @@ std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
     others_points += fit.points[k];
   }
   const double others_rms = others_points > 0 ? std::sqrt(others_sum2 / others_points) : 0.0;
-  if ((angle <= kMaxPullRad && shift <= kMaxPullFraction) ||
-      others_rms <= kMaxOthersRmsGrowth * without.rms_px + kOthersRmsMarginPx) {
+  if (others_rms <= kMaxOthersRmsGrowth * pull.without.rms_px + kOthersRmsMarginPx) {
     return std::nullopt;
   }
   std::ostringstream message;
-  message << "line " << line + 1 << "'s " << *weakest << " points (the others keep " << others[1]
-          << ") pull the pose " << angle * kDegPerRad << " deg and " << 100.0 * shift
-          << " % of the distance from where the other three stripes put it, their RMS from "
-          << without.rms_px << " to " << others_rms << " px: they are not all its stripe's";
+  message << "line " << line + 1 << "'s " << *weakest << " points (the others keep " << others
+          << ") " << pull.Describe() << ", their RMS from " << pull.without.rms_px << " to "
+          << others_rms << " px: they are not all its stripe's";
+  return message.str();
+}
+
+std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImageView& image) const {
+  const StripeFit& fit = frame_.fit;
+  if (!fit.ok) return std::nullopt;
+  int line = -1;
+  double most = 0.0, relative = 1.0;
+  for (int k = 0; k < 4; ++k) {
+    const double ratio =
+        fit.width_ratio[static_cast<std::size_t>(k)] / MedianOfOthers(fit.width_ratio, k);
+    if (std::fabs(std::log(ratio)) > most) {
+      most = std::fabs(std::log(ratio));
+      line = k;
+      relative = ratio;
+    }
+  }
+  if (!(most > kLopsidedWidthLog)) return std::nullopt;
+  const Pull pull = PullOf(line);
+  if (!pull.Matters()) return std::nullopt;
+  const StripeCheckOptions check = options_.StripeCheck();
+  const StripeAgreement all = CheckStripes(image, layout_, fit.cMo, camera_, check);
+  const StripeAgreement three = CheckStripes(image, layout_, pull.without.cMo, camera_, check);
+  if (three.Worst() < options_.min_stripe_agreement || three.Seen() < options_.min_stripe_seen ||
+      !(three.ShiftRms() < kLopsidedShiftRatio * all.ShiftRms())) {
+    return std::nullopt;
+  }
+  std::ostringstream message;
+  message << "line " << line + 1 << "'s runs are " << relative
+          << " times as wide as the others' (something lying along one side of its stripe) and "
+          << pull.Describe() << ", where the image's stripes lie: their edges are "
+          << three.ShiftRms() << " px off (both edges the same way) there, " << all.ShiftRms()
+          << " px with it";
   return message.str();
 }
 
 bool TargetPoseTracker::Verify(const GrayImageView& image) {
   if (measure_lens_) MeasureLens();
   if (const std::optional<std::string> pull = WeakStripePull()) {
+    frame_.status = TargetStatus::kNotFound;
+    frame_.message = *pull;
+    return false;
+  }
+  if (const std::optional<std::string> pull = LopsidedStripePull(image)) {
     frame_.status = TargetStatus::kNotFound;
     frame_.message = *pull;
     return false;

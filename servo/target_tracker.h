@@ -287,9 +287,24 @@ class TargetPoseTracker {
   /// The checks on the frame's pose: enough points on each line, the model check; the lens
   /// told from the lines (set_measure_lens, or a pose the check refuses).
   bool Verify(const GrayImageView& image);
+  /// The pose the three stripes other than `line` hold (the frame's fit without its points),
+  /// and how far it lies from the frame's.
+  struct Pull {
+    int line = -1;
+    StripeFit without;
+    double angle_rad = 0.0, shift = 0.0;  ///< the move, and the translation's over the distance
+    /// The three fix the pose, and it lies farther than kMaxPullRad or kMaxPullFraction.
+    bool Matters() const;
+    std::string Describe() const;
+  };
+  Pull PullOf(int line) const;
   /// Why the frame's stripe fit is not taken, when a stripe keeping few points beside the
   /// others' pulls the pose away from where the other three stripes alone put it.
   std::optional<std::string> WeakStripePull() const;
+  /// Why the frame's stripe fit is not taken, when a stripe whose runs are narrower or wider
+  /// than the others' (something light or dark along one side of it) pulls the pose away from
+  /// where the other three stripes put it, and the image's stripes lie where the three put them.
+  std::optional<std::string> LopsidedStripePull(const GrayImageView& image) const;
   /// frame_.lens from the frame's pose and its lines 1-4.
   void MeasureLens();
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,

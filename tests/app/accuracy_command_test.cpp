@@ -178,8 +178,11 @@ TEST(PoseAccuracy, DimLivedInFramesGiveAPose) {
 // (seed 1, frame 554), and a glare over a crossing (frame 775); the finder splits them at the
 // neck. And a frame over-exposed at 720p with a white hand over a crossing and its shadow where
 // a hidden stripe should be (seed 42, frame 966) gives no wrong pose: that stripe's few points,
-// the shadow's, pulled the fit 2.3 degrees from where the other three stripes put it.
-TEST(PoseAccuracy, WashedOutCrossingsGiveAPoseAndAShadowForAStripeNoWrongOne) {
+// the shadow's, pulled the fit 2.3 degrees from where the other three stripes put it. Nor does
+// an over-exposed far sheet with a white cable lying over one side of a stripe for most of its
+// length (seed 185, frame 588): its runs' middles, all off the same way, tilted the pose 2.7
+// degrees.
+TEST(PoseAccuracy, WashedOutCrossingsGiveAPoseAndAShadowOrACableAlongAStripeNoWrongOne) {
   test::TestDir dir;
   const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
   const std::string at_720p = " --width 1280 --height 720 --focal 914";
@@ -188,8 +191,10 @@ TEST(PoseAccuracy, WashedOutCrossingsGiveAPoseAndAShadowForAStripeNoWrongOne) {
     std::string camera;
     bool posed;  // a right pose expected; otherwise no wrong one
   };
-  for (const auto& [seed, frame, camera, posed] :
-       std::vector<Case>{{1, 554, "", true}, {1, 775, "", true}, {42, 966, at_720p, false}}) {
+  for (const auto& [seed, frame, camera, posed] : std::vector<Case>{{1, 554, "", true},
+                                                                    {1, 775, "", true},
+                                                                    {42, 966, at_720p, false},
+                                                                    {185, 588, "", false}}) {
     const std::string what = "seed " + std::to_string(seed) + ", frame " + std::to_string(frame);
     const test::OalservoRun run = test::RunOalservo(
         dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(seed) +

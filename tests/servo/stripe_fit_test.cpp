@@ -333,6 +333,35 @@ TEST(StripeCheck, ProfilesReadAPointEveryScaledPixelJudgeAsAtTheReferenceSize) {
   EXPECT_THROW(bad.Check(), std::invalid_argument);
 }
 
+// The shift both edges of a stripe share: about a tenth of a pixel at the truth (the image's
+// noise), also where a white cable over one side of line 3 moves that edge alone; a pose a tenth
+// of a degree off, which the check still agrees with everywhere, moves both edges of the
+// stripes the same way, by more than half a pixel.
+TEST(StripeCheck, BothEdgesShiftTheSameWayOffThePoseNotUnderACableAlongOneSide) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const RenderedFrame plain = renderer.Render(Tilted(), 6);
+  const StripeAgreement truth = CheckStripes(ViewOf(plain.image), layout, plain.cMo, kCamera);
+  EXPECT_LT(truth.ShiftRms(), 0.2);
+  const vpHomogeneousMatrix off =
+      vpHomogeneousMatrix(0.0, 0.0, 0.0, 0.0, vpMath::rad(0.1), 0.0) * plain.cMo;
+  const StripeAgreement shifted = CheckStripes(ViewOf(plain.image), layout, off, kCamera);
+  EXPECT_EQ(shifted.Worst(), 1.0);
+  EXPECT_GT(shifted.ShiftRms(), 0.5);
+  EXPECT_GT(shifted.ShiftRms(), 3.0 * truth.ShiftRms());
+
+  FrameEffects effects;
+  PlaneOccluder cable;  // line 3 is 16 mm wide at x = 0.09: the cable covers its right 2 mm
+  cable.capsules.push_back({0.1, -0.14, 0.1, 0.14, 0.004});
+  cable.grey = 250;
+  effects.plane_occluders.push_back(cable);
+  const RenderedFrame covered = renderer.Render(Tilted(), 6, effects);
+  const StripeAgreement under_cable =
+      CheckStripes(ViewOf(covered.image), layout, covered.cMo, kCamera);
+  EXPECT_GE(under_cable.dark[2], 4);
+  EXPECT_LT(under_cable.shift_rms_px[2], 0.2);
+}
+
 // A hand over part of a stripe tells nothing there; a glare saturating ink and paper neither.
 TEST(StripeCheck, AHandOrAGlareHidesWithoutContradicting) {
   const SceneRenderer renderer(FourLineA3Target(), Render());
