@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "base/check.h"
+#include "base/pose_distance.h"
 #include "detector/lens.h"
 
 namespace oal {
@@ -23,6 +24,8 @@ constexpr double kMaxStretchGap = 0.05;
 // Points this close to a crossing's stripe (beyond its half width), metres, are left out: a
 // run there may have merged with the crossing stripe.
 constexpr double kCrossingMarginM = 0.002;
+// Two fits' poses this close (radians, and metres over the depth) are one.
+constexpr double kSameFitRad = 2e-3;
 // A step smaller than this (radians, and metres over the target's distance) has converged.
 constexpr double kConverged = 1e-7;
 // A guided point may lie this fraction of its stripe's length beyond its ends as the starting
@@ -474,10 +477,17 @@ double SupportedExtent(std::vector<double>* along, double length) {
   return hi > lo ? std::min(1.0, (hi - lo) / length) : 0.0;
 }
 
+bool SameFitPose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
+  const PoseDistance d = Distance(a, b);
+  const double depth = std::max(std::fabs(b[2][3]), 1e-3);
+  return d.rotation_rad < kSameFitRad && d.translation_m < kSameFitRad * depth;
+}
+
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options,
-                     const StripeGuides* guides, int left_out_line) {
+                     const StripeGuides* guides, int left_out_line,
+                     const vpHomogeneousMatrix* known) {
   options.Check();
   StripeFit fit;
   fit.cMo = start;
@@ -492,7 +502,8 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   }
   for (StripePoints& stripe : stripes) KeepCollinear(camera.px(), camera.py(), &stripe);
   // The steps keep a subset of these: a stripe already short of points ends the fit here.
-  if (const int starved = FirstStarvedOf(stripes, left_out_line, options.min_points); starved >= 0) {
+  if (const int starved = FirstStarvedOf(stripes, left_out_line, options.min_points);
+      starved >= 0) {
     fit.starved_line = starved;
     fit.message = StarvedMessage(
         starved, static_cast<int>(stripes[static_cast<std::size_t>(starved)].p.size()),
@@ -572,6 +583,11 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     }
     pose.Move(step);
     ++fit.iterations;
+    if (known != nullptr && SameFitPose(pose.Matrix(), *known)) {
+      fit.cMo = pose.Matrix();
+      fit.message = "the fit came back to the known pose";
+      return fit;
+    }
     const double depth = std::max(std::fabs(pose.t(2)), 1e-3);
     if (step.tail<3>().norm() < kConverged && step.head<3>().norm() < kConverged * depth) break;
   }

@@ -115,9 +115,17 @@ vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo);
 /// stripe: a start tens of pixels off still converges when the stripes' lines were told.
 /// `left_out_line` (0-3), when given, keeps none of that stripe's points: the pose the other
 /// three hold (three lines fix a plane's pose), that line needing no min_points.
+/// `known`, when given, is a pose already fitted: the fit stops, not ok, as soon as its steps
+/// bring it back there (SameFitPose), as a fit from the other tilt mostly does.
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options = {},
-                     const StripeGuides* guides = nullptr, int left_out_line = -1);
+                     const StripeGuides* guides = nullptr, int left_out_line = -1,
+                     const vpHomogeneousMatrix* known = nullptr);
+
+/// Whether two fitted poses are one: within 2e-3 rad, and 2e-3 of `b`'s depth apart. A fit
+/// from the other tilt that comes back lands within 3e-3 rad of the first fit on the bench
+/// frames, however wide its corridor; one settling on the other tilt, 0.5 rad or more away.
+bool SameFitPose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b);
 
 }  // namespace oal
