@@ -11,9 +11,9 @@
 #include <cmath>
 #include <vector>
 
-namespace oal {
+#include "base/angles.h"
 
-constexpr double kPi = 3.14159265358979323846;
+namespace oal {
 
 struct Point2d {
   double u = 0.0;  ///< column, pixels

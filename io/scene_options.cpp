@@ -5,12 +5,12 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "io/image_source.h"
 
 namespace oal {
 
 void SceneOptions::ApplyTo(RenderOptions* render) const {
-  constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
   render->background_texel_m = background_texel_m;
   render->background_grey = background_grey;
   render->illumination_gradient = gradient;

@@ -13,12 +13,12 @@
 #include <utility>
 #include <vector>
 
+#include "base/angles.h"
 #include "base/format.h"
 
 namespace oal {
 namespace {
 
-constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 constexpr double kFullMarginMm = 10.0;  // the full page: blank paper around the board
 constexpr double kGapMm = 1.5;          // between two printed items other than stripes
 // A line number keeps farther from the other marks, so that it is read as its stripe's and not

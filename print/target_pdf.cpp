@@ -6,11 +6,12 @@
 #include <memory>
 #include <stdexcept>
 
+#include "base/angles.h"
+
 namespace oal {
 namespace {
 
 constexpr double kPointsPerMm = 72.0 / 25.4;
-constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 
 struct SurfaceDeleter {
   void operator()(cairo_surface_t* surface) const { cairo_surface_destroy(surface); }

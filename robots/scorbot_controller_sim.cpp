@@ -19,12 +19,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "base/angles.h"
 #include "base/check.h"
 
 namespace oal {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr char kCtrlA = 0x01;
 constexpr char kXon = 0x11;
 constexpr char kXoff = 0x13;

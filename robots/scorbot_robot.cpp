@@ -7,13 +7,12 @@
 #include <stdexcept>
 #include <thread>
 
+#include "base/angles.h"
 #include "base/check.h"
 #include "base/format.h"
 
 namespace oal {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 long AngleDiffTenths(long a, long b) {
   long d = (a - b) % 3600;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "base/angles.h"
+#include "base/clock.h"
 #include "base/pose_distance.h"
 #include "detector/lens.h"  // DistortedPixel
 #include "detector/options.h"
@@ -36,10 +37,6 @@ constexpr std::array<double, 3> kExpectedCorridorScales = {6.0, 2.5, 1.0};
 constexpr int kMiddleBordersPerPair = 4;
 // ... and, after a pose, when a stripe's points span less than this fraction of it.
 constexpr double kWeakStripeExtent = 0.3;
-// A fit from the other tilt this close to the first one's pose (radians, and metres over the
-// target's distance) has come back to it, however wide its corridor: on the bench frames such
-// fits land within 3e-3 rad of it, those settling on the other tilt 0.5 rad or more away.
-constexpr double kSameFitRad = 2e-3;
 // A stripe keeping fewer than this fraction of the median of the others' points is checked
 // against the pose the other three hold. Its points are not its stripe's when they move the pose
 // by more than kMaxPullRad or kMaxPullFraction of the distance at a cost to the others: their RMS
@@ -65,11 +62,6 @@ constexpr double kLopsidedShiftRatio = 1.0 / 3.0;
 
 // Candidates closed in on two sides set aside as corner cells, at most.
 constexpr std::size_t kMaxCornerGuesses = 3;
-
-double Microseconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
-      .count();
-}
 
 }  // namespace
 
@@ -296,14 +288,6 @@ bool RunsAsWideAsStripe(const StripeFit& fit, std::size_t k) {
   return !(std::fabs(std::log(fit.width_ratio[k])) > kMaxFittedWidthLog);
 }
 
-// Whether two fits' poses are one: kSameFitRad apart at most, the translation over the
-// target's distance.
-bool SameFit(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
-  const PoseDistance d = Distance(a, b);
-  const double depth = std::max(std::fabs(b[2][3]), 1e-3);
-  return d.rotation_rad < kSameFitRad && d.translation_m < kSameFitRad * depth;
-}
-
 // The first stripe (0-3) whose kept runs are not as wide as it; -1 when none.
 int MergedStripe(const StripeFit& fit) {
   for (std::size_t k = 0; k < 4; ++k) {
@@ -449,7 +433,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
                                 const std::optional<Expected>& expected) {
   auto start = std::chrono::steady_clock::now();
   const std::vector<DetectedLine>& lines = detector_.Detect(image, seeds, borders);
-  frame_.detect_us += Microseconds(start);
+  frame_.detect_us += MicrosecondsSince(start);
   lines_ = lines;
   frame_.source = source;
   frame_.borders = detector_.region_borders().count();
@@ -457,7 +441,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
       frame_.borders > 0 ? detector_.region_borders().Polygon(0) : std::vector<Point2d>{};
   start = std::chrono::steady_clock::now();
   frame_.pose = EstimatePose(lines_, target_, pose_options_, prior);
-  frame_.pose_us += Microseconds(start);
+  frame_.pose_us += MicrosecondsSince(start);
   frame_.agreement = StripeAgreement{};
   frame_.lens = RadialBend{};
   frame_.lens_measured = false;
@@ -506,13 +490,8 @@ StripeFit TargetPoseTracker::FitNarrowing(const vpHomogeneousMatrix& start,
     StripeFitOptions corridor = options_.stripe_fit;
     corridor.corridor_px *= scale;
     fit = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_, detector_.Undistorts(),
-                     corridor, scale == kExpectedCorridorScales[0] ? guides : nullptr);
+                     corridor, scale == kExpectedCorridorScales[0] ? guides : nullptr, -1, known);
     if (!fit.ok) break;
-    if (known != nullptr && SameFit(fit.cMo, *known)) {
-      fit.ok = false;
-      fit.message = "the fit came back to the known pose";
-      break;
-    }
   }
   return fit;
 }
@@ -885,7 +864,7 @@ bool TargetPoseTracker::AttemptCells(const GrayImageView& image,
     ++tried;
     const auto refine_start = std::chrono::steady_clock::now();
     finder_.Refine(image, &cell);
-    frame_.find_us += Microseconds(refine_start);
+    frame_.find_us += MicrosecondsSince(refine_start);
     const std::optional<vpHomography> plane_to_image = PlaneToImageFromCell(layout_, cell, camera_);
     if (plane_to_image && AttemptCandidate(image, *plane_to_image, ScanSource::kMiddleCell)) {
       return true;
@@ -950,7 +929,7 @@ bool TargetPoseTracker::AttemptCornerCells(const GrayImageView& image) {
       const int inner = ClosedCorner(quad);
       const auto refine_start = std::chrono::steady_clock::now();
       finder_.Refine(image, &quad);
-      frame_.find_us += Microseconds(refine_start);
+      frame_.find_us += MicrosecondsSince(refine_start);
       for (const TargetLayout::CornerCell& cell : layout_.corner_cells) {
         const std::optional<vpHomography> h =
             PlaneToImageFromCorners(cell.corners, cell.inner, quad, inner, camera_);
@@ -1004,7 +983,7 @@ const TargetFrame& TargetPoseTracker::Track(
       if (found) break;
       const auto start = std::chrono::steady_clock::now();
       const std::vector<LightQuad>& cells = (finder_.*look)(image);
-      frame_.find_us += Microseconds(start);
+      frame_.find_us += MicrosecondsSince(start);
       found = AttemptCells(image, cells);
     }
     if (!found && options_.corner_cells) found = AttemptCornerCells(image);

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "base/clock.h"
 #include "base/format.h"
 #include "detector/lens.h"
 
@@ -23,11 +24,6 @@ namespace {
 constexpr int kBlackModules = 8;
 constexpr double kPictureModules = 9.5;
 constexpr int kTexelsPerModule = 4;
-
-double Microseconds(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 // The sheet's pose from the tag's in ViSP's frame aligned with the camera (z into the tag, x
 // and y along the tag's corners 3 -> 2 and 3 -> 0 as the AprilTag library orders them). OpenCV
@@ -173,7 +169,7 @@ class AprilTagMethod : public MarkerMethod {
         best_area = area;
       }
     }
-    result.detect_us = Microseconds(start);
+    result.detect_us = MicrosecondsSince(start);
     if (best < 0) {
       result.status = MarkerStatus::kNotFound;
       result.message =
@@ -183,7 +179,7 @@ class AprilTagMethod : public MarkerMethod {
     start = std::chrono::steady_clock::now();
     vpHomogeneousMatrix cMt;
     const bool posed = detector_.getPose(static_cast<std::size_t>(best), tag_size_m_, camera_, cMt);
-    result.pose_us = Microseconds(start);
+    result.pose_us = MicrosecondsSince(start);
     if (!posed) {
       result.status = MarkerStatus::kNoPose;
       result.message = "vpDetectorAprilTag::getPose failed";

@@ -11,6 +11,7 @@
 #include <opencv2/aruco/charuco.hpp>
 #include <vector>
 
+#include "base/clock.h"
 #include "base/format.h"
 #include "detector/lens.h"
 
@@ -21,11 +22,6 @@ constexpr int kSquaresX = 10, kSquaresY = 7;
 constexpr double kMarkerOverSquare = 0.75;
 constexpr double kA3SquareM = 0.038;
 constexpr int kPixelsPerSquare = 60;
-
-double Microseconds(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 // `camera_matrix` in the aruco module's pixels, whose centres lie at (i + 1/2, j + 1/2) where
 // ours, ViSP's and the rest of OpenCV's (cornerSubPix, calibrateCamera) lie at (i, j): OpenCV
@@ -84,7 +80,7 @@ class CharucoMethod : public MarkerMethod {
       cv::aruco::interpolateCornersCharuco(markers, ids, view, board_, corners, corner_ids,
                                            camera_matrix_, distortion_);
     }
-    result.detect_us = Microseconds(start);
+    result.detect_us = MicrosecondsSince(start);
     if (ids.empty()) {
       result.status = MarkerStatus::kNotFound;
       result.message = "no marker of the board";
@@ -95,7 +91,7 @@ class CharucoMethod : public MarkerMethod {
     const bool posed = corner_ids.size() >= 4 &&
                        cv::aruco::estimatePoseCharucoBoard(corners, corner_ids, board_,
                                                            camera_matrix_, distortion_, rvec, tvec);
-    result.pose_us = Microseconds(start);
+    result.pose_us = MicrosecondsSince(start);
     if (!posed) {
       result.status = MarkerStatus::kNoPose;
       result.message = std::to_string(ids.size()) + " marker(s), " +

@@ -13,23 +13,10 @@
 #include "base/check.h"
 #include "detector/detector.h"
 #include "detector/image_view.h"
+#include "eval/lines/line_scoring.h"
 
 namespace oal {
 namespace {
-
-// Angle and largest offset of the truth chord's ends from `line`.
-std::pair<double, double> ErrorOf(const LineParams& line, const LineParams& truth, const Point2d& a,
-                                  const Point2d& b) {
-  return {
-      AngleBetween(line, truth) * kDegPerRad,
-      std::max(std::fabs(line.SignedDistance(a.u, a.v)), std::fabs(line.SignedDistance(b.u, b.v)))};
-}
-
-// The point of `line` nearest to `p`.
-Point2d Foot(const LineParams& line, const Point2d& p) {
-  const double distance = line.SignedDistance(p.u, p.v);
-  return {p.u - distance * std::cos(line.theta_rad), p.v - distance * std::sin(line.theta_rad)};
-}
 
 // Scores the first N `lines` of a frame against its truth and records the result.
 void Score(const std::vector<LineParams>& lines, const RenderedFrame& frame, bool undistorted,

@@ -10,17 +10,13 @@
 #include <memory>
 #include <stdexcept>
 
+#include "base/clock.h"
 #include "base/pose_distance.h"
 #include "detector/lens.h"
 #include "loop/lens_estimate.h"
 
 namespace oal {
 namespace {
-
-double MicrosecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 // Roll of cMo in the convention of PoseResult::roll_deg: cRo = Rz(roll) Ry(yaw) Rx(pitch).
 double RollDeg(const vpHomogeneousMatrix& cMo) {

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <random>
 
+#include "base/angles.h"
+
 namespace oal {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // What the distance means: ViSP's a^-1 b, its translation's norm and its theta-u angle.
 PoseDistance ThroughViSP(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {

@@ -8,10 +8,11 @@
 #include <optional>
 #include <vector>
 
+#include "base/angles.h"
+
 namespace oal {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // The line v = 100: its normal points along +v, so a point's distance from it is v - 100.
 const LineParams kLine{100.0, 0.5 * kPi};
 

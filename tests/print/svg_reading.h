@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
+#include "base/angles.h"
 #include "print/target_page.h"
 #include "target/line_target.h"
 
 namespace oal::test {
 
 inline constexpr double kToleranceMm = 0.01;  // drawing coordinates against the target geometry
-inline constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 
 struct Point {
   double x = 0.0, y = 0.0;

@@ -13,6 +13,7 @@
 #include <deque>
 #include <thread>
 
+#include "base/angles.h"
 #include "scorbot_test_util.h"
 
 namespace oal {
@@ -218,7 +219,7 @@ TEST(AclClient, ImpactDuringAMoveIsReportedWithTheNextCommand) {
   EXPECT_FALSE(link.sim.control_enabled());
   const double base = link.sim.joints()[0];
   EXPECT_GT(base, 0.0);
-  EXPECT_LT(base, 30 * 3.14159265358979323846 / 180 - 1e-3);  // stopped on the way
+  EXPECT_LT(base, 30 * kRadPerDeg - 1e-3);  // stopped on the way
   AclPositionValues v;
   const AclReply r = link.client->ListPosition("POSITION", &v);
   ASSERT_EQ(r.status, AclStatus::kControllerError);

@@ -10,12 +10,12 @@
 #include <random>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "robots/robot.h"
 
 namespace oal {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kTolM = 1e-9;
 constexpr double kTolRad = 1e-9;
 
