@@ -198,25 +198,6 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
   *stripe = std::move(kept);
 }
 
-// The first line (0-3) other than `left_out` with fewer than `min_points` points; -1 if none.
-int FirstStarved(const std::array<int, 4>& points, int left_out, int min_points) {
-  for (int k = 0; k < 4; ++k) {
-    if (k != left_out && points[static_cast<std::size_t>(k)] < min_points) return k;
-  }
-  return -1;
-}
-int FirstStarvedOf(const std::array<StripePoints, 4>& stripes, int left_out, int min_points) {
-  std::array<int, 4> counts{};
-  for (std::size_t k = 0; k < 4; ++k) counts[k] = static_cast<int>(stripes[k].p.size());
-  return FirstStarved(counts, left_out, min_points);
-}
-std::string StarvedMessage(int line, int points, int min_points) {
-  std::ostringstream message;
-  message << "line " << line + 1 << " keeps " << points
-          << " of its stripe's points (min_points = " << min_points << ")";
-  return message.str();
-}
-
 class Fitter {
  public:
   Fitter(const TargetLayout& layout, const Lens& camera, const StripeFitOptions& options)
@@ -501,15 +482,6 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     stripes[static_cast<std::size_t>(left_out_line)] = StripePoints{};
   }
   for (StripePoints& stripe : stripes) KeepCollinear(camera.px(), camera.py(), &stripe);
-  // The steps keep a subset of these: a stripe already short of points ends the fit here.
-  if (const int starved = FirstStarvedOf(stripes, left_out_line, options.min_points);
-      starved >= 0) {
-    fit.starved_line = starved;
-    fit.message = StarvedMessage(
-        starved, static_cast<int>(stripes[static_cast<std::size_t>(starved)].p.size()),
-        options.min_points);
-    return fit;
-  }
 
   std::vector<double> magnitudes;
   double scale = options.min_scale_px;
@@ -619,12 +591,15 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   fit.scale_px = scale;
   fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;
   fit.cMo = pose.Matrix();
-  if (const int starved = FirstStarved(fit.points, left_out_line, options.min_points);
-      starved >= 0) {
-    fit.starved_line = starved;
-    fit.message =
-        StarvedMessage(starved, fit.points[static_cast<std::size_t>(starved)], options.min_points);
-    return fit;
+  for (int k = 0; k < 4; ++k) {
+    if (k != left_out_line && fit.points[static_cast<std::size_t>(k)] < options.min_points) {
+      std::ostringstream message;
+      message << "line " << k + 1 << " keeps " << fit.points[static_cast<std::size_t>(k)]
+              << " of its stripe's points (min_points = " << options.min_points << ")";
+      fit.message = message.str();
+      fit.starved_line = k;
+      return fit;
+    }
   }
   fit.ok = true;
   return fit;
