@@ -209,6 +209,22 @@ TEST(PoseAccuracy, WashedOutCrossingsGiveAPoseAndAShadowOrACableAlongAStripeNoWr
   }
 }
 
+// The 2 m board seen from near (seed 1, frame 665): the whole image's lines give its pose, and
+// the borders on the board's plane leave too few stripe points for a fit to tell anything
+// against it (its steps cannot fix the pose): the whole image's pose stands, a right one.
+TEST(PoseAccuracy, TheBoardSeenFromNearKeepsTheWholeImagesPose) {
+  test::TestDir dir;
+  const test::OalservoRun run =
+      test::RunOalservo(dir,
+                        "pose-accuracy --target four-line-board --seed 1 --first-frame 665 "
+                        "--frames 1 --out '" +
+                            dir / "report.json" + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json report = json::parse(test::ReadText(dir / "report.json"));
+  EXPECT_EQ(report.at("posed"), 1);
+  EXPECT_EQ(report.at("wrong_poses"), json::array());
+}
+
 // The report: status_counts keyed by status name, and the roll median the table shows.
 TEST(PoseAccuracy, ReportJsonNamesTheStatusCountsAndHasTheRollMedian) {
   test::TestDir dir;
