@@ -6,13 +6,12 @@
 #include <limits>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "detector/lens.h"
 #include "detector/simd.h"
 
 namespace oal {
 namespace {
-
-constexpr double kDegToRad = kPi / 180.0;
 
 int MaxPairs(int points) {
   return points * (points - 1) / 2;
@@ -103,7 +102,7 @@ bool OalDetector::BorderOutline<kPoints>::Crossed(const OalEntry& entry) const {
 
 OalDetector::OalDetector(const DetectorOptions& options)
     : options_((options.Check(), options)),
-      oal_(options.angle_change_deg * kDegToRad, options.r_change_px, options.max_lines,
+      oal_(options.angle_change_deg * kRadPerDeg, options.r_change_px, options.max_lines,
            options.max_lines + MaxPairs(options.max_points_per_border)) {}
 
 OalDetector::OalDetector(const DetectorOptions& options, const Lens& camera)
@@ -430,7 +429,7 @@ void OalDetector::ReadOff(int width, int height, bool in_region) {
 
   // Near-duplicates are judged with rho from the list's origin, as the list matches lines,
   // so that the same two lines are duplicates wherever they lie in the image.
-  const double duplicate_angle = options_.duplicate_angle_deg * kDegToRad;
+  const double duplicate_angle = options_.duplicate_angle_deg * kRadPerDeg;
   const Point2d centre{origin_u_, origin_v_};
   for (const DetectedLine& candidate : candidates_) {
     if (static_cast<int>(lines_.size()) >= options_.max_output_lines) break;

@@ -9,12 +9,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/angles.h"
 #include "detector/lens.h"
 
 namespace oal {
 namespace {
-
-constexpr double kDegToRad = kPi / 180.0;
 
 // The detector's line for a track that has none this frame: the prediction, with its ends.
 DetectedLine PredictedLine(const LineParams& line, int width, int height) {
@@ -140,7 +139,7 @@ void OalLineTracker::Update(const std::vector<DetectedLine>& detected) {
   };
   std::vector<Pair> pairs;
   std::vector<LineParams> predictions(tracks_.size());
-  const double gate_angle = options_.gate_angle_deg * kDegToRad;
+  const double gate_angle = options_.gate_angle_deg * kRadPerDeg;
   for (std::size_t k = 0; k < tracks_.size(); ++k) {
     predictions[k] = Predict(k);
     for (std::size_t d = 0; d < detected.size(); ++d) {

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/angles.h"
 #include "base/random.h"
 #include "detector/lens.h"
 #include "scene/geometry.h"
@@ -16,7 +17,6 @@
 namespace oal {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
 constexpr int kWidth = 640, kHeight = 480;
 constexpr double kFocalPx = 600.0;
 constexpr double kNoiseSigma = 5.0;
@@ -172,13 +172,13 @@ RenderOptions BaseOptions(double kdu) {
 // amplitude, sideways amplitude and rate, tilt, roll amplitude and rate.
 // The slow motion is shared by slow, occlusion, illumination and leave-reenter.
 Motion SlowMotion() {
-  return Motion{0.7, 0.04, 0.05, 0.06, 12.0 * kDeg, 3.0 * kDeg, 0.04};
+  return Motion{0.7, 0.04, 0.05, 0.06, 12.0 * kRadPerDeg, 3.0 * kRadPerDeg, 0.04};
 }
 Motion FastMotion() {
-  return Motion{0.65, 0.08, 0.13, 0.3, 12.0 * kDeg, 15.0 * kDeg, 0.35};
+  return Motion{0.65, 0.08, 0.13, 0.3, 12.0 * kRadPerDeg, 15.0 * kRadPerDeg, 0.35};
 }
 Motion DistortionMotion() {
-  return Motion{0.5, 0.05, 0.08, 0.06, 10.0 * kDeg, 10.0 * kDeg, 0.05};
+  return Motion{0.5, 0.05, 0.08, 0.06, 10.0 * kRadPerDeg, 10.0 * kRadPerDeg, 0.05};
 }
 
 // Draws m's phases (roll0 within +-roll0_range_rad) and sets every frame's pose from it.
@@ -201,10 +201,10 @@ std::string Common(const Sequence& s, std::size_t count) {
 std::string MotionText(const Motion& m) {
   std::ostringstream out;
   out << "camera " << m.distance_m << " m +- " << m.distance_amplitude_m
-      << " m from the board, optical axis tilted " << m.tilt_rad / kDeg
+      << " m from the board, optical axis tilted " << m.tilt_rad / kRadPerDeg
       << " deg, sliding parallel to the board by +- " << m.shift_amplitude_m << " m at about "
-      << m.shift_rate_rad << " rad per frame, roll " << m.roll0_rad / kDeg << " +- "
-      << m.roll_amplitude_rad / kDeg << " deg at " << m.roll_rate_rad << " rad per frame";
+      << m.shift_rate_rad << " rad per frame, roll " << m.roll0_rad / kRadPerDeg << " +- "
+      << m.roll_amplitude_rad / kRadPerDeg << " deg at " << m.roll_rate_rad << " rad per frame";
   return out.str();
 }
 
@@ -306,7 +306,7 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
       }
       text << "Slow motion: " << MotionText(m) << ". An opaque rectangle (grey " << occluder.grey
            << ", " << 2 * occluder.half_width_px << " x " << 2 * occluder.half_height_px
-           << " px) crosses the image at constant speed in direction " << angle / kDeg
+           << " px) crosses the image at constant speed in direction " << angle / kRadPerDeg
            << " deg from frame " << std::ceil(begin) << " to frame " << std::floor(end)
            << ", passing over the crossing of lines 1 and 2 at frame " << mid << ".";
       break;
@@ -322,19 +322,19 @@ Sequence MakeSequence(SequenceKind kind, int frame_count, std::uint64_t seed,
         s.frames[i].effects.offset = kOffset;
       }
       text << "Slow motion: " << MotionText(m) << ". Illumination falls by 30 % across the image "
-           << "towards " << s.options.gradient_angle_rad / kDeg << " deg; from frame " << change
-           << " on, every grey level g becomes " << kGain << " g + " << kOffset << ".";
+           << "towards " << s.options.gradient_angle_rad / kRadPerDeg << " deg; from frame "
+           << change << " on, every grey level g becomes " << kGain << " g + " << kOffset << ".";
       break;
     }
     case SequenceKind::kLeaveReenter: {
       Motion m = SlowMotion();
-      m.Draw(gen, 15.0 * kDeg);
-      const double pan_rad = (Uniform(gen) < 0.5 ? -1.0 : 1.0) * 32.0 * kDeg;
+      m.Draw(gen, 15.0 * kRadPerDeg);
+      const double pan_rad = (Uniform(gen) < 0.5 ? -1.0 : 1.0) * 32.0 * kRadPerDeg;
       for (int i = 0; i < frame_count; ++i) {
         const double a = 0.5 * (1.0 - std::cos(2.0 * kPi * i / last));
         s.frames[i].cMo = m.At(i, pan_rad * a);
       }
-      text << "Slow motion: " << MotionText(m) << ", plus a pan of " << pan_rad / kDeg
+      text << "Slow motion: " << MotionText(m) << ", plus a pan of " << pan_rad / kRadPerDeg
            << " deg * (1 - cos(2 pi i / " << last << ")) / 2 at frame i: the camera turns "
            << (pan_rad > 0.0 ? "right" : "left") << " and back, so the line(s) on the "
            << (pan_rad > 0.0 ? "left" : "right")

@@ -11,14 +11,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "base/check.h"
 #include "io/atomic_file.h"
 #include "io/image_source.h"
 
 namespace oal {
 namespace {
-
-constexpr double kDegToRad = kPi / 180.0;
 
 struct EdgePoint {
   double u = 0.0, v = 0.0;    ///< sub-pixel position
@@ -204,7 +203,7 @@ EdgeReference FitEdgeReference(const vpImage<unsigned char>& image,
   const int wanted_sign = PolaritySign(options.polarity);
   if (prior) {
     const double c = std::cos(prior->theta_rad), s = std::sin(prior->theta_rad);
-    const double min_cos = std::cos(options.max_prior_angle_deg * kDegToRad);
+    const double min_cos = std::cos(options.max_prior_angle_deg * kRadPerDeg);
     points.erase(
         std::remove_if(points.begin(), points.end(),
                        [&](const EdgePoint& p) {
@@ -225,7 +224,7 @@ EdgeReference FitEdgeReference(const vpImage<unsigned char>& image,
   }
 
   // Step 4: RANSAC on pairs, support with one polarity.
-  const double min_cos = std::cos(options.max_normal_angle_deg * kDegToRad);
+  const double min_cos = std::cos(options.max_normal_angle_deg * kRadPerDeg);
   std::mt19937_64 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
   std::size_t best_support = 0;

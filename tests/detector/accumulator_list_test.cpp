@@ -4,10 +4,11 @@
 
 #include <cmath>
 
+#include "base/angles.h"
+
 namespace oal {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
 constexpr double kTol = 1e-9;
 
 // Votes for the line (rho, theta) as the detector does: with its unit normal.
@@ -16,7 +17,7 @@ int VoteFor(OrderedAccumulatorList* list, double rho, double theta, int border =
 }
 
 TEST(OrderedAccumulatorList, NewEntryHasWeightOneCountZero) {
-  OrderedAccumulatorList list(2 * kDeg, 4.0, 20, 40);
+  OrderedAccumulatorList list(2 * kRadPerDeg, 4.0, 20, 40);
   EXPECT_EQ(VoteFor(&list, 10.0, 0.5), 0);
   ASSERT_EQ(list.entries().size(), 1u);
   EXPECT_EQ(list.entries()[0].weight, 1);
@@ -26,7 +27,7 @@ TEST(OrderedAccumulatorList, NewEntryHasWeightOneCountZero) {
 }
 
 TEST(OrderedAccumulatorList, MatchesAverageWeightedByPriorVotes) {
-  OrderedAccumulatorList list(2 * kDeg, 4.0, 20, 40);
+  OrderedAccumulatorList list(2 * kRadPerDeg, 4.0, 20, 40);
   VoteFor(&list, 10.0, 0.50);
   EXPECT_EQ(VoteFor(&list, 12.0, 0.51), 0);  // (10*1 + 12) / 2, (0.50*1 + 0.51) / 2
   EXPECT_NEAR(list.entries()[0].rho_px, 11.0, kTol);
@@ -42,25 +43,25 @@ TEST(OrderedAccumulatorList, MatchesAverageWeightedByPriorVotes) {
 // With a wide anglechange (Check() allows up to 45 deg) the mean is still exact: the step's
 // angle and rotation leave the small-angle series for the library functions.
 TEST(OrderedAccumulatorList, WideAngleChangeStillAveragesExactly) {
-  OrderedAccumulatorList list(40 * kDeg, 4.0, 20, 40);
+  OrderedAccumulatorList list(40 * kRadPerDeg, 4.0, 20, 40);
   VoteFor(&list, 10.0, 0.5);
-  EXPECT_EQ(VoteFor(&list, 12.0, 0.5 + 35 * kDeg), 0);
-  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5 + 17.5 * kDeg, kTol);
-  EXPECT_EQ(VoteFor(&list, 11.0, 0.5 + 3 * kDeg), 0);  // (2 * 17.5 + 3) / 3 = 12.67 deg
-  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5 + (38.0 / 3.0) * kDeg, kTol);
+  EXPECT_EQ(VoteFor(&list, 12.0, 0.5 + 35 * kRadPerDeg), 0);
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5 + 17.5 * kRadPerDeg, kTol);
+  EXPECT_EQ(VoteFor(&list, 11.0, 0.5 + 3 * kRadPerDeg), 0);  // (2 * 17.5 + 3) / 3 = 12.67 deg
+  EXPECT_NEAR(list.entries()[0].Line().theta_rad, 0.5 + (38.0 / 3.0) * kRadPerDeg, kTol);
   EXPECT_NEAR(std::hypot(list.entries()[0].cos_theta, list.entries()[0].sin_theta), 1.0, 1e-15);
 }
 
 TEST(OrderedAccumulatorList, ThresholdsOfEquationsOneAndTwo) {
-  OrderedAccumulatorList list(2 * kDeg, 4.0, 20, 40);
+  OrderedAccumulatorList list(2 * kRadPerDeg, 4.0, 20, 40);
   VoteFor(&list, 10.0, 0.5);
-  EXPECT_EQ(VoteFor(&list, 10.0, 0.5 + 2.1 * kDeg), 1);  // angle just beyond anglechange
-  EXPECT_EQ(VoteFor(&list, 14.5, 0.5), 2);               // rho just beyond rchange
-  EXPECT_EQ(VoteFor(&list, 13.9, 0.5 + 1.9 * kDeg), 0);  // within both
+  EXPECT_EQ(VoteFor(&list, 10.0, 0.5 + 2.1 * kRadPerDeg), 1);  // angle just beyond anglechange
+  EXPECT_EQ(VoteFor(&list, 14.5, 0.5), 2);                     // rho just beyond rchange
+  EXPECT_EQ(VoteFor(&list, 13.9, 0.5 + 1.9 * kRadPerDeg), 0);  // within both
 }
 
 TEST(OrderedAccumulatorList, AveragesAcrossTheThetaWrap) {
-  OrderedAccumulatorList list(2 * kDeg, 4.0, 20, 40);
+  OrderedAccumulatorList list(2 * kRadPerDeg, 4.0, 20, 40);
   VoteFor(&list, 5.0, 0.01);
   // theta = pi - 0.01 with rho = -5 is theta = -0.01 with rho = 5: the same family.
   EXPECT_EQ(VoteFor(&list, -5.0, kPi - 0.01), 0);
@@ -75,7 +76,7 @@ TEST(OrderedAccumulatorList, AveragesAcrossTheThetaWrap) {
 }
 
 TEST(OrderedAccumulatorList, ReordersByWeightMinusHalfCount) {
-  OrderedAccumulatorList list(1 * kDeg, 2.0, 20, 40);
+  OrderedAccumulatorList list(1 * kRadPerDeg, 2.0, 20, 40);
   VoteFor(&list, 0.0, 0.2);   // A: 1 vote
   VoteFor(&list, 50.0, 1.0);  // B: 3 votes
   VoteFor(&list, 50.0, 1.0);
@@ -91,7 +92,7 @@ TEST(OrderedAccumulatorList, ReordersByWeightMinusHalfCount) {
 }
 
 TEST(OrderedAccumulatorList, MostLikelyEntryGetsTheVote) {
-  OrderedAccumulatorList list(3 * kDeg, 4.0, 20, 40);
+  OrderedAccumulatorList list(3 * kRadPerDeg, 4.0, 20, 40);
   VoteFor(&list, 0.0, 1.0);  // weak entry first
   VoteFor(&list, 7.0, 1.0);  // strong entry
   VoteFor(&list, 7.0, 1.0);
@@ -104,7 +105,7 @@ TEST(OrderedAccumulatorList, MostLikelyEntryGetsTheVote) {
 }
 
 TEST(OrderedAccumulatorList, CullsNegativeScoresOnlyBeyondMaxLines) {
-  OrderedAccumulatorList list(1 * kDeg, 2.0, /*max_lines=*/2, 40);
+  OrderedAccumulatorList list(1 * kRadPerDeg, 2.0, /*max_lines=*/2, 40);
   for (int i = 0; i < 3; ++i) VoteFor(&list, 0.0, 0.3);  // A: 3 votes
   VoteFor(&list, 40.0, 0.3);                             // B, C, D: 1 vote each
   VoteFor(&list, 80.0, 0.3);
@@ -121,7 +122,7 @@ TEST(OrderedAccumulatorList, CullsNegativeScoresOnlyBeyondMaxLines) {
 }
 
 TEST(OrderedAccumulatorList, CountsOnlyWhereThePredicateHolds) {
-  OrderedAccumulatorList list(1 * kDeg, 2.0, 20, 40);
+  OrderedAccumulatorList list(1 * kRadPerDeg, 2.0, 20, 40);
   VoteFor(&list, 0.0, 0.3);
   VoteFor(&list, 40.0, 0.3);
   list.EndBorder([](const OalEntry& entry) { return entry.rho_px > 20.0; });
@@ -131,7 +132,7 @@ TEST(OrderedAccumulatorList, CountsOnlyWhereThePredicateHolds) {
 }
 
 TEST(OrderedAccumulatorList, FullListDropsNewVotes) {
-  OrderedAccumulatorList list(1 * kDeg, 2.0, 2, 3);
+  OrderedAccumulatorList list(1 * kRadPerDeg, 2.0, 2, 3);
   EXPECT_EQ(VoteFor(&list, 0.0, 0.1), 0);
   EXPECT_EQ(VoteFor(&list, 10.0, 0.1), 1);
   EXPECT_EQ(VoteFor(&list, 20.0, 0.1), 2);
@@ -141,7 +142,7 @@ TEST(OrderedAccumulatorList, FullListDropsNewVotes) {
 }
 
 TEST(OrderedAccumulatorList, BordersCountsDistinctBorders) {
-  OrderedAccumulatorList list(1 * kDeg, 2.0, 20, 40);
+  OrderedAccumulatorList list(1 * kRadPerDeg, 2.0, 20, 40);
   VoteFor(&list, 0.0, 0.3, 0);
   VoteFor(&list, 0.0, 0.3, 0);
   VoteFor(&list, 0.0, 0.3, 1);

@@ -8,6 +8,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "scene/scene.h"
 #include "test_images.h"
 
@@ -59,8 +60,6 @@ void operator delete[](void* p, const std::nothrow_t&) noexcept {
 namespace oal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / kPi;
-
 struct LineError {
   double angle_deg = 1e9;
   double offset_px = 1e9;  ///< largest distance of the truth chord's ends from the line
@@ -69,7 +68,7 @@ struct LineError {
 LineError ErrorOf(const LineParams& detected, const LineParams& truth, const Point2d& a,
                   const Point2d& b) {
   LineError error;
-  error.angle_deg = AngleBetween(detected, truth) * kRadToDeg;
+  error.angle_deg = AngleBetween(detected, truth) * kDegPerRad;
   error.offset_px = std::max(std::fabs(detected.SignedDistance(a.u, a.v)),
                              std::fabs(detected.SignedDistance(b.u, b.v)));
   return error;
@@ -160,7 +159,7 @@ TEST(OalDetector, FindsTwoStripesWithSubPixelAccuracyAndWidth) {
   ASSERT_GE(lines.size(), 2u);
   for (const auto& [truth, width] : {std::pair{first, 8.0}, std::pair{second, 5.0}}) {
     const auto found = std::find_if(lines.begin(), lines.begin() + 2, [&](const DetectedLine& l) {
-      return AngleBetween(l.line, truth) < 0.5 / kRadToDeg;
+      return AngleBetween(l.line, truth) < 0.5 / kDegPerRad;
     });
     ASSERT_NE(found, lines.begin() + 2) << "no line near theta " << truth.theta_rad;
     Point2d a, b;
@@ -184,7 +183,7 @@ TEST(OalDetector, PaperModeFindsCleanStripes) {
   ASSERT_GE(lines.size(), 2u);
   for (int i = 0; i < 2; ++i) {
     const LineParams& truth = std::fabs(lines[i].line.rho_px - 120.0) < 10.0 ? first : second;
-    EXPECT_LT(AngleBetween(lines[i].line, truth) * kRadToDeg, 1.0);
+    EXPECT_LT(AngleBetween(lines[i].line, truth) * kDegPerRad, 1.0);
     EXPECT_NEAR(lines[i].line.rho_px, truth.rho_px, 2.0);
   }
 }
@@ -198,7 +197,7 @@ TEST(OalDetector, LightLinesOnDark) {
   OalDetector detector(options);
   const auto& lines = detector.Detect(image.View());
   ASSERT_FALSE(lines.empty());
-  EXPECT_LT(AngleBetween(lines[0].line, truth) * kRadToDeg, 0.3);
+  EXPECT_LT(AngleBetween(lines[0].line, truth) * kDegPerRad, 0.3);
   EXPECT_NEAR(lines[0].line.rho_px, truth.rho_px, 0.5);
 }
 
@@ -296,7 +295,7 @@ TEST(OalDetector, PairWidthCheckKeepsCrossPairsOutOfTheList) {
     detector.Detect(image.View());
     int tilted = 0;
     for (const OalEntry& entry : detector.accumulator_list().entries()) {
-      tilted += AngleBetween(entry.Line(), LineParams{0.0, 0.0}) > 2.0 / kRadToDeg;
+      tilted += AngleBetween(entry.Line(), LineParams{0.0, 0.0}) > 2.0 / kDegPerRad;
     }
     return tilted;
   };

@@ -10,12 +10,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/angles.h"
 #include "scene/scene.h"
 
 namespace oal {
 namespace {
-
-constexpr double kDeg = kPi / 180.0;
 
 // The middle cell of a '#' target whose lines 1 and 3 run along y and 2 and 4 along x (the
 // built-in sheets): between the stripes' inner edges, object frame.
@@ -72,8 +71,8 @@ TEST_P(SheetFinderOnRenderedSheets, FindsTheMiddleCellClosedInAndRefinesItOntoTh
   render.background_grey = param.background_grey;
   const LineTarget target = TargetByName(param.target);
   const SceneRenderer renderer(target, render);
-  const vpHomogeneousMatrix cMo(0.01, -0.01, param.distance_m, param.tilt_deg * kDeg, 0.0,
-                                param.roll_deg * kDeg);
+  const vpHomogeneousMatrix cMo(0.01, -0.01, param.distance_m, param.tilt_deg * kRadPerDeg, 0.0,
+                                param.roll_deg * kRadPerDeg);
   const RenderedFrame frame = renderer.Render(cMo, 7);
 
   SheetFinder finder;
@@ -140,7 +139,8 @@ class SheetFinderInALivedInScene : public ::testing::Test {
   Point2d Crossing12() const { return Point2d{target_.lines[0].x1_m, target_.lines[1].y1_m}; }
   // The sheet seen with `effects`: does the finder find its middle cell?
   bool FindsTheMiddleCellWith(const FrameEffects& effects) const {
-    const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
+    const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kRadPerDeg, -8.0 * kRadPerDeg,
+                                  30.0 * kRadPerDeg);
     return FindsTheMiddleCell(SceneRenderer(target_, render_).Render(cMo, 5, effects), target_,
                               render_.camera);
   }
@@ -183,7 +183,8 @@ TEST_F(SheetFinderInALivedInScene, APaleHandAcrossAStripeIsTakenAsDarkAtLast) {
   arm.capsules.push_back({0.0, -0.02, 0.04, -0.3, 0.022});
   FrameEffects effects;
   effects.plane_occluders.push_back(arm);
-  const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
+  const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kRadPerDeg, -8.0 * kRadPerDeg,
+                                30.0 * kRadPerDeg);
   const RenderedFrame frame = SceneRenderer(target_, render_).Render(cMo, 5, effects);
   EXPECT_FALSE(FindsTheMiddleCell(frame, target_, render_.camera));
   EXPECT_TRUE(FindsTheMiddleCellAtLast(frame, target_, render_.camera));
@@ -331,7 +332,8 @@ TEST_F(SheetFinderInALivedInScene, ADimFrameNeedsLessContrastInProportionToItsPa
   render_.background_grey = 120;
   FrameEffects dim;
   dim.gain = 0.2;
-  const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kDeg, -8.0 * kDeg, 30.0 * kDeg);
+  const vpHomogeneousMatrix cMo(0.02, 0.01, 0.5, 12.0 * kRadPerDeg, -8.0 * kRadPerDeg,
+                                30.0 * kRadPerDeg);
   const RenderedFrame frame = SceneRenderer(target_, render_).Render(cMo, 5, dim);
   EXPECT_TRUE(FindsTheMiddleCell(frame, target_, render_.camera));
   SheetFinderOptions absolute;

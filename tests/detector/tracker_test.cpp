@@ -5,13 +5,12 @@
 #include <cmath>
 #include <map>
 
+#include "base/angles.h"
 #include "scene/scene.h"
 #include "test_images.h"
 
 namespace oal {
 namespace {
-
-constexpr double kDeg = kPi / 180.0;
 
 // A small two- or four-line scene whose camera slides sideways by `shift_m` per frame.
 class TrackerScene {
@@ -30,7 +29,7 @@ class TrackerScene {
 
   // Camera 0.6 m in front of the board, rolled by `roll_deg`, moved by x_m along its x axis.
   RenderedFrame Frame(double x_m, std::uint64_t seed, double roll_deg = 20.0) const {
-    const vpHomogeneousMatrix cMo(x_m, 0.01, 0.6, 0.0, 0.0, roll_deg * kDeg);
+    const vpHomogeneousMatrix cMo(x_m, 0.01, 0.6, 0.0, 0.0, roll_deg * kRadPerDeg);
     return renderer_.Render(cMo, seed);
   }
 
@@ -44,7 +43,7 @@ const TrackedLine* Near(const OalLineTracker& tracker, const LineParams& truth) 
   double best_distance = 1e9;
   for (const TrackedLine& track : tracker.getLines()) {
     if (track.status == TrackStatus::kLost) continue;
-    const double distance = AngleBetween(track.line.line, truth) / kDeg +
+    const double distance = AngleBetween(track.line.line, truth) / kRadPerDeg +
                             std::fabs(RhoAlignedTo(truth, track.line.line) - truth.rho_px);
     if (distance < best_distance) {
       best_distance = distance;

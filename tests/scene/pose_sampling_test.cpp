@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "base/angles.h"
 #include "scene/scene.h"
 #include "tests/scene/scene_image_util.h"
 #include "tests/scene/scene_test_util.h"
@@ -16,8 +17,6 @@ namespace oal {
 namespace {
 
 using testing::Project;
-
-constexpr double kDeg = kPi / 180.0;
 
 // The camera centre and optical axis in the object frame.
 struct CameraInObject {
@@ -92,10 +91,10 @@ TEST(SamplePose, RespectsDistanceTiltOffsetAndRollBounds) {
   EXPECT_LE(max_distance, sampling.max_distance_m + 1e-12);
   EXPECT_LT(min_distance, 0.53);  // the whole range is used
   EXPECT_GT(max_distance, 0.77);
-  EXPECT_LE(max_tilt, sampling.max_tilt_deg * kDeg + 1e-9);
-  EXPECT_GT(max_tilt, 0.8 * sampling.max_tilt_deg * kDeg);
-  EXPECT_LE(max_roll, sampling.max_tilt_deg * kDeg + 1e-9);
-  EXPECT_GT(max_roll, 0.8 * sampling.max_tilt_deg * kDeg);
+  EXPECT_LE(max_tilt, sampling.max_tilt_deg * kRadPerDeg + 1e-9);
+  EXPECT_GT(max_tilt, 0.8 * sampling.max_tilt_deg * kRadPerDeg);
+  EXPECT_LE(max_roll, sampling.max_tilt_deg * kRadPerDeg + 1e-9);
+  EXPECT_GT(max_roll, 0.8 * sampling.max_tilt_deg * kRadPerDeg);
 }
 
 TEST(SamplePose, EveryLineIsLongEnough) {

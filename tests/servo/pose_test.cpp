@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "base/angles.h"
 #include "detector/detector.h"
 #include "detector/lens.h"
 #include "scene/scene.h"
@@ -27,7 +28,6 @@
 namespace oal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / kPi;
 // Per-frame accuracy on rendered frames through the detector (see the report in EndToEnd).
 constexpr double kMaxTranslationError = 0.01;  // fraction of the distance
 // (A frame of the strongly distorted 320x240 set reaches 0.51 deg: its stripes are 4-8 px.)
@@ -73,7 +73,7 @@ PoseSampling WideSampling() {
 double RotationErrorDeg(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
   const vpRotationMatrix r = a.getRotationMatrix().t() * b.getRotationMatrix();
   const vpThetaUVector tu(r);
-  return std::sqrt(tu[0] * tu[0] + tu[1] * tu[1] + tu[2] * tu[2]) * kRadToDeg;
+  return std::sqrt(tu[0] * tu[0] + tu[1] * tu[1] + tu[2] * tu[2]) * kDegPerRad;
 }
 
 double TranslationError(const vpHomogeneousMatrix& estimate, const vpHomogeneousMatrix& truth) {
@@ -98,7 +98,7 @@ double TrueLine1RollDeg(const vpHomogeneousMatrix& cMo) {
   double u0, v0, u1, v1;
   project(-0.08, -0.07, &u0, &v0);
   project(-0.08, 0.06, &u1, &v1);
-  double roll = std::atan2(-(u1 - u0), v1 - v0) * kRadToDeg;
+  double roll = std::atan2(-(u1 - u0), v1 - v0) * kDegPerRad;
   return roll < 0.0 ? roll + 360.0 : roll;
 }
 
