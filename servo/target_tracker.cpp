@@ -639,7 +639,6 @@ void TargetPoseTracker::MeasureLens() {
 TargetPoseTracker::Pull TargetPoseTracker::PullOf(int line) const {
   const StripeFit& fit = frame_.fit;
   Pull pull;
-  pull.line = line;
   pull.without = FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_,
                             detector_.Undistorts(), options_.stripe_fit, nullptr, line);
   const PoseDistance moved = Distance(fit.cMo, pull.without.cMo);

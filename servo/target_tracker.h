@@ -290,7 +290,6 @@ class TargetPoseTracker {
   /// The pose the three stripes other than `line` hold (the frame's fit without its points),
   /// and how far it lies from the frame's.
   struct Pull {
-    int line = -1;
     StripeFit without;
     double angle_rad = 0.0, shift = 0.0;  ///< the move, and the translation's over the distance
     /// The three fix the pose, and it lies farther than kMaxPullRad or kMaxPullFraction.
