@@ -555,10 +555,12 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     }
     pose.Move(step);
     ++fit.iterations;
-    if (known != nullptr && SameFitPose(pose.Matrix(), *known)) {
+    if (known != nullptr) {
       fit.cMo = pose.Matrix();
-      fit.message = "the fit came back to the known pose";
-      return fit;
+      if (SameFitPose(fit.cMo, *known)) {
+        fit.message = "the fit came back to the known pose";
+        return fit;
+      }
     }
     const double depth = std::max(std::fabs(pose.t(2)), 1e-3);
     if (step.tail<3>().norm() < kConverged && step.head<3>().norm() < kConverged * depth) break;

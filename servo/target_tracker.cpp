@@ -45,7 +45,7 @@ constexpr double kWeakStripeExtent = 0.3;
 // against 0.09). Three stripes alone tell the tilt loosely (their pose may lie degrees away, the
 // RMS the same): a move alone says nothing.
 constexpr double kFewPointsRatio = 0.5;
-constexpr double kMaxPullRad = 1.0 * kPi / 180.0;
+constexpr double kMaxPullRad = 1.0 * kRadPerDeg;
 constexpr double kMaxPullFraction = 0.01;
 constexpr double kMaxOthersRmsGrowth = 2.0;
 constexpr double kOthersRmsMarginPx = 0.05;
@@ -694,8 +694,9 @@ std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImage
   for (int k = 0; k < 4; ++k) {
     const double ratio =
         fit.width_ratio[static_cast<std::size_t>(k)] / MedianOfOthers(fit.width_ratio, k);
-    if (std::fabs(std::log(ratio)) > most) {
-      most = std::fabs(std::log(ratio));
+    const double apart = std::fabs(std::log(ratio));
+    if (apart > most) {
+      most = apart;
       line = k;
       relative = ratio;
     }

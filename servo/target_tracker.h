@@ -36,7 +36,9 @@
 // A pose is refined on the stripes' own feature points, the target held rigid (stripe_fit.h);
 // a stripe keeping under half the points of the others is fitted without, and when its points
 // pull the pose away from where the other three put it at a cost to theirs (their RMS doubled),
-// they are not its stripe's and the pose is not taken. A pose is accepted only when the image
+// they are not its stripe's and the pose is not taken; so is a stripe whose runs are narrower or
+// wider than the others' (something along one side of it) when the image's stripe edges lie
+// three times nearer where the other three stripes put them. A pose is accepted only when the image
 // shows the target where it says (stripe_check.h): across each stripe, between the crossings
 // and the printed ends, its dark run where the pose puts it
 // (min_stripe_agreement of the samples that agree or contradict, min_stripe_seen of all the

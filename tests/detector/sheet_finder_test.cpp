@@ -290,9 +290,7 @@ TEST(SheetFinder, ACrossingWashedOutOverSeveralCellsIsSplitAtTheNeck) {
 // the split finds nothing Find did not.
 TEST(SheetFinder, ARoomWithoutANeckIsNotSplit) {
   vpImage<unsigned char> image(480, 640, 70);
-  for (int v = 60; v < 420; ++v) {
-    for (int u = 100; u < 540; ++u) image[v][u] = 215;
-  }
+  Fill(&image, 100, 60, 540, 420, 215);  // the sheet
   SheetFinder finder;
   const GrayImageView view = ViewOf(image);
   const std::vector<LightQuad> found = finder.Find(view);
