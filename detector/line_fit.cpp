@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/statistics.h"
+
 namespace oal {
 
 LineParams RefitLine(const LineParams& line, const std::vector<FramePoint>& points,
@@ -171,9 +173,8 @@ LineBend FitLineBend(const LineParams& line, const std::vector<FramePoint>& poin
       magnitudes.push_back(distance);
       if (distance > worst_distance) worst_distance = distance, worst = &sample;
     }
-    auto median = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
-    std::nth_element(magnitudes.begin(), median, magnitudes.end());
-    if (worst == nullptr || !(worst_distance > std::max(4.0 * 1.4826 * *median, 1.0 / 3.0))) break;
+    const double median = MedianInPlace(&magnitudes);
+    if (worst == nullptr || !(worst_distance > std::max(4.0 * 1.4826 * median, 1.0 / 3.0))) break;
     worst->kept = false;
     Parabola refit;
     if (!FitParabola(samples, &refit)) {

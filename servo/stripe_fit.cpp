@@ -7,6 +7,7 @@
 
 #include "base/check.h"
 #include "base/pose_distance.h"
+#include "base/statistics.h"
 #include "detector/lens.h"
 
 namespace oal {
@@ -102,13 +103,6 @@ ImageLine Through(const Vec3& a, const Vec3& b) {
   return line;
 }
 
-double Median(std::vector<double>* values) {
-  if (values->empty()) return 0.0;
-  const auto middle = values->begin() + static_cast<std::ptrdiff_t>(values->size() / 2);
-  std::nth_element(values->begin(), middle, values->end());
-  return *middle;
-}
-
 // A stripe's points, in normalised coordinates, their runs' middles moved onto the centre
 // line's locus, and their place along the stripe ('#' coordinate).
 struct StripePoints {
@@ -179,7 +173,7 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
       PixelLine line{-dv / length, du / length, 0.0};
       line.c = line.nu * u[i] + line.nv * v[i];
       for (std::size_t k = 0; k < n; ++k) distances[k] = line.Distance(u[k], v[k]);
-      const double median = Median(&distances);
+      const double median = MedianInPlace(&distances);
       if (median < best_median) {
         best_median = median;
         best = line;
@@ -509,7 +503,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       for (const Vec3& p : stripes[k].p)
         magnitudes.push_back(std::fabs(lines[k].n.dot(p)) * inv_scale[k]);
     }
-    scale = std::max(options.min_scale_px, 1.4826 * Median(&magnitudes));
+    scale = std::max(options.min_scale_px, 1.4826 * MedianInPlace(&magnitudes));
     const double cut = kTukey * scale, inv_cut2 = 1.0 / (cut * cut);
     // Point i of stripe k: r = s n.p (s = 1 / |n| in pixels), and its row of the Jacobian
     // dr = s p^T (dn - n ds / s^2 ...) = s p^T M, M = dn - n g, g = (n0 dn0 / px^2 + n1 dn1 /
@@ -586,7 +580,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       ++kept;
     }
     fit.line_rms_px[k] = fit.points[k] > 0 ? std::sqrt(line_sum2 / fit.points[k]) : 0.0;
-    fit.width_ratio[k] = Median(&magnitudes);
+    fit.width_ratio[k] = MedianInPlace(&magnitudes);
     const StripeSpan& span = layout.stripes[k];
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }

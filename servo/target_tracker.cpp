@@ -10,6 +10,7 @@
 #include "base/angles.h"
 #include "base/clock.h"
 #include "base/pose_distance.h"
+#include "base/statistics.h"
 #include "detector/lens.h"  // DistortedPixel
 #include "detector/options.h"
 
@@ -307,13 +308,6 @@ int ClosedCorner(const LightQuad& quad) {
   return -1;
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 }  // namespace
 
 LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames) {
@@ -325,8 +319,8 @@ LensCheck CheckLens(const std::vector<RadialBend>& frames, int min_frames) {
     if (std::isfinite(frame.kdu_error_sd)) errors.push_back(frame.kdu_error);
     check.contradicting += ContradictsLens(frame);
   }
-  check.median_px = Median(bends);
-  check.median_kdu_error = Median(errors);
+  check.median_px = MedianInPlace(&bends);
+  check.median_kdu_error = MedianInPlace(&errors);
   check.mismatch = check.frames >= min_frames && 2 * check.contradicting > check.frames;
   return check;
 }
