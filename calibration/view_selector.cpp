@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "base/check.h"
+#include "base/statistics.h"
 #include "calibration/plane_lines.h"
 
 namespace oal {
@@ -63,17 +64,22 @@ double MedianSpacing(const std::vector<Point2d>& seen) {
     }
     nearest.push_back(d);
   }
-  const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
-  std::nth_element(nearest.begin(), middle, nearest.end());
-  return *middle;
+  return MedianInPlace(&nearest);
 }
 
 // A line's points near those seen before needed to say how it moved.
 constexpr double kMinMeasured = 3.0;
+// A point whose offset lies further than this many robust deviations (and kMinOutlierPx) from
+// the line's median offset is not the stripe's: a run cut short by the stripe's printed end, by
+// the image's edge or by a hand has its middle pixels off the stripe's, and a view found along
+// another route of scans sees such runs where the last did not.
+constexpr double kOutlierScales = 4.0;
+constexpr double kMinOutlierPx = 0.5;
 
 // How far a line seen as `before` moved to `after`: the offsets of after's points from the
 // curve before's points trace, as a straight trend along the line, at the ends of the stretch
-// measured; infinite when fewer than a quarter of after's points lie within reach of before's.
+// measured, the offsets far from the others left out; infinite when fewer than a quarter of
+// after's points lie within reach of before's.
 double LineMotion(const std::vector<Point2d>& before, const std::vector<Point2d>& after,
                   double reach_px) {
   // The line's direction: that of the straight line through the points seen before (s below
@@ -83,18 +89,32 @@ double LineMotion(const std::vector<Point2d>& before, const std::vector<Point2d>
   const Point2d foot{line.rho_px * std::cos(line.theta_rad),
                      line.rho_px * std::sin(line.theta_rad)};
   const double reach = reach_px + MedianSpacing(before);
-  // Least squares of offset = a + b s, s along the line.
-  double n = 0.0, ss = 0.0, sd = 0.0, sss = 0.0, ssd = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
+  struct Measured {
+    double along, offset;
+  };
+  std::vector<Measured> measured;
   for (const Point2d& q : after) {
     double offset = 0.0;
     if (!OffsetFromSeen(before, tangent, q, reach, &offset)) continue;
-    const double s = (q.u - foot.u) * tangent.u + (q.v - foot.v) * tangent.v;
-    n += 1.0, ss += s, sd += offset, sss += s * s, ssd += s * offset;
-    lo = std::min(lo, s), hi = std::max(hi, s);
+    measured.push_back({(q.u - foot.u) * tangent.u + (q.v - foot.v) * tangent.v, offset});
   }
   // A stripe moved by more than the reach leaves none of its points near those seen before; one
   // seen over another stretch, some (sliding along it shows on the lines across it).
-  if (n < kMinMeasured || 4.0 * n < static_cast<double>(after.size())) return HUGE_VAL;
+  const auto count = static_cast<double>(measured.size());
+  if (count < kMinMeasured || 4.0 * count < static_cast<double>(after.size())) return HUGE_VAL;
+  std::vector<double> offsets;
+  for (const Measured& m : measured) offsets.push_back(m.offset);
+  const double median = MedianInPlace(&offsets);
+  for (double& offset : offsets) offset = std::fabs(offset - median);
+  const double keep = std::max(kMinOutlierPx, kOutlierScales * 1.4826 * MedianInPlace(&offsets));
+  // Least squares of offset = a + b s over the points kept.
+  double n = 0.0, ss = 0.0, sd = 0.0, sss = 0.0, ssd = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (const auto& [along, offset] : measured) {
+    if (std::fabs(offset - median) > keep) continue;
+    n += 1.0, ss += along, sd += offset, sss += along * along, ssd += along * offset;
+    lo = std::min(lo, along), hi = std::max(hi, along);
+  }
+  if (n < kMinMeasured) return HUGE_VAL;
   const double spread = sss - ss * ss / n;
   const double slope = spread > 1e-9 ? (ssd - ss * sd / n) / spread : 0.0;
   const double at_mean = sd / n, mean_s = ss / n;

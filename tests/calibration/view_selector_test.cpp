@@ -144,6 +144,44 @@ TEST(TargetMotion, IsTheStripesNotTheStretchesSeen) {
   EXPECT_FALSE(TargetMotion(whole, CalibrationView{"blank", {}, {}}, 6.0));
 }
 
+// A still sheet whose next view also holds runs cut short at one stripe's printed end (their
+// middles 2-8 px off the stripe, at one end of it: a scan route the last frame did not take)
+// is still; moved by two pixels with those runs, it has moved.
+TEST(TargetMotion, LeavesOutRunsCutShortAtAStripesEnd) {
+  const LineTarget target = FourLineA3Target();
+  const Lens bending = Lens::WithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
+  std::mt19937 random(7);
+  const vpHomogeneousMatrix pose = LookingAtTheSheet(0.45, 25.0, -10.0, 20.0);
+  const auto view_at = [&](const vpHomogeneousMatrix& cMo) {
+    return SheetView(target, SeenAlongStripes(target, bending, cMo, 0.05, &random), "frame");
+  };
+  const auto with_cut_runs = [](CalibrationView view) {
+    std::vector<Point2d>& seen = view.lines.front().seen;
+    const auto [first, last] = std::minmax_element(
+        seen.begin(), seen.end(), [](const Point2d& a, const Point2d& b) { return a.u < b.u; });
+    const Point2d end = *last;
+    const double du = last->u - first->u, dv = last->v - first->v, length = std::hypot(du, dv);
+    for (int k = 0; k < 10; ++k) {
+      // Along the stripe towards its end, further off the nearer the end.
+      const double along = -1.0 * k, off = -(2.0 + 0.6 * (9 - k));
+      seen.push_back(
+          {end.u + (along * du - off * dv) / length, end.v + (along * dv + off * du) / length});
+    }
+    return view;
+  };
+  const CalibrationView before = view_at(pose);
+  const std::optional<double> still = TargetMotion(before, with_cut_runs(view_at(pose)), 6.0);
+  ASSERT_TRUE(still);
+  EXPECT_LT(*still, 0.5);
+  const std::optional<double> back = TargetMotion(with_cut_runs(view_at(pose)), before, 6.0);
+  ASSERT_TRUE(back);
+  EXPECT_LT(*back, 0.5);
+  const vpHomogeneousMatrix shifted = vpHomogeneousMatrix(0.0013, 0.0, 0.0, 0.0, 0.0, 0.0) * pose;
+  const std::optional<double> moved = TargetMotion(before, with_cut_runs(view_at(shifted)), 6.0);
+  ASSERT_TRUE(moved);
+  EXPECT_GT(*moved, 1.5);
+}
+
 TEST_F(ViewSelectorTest, AStillTargetSeenOverChangingStretchesIsTaken) {
   ViewSelectorOptions options;
   options.still_frames = 4;
