@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "detector/lens.h"
+#include "detector/sheet_finder.h"
 #include "scene/bench_scene.h"
 #include "scene/scene.h"
 #include "servo/pbvs.h"
@@ -306,6 +307,31 @@ void StripeCheckAlone(benchmark::State& state) {
   state.counters["agreeing"] = agreeing;
 }
 
+// The sheet finder's look at a frame with no prior and the refinement of its best candidate
+// (detector/sheet_finder.h): its share of a first frame, the image as delivered (copied in
+// before each look, as TargetFirstFrameFromGrabber's).
+void SheetFinderAlone(benchmark::State& state) {
+  const TargetInputs& inputs = Inputs(state);
+  const TargetTrackerOptions defaults;
+  SheetFinder finder(defaults.ScaledBy(defaults.PixelScale(inputs.camera)).finder);
+  vpImage<unsigned char> delivered = inputs.still.front().image;
+  std::size_t frame = 0;
+  double candidates = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const vpImage<unsigned char>& next = inputs.still[frame].image;
+    std::copy(next.bitmap, next.bitmap + next.getSize(), delivered.bitmap);
+    frame = (frame + 1) % inputs.still.size();
+    state.ResumeTiming();
+    const GrayImageView view = ViewOf(delivered);
+    std::vector<LightQuad> found = finder.Find(view);
+    if (!found.empty()) finder.Refine(view, &found.front());
+    candidates += static_cast<double>(found.size());
+    benchmark::DoNotOptimize(found.data());
+  }
+  state.counters["candidates"] = candidates / static_cast<double>(state.iterations());
+}
+
 // Arguments: the image width, and the lens model the tracker is told (0: ViSP's, 1: OpenCV's).
 BENCHMARK(TargetFirstFrame)
     ->Args({640, 0})
@@ -326,6 +352,7 @@ BENCHMARK(TargetTracked)
 BENCHMARK(TargetTrackedFromGrabber)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
 BENCHMARK(StripeFitAlone)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
 BENCHMARK(StripeCheckAlone)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
+BENCHMARK(SheetFinderAlone)->Args({640, 0})->Args({1920, 0})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace oal

@@ -94,16 +94,39 @@ void ReduceTo(std::vector<Point2d>* polygon, std::size_t count) {
   }
 }
 
-// The grey level at (u, v): the mean of the pixel and its neighbours one pixel away along
-// (du, dv) on both sides, nearest pixels; -1 when one of them lies outside the image.
-double Probe(const GrayImageView& image, double u, double v, double du, double dv) {
-  int sum = 0;
+// Whether the probe at (u, v) lies inside the image, by a hundredth of a pixel at least (what
+// ProbeSums' fixed point may drift): its pixel and its neighbours one pixel away along (du, dv)
+// on both sides, nearest pixels.
+bool ProbeInside(const GrayImageView& image, double u, double v, double du, double dv) {
+  constexpr double kMargin = 0.01;
   for (int k = -1; k <= 1; ++k) {
     const double x = u + k * du + 0.5, y = v + k * dv + 0.5;
-    if (!(x >= 0.0 && y >= 0.0 && x < image.width && y < image.height)) return -1.0;
-    sum += image.at(static_cast<int>(x), static_cast<int>(y));
+    if (!(x >= kMargin && y >= kMargin && x < image.width - kMargin &&
+          y < image.height - kMargin)) {
+      return false;
+    }
   }
-  return sum / 3.0;
+  return true;
+}
+
+// The sums of the grey levels of n probes at from + i step (i < n), each its pixel and its
+// neighbours one pixel away along `along`, nearest pixels, into sums[i]; the first and the last
+// probe must be inside the image (ProbeInside), and so all are. Positions in fixed point (16
+// fractional bits): a probe lands at most n / 2^16 px off.
+void ProbeSums(const GrayImageView& image, const Point2d& from, const Point2d& step,
+               const Point2d& along, int n, int* sums) {
+  const auto fixed = [](double x) { return static_cast<std::int64_t>(std::lround(x * 65536.0)); };
+  const std::int64_t step_u = fixed(step.u), step_v = fixed(step.v);
+  const std::int64_t along_u = fixed(along.u), along_v = fixed(along.v);
+  std::int64_t u = fixed(from.u + 0.5), v = fixed(from.v + 0.5);
+  const std::uint8_t* const data = image.data;
+  const std::ptrdiff_t stride = image.stride;
+  const auto pixel = [data, stride](std::int64_t fu, std::int64_t fv) {
+    return static_cast<int>(data[(fv >> 16) * stride + (fu >> 16)]);
+  };
+  for (int i = 0; i < n; ++i, u += step_u, v += step_v) {
+    sums[i] = pixel(u - along_u, v - along_v) + pixel(u, v) + pixel(u + along_u, v + along_v);
+  }
 }
 
 // A side from a to b of a quadrilateral turning like the image borders: its unit direction
@@ -128,22 +151,24 @@ struct Side {
 bool EdgeAt(const GrayImageView& image, const Side& side, double t, double light, double search,
             double min_contrast, Point2d* edge) {
   const int n = static_cast<int>(2.0 * search) + 1;
-  std::array<double, 512> profile;
-  if (n > static_cast<int>(profile.size())) return false;
-  double darkest = 255.0;
-  for (int i = 0; i < n; ++i) {
-    const Point2d p = side.At(t, i - search);
-    profile[static_cast<std::size_t>(i)] =
-        Probe(image, p.u, p.v, side.direction.u, side.direction.v);
-    if (profile[static_cast<std::size_t>(i)] < 0.0) return false;
-    darkest = std::min(darkest, profile[static_cast<std::size_t>(i)]);
+  std::array<int, 512> sums;  // three pixels' sums along the normal
+  if (n > static_cast<int>(sums.size())) return false;
+  const Point2d& along = side.direction;
+  // The probes lie on a segment: when both of its ends are inside the image, all are (one
+  // outside leaves no edge to find).
+  const Point2d first = side.At(t, -search), last = side.At(t, n - 1 - search);
+  if (!ProbeInside(image, first.u, first.v, along.u, along.v) ||
+      !ProbeInside(image, last.u, last.v, along.u, along.v)) {
+    return false;
   }
-  if (light - darkest < min_contrast) return false;
-  const double threshold = 0.5 * (light + darkest);
+  ProbeSums(image, first, side.outward, along, n, sums.data());
+  const int darkest_sum = *std::min_element(sums.begin(), sums.begin() + n);
+  if (light - darkest_sum / 3.0 < min_contrast) return false;
+  // Halfway between the light and the darkest, in the sums' units (three grey levels).
+  const double threshold = 1.5 * light + 0.5 * darkest_sum;
   double best = HUGE_VAL;
   for (int i = 0; i + 1 < n; ++i) {
-    const double g0 = profile[static_cast<std::size_t>(i)],
-                 g1 = profile[static_cast<std::size_t>(i + 1)];
+    const int g0 = sums[static_cast<std::size_t>(i)], g1 = sums[static_cast<std::size_t>(i + 1)];
     if (!(g0 >= threshold && g1 < threshold)) continue;  // light to dark, outward
     const double s = i - search + (g0 - threshold) / (g0 - g1);
     if (std::fabs(s) < std::fabs(best)) best = s;
@@ -176,7 +201,8 @@ bool RefineSide(const GrayImageView& image, const Side& side, double light, doub
   };
   const auto pair_of = [&points](std::size_t i, std::size_t j) {
     const double du = points[j].u - points[i].u, dv = points[j].v - points[i].v;
-    return Pair{points[i], du, dv, kEdgeTolerancePx * std::hypot(du, dv)};
+    // A chord of tens of pixels: hypot's care for overflow is not needed, its cost is.
+    return Pair{points[i], du, dv, kEdgeTolerancePx * std::sqrt(du * du + dv * dv)};
   };
   std::size_t most = 0;
   Pair best;
@@ -355,6 +381,10 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
   const int window = c >= 16 ? 16 : (c >= 8 ? 8 : c);
   const int offset = (c - window) / 2;
   const std::uint32_t count = static_cast<std::uint32_t>(rows_used * window);
+  // Dividing by `count` as a multiply (a division per cell is most of this function's time):
+  // ceil(2^32 / count) gives the exact quotient for numerators below 2^32 / count, and a
+  // cell's rounded sum is below 256 count + count.
+  const std::uint64_t reciprocal = ((std::uint64_t{1} << 32) + count - 1) / count;
   for (int gy = 0; gy < grid_height_; ++gy) {
     std::fill(sums.begin(), sums.end(), 0u);
     for (int r = first_row; r < c; r += row_step) {
@@ -403,7 +433,8 @@ void SheetFinder::ComputeCells(const GrayImageView& image) {
     }
     std::uint8_t* out = cells_.data() + static_cast<std::size_t>(gy) * grid_width_;
     for (int gx = 0; gx < grid_width_; ++gx) {
-      out[gx] = static_cast<std::uint8_t>((sums[static_cast<std::size_t>(gx)] + count / 2) / count);
+      const std::uint64_t rounded = sums[static_cast<std::size_t>(gx)] + count / 2;
+      out[gx] = static_cast<std::uint8_t>((rounded * reciprocal) >> 32);
     }
   }
 }
