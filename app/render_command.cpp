@@ -58,6 +58,7 @@ PoseSampling ToPoseSampling(const RenderCommandOptions& options) {
   sampling.min_distance_m = options.min_distance_m;
   sampling.max_distance_m = options.max_distance_m;
   sampling.max_tilt_deg = options.max_tilt_deg;
+  sampling.min_tilt_deg = options.min_tilt_deg;
   sampling.max_offset_m = options.max_offset_m;
   sampling.min_visible_length_px = options.min_visible_px;
   sampling.crossings_in_view = options.crossings_margin_px >= 0.0;
@@ -147,6 +148,8 @@ void RenderCommandOptions::Check() const {
                 "--max-distance >= --min-distance");
   RequireOption(max_tilt_deg >= 0.0 && max_tilt_deg <= 80.0, "--max-tilt-deg", max_tilt_deg,
                 "0 <= --max-tilt-deg <= 80");
+  RequireOption(min_tilt_deg >= 0.0 && min_tilt_deg <= max_tilt_deg, "--min-tilt-deg", min_tilt_deg,
+                "0 <= --min-tilt-deg <= --max-tilt-deg");
   RequireOption(min_visible_px >= 0.0, "--min-visible-px", min_visible_px, "--min-visible-px >= 0");
   RequireOption(max_offset_m >= 0.0 && max_offset_m <= 100.0, "--max-offset", max_offset_m,
                 "0 <= --max-offset <= 100");
@@ -245,6 +248,9 @@ int RunRender(int argc, char** argv) {
           ->capture_default_str(),
       cli.add_option("--max-tilt-deg", options.max_tilt_deg,
                      "optical axis to board normal, degrees")
+          ->capture_default_str(),
+      cli.add_option("--min-tilt-deg", options.min_tilt_deg,
+                     "... at least, degrees (views for a calibration: 30, with --max-tilt-deg 45)")
           ->capture_default_str(),
       cli.add_option("--min-visible-px", options.min_visible_px,
                      "every target line visible over at least this length, pixels")

@@ -47,6 +47,7 @@ struct RenderCommandOptions {
   double min_distance_m = 0.4;  ///< camera to board, metres, > 0
   double max_distance_m = 0.9;  ///< metres, >= min_distance_m
   double max_tilt_deg = 30.0;   ///< optical axis to board normal, degrees, [0, 80]
+  double min_tilt_deg = 0.0;    ///< ... at least, [0, max_tilt_deg]
   double min_visible_px = 0.0;  ///< each line's visible length at least this, pixels
   /// Where the optical axis meets the board, at most this far from its centre, metres, >= 0.
   double max_offset_m = 0.05;

@@ -548,7 +548,8 @@ vpHomogeneousMatrix DrawPose(const PoseSampling& sampling, std::mt19937_64& gen)
   const double offset_angle = 2.0 * kPi * Uniform(gen);
   const double distance =
       sampling.min_distance_m + (sampling.max_distance_m - sampling.min_distance_m) * Uniform(gen);
-  const double tilt = sampling.max_tilt_deg * deg * Uniform(gen);
+  const double tilt = sampling.min_tilt_deg * deg +
+                      (sampling.max_tilt_deg - sampling.min_tilt_deg) * deg * Uniform(gen);
   const double azimuth = 2.0 * kPi * Uniform(gen);
   const double roll = sampling.any_roll ? 2.0 * kPi * Uniform(gen)
                                         : sampling.max_tilt_deg * deg * (2.0 * Uniform(gen) - 1.0);
@@ -1577,6 +1578,8 @@ void PoseSampling::Check() const {
                 "PoseSampling::max_distance_m", max_distance_m, "min_distance_m <= max_distance_m");
   RequireOption(InRange(max_tilt_deg, 0.0, 80.0), "PoseSampling::max_tilt_deg", max_tilt_deg,
                 "0 <= max_tilt_deg <= 80");
+  RequireOption(InRange(min_tilt_deg, 0.0, max_tilt_deg), "PoseSampling::min_tilt_deg",
+                min_tilt_deg, "0 <= min_tilt_deg <= max_tilt_deg");
   RequireOption(max_offset_m >= 0.0 && std::isfinite(max_offset_m), "PoseSampling::max_offset_m",
                 max_offset_m, "max_offset_m >= 0");
   RequireOption(min_visible_length_px >= 0.0 && std::isfinite(min_visible_length_px),

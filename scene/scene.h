@@ -300,6 +300,9 @@ class SceneRenderer {
 struct PoseSampling {
   double min_distance_m = 0.4, max_distance_m = 0.9;  ///< 0 < min <= max
   double max_tilt_deg = 30.0;  ///< angle between optical axis and board normal, [0, 80]
+  /// ... uniform from this angle to max_tilt_deg: views tilted as a calibration asks for
+  /// them (30-45 degrees). [0, max_tilt_deg].
+  double min_tilt_deg = 0.0;
   double max_offset_m = 0.05;  ///< where the optical axis meets the board, from its centre, >= 0
   bool any_roll = true;        ///< roll uniform in [0, 360) deg; else within +-max_tilt_deg
   /// Every target line must cross the image over at least this length (0: no check).

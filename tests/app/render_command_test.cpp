@@ -207,6 +207,9 @@ TEST(Render, BadOptionsNameTheCommandLineOption) {
               HasSubstr("--kdu = 1.5. Violated constraint: -1 < --kdu < 1"));
   EXPECT_THAT(error([](RenderCommandOptions* o) { o->max_tilt_deg = 90.0; }),
               HasSubstr("--max-tilt-deg = 90"));
+  EXPECT_THAT(error([](RenderCommandOptions* o) { o->min_tilt_deg = 40.0; }),
+              HasSubstr("--min-tilt-deg = 40. Violated constraint: 0 <= --min-tilt-deg <= "
+                        "--max-tilt-deg"));
   EXPECT_THAT(error([](RenderCommandOptions* o) { o->min_visible_px = -1.0; }),
               HasSubstr("--min-visible-px = -1"));
   EXPECT_FALSE(fs::exists(dir / "data"));

@@ -97,6 +97,27 @@ TEST(SamplePose, RespectsDistanceTiltOffsetAndRollBounds) {
   EXPECT_GT(max_roll, 0.8 * sampling.max_tilt_deg * kRadPerDeg);
 }
 
+// Views for a calibration: every one tilted between the two bounds, the whole range used.
+TEST(SamplePose, TiltsBetweenTheLeastAndTheMost) {
+  const SceneRenderer renderer(FourLineA3Target(), RenderOptions());
+  PoseSampling sampling;
+  sampling.min_tilt_deg = 30.0;
+  sampling.max_tilt_deg = 45.0;
+  std::uint64_t state = 11;
+  double least = HUGE_VAL, most = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const double tilt = std::acos(Locate(SamplePose(renderer, sampling, &state)).axis[2]);
+    least = std::min(least, tilt);
+    most = std::max(most, tilt);
+  }
+  EXPECT_GE(least, 30.0 * kRadPerDeg - 1e-9);
+  EXPECT_LT(least, 31.0 * kRadPerDeg);
+  EXPECT_LE(most, 45.0 * kRadPerDeg + 1e-9);
+  EXPECT_GT(most, 44.0 * kRadPerDeg);
+  sampling.min_tilt_deg = 50.0;
+  EXPECT_THROW(SamplePose(renderer, sampling, &state), std::invalid_argument);
+}
+
 TEST(SamplePose, EveryLineIsLongEnough) {
   const SceneRenderer renderer(FourLineTarget(), RenderOptions());
   PoseSampling sampling;
