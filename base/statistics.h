@@ -6,24 +6,35 @@
 #include <cstddef>
 #include <cstdint>
 #include <numeric>
+#include <type_traits>
 #include <vector>
 
 namespace oal {
 
+namespace statistics_internal {
+template <typename T>
+bool IsNaN(T value) {
+  if constexpr (std::is_floating_point_v<T>) return std::isnan(value);
+  return false;
+}
+}  // namespace statistics_internal
+
 /// The k-th smallest (0-based) of values[0, n), k < n, NaNs counted as the largest; `values`
 /// is reordered. The value std::nth_element finds, by a quickselect whose partitions do not branch
 /// on the values: the order of residuals is random, so a branch per value mispredicts half the
-/// time, and this takes a third of std::nth_element's time over a few hundred of them.
-inline double NthSmallest(double* values, std::size_t n, std::size_t k) {
+/// time, and this takes a third of std::nth_element's time over a few hundred of them. T: a
+/// floating-point or integer type.
+template <typename T>
+T NthSmallest(T* values, std::size_t n, std::size_t k) {
   std::size_t lo = 0, hi = n;
-  while (hi - lo > 24) {
-    const double a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi - 1];
-    const double pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));
+  while (hi - lo > 1) {
+    const T a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi - 1];
+    const T pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));
     // [lo, less_end) < pivot, then [less_end, equal_end) == pivot: the pivot is one of the
     // values, so every pass narrows the range (unless it is a NaN).
     std::size_t less_end = lo;
     for (std::size_t i = lo; i < hi; ++i) {
-      const double x = values[i];
+      const T x = values[i];
       values[i] = values[less_end];
       values[less_end] = x;
       less_end += x < pivot;
@@ -34,7 +45,7 @@ inline double NthSmallest(double* values, std::size_t n, std::size_t k) {
     }
     std::size_t equal_end = less_end;
     for (std::size_t i = less_end; i < hi; ++i) {
-      const double x = values[i];
+      const T x = values[i];
       values[i] = values[equal_end];
       values[equal_end] = x;
       equal_end += x == pivot;
@@ -43,9 +54,13 @@ inline double NthSmallest(double* values, std::size_t n, std::size_t k) {
     if (equal_end == lo) break;  // a NaN pivot equals nothing: sorting ends it
     lo = equal_end;
   }
-  // NaNs last, as the partitions leave them (std::sort needs a strict weak order).
-  std::sort(values + lo, values + hi,
-            [](double a, double b) { return a < b || (std::isnan(b) && !std::isnan(a)); });
+  if (hi - lo == 1) return values[lo];
+  // After a NaN pivot: NaNs last, as the partitions leave them (std::sort needs a strict weak
+  // order).
+  std::sort(values + lo, values + hi, [](T a, T b) {
+    using statistics_internal::IsNaN;
+    return a < b || (IsNaN(b) && !IsNaN(a));
+  });
   return values[k];
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "base/check.h"
+#include "base/statistics.h"
 #include "detector/lens.h"
 
 namespace oal {
@@ -135,10 +136,7 @@ int Contrast(const Profile& p) {
 }
 
 int MedianOf(std::vector<int>* values) {
-  if (values->empty()) return 0;
-  const auto middle = values->begin() + static_cast<std::ptrdiff_t>(values->size() / 2);
-  std::nth_element(values->begin(), middle, values->end());
-  return *middle;
+  return values->empty() ? 0 : NthSmallest(values->data(), values->size(), values->size() / 2);
 }
 
 // How far both edges of a dark run lie off the stripe's the same way: the smaller offset when

@@ -71,6 +71,16 @@ TEST(NthSmallest, EndsWithNaNs) {
   EXPECT_EQ(NthSmallest(one_nan.data(), one_nan.size(), 10), sorted[10]);
 }
 
+TEST(NthSmallest, OfIntegers) {
+  std::vector<int> values{7, 3, 9, 3, 1, 8, 3, 6};
+  std::vector<int> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    std::vector<int> scratch = values;
+    EXPECT_EQ(NthSmallest(scratch.data(), scratch.size(), k), sorted[k]) << k;
+  }
+}
+
 TEST(MedianInPlace, IsTheUpperMiddleValueAndZeroForNone) {
   std::vector<double> none;
   EXPECT_EQ(MedianInPlace(&none), 0.0);
