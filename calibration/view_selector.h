@@ -18,8 +18,9 @@ struct ViewSelectorOptions {
   /// The most the target may move between two frames that count as still, pixels: each known
   /// point (the same point of the plane), and each line across the stretch seen in both (its
   /// points' offsets from the curve the last frame's points trace, a straight trend along
-  /// it, at its two ends). Frames see different stretches of a stripe and a lens bends it: a
-  /// straight fit through its points, or the outline it gives, moves when the stripe does
+  /// it, at its two ends, the offsets far from the line's others left out: runs cut short at
+  /// a stripe's printed end). Frames see different stretches of a stripe and a lens bends it:
+  /// a straight fit through its points, or the outline it gives, moves when the stripe does
   /// not. Range (0, 100].
   double still_px = 1.5;
   /// A view is taken only when the corners of its outline lie, on average, at least this far
