@@ -255,6 +255,7 @@ void PolygonLoop::AddEdge(const Point2d& a, const Point2d& b) {
       edge.step = Point2d{step_across, step};
     }
   }
+  edge.spacing = std::hypot(edge.step.u, edge.step.v);
   perimeter_ += edge.count;
   edges_.push_back(edge);
 }
@@ -441,8 +442,7 @@ double PolygonLoop::Spacing(double s) const {
   if (perimeter_ <= 0) return 1.0;
   s = std::fmod(s, static_cast<double>(perimeter_));
   if (s < 0.0) s += perimeter_;
-  const Edge& edge = edges_[static_cast<std::size_t>(EdgeAt(s))];
-  return std::hypot(edge.step.u, edge.step.v);
+  return edges_[static_cast<std::size_t>(EdgeAt(s))].spacing;
 }
 
 bool PolygonLoop::HasCornerInside(double first, double last) const {

@@ -120,11 +120,12 @@ class PolygonLoop {
 
  private:
   struct Edge {
-    int first = 0;      ///< loop coordinate of its first sample
-    int count = 0;      ///< samples (may be 0 for an edge shorter than a pixel)
-    Point2d start;      ///< position of its first sample
-    Point2d step;       ///< from one sample to the next
-    Point2d direction;  ///< unit direction
+    int first = 0;         ///< loop coordinate of its first sample
+    int count = 0;         ///< samples (may be 0 for an edge shorter than a pixel)
+    Point2d start;         ///< position of its first sample
+    Point2d step;          ///< from one sample to the next
+    double spacing = 0.0;  ///< |step|, pixels (asked for at every run found on the edge)
+    Point2d direction;     ///< unit direction
     bool mostly_horizontal = true;
   };
   void AddEdge(const Point2d& a, const Point2d& b);
