@@ -66,8 +66,9 @@ T NthSmallest(T* values, std::size_t n, std::size_t k) {
 
 /// The median of `values` (of an even count, the upper of the middle two), reordering them;
 /// 0 for an empty vector.
-inline double MedianInPlace(std::vector<double>* values) {
-  return values->empty() ? 0.0 : NthSmallest(values->data(), values->size(), values->size() / 2);
+template <typename T>
+T MedianInPlace(std::vector<T>* values) {
+  return values->empty() ? T{0} : NthSmallest(values->data(), values->size(), values->size() / 2);
 }
 
 /// The q-quantile (0..1) of `values`, by nearest rank; 0 for an empty vector.

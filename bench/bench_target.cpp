@@ -119,6 +119,12 @@ const TargetInputs& Inputs(const benchmark::State& state) {
   return found->second;
 }
 
+// `frame` written into `delivered` (of its size), as a grabber writes each frame into the
+// caller's image: the tracker then reads pixels the CPU has just written.
+void Deliver(const vpImage<unsigned char>& frame, vpImage<unsigned char>* delivered) {
+  std::copy(frame.bitmap, frame.bitmap + frame.getSize(), delivered->bitmap);
+}
+
 // The tracker told the rendered lens: in ViSP's model as rendered, or, when the benchmark's
 // second argument is 1, as its OpenCV model (k1, k2, k3 fitted over the image: the same lens
 // to a tenth of a pixel), whose undistortion is solved point by point.
@@ -184,8 +190,7 @@ void TargetFirstFrameFromGrabber(benchmark::State& state) {
   StepTally tally;
   for (auto _ : state) {
     state.PauseTiming();
-    const vpImage<unsigned char>& next = inputs.still[frame].image;
-    std::copy(next.bitmap, next.bitmap + next.getSize(), delivered.bitmap);
+    Deliver(inputs.still[frame].image, &delivered);
     frame = (frame + 1) % inputs.still.size();
     tracker.Reset();
     state.ResumeTiming();
@@ -236,8 +241,7 @@ void TargetTrackedFromGrabber(benchmark::State& state) {
       tracker.Track(ViewOf(inputs.moving.front().image));
       frame = 1;
     }
-    const vpImage<unsigned char>& next = inputs.moving[frame++].image;
-    std::copy(next.bitmap, next.bitmap + next.getSize(), delivered.bitmap);
+    Deliver(inputs.moving[frame++].image, &delivered);
     state.ResumeTiming();
     const TargetFrame& result = tracker.Track(ViewOf(delivered));
     tally.Add(result);
@@ -294,7 +298,7 @@ void StripeCheckAlone(benchmark::State& state) {
   int samples = 0, agreeing = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    std::copy(frame.bitmap, frame.bitmap + frame.getSize(), delivered.bitmap);
+    Deliver(frame, &delivered);
     state.ResumeTiming();
     const StripeAgreement agreement =
         CheckStripes(ViewOf(delivered), layout, cMo, inputs.camera, check);
@@ -319,8 +323,7 @@ void SheetFinderAlone(benchmark::State& state) {
   double candidates = 0.0;
   for (auto _ : state) {
     state.PauseTiming();
-    const vpImage<unsigned char>& next = inputs.still[frame].image;
-    std::copy(next.bitmap, next.bitmap + next.getSize(), delivered.bitmap);
+    Deliver(inputs.still[frame].image, &delivered);
     frame = (frame + 1) % inputs.still.size();
     state.ResumeTiming();
     const GrayImageView view = ViewOf(delivered);

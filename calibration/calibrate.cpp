@@ -12,6 +12,7 @@
 #include "base/angles.h"
 #include "base/check.h"
 #include "base/format.h"
+#include "base/statistics.h"
 #include "calibration/plane_lines.h"
 
 namespace oal {
@@ -547,8 +548,7 @@ int MarkOutliers(const std::vector<const CalibrationView*>& views, const cv::Mat
     all.insert(all.end(), residuals[i].begin(), residuals[i].end());
   }
   if (all.empty()) return 0;
-  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
-  const double limit = std::max(kOutlierFloorPx, kOutlierSigmas * 1.4826 * all[all.size() / 2]);
+  const double limit = std::max(kOutlierFloorPx, kOutlierSigmas * 1.4826 * MedianInPlace(&all));
   int changed = 0;
   for (std::size_t i = 0; i < views.size(); ++i) {
     LinePairing& pairing = (*pairings)[i];
@@ -573,9 +573,8 @@ bool MarkDisagreeingView(const cv::Mat& view_errors, const std::vector<std::size
   }
   const std::size_t worst =
       static_cast<std::size_t>(std::max_element(rms.begin(), rms.end()) - rms.begin());
-  std::vector<double> sorted = rms;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double median = sorted[sorted.size() / 2];
+  std::vector<double> reordered = rms;
+  const double median = MedianInPlace(&reordered);
   if (rms[worst] <= kViewOutlierFloorPx || rms[worst] <= kViewOutlierRatio * median) return false;
   result->views[used[worst]].rejected = "its points disagree with the other views' (RMS " +
                                         Fixed(rms[worst], 2) + " px, the views' median " +

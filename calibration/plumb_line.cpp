@@ -7,6 +7,7 @@
 
 #include "base/check.h"
 #include "base/format.h"
+#include "base/statistics.h"
 #include "detector/lens.h"  // FitKud
 
 namespace oal {
@@ -68,9 +69,7 @@ void CutOutliers(double kdu, double floor, std::vector<Line>* lines) {
   for (const Line& line : *lines) {
     for (const Normalised& p : line.points) magnitudes.push_back(std::fabs(Residual(line, p, kdu)));
   }
-  const auto middle = magnitudes.begin() + magnitudes.size() / 2;
-  std::nth_element(magnitudes.begin(), middle, magnitudes.end());
-  const double limit = std::max(floor, 4.0 * 1.4826 * *middle);
+  const double limit = std::max(floor, 4.0 * 1.4826 * MedianInPlace(&magnitudes));
   for (Line& line : *lines) {
     for (std::size_t i = 0; i < line.points.size(); ++i) {
       line.inlier[i] = std::fabs(Residual(line, line.points[i], kdu)) <= limit;

@@ -135,10 +135,6 @@ int Contrast(const Profile& p) {
   return light - p.darkest;
 }
 
-int MedianOf(std::vector<int>* values) {
-  return values->empty() ? 0 : NthSmallest(values->data(), values->size(), values->size() / 2);
-}
-
 // How far both edges of a dark run lie off the stripe's the same way: the smaller offset when
 // they agree in sign, else 0 (a run narrowed or widened on one side moves one edge only).
 double SharedShift(double low_offset, double high_offset) {
@@ -340,7 +336,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
     const int contrast = Contrast(p);
     if (contrast >= options.min_contrast) contrasts.push_back(contrast);
   }
-  const int min_contrast = std::max(options.min_contrast, MedianOf(&contrasts) / 2);
+  const int min_contrast = std::max(options.min_contrast, MedianInPlace(&contrasts) / 2);
   std::vector<Verdict> verdicts;
   std::vector<int> lights, paper;
   verdicts.reserve(profiles.size());
@@ -362,7 +358,7 @@ StripeAgreement CheckStripes(const GrayImageView& image, const TargetLayout& lay
   // A profile reaching saturation where the sheet's paper does not (or lit well above that
   // paper) lies under a glare, which washes the ink out and bends its edges: it tells nothing
   // either way. (Where the whole sheet saturates, an over-exposed frame, saturation is no sign.)
-  const int paper_level = MedianOf(&paper);
+  const int paper_level = MedianInPlace(&paper);
   const auto under_glare = [&](std::size_t i) {
     const Profile& p = profiles[i].second;
     return !paper.empty() &&

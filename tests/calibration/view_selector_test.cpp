@@ -105,17 +105,23 @@ CalibrationView MiddleOfEachLine(CalibrationView view, double fraction) {
   return view;
 }
 
+// The A3 sheet's view from cMo through `lens`, its stripes' points with 0.05 px of noise.
+CalibrationView SheetSeenThrough(const Lens& lens, const vpHomogeneousMatrix& cMo,
+                                 std::mt19937* random) {
+  const LineTarget target = FourLineA3Target();
+  return SheetView(target, SeenAlongStripes(target, lens, cMo, 0.05, random), "frame");
+}
+
 // Through a lens that bends the stripes (kdu 0.25), a still sheet seen over all of its stripes
 // in one frame and over their middle halves in the next: the straight lines through the
 // points, and the outline they give, move by pixels; the stripes do not, and the target counts
 // as still. Turned by half a degree, or moved by two pixels, it has moved.
 TEST(TargetMotion, IsTheStripesNotTheStretchesSeen) {
-  const LineTarget target = FourLineA3Target();
   const Lens bending = Lens::WithKdu(690.0, 694.0, 331.0, 232.0, 0.25, 640, 480);
   std::mt19937 random(5);
   const vpHomogeneousMatrix pose = LookingAtTheSheet(0.45, 25.0, -10.0, 20.0);
   const auto view_at = [&](const vpHomogeneousMatrix& cMo) {
-    return SheetView(target, SeenAlongStripes(target, bending, cMo, 0.05, &random), "frame");
+    return SheetSeenThrough(bending, cMo, &random);
   };
   const CalibrationView whole = view_at(pose);
   const CalibrationView middle = MiddleOfEachLine(view_at(pose), 0.5);
@@ -148,12 +154,11 @@ TEST(TargetMotion, IsTheStripesNotTheStretchesSeen) {
 // middles 2-8 px off the stripe, at one end of it: a scan route the last frame did not take)
 // is still; moved by two pixels with those runs, it has moved.
 TEST(TargetMotion, LeavesOutRunsCutShortAtAStripesEnd) {
-  const LineTarget target = FourLineA3Target();
   const Lens bending = Lens::WithKdu(690.0, 694.0, 331.0, 232.0, 0.2, 640, 480);
   std::mt19937 random(7);
   const vpHomogeneousMatrix pose = LookingAtTheSheet(0.45, 25.0, -10.0, 20.0);
   const auto view_at = [&](const vpHomogeneousMatrix& cMo) {
-    return SheetView(target, SeenAlongStripes(target, bending, cMo, 0.05, &random), "frame");
+    return SheetSeenThrough(bending, cMo, &random);
   };
   const auto with_cut_runs = [](CalibrationView view) {
     std::vector<Point2d>& seen = view.lines.front().seen;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "base/statistics.h"
 #include "scene/scene.h"
 #include "tests/scene/scene_test_util.h"
 
@@ -41,8 +42,7 @@ double MedianDisplacementPx(const std::vector<std::vector<TruthLine>>& truth) {
     }
   }
   if (d.empty()) return std::nan("");
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
+  return MedianInPlace(&d);
 }
 
 double MeanGrey(const vpImage<unsigned char>& image) {
