@@ -108,7 +108,8 @@ ImageLine Through(const Vec3& a, const Vec3& b) {
 struct StripePoints {
   std::vector<Vec3> p;
   std::vector<double> along;
-  std::vector<double> width_ratio;  // the run's width across over the stripe's, there
+  std::vector<double> width_ratio;   // the run's width across over the stripe's, there
+  std::vector<double> width_excess;  // ... less the stripe's, pixels
 };
 
 // A line through pixel points: unit normal (nu, nv) and offset, nu u + nv v = c.
@@ -188,6 +189,7 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
     kept.p.push_back(stripe->p[i]);
     kept.along.push_back(stripe->along[i]);
     kept.width_ratio.push_back(stripe->width_ratio[i]);
+    kept.width_excess.push_back(stripe->width_excess[i]);
   }
   *stripe = std::move(kept);
 }
@@ -206,7 +208,8 @@ class Fitter {
 
   // Sorts `points` onto the stripes where `pose` puts them.
   void Assign(const Pose& pose, const std::vector<FramePoint>& points, bool undistorted,
-              const StripeGuides* guides, std::array<StripePoints, 4>* stripes) const {
+              const StripeGuides* guides, const RunWidthBand* band,
+              std::array<StripePoints, 4>* stripes) const {
     Mat3 homography;
     homography << pose.r.col(0), pose.r.col(1), pose.t;
     const Mat3 image_to_plane = homography.inverse();
@@ -216,9 +219,11 @@ class Fitter {
       s.p.clear();
       s.along.clear();
       s.width_ratio.clear();
+      s.width_excess.clear();
       s.p.reserve(points.size());
       s.along.reserve(points.size());
       s.width_ratio.reserve(points.size());
+      s.width_excess.reserve(points.size());
       sights[static_cast<std::size_t>(k)] = SightOf(pose, k);
     }
     for (const FramePoint& source : points) {
@@ -262,13 +267,16 @@ class Fitter {
           guided = k;
           const StripeSight& sight = sights[static_cast<std::size_t>(k)];
           Vec3 shifted;
-          double ratio = 0.0;
+          double ratio = 0.0, excess = 0.0;
           OnLocus(source, p, sight, &shifted);
-          if (!WidthAgrees(sight, along, source, &ratio)) continue;
+          if (!WidthAgrees(sight, along, source, &ratio, &excess) || !InBand(band, k, excess)) {
+            continue;
+          }
           StripePoints& stripe = (*stripes)[static_cast<std::size_t>(k)];
           stripe.p.push_back(shifted);
           stripe.along.push_back(along);
           stripe.width_ratio.push_back(ratio);
+          stripe.width_excess.push_back(excess);
         }
         if (guided >= 0) continue;
       }
@@ -282,14 +290,18 @@ class Fitter {
         }
         const StripeSight& sight = sights[static_cast<std::size_t>(k)];
         Vec3 shifted;
-        double ratio = 0.0;
-        if (!OnLocus(source, p, sight, &shifted) || !WidthAgrees(sight, along, source, &ratio)) {
+        double ratio = 0.0, excess = 0.0;
+        if (!OnLocus(source, p, sight, &shifted) ||
+            !WidthAgrees(sight, along, source, &ratio, &excess)) {
           continue;
         }
+        // Off the band's width: not taken, and not another stripe's either.
+        if (!InBand(band, k, excess)) break;
         StripePoints& stripe = (*stripes)[static_cast<std::size_t>(k)];
         stripe.p.push_back(shifted);
         stripe.along.push_back(along);
         stripe.width_ratio.push_back(ratio);
+        stripe.width_excess.push_back(excess);
         break;  // the stripes lie apart: a run is on one of them at most
       }
     }
@@ -376,8 +388,8 @@ class Fitter {
 
   // Whether the run is about as wide across the stripe as the stripe is there (its width
   // interpolated between its ends and middle: it changes slowly along the stripe).
-  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source,
-                   double* ratio) const {
+  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source, double* ratio,
+                   double* excess) const {
     const double t = 2.0 * (along - sight.lo) / (sight.hi - sight.lo) - 1.0;  // [-1, 1]
     const std::array<double, 3>& w = sight.width;
     if (!(w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0)) return false;
@@ -385,9 +397,15 @@ class Fitter {
         w[1] + 0.5 * t * (w[2] - w[0]) + 0.5 * t * t * (w[0] + w[2] - 2.0 * w[1]);
     const double measured = WidthAcross(source, sight.nu, sight.nv);
     *ratio = predicted > 0.0 ? measured / predicted : 0.0;
+    *excess = measured - predicted;
     return measured > 0.0 && predicted > 0.0 &&
            std::max(measured, predicted) <=
                options_.max_width_ratio * std::min(measured, predicted);
+  }
+
+  static bool InBand(const RunWidthBand* band, int k, double excess) {
+    return band == nullptr || band->line != k ||
+           (excess >= band->min_excess_px && excess <= band->max_excess_px);
   }
 
   const TargetLayout& layout_;
@@ -462,7 +480,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options,
                      const StripeGuides* guides, int left_out_line,
-                     const vpHomogeneousMatrix* known) {
+                     const vpHomogeneousMatrix* known, const RunWidthBand* band) {
   options.Check();
   StripeFit fit;
   fit.cMo = start;
@@ -471,7 +489,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   // Which stripe each point is on, from the starting pose: a step moves the lines by a
   // fraction of the corridor at most, and points must not hop between stripes as it goes.
   std::array<StripePoints, 4> stripes;
-  fitter.Assign(pose, points, points_undistorted, guides, &stripes);
+  fitter.Assign(pose, points, points_undistorted, guides, band, &stripes);
   if (left_out_line >= 0 && left_out_line < 4) {
     stripes[static_cast<std::size_t>(left_out_line)] = StripePoints{};
   }
@@ -564,16 +582,18 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   look();
   double sum2 = 0.0;
   int kept = 0;
-  std::vector<double> along;
+  std::vector<double> along, excesses;
   for (std::size_t k = 0; k < 4; ++k) {
     magnitudes.clear();  // the kept points' width ratios
     along.clear();
+    excesses.clear();
     double line_sum2 = 0.0;
     for (std::size_t i = 0; i < stripes[k].p.size(); ++i) {
       const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
       if (!(std::fabs(r) <= kKeptScales * scale)) continue;
       ++fit.points[k];
       magnitudes.push_back(stripes[k].width_ratio[i]);
+      excesses.push_back(stripes[k].width_excess[i]);
       along.push_back(stripes[k].along[i]);
       sum2 += r * r;
       line_sum2 += r * r;
@@ -581,6 +601,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     }
     fit.line_rms_px[k] = fit.points[k] > 0 ? std::sqrt(line_sum2 / fit.points[k]) : 0.0;
     fit.width_ratio[k] = MedianInPlace(&magnitudes);
+    fit.width_excess_px[k] = MedianInPlace(&excesses);
     const StripeSpan& span = layout.stripes[k];
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }

@@ -81,6 +81,9 @@ struct StripeFit {
   /// width there where the pose puts it: about 1 for the right pose, the ratio of two stripes'
   /// widths for one that takes a stripe for another (turned by 180 degrees).
   std::array<double, 4> width_ratio{};
+  /// The same as a difference, pixels: the median of the kept runs' widths across less the
+  /// stripe's there. Blur and the threshold widen every stripe's runs by about as many pixels.
+  std::array<double, 4> width_excess_px{};
   double rms_px = 0.0;                  ///< of the kept points' distances to their lines, pixels
   std::array<double, 4> line_rms_px{};  ///< the same for each line's kept points
   double scale_px = 0.0;                ///< the residuals' robust scale at the end, pixels
@@ -93,6 +96,13 @@ struct StripeFit {
 /// Lines known to be lines 1-4 (a detected line identified with a stripe), in the points'
 /// pixels; a stripe without one is found by the corridor alone.
 using StripeGuides = std::array<std::optional<LineParams>, 4>;
+
+/// The runs of one stripe a fit keeps by their width: those whose width across less the
+/// stripe's, pixels, lies in [min_excess_px, max_excess_px].
+struct RunWidthBand {
+  int line = -1;  ///< 0-3
+  double min_excess_px = 0.0, max_excess_px = 0.0;
+};
 
 /// The fraction of a stripe `length` long (its ends in `along`'s units) that the points at
 /// `along` (sorted in place) span, counting only stretches of three points or more, each
@@ -117,11 +127,13 @@ vpHomogeneousMatrix MirroredTilt(const vpHomogeneousMatrix& cMo);
 /// three hold (three lines fix a plane's pose), that line needing no min_points.
 /// `known`, when given, is a pose already fitted: the fit stops, not ok, as soon as its steps
 /// bring it back there (SameFitPose), as a fit from the other tilt mostly does.
+/// `band`, when given, keeps only those of its stripe's runs whose width it holds.
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options = {},
                      const StripeGuides* guides = nullptr, int left_out_line = -1,
-                     const vpHomogeneousMatrix* known = nullptr);
+                     const vpHomogeneousMatrix* known = nullptr,
+                     const RunWidthBand* band = nullptr);
 
 /// Whether two fitted poses are one: within 2e-3 rad, and 2e-3 of `b`'s depth apart. A fit
 /// from the other tilt that comes back lands within 3e-3 rad of the first fit on the bench

@@ -57,7 +57,13 @@ constexpr double kOthersRmsMarginPx = 0.05;
 // when the model check finds the stripes' edges, both shifted the same way, at most
 // kLopsidedShiftRatio as far off at the three's pose as at the four's (a cable along a stripe of
 // an over-exposed far sheet: 0.05 px against 0.46; right poses on the lived-in scenes: 0.47
-// of it at least).
+// of it at least). Otherwise the fit is made again with only its runs as wide as the others'
+// runs: blur and the threshold widen every stripe's runs by about as many pixels, and a run
+// merged with something along one side is wider (or, under something light, narrower) by its
+// width. The band keeps the runs nearer the others' excess width than the stripe's own median
+// excess; at least min_points of them, or the frame is not taken (a dark cable crossing a
+// stripe at a shallow angle under motion blur: its wide runs turned the pose by 2 degrees, and
+// the image's edges told the two poses apart by 0.48 against 1/3).
 constexpr double kLopsidedWidthLog = 0.08;
 constexpr double kLopsidedShiftRatio = 1.0 / 3.0;
 
@@ -282,6 +288,14 @@ T MedianOfOthers(const std::array<T, 4>& values, int line) {
   }
   std::sort(others.begin(), others.end());
   return others[1];
+}
+
+// The runs of `line` (lopsided: its median excess width off the others') nearer the others'
+// median excess width than its own: the band about the others' excess reaching half way to it.
+RunWidthBand AsWideAsTheOthers(const StripeFit& fit, int line) {
+  const double others = MedianOfOthers(fit.width_excess_px, line);
+  const double half = 0.5 * std::fabs(fit.width_excess_px[static_cast<std::size_t>(line)] - others);
+  return RunWidthBand{line, others - half, others + half};
 }
 
 // Whether stripe k's kept runs are, at their median, as wide as it.
@@ -570,21 +584,34 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
   }
   if (expected.either_way) best = OtherTiltIfBetter(*best);
   frame_.fit = *best;
+  if (const int behind = SetLinesFromFit(); behind >= 0) {
+    frame_.pose.message =
+        why + "; the fitted pose puts line " + std::to_string(behind + 1) + " behind the camera";
+    return false;
+  }
+  PoseResult& pose = frame_.pose;
+  pose.residual_px = best->rms_px;
+  pose.method = PoseMethod::kStripes;
+  pose.identification_cost = best_score;
+  pose.identification_margin = other_score - best_score;
+  ReplacePose(best->cMo, target_, &pose);
+  pose.status = PoseStatus::kOk;
+  pose.message.clear();
+  return true;
+}
+
+int TargetPoseTracker::SetLinesFromFit() {
   // The four lines are the stripes' centre lines where the fit puts them.
-  const vpHomography plane_to_image = PlaneToImage(best->cMo);
-  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(plane_to_image);
+  const StripeFit& fit = frame_.fit;
+  const std::array<std::optional<LineExtent>, 4> ends = StripeEnds(PlaneToImage(fit.cMo));
   std::vector<DetectedLine> lines;
   for (std::size_t k = 0; k < 4; ++k) {
-    if (!ends[k]) {
-      frame_.pose.message =
-          why + "; the fitted pose puts line " + std::to_string(k + 1) + " behind the camera";
-      return false;
-    }
+    if (!ends[k]) return static_cast<int>(k);
     DetectedLine line;
     line.line = LineThrough(ends[k]->a, ends[k]->b);
     line.end_a = line.support_a = ends[k]->a;
     line.end_b = line.support_b = ends[k]->b;
-    line.support = best->points[k];
+    line.support = fit.points[k];
     line.seed_id = static_cast<int>(k);
     lines.push_back(line);
   }
@@ -607,14 +634,7 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
     pose.corners_m[k][0] = x;
     pose.corners_m[k][1] = y;
   }
-  pose.residual_px = best->rms_px;
-  pose.method = PoseMethod::kStripes;
-  pose.identification_cost = best_score;
-  pose.identification_margin = other_score - best_score;
-  ReplacePose(best->cMo, target_, &pose);
-  pose.status = PoseStatus::kOk;
-  pose.message.clear();
-  return true;
+  return -1;
 }
 
 void TargetPoseTracker::MeasureLens() {
@@ -680,7 +700,7 @@ std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
   return message.str();
 }
 
-std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImageView& image) const {
+std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImageView& image) {
   const StripeFit& fit = frame_.fit;
   if (!fit.ok) return std::nullopt;
   int line = -1;
@@ -701,17 +721,39 @@ std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImage
   const StripeCheckOptions check = options_.StripeCheck();
   const StripeAgreement all = CheckStripes(image, layout_, fit.cMo, camera_, check);
   const StripeAgreement three = CheckStripes(image, layout_, pull.without.cMo, camera_, check);
-  if (three.Worst() < options_.min_stripe_agreement || three.Seen() < options_.min_stripe_seen ||
-      !(three.ShiftRms() < kLopsidedShiftRatio * all.ShiftRms())) {
-    return std::nullopt;
-  }
   std::ostringstream message;
   message << "line " << line + 1 << "'s runs are " << relative
           << " times as wide as the others' (something lying along one side of its stripe) and "
-          << pull.Describe() << ", where the image's stripes lie: their edges are "
-          << three.ShiftRms() << " px off (both edges the same way) there, " << all.ShiftRms()
-          << " px with it";
-  return message.str();
+          << pull.Describe();
+  if (three.Worst() >= options_.min_stripe_agreement && three.Seen() >= options_.min_stripe_seen &&
+      three.ShiftRms() < kLopsidedShiftRatio * all.ShiftRms()) {
+    message << ", where the image's stripes lie: their edges are " << three.ShiftRms()
+            << " px off (both edges the same way) there, " << all.ShiftRms() << " px with it";
+    return message.str();
+  }
+  const RunWidthBand band = AsWideAsTheOthers(fit, line);
+  const StripeFit banded =
+      FitStripes(pull.without.cMo, layout_, detector_.feature_points(), camera_,
+                 detector_.Undistorts(), options_.stripe_fit, nullptr, -1, nullptr, &band);
+  if (!banded.ok) {
+    message << "; of its runs, those as wide as the others' (" << band.min_excess_px << " to "
+            << band.max_excess_px << " px wider than the stripe) are too few: " << banded.message;
+    return message.str();
+  }
+  if (const int behind = AdoptFit(banded); behind >= 0) {
+    message << "; fitted again from its runs as wide as the others', the pose puts line "
+            << behind + 1 << " behind the camera";
+    return message.str();
+  }
+  return std::nullopt;
+}
+
+int TargetPoseTracker::AdoptFit(const StripeFit& fit) {
+  frame_.fit = fit;
+  ReplacePose(fit.cMo, target_, &frame_.pose);
+  if (frame_.pose.method != PoseMethod::kStripes) return -1;
+  frame_.pose.residual_px = fit.rms_px;
+  return SetLinesFromFit();
 }
 
 bool TargetPoseTracker::Verify(const GrayImageView& image) {

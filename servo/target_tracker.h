@@ -302,10 +302,18 @@ class TargetPoseTracker {
   /// Why the frame's stripe fit is not taken, when a stripe keeping few points beside the
   /// others' pulls the pose away from where the other three stripes alone put it.
   std::optional<std::string> WeakStripePull() const;
-  /// Why the frame's stripe fit is not taken, when a stripe whose runs are narrower or wider
-  /// than the others' (something light or dark along one side of it) pulls the pose away from
-  /// where the other three stripes put it, and the image's stripes lie where the three put them.
-  std::optional<std::string> LopsidedStripePull(const GrayImageView& image) const;
+  /// A stripe whose runs are narrower or wider than the others' (something light or dark
+  /// along one side of it) and pull the pose away from where the other three stripes put it:
+  /// why the frame's stripe fit is not taken, when the image's stripes lie where the three put
+  /// them or too few of its runs are as wide as the others'; else the fit is made again from
+  /// those alone, and the frame takes it.
+  std::optional<std::string> LopsidedStripePull(const GrayImageView& image);
+  /// The frame's pose becomes `fit`'s (and, for a pose fitted without lines, its lines and
+  /// residual); SetLinesFromFit's answer, -1 for a pose from lines.
+  int AdoptFit(const StripeFit& fit);
+  /// lines_ and the pose's corners from frame_.fit's stripes (a pose fitted without lines); the
+  /// line (0-3) the fit puts behind the camera, else -1.
+  int SetLinesFromFit();
   /// frame_.lens from the frame's pose and its lines 1-4.
   void MeasureLens();
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,

@@ -176,6 +176,49 @@ TEST(StripeFit, KeepsTheStripesOwnLineWhenAnotherLinesUpWithIt) {
   EXPECT_LT(t, 1e-3);
 }
 
+// Three of every four runs of line 1 a seventh wider (both ends out, their middles where they
+// were): the stripe's median excess width says so, and a band of widths about the others'
+// keeps only the runs as wide as the stripe, the pose where it was.
+TEST(StripeFit, ABandOfRunWidthsKeepsOnlyTheRunsItHolds) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 7);
+  const Tracked tracked = Track(rendered);
+  ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  const StripeFit clean = FitStripes(rendered.cMo, layout, tracked.points, kCamera, true);
+  ASSERT_TRUE(clean.ok) << clean.message;
+  for (int k = 0; k < 4; ++k) EXPECT_LT(std::fabs(clean.width_excess_px[k]), 1.0) << k;
+
+  const LineParams& line1 = rendered.truth[0].ideal;
+  std::vector<FramePoint> widened = tracked.points;
+  int on_line1 = 0;
+  for (FramePoint& point : widened) {
+    if (std::fabs(line1.SignedDistance(point.p.u, point.p.v)) > 3.0) continue;
+    if (on_line1++ % 4 == 0) continue;
+    point.across_u *= 1.15f;
+    point.across_v *= 1.15f;
+  }
+  ASSERT_GE(on_line1, 12);
+  const StripeFit wide = FitStripes(rendered.cMo, layout, widened, kCamera, true);
+  ASSERT_TRUE(wide.ok) << wide.message;
+  EXPECT_GT(wide.width_excess_px[0], clean.width_excess_px[0] + 2.0);
+  EXPECT_EQ(wide.points[0], clean.points[0]);
+
+  const double half = 0.5 * (wide.width_excess_px[0] - clean.width_excess_px[0]);
+  const RunWidthBand band{0, clean.width_excess_px[0] - half, clean.width_excess_px[0] + half};
+  const StripeFit banded =
+      FitStripes(rendered.cMo, layout, widened, kCamera, true, {}, nullptr, -1, nullptr, &band);
+  ASSERT_TRUE(banded.ok) << banded.message;
+  EXPECT_LE(banded.points[0], (on_line1 + 3) / 4);
+  EXPECT_GE(banded.points[0], 4);
+  EXPECT_LT(std::fabs(banded.width_excess_px[0] - clean.width_excess_px[0]), 1.0);
+  const auto [t, r] = PoseError(banded.cMo, rendered.cMo);
+  EXPECT_LT(r, 0.1);
+  EXPECT_LT(t, 1e-3);
+  // The band is line 1's: the others keep their runs.
+  for (int k = 1; k < 4; ++k) EXPECT_NEAR(banded.points[k], clean.points[k], 2) << k;
+}
+
 TEST(StripeFit, AStripeWithoutPointsIsNamed) {
   const SceneRenderer renderer(FourLineA3Target(), Render());
   const RenderedFrame rendered = renderer.Render(Tilted(), 5);
