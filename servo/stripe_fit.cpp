@@ -110,6 +110,15 @@ struct StripePoints {
   std::vector<double> along;
   std::vector<double> width_ratio;   // the run's width across over the stripe's, there
   std::vector<double> width_excess;  // ... less the stripe's, pixels
+  std::vector<double> width;         // the stripe's width across there, pixels
+
+  void Add(const Vec3& point, double at, double measured_px, double predicted_px) {
+    p.push_back(point);
+    along.push_back(at);
+    width_ratio.push_back(measured_px / predicted_px);
+    width_excess.push_back(measured_px - predicted_px);
+    width.push_back(predicted_px);
+  }
 };
 
 // A line through pixel points: unit normal (nu, nv) and offset, nu u + nv v = c.
@@ -190,6 +199,7 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
     kept.along.push_back(stripe->along[i]);
     kept.width_ratio.push_back(stripe->width_ratio[i]);
     kept.width_excess.push_back(stripe->width_excess[i]);
+    kept.width.push_back(stripe->width[i]);
   }
   *stripe = std::move(kept);
 }
@@ -220,10 +230,12 @@ class Fitter {
       s.along.clear();
       s.width_ratio.clear();
       s.width_excess.clear();
+      s.width.clear();
       s.p.reserve(points.size());
       s.along.reserve(points.size());
       s.width_ratio.reserve(points.size());
       s.width_excess.reserve(points.size());
+      s.width.reserve(points.size());
       sights[static_cast<std::size_t>(k)] = SightOf(pose, k);
     }
     for (const FramePoint& source : points) {
@@ -267,16 +279,13 @@ class Fitter {
           guided = k;
           const StripeSight& sight = sights[static_cast<std::size_t>(k)];
           Vec3 shifted;
-          double ratio = 0.0, excess = 0.0;
+          double measured = 0.0, predicted = 0.0;
           OnLocus(source, p, sight, &shifted);
-          if (!WidthAgrees(sight, along, source, &ratio, &excess) || !InBand(band, k, excess)) {
+          if (!WidthAgrees(sight, along, source, &measured, &predicted) ||
+              !InBand(band, k, measured - predicted)) {
             continue;
           }
-          StripePoints& stripe = (*stripes)[static_cast<std::size_t>(k)];
-          stripe.p.push_back(shifted);
-          stripe.along.push_back(along);
-          stripe.width_ratio.push_back(ratio);
-          stripe.width_excess.push_back(excess);
+          (*stripes)[static_cast<std::size_t>(k)].Add(shifted, along, measured, predicted);
         }
         if (guided >= 0) continue;
       }
@@ -290,18 +299,14 @@ class Fitter {
         }
         const StripeSight& sight = sights[static_cast<std::size_t>(k)];
         Vec3 shifted;
-        double ratio = 0.0, excess = 0.0;
+        double measured = 0.0, predicted = 0.0;
         if (!OnLocus(source, p, sight, &shifted) ||
-            !WidthAgrees(sight, along, source, &ratio, &excess)) {
+            !WidthAgrees(sight, along, source, &measured, &predicted)) {
           continue;
         }
         // Off the band's width: not taken, and not another stripe's either.
-        if (!InBand(band, k, excess)) break;
-        StripePoints& stripe = (*stripes)[static_cast<std::size_t>(k)];
-        stripe.p.push_back(shifted);
-        stripe.along.push_back(along);
-        stripe.width_ratio.push_back(ratio);
-        stripe.width_excess.push_back(excess);
+        if (!InBand(band, k, measured - predicted)) break;
+        (*stripes)[static_cast<std::size_t>(k)].Add(shifted, along, measured, predicted);
         break;  // the stripes lie apart: a run is on one of them at most
       }
     }
@@ -388,16 +393,16 @@ class Fitter {
 
   // Whether the run is about as wide across the stripe as the stripe is there (its width
   // interpolated between its ends and middle: it changes slowly along the stripe).
-  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source, double* ratio,
-                   double* excess) const {
+  bool WidthAgrees(const StripeSight& sight, double along, const FramePoint& source,
+                   double* measured_px, double* predicted_px) const {
     const double t = 2.0 * (along - sight.lo) / (sight.hi - sight.lo) - 1.0;  // [-1, 1]
     const std::array<double, 3>& w = sight.width;
     if (!(w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0)) return false;
     const double predicted =
         w[1] + 0.5 * t * (w[2] - w[0]) + 0.5 * t * t * (w[0] + w[2] - 2.0 * w[1]);
     const double measured = WidthAcross(source, sight.nu, sight.nv);
-    *ratio = predicted > 0.0 ? measured / predicted : 0.0;
-    *excess = measured - predicted;
+    *measured_px = measured;
+    *predicted_px = predicted;
     return measured > 0.0 && predicted > 0.0 &&
            std::max(measured, predicted) <=
                options_.max_width_ratio * std::min(measured, predicted);
@@ -582,11 +587,12 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
   look();
   double sum2 = 0.0;
   int kept = 0;
-  std::vector<double> along, excesses;
+  std::vector<double> along, excesses, widths;
   for (std::size_t k = 0; k < 4; ++k) {
     magnitudes.clear();  // the kept points' width ratios
     along.clear();
     excesses.clear();
+    widths.clear();
     double line_sum2 = 0.0;
     for (std::size_t i = 0; i < stripes[k].p.size(); ++i) {
       const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
@@ -594,6 +600,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       ++fit.points[k];
       magnitudes.push_back(stripes[k].width_ratio[i]);
       excesses.push_back(stripes[k].width_excess[i]);
+      widths.push_back(stripes[k].width[i]);
       along.push_back(stripes[k].along[i]);
       sum2 += r * r;
       line_sum2 += r * r;
@@ -602,6 +609,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     fit.line_rms_px[k] = fit.points[k] > 0 ? std::sqrt(line_sum2 / fit.points[k]) : 0.0;
     fit.width_ratio[k] = MedianInPlace(&magnitudes);
     fit.width_excess_px[k] = MedianInPlace(&excesses);
+    fit.width_px[k] = MedianInPlace(&widths);
     const StripeSpan& span = layout.stripes[k];
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }

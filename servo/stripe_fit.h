@@ -84,6 +84,9 @@ struct StripeFit {
   /// The same as a difference, pixels: the median of the kept runs' widths across less the
   /// stripe's there. Blur and the threshold widen every stripe's runs by about as many pixels.
   std::array<double, 4> width_excess_px{};
+  /// The median, over each stripe's kept points, of the stripe's width across where the pose
+  /// puts it, pixels.
+  std::array<double, 4> width_px{};
   double rms_px = 0.0;                  ///< of the kept points' distances to their lines, pixels
   std::array<double, 4> line_rms_px{};  ///< the same for each line's kept points
   double scale_px = 0.0;                ///< the residuals' robust scale at the end, pixels

@@ -57,14 +57,21 @@ constexpr double kOthersRmsMarginPx = 0.05;
 // when the model check finds the stripes' edges, both shifted the same way, at most
 // kLopsidedShiftRatio as far off at the three's pose as at the four's (a cable along a stripe of
 // an over-exposed far sheet: 0.05 px against 0.46; right poses on the lived-in scenes: 0.47
-// of it at least). Otherwise the fit is made again with only its runs as wide as the others'
-// runs: blur and the threshold widen every stripe's runs by about as many pixels, and a run
-// merged with something along one side is wider (or, under something light, narrower) by its
-// width. The band keeps the runs nearer the others' excess width than the stripe's own median
-// excess; at least min_points of them, or the frame is not taken (a dark cable crossing a
-// stripe at a shallow angle under motion blur: its wide runs turned the pose by 2 degrees, and
-// the image's edges told the two poses apart by 0.48 against 1/3).
+// of it at least). Otherwise, when its runs' excess width over the stripe's (pixels) is off its
+// parallel stripe's by more than 8 % of its width, the fit is made again with only its runs as
+// wide as the parallel stripe's: blur and the threshold widen both by about as many pixels (a
+// motion blur across one pair of stripes widens that pair alone), and a run merged with
+// something along one side is wider (or, under something light, narrower) by its width. The
+// band keeps the runs nearer the parallel stripe's excess than its own median excess; the fit
+// starts from the four's pose (the three's may lie degrees off: a near board's, 14); at least
+// min_points of them, or the frame is not taken (a dark cable crossing a stripe at a shallow
+// angle under motion blur: its wide runs turned the pose by 2 degrees, and the image's edges
+// told the two poses apart by 0.48 against 1/3).
 constexpr double kLopsidedWidthLog = 0.08;
+// ... when fewer than this fraction of its runs lie in the band, and too few for a fit, they are
+// all off alike (its predicted width off: a strong lens near the image's edge; a clean board's
+// stripe there was 18 % wider than its parallel one), and the pose stands as the image decided.
+constexpr double kMixedWidthsFraction = 1.0 / 3.0;
 constexpr double kLopsidedShiftRatio = 1.0 / 3.0;
 
 // Candidates closed in on two sides set aside as corner cells, at most.
@@ -290,12 +297,25 @@ T MedianOfOthers(const std::array<T, 4>& values, int line) {
   return others[1];
 }
 
-// The runs of `line` (lopsided: its median excess width off the others') nearer the others'
-// median excess width than its own: the band about the others' excess reaching half way to it.
-RunWidthBand AsWideAsTheOthers(const StripeFit& fit, int line) {
-  const double others = MedianOfOthers(fit.width_excess_px, line);
-  const double half = 0.5 * std::fabs(fit.width_excess_px[static_cast<std::size_t>(line)] - others);
-  return RunWidthBand{line, others - half, others + half};
+// The runs of `line` nearer the median excess width of its parallel stripe's runs than its
+// own: the band about the parallel stripe's excess reaching half way to it. Blur and the
+// threshold widen a stripe's runs by about as many pixels as its parallel one's (a motion blur
+// across one pair of stripes widens that pair alone); something along one side of it, by its
+// width. None when the two excesses differ by less than kLopsidedWidthLog of its width.
+std::optional<RunWidthBand> AsWideAsItsParallel(const StripeFit& fit, const TargetLayout& layout,
+                                                int line) {
+  const auto k = static_cast<std::size_t>(line);
+  std::size_t parallel = k;
+  for (std::size_t other = 0; other < layout.stripes.size(); ++other) {
+    if (other != k && layout.stripes[other].along_b == layout.stripes[k].along_b) {
+      parallel = other;
+    }
+  }
+  if (parallel == k) return std::nullopt;
+  const double reference = fit.width_excess_px[parallel];
+  const double apart = std::fabs(fit.width_excess_px[k] - reference);
+  if (!(apart > kLopsidedWidthLog * fit.width_px[k])) return std::nullopt;
+  return RunWidthBand{line, reference - 0.5 * apart, reference + 0.5 * apart};
 }
 
 // Whether stripe k's kept runs are, at their median, as wide as it.
@@ -731,17 +751,27 @@ std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImage
             << " px off (both edges the same way) there, " << all.ShiftRms() << " px with it";
     return message.str();
   }
-  const RunWidthBand band = AsWideAsTheOthers(fit, line);
+  const std::optional<RunWidthBand> parallel_band = AsWideAsItsParallel(fit, layout_, line);
+  if (!parallel_band) return std::nullopt;
+  const RunWidthBand& band = *parallel_band;
   const StripeFit banded =
-      FitStripes(pull.without.cMo, layout_, detector_.feature_points(), camera_,
-                 detector_.Undistorts(), options_.stripe_fit, nullptr, -1, nullptr, &band);
+      FitStripes(fit.cMo, layout_, detector_.feature_points(), camera_, detector_.Undistorts(),
+                 options_.stripe_fit, nullptr, -1, nullptr, &band);
+  const int in_band = banded.points[static_cast<std::size_t>(line)];
+  if (!banded.ok && banded.starved_line == line &&
+      in_band < kMixedWidthsFraction * fit.points[static_cast<std::size_t>(line)]) {
+    // Nearly all its runs are as far off: the widths it is predicted (a strong lens at the
+    // image's edge, a slanted view) or a blur along it, not something along part of it.
+    return std::nullopt;
+  }
   if (!banded.ok) {
-    message << "; of its runs, those as wide as the others' (" << band.min_excess_px << " to "
-            << band.max_excess_px << " px wider than the stripe) are too few: " << banded.message;
+    message << "; fitted again with only those of its runs as wide as its parallel stripe's ("
+            << band.min_excess_px << " to " << band.max_excess_px
+            << " px wider than the stripe): " << banded.message;
     return message.str();
   }
   if (const int behind = AdoptFit(banded); behind >= 0) {
-    message << "; fitted again from its runs as wide as the others', the pose puts line "
+    message << "; fitted again from its runs as wide as its parallel stripe's, the pose puts line "
             << behind + 1 << " behind the camera";
     return message.str();
   }

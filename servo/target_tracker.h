@@ -305,8 +305,9 @@ class TargetPoseTracker {
   /// A stripe whose runs are narrower or wider than the others' (something light or dark
   /// along one side of it) and pull the pose away from where the other three stripes put it:
   /// why the frame's stripe fit is not taken, when the image's stripes lie where the three put
-  /// them or too few of its runs are as wide as the others'; else the fit is made again from
-  /// those alone, and the frame takes it.
+  /// them. Else, when its runs are wider or narrower than its parallel stripe's too, the fit is
+  /// made again from its runs as wide as those alone, and the frame takes it; why not, when
+  /// that fit fails (too few such runs).
   std::optional<std::string> LopsidedStripePull(const GrayImageView& image);
   /// The frame's pose becomes `fit`'s (and, for a pose fitted without lines, its lines and
   /// residual); SetLinesFromFit's answer, -1 for a pose from lines.
