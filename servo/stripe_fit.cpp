@@ -108,15 +108,13 @@ ImageLine Through(const Vec3& a, const Vec3& b) {
 struct StripePoints {
   std::vector<Vec3> p;
   std::vector<double> along;
-  std::vector<double> width_ratio;   // the run's width across over the stripe's, there
-  std::vector<double> width_excess;  // ... less the stripe's, pixels
-  std::vector<double> width;         // the stripe's width across there, pixels
+  std::vector<double> run_width;  // the run's width across the stripe, pixels
+  std::vector<double> width;      // the stripe's width across there, pixels
 
   void Add(const Vec3& point, double at, double measured_px, double predicted_px) {
     p.push_back(point);
     along.push_back(at);
-    width_ratio.push_back(measured_px / predicted_px);
-    width_excess.push_back(measured_px - predicted_px);
+    run_width.push_back(measured_px);
     width.push_back(predicted_px);
   }
 };
@@ -197,8 +195,7 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
     if (best.Distance(u[i], v[i]) > keep) continue;
     kept.p.push_back(stripe->p[i]);
     kept.along.push_back(stripe->along[i]);
-    kept.width_ratio.push_back(stripe->width_ratio[i]);
-    kept.width_excess.push_back(stripe->width_excess[i]);
+    kept.run_width.push_back(stripe->run_width[i]);
     kept.width.push_back(stripe->width[i]);
   }
   *stripe = std::move(kept);
@@ -228,13 +225,11 @@ class Fitter {
       StripePoints& s = (*stripes)[static_cast<std::size_t>(k)];
       s.p.clear();
       s.along.clear();
-      s.width_ratio.clear();
-      s.width_excess.clear();
+      s.run_width.clear();
       s.width.clear();
       s.p.reserve(points.size());
       s.along.reserve(points.size());
-      s.width_ratio.reserve(points.size());
-      s.width_excess.reserve(points.size());
+      s.run_width.reserve(points.size());
       s.width.reserve(points.size());
       sights[static_cast<std::size_t>(k)] = SightOf(pose, k);
     }
@@ -598,9 +593,10 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       const double r = lines[k].n.dot(stripes[k].p[i]) * inv_scale[k];
       if (!(std::fabs(r) <= kKeptScales * scale)) continue;
       ++fit.points[k];
-      magnitudes.push_back(stripes[k].width_ratio[i]);
-      excesses.push_back(stripes[k].width_excess[i]);
-      widths.push_back(stripes[k].width[i]);
+      const double run_width = stripes[k].run_width[i], width = stripes[k].width[i];
+      magnitudes.push_back(run_width / width);
+      excesses.push_back(run_width - width);
+      widths.push_back(width);
       along.push_back(stripes[k].along[i]);
       sum2 += r * r;
       line_sum2 += r * r;
