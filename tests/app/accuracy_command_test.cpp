@@ -9,9 +9,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "app/command_line.h"
@@ -124,22 +124,61 @@ TEST(PoseAccuracy, AFrameOfALongerRunIsReplayedOnItsOwn) {
   EXPECT_THAT(strict.out, HasSubstr("| frames | 2 (from frame 7) |"));
 }
 
+// A frame of the lived-in evaluation (config/scene-lived-in.yaml) replayed on its own, and what
+// is expected of it: a right pose, or (posed false) no wrong one.
+struct LivedInFrame {
+  int seed = 0, frame = 0;
+  std::string options;  // added to the command line: the camera, the backgrounds
+  bool posed = false;
+};
+
+// Replays each frame through the binary: its report holds no wrong pose, and a pose where one
+// is expected.
+void ExpectRightPosesOrNone(const std::vector<LivedInFrame>& frames) {
+  test::TestDir dir;
+  const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
+  for (const LivedInFrame& replayed : frames) {
+    SCOPED_TRACE("seed " + std::to_string(replayed.seed) + ", frame " +
+                 std::to_string(replayed.frame));
+    const test::OalservoRun run = test::RunOalservo(
+        dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(replayed.seed) +
+                 " --first-frame " + std::to_string(replayed.frame) + " --frames 1" +
+                 replayed.options + " --out '" + dir / "report.json" + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const json report = json::parse(test::ReadText(dir / "report.json"));
+    EXPECT_EQ(report.at("wrong_poses"), json::array());
+    if (replayed.posed) {
+      EXPECT_EQ(report.at("posed"), 1);
+    }
+  }
+}
+
+// opencv-doc's photographs as the scene's backgrounds (the benchmarks' sets of seven and of
+// twelve), or nothing when they are not installed.
+std::optional<std::string> OpenCvPhotographs(const std::vector<std::string>& names) {
+  const std::string photos = "/usr/share/doc/opencv-doc/examples/data/";
+  std::string backgrounds = " --background";
+  for (const std::string& name : names) {
+    if (!fs::exists(photos + name)) return std::nullopt;
+    backgrounds += " '" + photos + name + "'";
+  }
+  return backgrounds;
+}
+const std::vector<std::string> kSevenPhotographs{"building.jpg", "home.jpg",   "box_in_scene.png",
+                                                 "board.jpg",    "fruits.jpg", "messi5.jpg",
+                                                 "aero1.jpg"};
+const std::vector<std::string> kTwelvePhotographs{
+    "baboon.jpg",       "apple.jpg",        "orange.jpg",       "butterfly.jpg",
+    "graf1.png",        "leuvenA.jpg",      "starry_night.jpg", "stuff.jpg",
+    "rubberwhale1.png", "squirrel_cls.jpg", "smarties.png",     "sudoku.png"};
+const std::string kAt720p = " --width 1280 --height 720 --focal 914";
+const std::string kAt1080p = " --width 1920 --height 1080 --focal 1371";
+
 // Frames of the lived-in evaluation that once got a wrong pose give a right one or none: a hand
 // over the crossing of a blurred stripe, no light cell found, the whole image's pose 3.7
 // degrees off (seed 91, frame 730); a hand's edge across a short stripe (seed 41, frame 931).
 TEST(PoseAccuracy, TheLivedInFramesThatOnceGaveWrongPosesGiveARightOneOrNone) {
-  test::TestDir dir;
-  const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
-  for (const auto& [seed, frame] : {std::pair{91, 730}, std::pair{41, 931}}) {
-    const std::string what = "seed " + std::to_string(seed) + ", frame " + std::to_string(frame);
-    const test::OalservoRun run = test::RunOalservo(
-        dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(seed) +
-                 " --first-frame " + std::to_string(frame) + " --frames 1 --out '" +
-                 dir / "report.json" + "'");
-    ASSERT_EQ(run.exit_code, 0) << what << ": " << run.err;
-    const json report = json::parse(test::ReadText(dir / "report.json"));
-    EXPECT_EQ(report.at("wrong_poses"), json::array()) << what;
-  }
+  ExpectRightPosesOrNone({{91, 730, "", false}, {41, 931, "", false}});
 }
 
 // Dim frames of the lived-in evaluation give a pose: exposed at 0.43 of the right level,
@@ -147,30 +186,10 @@ TEST(PoseAccuracy, TheLivedInFramesThatOnceGaveWrongPosesGiveARightOneOrNone) {
 // opencv-doc's photographs); a dim frame with a hand over a crossing, whose middle cell is
 // closed in on four sides only at the finder's last pass (seed 91, frame 259).
 TEST(PoseAccuracy, DimLivedInFramesGiveAPose) {
-  test::TestDir dir;
-  const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
-  const std::string photos = "/usr/share/doc/opencv-doc/examples/data/";
-  std::vector<std::tuple<int, int, std::string>> frames{{91, 259, ""}};
-  if (std::filesystem::exists(photos + "messi5.jpg")) {
-    std::string backgrounds = " --background";
-    for (const char* name : {"building.jpg", "home.jpg", "box_in_scene.png", "board.jpg",
-                             "fruits.jpg", "messi5.jpg", "aero1.jpg"}) {
-      backgrounds += " '" + photos + name + "'";
-    }
-    frames.emplace_back(131, 713, backgrounds);
-  }
-  for (const auto& [seed, frame, backgrounds] : frames) {
-    const std::string what = "seed " + std::to_string(seed) + ", frame " + std::to_string(frame);
-    const test::OalservoRun run = test::RunOalservo(
-        dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(seed) +
-                 " --first-frame " + std::to_string(frame) + " --frames 1" + backgrounds +
-                 " --out '" + dir / "report.json" + "'");
-    ASSERT_EQ(run.exit_code, 0) << what << ": " << run.err;
-    const json report = json::parse(test::ReadText(dir / "report.json"));
-    EXPECT_EQ(report.at("posed"), 1) << what;
-    EXPECT_EQ(report.at("wrong_poses"), json::array()) << what;
-  }
-  if (frames.size() == 1) GTEST_SKIP() << "opencv-doc's photographs are not installed";
+  ExpectRightPosesOrNone({{91, 259, "", true}});
+  const std::optional<std::string> photographs = OpenCvPhotographs(kSevenPhotographs);
+  if (!photographs) GTEST_SKIP() << "opencv-doc's photographs are not installed";
+  ExpectRightPosesOrNone({{131, 713, *photographs, true}});
 }
 
 // Lived-in frames whose glare washes out a stripe over several of the finder's cells give a
@@ -183,30 +202,8 @@ TEST(PoseAccuracy, DimLivedInFramesGiveAPose) {
 // length (seed 185, frame 588): its runs' middles, all off the same way, tilted the pose 2.7
 // degrees.
 TEST(PoseAccuracy, WashedOutCrossingsGiveAPoseAndAShadowOrACableAlongAStripeNoWrongOne) {
-  test::TestDir dir;
-  const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
-  const std::string at_720p = " --width 1280 --height 720 --focal 914";
-  struct Case {
-    int seed, frame;
-    std::string camera;
-    bool posed;  // a right pose expected; otherwise no wrong one
-  };
-  for (const auto& [seed, frame, camera, posed] : std::vector<Case>{{1, 554, "", true},
-                                                                    {1, 775, "", true},
-                                                                    {42, 966, at_720p, false},
-                                                                    {185, 588, "", false}}) {
-    const std::string what = "seed " + std::to_string(seed) + ", frame " + std::to_string(frame);
-    const test::OalservoRun run = test::RunOalservo(
-        dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(seed) +
-                 " --first-frame " + std::to_string(frame) + " --frames 1" + camera + " --out '" +
-                 dir / "report.json" + "'");
-    ASSERT_EQ(run.exit_code, 0) << what << ": " << run.err;
-    const json report = json::parse(test::ReadText(dir / "report.json"));
-    EXPECT_EQ(report.at("wrong_poses"), json::array()) << what;
-    if (posed) {
-      EXPECT_EQ(report.at("posed"), 1) << what;
-    }
-  }
+  ExpectRightPosesOrNone(
+      {{1, 554, "", true}, {1, 775, "", true}, {42, 966, kAt720p, false}, {185, 588, "", false}});
 }
 
 // Frames whose stripe's runs are wider or narrower than the others': a dark cable crossing a
@@ -216,38 +213,10 @@ TEST(PoseAccuracy, WashedOutCrossingsGiveAPoseAndAShadowOrACableAlongAStripeNoWr
 // opencv-doc's photographs), keeps its right pose (fitted from a band about the smeared pair's
 // widths, it was 2.5 degrees off).
 TEST(PoseAccuracy, AStripesRunsWiderThanItsParallelsGiveNoWrongPose) {
-  test::TestDir dir;
-  const std::string config = std::string(OAL_SOURCE_DIR) + "/config/scene-lived-in.yaml";
-  const std::string photos = "/usr/share/doc/opencv-doc/examples/data/";
-  struct Case {
-    int seed, frame;
-    std::string options;
-    bool posed;  // a right pose expected; otherwise no wrong one
-  };
-  std::vector<Case> cases{{190, 109, " --width 1920 --height 1080 --focal 1371", false}};
-  if (std::filesystem::exists(photos + "sudoku.png")) {
-    std::string backgrounds = " --background";
-    for (const char* name : {"baboon.jpg", "apple.jpg", "orange.jpg", "butterfly.jpg", "graf1.png",
-                             "leuvenA.jpg", "starry_night.jpg", "stuff.jpg", "rubberwhale1.png",
-                             "squirrel_cls.jpg", "smarties.png", "sudoku.png"}) {
-      backgrounds += " '" + photos + name + "'";
-    }
-    cases.push_back({161, 58, backgrounds, true});
-  }
-  for (const auto& [seed, frame, options, posed] : cases) {
-    const std::string what = "seed " + std::to_string(seed) + ", frame " + std::to_string(frame);
-    const test::OalservoRun run = test::RunOalservo(
-        dir, "pose-accuracy --config '" + config + "' --seed " + std::to_string(seed) +
-                 " --first-frame " + std::to_string(frame) + " --frames 1" + options + " --out '" +
-                 dir / "report.json" + "'");
-    ASSERT_EQ(run.exit_code, 0) << what << ": " << run.err;
-    const json report = json::parse(test::ReadText(dir / "report.json"));
-    EXPECT_EQ(report.at("wrong_poses"), json::array()) << what;
-    if (posed) {
-      EXPECT_EQ(report.at("posed"), 1) << what;
-    }
-  }
-  if (cases.size() == 1) GTEST_SKIP() << "opencv-doc's photographs are not installed";
+  ExpectRightPosesOrNone({{190, 109, kAt1080p, false}});
+  const std::optional<std::string> photographs = OpenCvPhotographs(kTwelvePhotographs);
+  if (!photographs) GTEST_SKIP() << "opencv-doc's photographs are not installed";
+  ExpectRightPosesOrNone({{161, 58, *photographs, true}});
 }
 
 // The 2 m board seen from near (seed 1, frame 665): the whole image's lines give its pose, and
