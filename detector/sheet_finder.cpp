@@ -559,12 +559,16 @@ bool SheetFinder::Refine(const GrayImageView& image, LightQuad* quad) const {
   return quad->refined;
 }
 
-void SheetFinder::MarkLocallyDark(double light_ratio) {
+bool SheetFinder::GlareSaturates() const {
+  return first_light_ < kSaturatedGrey - kLocalSaturationMargin;
+}
+
+void SheetFinder::MarkLocallyDark(double light_ratio, bool clipped_is_glare) {
   // The brightest over (2 kLocalRadiusCells + 1)^2 cells, then the cells darker than
   // light_ratio of it set to 0.
   // Where the paper itself is not saturated, a saturated cell is a glare's core, over ink and
   // paper alike: it tells nothing, and taken as light it would join the cells around it.
-  const bool glare_saturates = first_light_ < kSaturatedGrey - kLocalSaturationMargin;
+  const bool glare_saturates = clipped_is_glare && GlareSaturates();
   ExtremeAround(cells_, grid_width_, grid_height_, kLocalRadiusCells, true, &rows_, &brightest_);
   local_.resize(cells_.size());
   for (std::size_t i = 0; i < cells_.size(); ++i) {
@@ -771,6 +775,18 @@ const std::vector<LightQuad>& SheetFinder::FindSplitAtNecks(const GrayImageView&
   candidates_.clear();
   if (first_threshold_ >= 0 && OnTheLastGrid(image)) {
     MarkLocallyDark(kLocalLightRatio);
+    SplitAtNecks(local_, first_threshold_, &split_);
+    AddComponents(image, split_.data(), first_threshold_);
+    KeepBest();
+  }
+  return candidates_;
+}
+
+const std::vector<LightQuad>& SheetFinder::FindClippedAsPaper(const GrayImageView& image) {
+  candidates_.clear();
+  if (first_threshold_ >= 0 && GlareSaturates() && OnTheLastGrid(image)) {
+    MarkLocallyDark(kLocalLightRatio, false);
+    AddComponents(image, local_.data(), first_threshold_);
     SplitAtNecks(local_, first_threshold_, &split_);
     AddComponents(image, split_.data(), first_threshold_);
     KeepBest();

@@ -21,7 +21,9 @@
 //      or sleeve), and FindNarrowed's with each cell then the darkest of the 3 x 3 around it
 //      (a bridge of light cells a cell or two wide, a stripe washed out over a short stretch),
 //      and FindSplitAtNecks' with the light cells split where two rooms of them meet at a
-//      neck much narrower than either (a crossing washed out over several cells);
+//      neck much narrower than either (a crossing washed out over several cells), and
+//      FindClippedAsPaper's, both again with the saturated cells light (paper over-exposed
+//      among light things that are not);
 //   2. at each threshold, the 4-connected components of light cells of at least
 //      min_area_fraction of the image; each one's quadrilateral is the convex hull of its
 //      cells cut down to four vertices by dropping, each time, the vertex whose triangle with
@@ -133,6 +135,14 @@ class SheetFinder {
   /// the image is left out as in Find, the rooms inside it are not. Quadrilaterals found
   /// before are left out. Same validity as Find's.
   const std::vector<LightQuad>& FindSplitAtNecks(const GrayImageView& image);
+  /// More candidates of the image last given to Find, for when none of the looks above found
+  /// the target, and they took its saturated cells for a glare's core (the light cells' mean
+  /// well below saturation): FindLocallyLight's and FindSplitAtNecks' cells again with the
+  /// saturated cells as light as their grey. Paper over-exposed, clipped, among light things
+  /// that are not (a light bench, a page, a bright photograph) is no glare: taken as dark, it
+  /// leaves no middle cell. Empty when the looks above took no saturated cell for a glare.
+  /// Quadrilaterals found before are left out. Same validity as Find's.
+  const std::vector<LightQuad>& FindClippedAsPaper(const GrayImageView& image);
   /// Step 4 for one candidate of the same image (done on demand: a caller usually needs the
   /// first only): its sides moved onto the light/dark edges, sub-pixel. True when quad is
   /// (now) refined; its corners are unchanged otherwise.
@@ -159,8 +169,12 @@ class SheetFinder {
                      int threshold, double reach) const;
   /// Adds the candidates of the light cells at `threshold` to candidates_.
   void AddComponents(const GrayImageView& image, const std::uint8_t* grid, int threshold);
-  /// local_: the cells, those much darker than the brightest near them set to 0.
-  void MarkLocallyDark(double light_ratio);
+  /// local_: the cells, those much darker than the brightest near them set to 0, and the
+  /// saturated ones too when `clipped_is_glare` and GlareSaturates().
+  void MarkLocallyDark(double light_ratio, bool clipped_is_glare = true);
+  /// Whether a saturated cell of the last frame is taken for a glare's core: the first pass's
+  /// light cells' mean is well below saturation (the paper is not clipped).
+  bool GlareSaturates() const;
   /// `grid`'s light cells (>= threshold) set to 0 where two rooms meet at a neck (see
   /// FindSplitAtNecks), into *out.
   void SplitAtNecks(const std::vector<std::uint8_t>& grid, int threshold,

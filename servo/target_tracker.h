@@ -18,7 +18,9 @@
 //      looks (SheetFinder::FindLocallyLight: a hand or a glare joining the middle cell to its
 //      neighbour; FindFaintlyDark: a pale hand; FindNarrowed: a stripe washed out over a short
 //      stretch, a bridge a cell or two wide; FindSplitAtNecks: a crossing washed out over
-//      several cells, the middle cell joined through it to paper out of view); then the candidates
+//      several cells, the middle cell joined through it to paper out of view;
+//      FindClippedAsPaper: over-exposed paper, clipped, not taken for a glare's core beside a
+//      light bench or page that is not); then the candidates
 //      closed in on two sides that meet, set aside on the way, as each of the sheet's corner cells
 //      (the paper beyond one stripe of each pair, out to the sheet's corner: a glare over the
 //      middle of the sheet joins the middle cell to the cells beyond all four stripes).
@@ -318,8 +320,10 @@ class TargetPoseTracker {
   /// frame_.lens from the frame's pose and its lines 1-4.
   void MeasureLens();
   /// Step 2 for the sheet finder's candidates `cells`: those closed in on three sides or more,
-  /// at most max_candidates of them, best first; true when a pose is accepted.
-  bool AttemptCells(const GrayImageView& image, const std::vector<LightQuad>& cells);
+  /// at most max_candidates of them, best first (`as_middle_only`: as the middle cell alone,
+  /// not also as a cell beyond a stripe or cut short); true when a pose is accepted.
+  bool AttemptCells(const GrayImageView& image, const std::vector<LightQuad>& cells,
+                    bool as_middle_only = false);
   /// A candidate closed in on four sides that gave no pose, taken as a cell beyond a stripe
   /// with each of its sides in turn on the sheet's edge; when none gives a pose, the frame is
   /// left as the candidate itself left it, with the time spent added.
@@ -348,6 +352,13 @@ class TargetPoseTracker {
   /// from that pose, the new pose kept when it passes the checks, else the first unless a
   /// stripe of it is seen over less than kMinFittedExtent. False when no pose is kept.
   bool RescanWeakStripe(const GrayImageView& image, ScanSource source);
+  /// Whether the accepted pose's stripe fit (when it has one) sees each stripe over
+  /// kMinFittedExtent of it at least (`of_its_view`: of its stretch the pose puts in view);
+  /// otherwise the frame is refused, saying so, `tried` added to the message. A stripe seen
+  /// over less leaves the pose's tilt about it to a few runs.
+  bool EachStripeSeenOverEnough(bool of_its_view, const std::string& tried);
+  /// The fraction of stripe `line`'s centre line that the frame's pose puts in the image.
+  double InViewFraction(int line) const;
   /// The whole image's accepted pose scanned again on the target's plane (step 3): false when
   /// the two poses disagree; the frame keeps the better fitting one.
   bool ConfirmOnTarget(const GrayImageView& image);

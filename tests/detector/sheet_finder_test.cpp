@@ -9,6 +9,9 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "base/angles.h"
 #include "scene/scene.h"
@@ -248,12 +251,10 @@ TEST(SheetFinder, AGapOfACellInAStripeIsClosedWhenTheCellsAreNarrowed) {
                           [&](const LightQuad& quad) { return is_middle(quad, finder); }));
 }
 
-// An over-exposed '#' (paper and a glare clip at 255 alike) whose sheet runs out of the image
-// at the bottom, its lower left crossing washed out by a glare eleven cells across: the middle
-// cell joins through it to the cells beyond lines 1 and 4, which run out of view, at every
-// threshold, ratio and narrowing. Split where the rooms meet at the washed-out crossing, a neck
-// much narrower than the middle cell, it stands alone and refines onto the stripes' edges.
-TEST(SheetFinder, ACrossingWashedOutOverSeveralCellsIsSplitAtTheNeck) {
+// An over-exposed '#' (paper and a glare clip at 255 alike) on a bench of grey 120, whose sheet
+// runs out of the image at the bottom, its lower left crossing washed out by a glare eleven
+// cells across.
+vpImage<unsigned char> ClippedSheetWithAGlare() {
   vpImage<unsigned char> image(480, 640, 120);
   Fill(&image, 100, 60, 540, 480, 255);  // the sheet, out of view at the bottom
   Fill(&image, 230, 70, 250, 480, 30);   // line 1
@@ -265,25 +266,58 @@ TEST(SheetFinder, ACrossingWashedOutOverSeveralCellsIsSplitAtTheNeck) {
       if (std::hypot(u - 240.0, v - 310.0) < 44.0) image[v][u] = 255;  // the glare
     }
   }
+  return image;
+}
+
+// The first of the finder's looks, in the tracker's order, with a quadrilateral closed in on
+// three sides at least that refines onto the middle cell of ClippedSheetWithAGlare's sheet in
+// `image` ("none" when no look has one).
+std::string FirstLookHoldingTheClippedSheetsMiddle(const vpImage<unsigned char>& image) {
   const std::array<Point2d, 4> middle = {Point2d{249.5, 176.5}, Point2d{391.5, 176.5},
                                          Point2d{391.5, 301.5}, Point2d{249.5, 301.5}};
   SheetFinder finder;
   const GrayImageView view = ViewOf(image);
-  const auto holds_middle = [&](const std::vector<LightQuad>& found) {
-    return std::any_of(found.begin(), found.end(), [&](LightQuad quad) {
-      if (quad.ClosedSideCount() < 3 || !finder.Refine(view, &quad)) return false;
-      return std::all_of(quad.corners.begin(), quad.corners.end(), [&](const Point2d& corner) {
-        return std::any_of(middle.begin(), middle.end(), [&](const Point2d& m) {
-          return std::hypot(corner.u - m.u, corner.v - m.v) < 2.0;
-        });
+  const auto is_middle = [&](LightQuad quad) {
+    if (quad.ClosedSideCount() < 3 || !finder.Refine(view, &quad)) return false;
+    return std::all_of(quad.corners.begin(), quad.corners.end(), [&](const Point2d& corner) {
+      return std::any_of(middle.begin(), middle.end(), [&](const Point2d& m) {
+        return std::hypot(corner.u - m.u, corner.v - m.v) < 2.0;
       });
     });
   };
-  EXPECT_FALSE(holds_middle(finder.Find(view)));
-  EXPECT_FALSE(holds_middle(finder.FindLocallyLight(view)));
-  EXPECT_FALSE(holds_middle(finder.FindFaintlyDark(view)));
-  EXPECT_FALSE(holds_middle(finder.FindNarrowed(view)));
-  EXPECT_TRUE(holds_middle(finder.FindSplitAtNecks(view)));
+  using Look = const std::vector<LightQuad>& (SheetFinder::*)(const GrayImageView&);
+  const std::vector<std::pair<std::string, Look>> looks{
+      {"Find", &SheetFinder::Find},
+      {"FindLocallyLight", &SheetFinder::FindLocallyLight},
+      {"FindFaintlyDark", &SheetFinder::FindFaintlyDark},
+      {"FindNarrowed", &SheetFinder::FindNarrowed},
+      {"FindSplitAtNecks", &SheetFinder::FindSplitAtNecks},
+      {"FindClippedAsPaper", &SheetFinder::FindClippedAsPaper}};
+  for (const auto& [name, look] : looks) {
+    const std::vector<LightQuad>& found = (finder.*look)(view);
+    if (std::any_of(found.begin(), found.end(), is_middle)) return name;
+  }
+  return "none";
+}
+
+// ClippedSheetWithAGlare: the middle cell joins through the washed-out crossing to the cells
+// beyond lines 1 and 4, which run out of view, at every threshold, ratio and narrowing. Split
+// where the rooms meet at the washed-out crossing, a neck much narrower than the middle cell,
+// it stands alone and refines onto the stripes' edges.
+TEST(SheetFinder, ACrossingWashedOutOverSeveralCellsIsSplitAtTheNeck) {
+  EXPECT_EQ(FirstLookHoldingTheClippedSheetsMiddle(ClippedSheetWithAGlare()), "FindSplitAtNecks");
+}
+
+// ClippedSheetWithAGlare among pages of paper as light as the threshold but not clipped (200)
+// that bring the light cells' mean below saturation: the looks that take clipped cells for a
+// glare's core leave no paper; taken as paper, the middle cell is split off at the washed-out
+// crossing as on a dark bench.
+TEST(SheetFinder, AClippedSheetAmongLightPagesIsNotTakenForAGlare) {
+  vpImage<unsigned char> image = ClippedSheetWithAGlare();
+  Fill(&image, 0, 0, 100, 480, 200);    // pages left,
+  Fill(&image, 540, 0, 640, 480, 200);  // right
+  Fill(&image, 100, 0, 540, 52, 200);   // and above the sheet
+  EXPECT_EQ(FirstLookHoldingTheClippedSheetsMiddle(image), "FindClippedAsPaper");
 }
 
 // A room of light cells with no neck (the paper alone, a '#'s intact middle cell) is not split:
