@@ -302,12 +302,8 @@ class TargetPoseTracker {
   };
   Pull PullOf(int line) const;
   /// Why the frame's stripe fit is not taken, when a stripe keeping few points beside the
-  /// others' (or any stripe, when the fit is poor) pulls the pose away from where the other
-  /// three stripes alone put it.
+  /// others' pulls the pose away from where the other three stripes alone put it.
   std::optional<std::string> WeakStripePull() const;
-  /// Why, when stripe `line`'s points move the pose from the other three's at a cost to
-  /// their RMS (see kMaxOthersRmsGrowth).
-  std::optional<std::string> PullAgainstTheOthers(int line) const;
   /// A stripe whose runs are narrower or wider than the others' (something light or dark
   /// along one side of it) and pull the pose away from where the other three stripes put it:
   /// why the frame's stripe fit is not taken, when the image's stripes lie where the three put
