@@ -193,10 +193,7 @@ void KeepCollinear(double px, double py, StripePoints* stripe) {
   StripePoints kept;
   for (std::size_t i = 0; i < n; ++i) {
     if (best.Distance(u[i], v[i]) > keep) continue;
-    kept.p.push_back(stripe->p[i]);
-    kept.along.push_back(stripe->along[i]);
-    kept.run_width.push_back(stripe->run_width[i]);
-    kept.width.push_back(stripe->width[i]);
+    kept.Add(stripe->p[i], stripe->along[i], stripe->run_width[i], stripe->width[i]);
   }
   *stripe = std::move(kept);
 }

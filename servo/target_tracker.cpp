@@ -935,8 +935,11 @@ bool TargetPoseTracker::EachStripeSeenOverEnough(bool of_its_view, const std::st
   double weakest = HUGE_VAL;
   for (int k = 0; k < 4; ++k) {
     const double extent = frame_.fit.extent[static_cast<std::size_t>(k)];
-    weakest = std::min(
-        weakest, of_its_view ? extent / std::max(InViewFraction(k), 1.0 / kInViewSamples) : extent);
+    // A stripe seen over enough of its whole length is seen over enough of its view.
+    const bool short_of_view = of_its_view && extent < kMinFittedExtent;
+    weakest =
+        std::min(weakest, short_of_view ? extent / std::max(InViewFraction(k), 1.0 / kInViewSamples)
+                                        : extent);
   }
   if (weakest >= kMinFittedExtent) return true;
   std::ostringstream message;
