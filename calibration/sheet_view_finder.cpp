@@ -38,9 +38,11 @@ TargetTrackerOptions ForAGuessedCamera(TargetTrackerOptions tracking) {
 }
 
 // A camera calibrated from other views: the tracker's own checks, every view on
-// kCalibrationBorders borders.
+// kCalibrationBorders borders, but a poor fit of the stripes is the lens not told yet (a view
+// reaching a wide lens's corner fits 0.5-0.9 px through the lens the others gave).
 TargetTrackerOptions ForACalibratedCamera(TargetTrackerOptions tracking) {
   tracking.borders = std::max(tracking.borders, kCalibrationBorders);
+  tracking.check_stripes_on_poor_fit = false;
   tracking.corner_cells = false;
   return tracking;
 }

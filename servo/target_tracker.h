@@ -175,6 +175,11 @@ struct TargetTrackerOptions {
   /// (stripe_fit.h), and, where the lines give none, the pose fitted to those points from
   /// where the target was expected; false: the intersections' pose as the paper gives it.
   bool fit_stripes = true;
+  /// When the four stripes' fit is poor, each stripe is checked against the pose the other
+  /// three hold (something lying along a stripe moves its points and the pose). false while
+  /// the camera model is still being told: a lens told from a few other views is least sure
+  /// where they did not reach, and a stripe there fits poorly for the model's sake.
+  bool check_stripes_on_poor_fit = true;
   StripeFitOptions stripe_fit;
 
   /// Throws std::invalid_argument naming the field, its value and the violated constraint.
@@ -302,8 +307,12 @@ class TargetPoseTracker {
   };
   Pull PullOf(int line) const;
   /// Why the frame's stripe fit is not taken, when a stripe keeping few points beside the
-  /// others' pulls the pose away from where the other three stripes alone put it.
+  /// others' (or any stripe, when the fit is poor) pulls the pose away from where the other
+  /// three stripes alone put it.
   std::optional<std::string> WeakStripePull() const;
+  /// Why, when stripe `line`'s points move the pose from the other three's at a cost to
+  /// their RMS (see kMaxOthersRmsGrowth).
+  std::optional<std::string> PullAgainstTheOthers(int line) const;
   /// A stripe whose runs are narrower or wider than the others' (something light or dark
   /// along one side of it) and pull the pose away from where the other three stripes put it:
   /// why the frame's stripe fit is not taken, when the image's stripes lie where the three put
