@@ -26,7 +26,8 @@ constexpr double kWaysRoundMargin = 0.1;
 constexpr double kGuideReach = 0.3;
 constexpr double kGuideMaxAngleRad = 8.0 * kPi / 180.0;
 // A pose fitted to the stripes: each stripe's runs within this log ratio of its width (0.22:
-// 0.8 to 1.25 times; a stripe taken for its partner is 1.5 or 0.67 times); without four lines
+// 0.8 to 1.25 times; a stripe taken for its partner is 1.5 or 0.67 times), beside the widening
+// its parallel stripe shares (RunsAsWideAsStripe); without four lines
 // also its points spanning this fraction of it at least (a stripe seen over less, its other
 // stretches under a hand or beyond the image, leaves the pose's tilt about it poorly told).
 constexpr double kMaxFittedWidthLog = 0.22;
@@ -303,6 +304,14 @@ T MedianOfOthers(const std::array<T, 4>& values, int line) {
   return others[1];
 }
 
+// The stripe (0-3) parallel to stripe k; k itself when it has none.
+std::size_t ParallelStripe(const TargetLayout& layout, std::size_t k) {
+  for (std::size_t other = 0; other < layout.stripes.size(); ++other) {
+    if (other != k && layout.stripes[other].along_b == layout.stripes[k].along_b) return other;
+  }
+  return k;
+}
+
 // The runs of `line` nearer the median excess width of its parallel stripe's runs than its
 // own: the band about the parallel stripe's excess reaching half way to it. Blur and the
 // threshold widen a stripe's runs by about as many pixels as its parallel one's (a motion blur
@@ -311,12 +320,7 @@ T MedianOfOthers(const std::array<T, 4>& values, int line) {
 std::optional<RunWidthBand> AsWideAsItsParallel(const StripeFit& fit, const TargetLayout& layout,
                                                 int line) {
   const auto k = static_cast<std::size_t>(line);
-  std::size_t parallel = k;
-  for (std::size_t other = 0; other < layout.stripes.size(); ++other) {
-    if (other != k && layout.stripes[other].along_b == layout.stripes[k].along_b) {
-      parallel = other;
-    }
-  }
+  const std::size_t parallel = ParallelStripe(layout, k);
   if (parallel == k) return std::nullopt;
   const double reference = fit.width_excess_px[parallel];
   const double apart = std::fabs(fit.width_excess_px[k] - reference);
@@ -324,15 +328,29 @@ std::optional<RunWidthBand> AsWideAsItsParallel(const StripeFit& fit, const Targ
   return RunWidthBand{line, reference - 0.5 * apart, reference + 0.5 * apart};
 }
 
-// Whether stripe k's kept runs are, at their median, as wide as it.
-bool RunsAsWideAsStripe(const StripeFit& fit, std::size_t k) {
-  return !(std::fabs(std::log(fit.width_ratio[k])) > kMaxFittedWidthLog);
+// Whether stripe k's kept runs are, at their median, as wide as it, beside the widening its
+// parallel stripe's runs show as well: a motion blur across a pair of stripes widens both by as
+// many pixels (a thin stripe's runs 1.3 times its width under a blur of a few pixels), while a
+// stripe taken for its partner leaves the pair's excesses twice their widths' difference apart.
+bool RunsAsWideAsStripe(const StripeFit& fit, const TargetLayout& layout, std::size_t k) {
+  const std::size_t parallel = ParallelStripe(layout, k);
+  const double width = fit.width_px[k];
+  double shared_px = 0.0;
+  if (parallel != k && width > 0.0) {
+    const double mine = fit.width_excess_px[k], theirs = fit.width_excess_px[parallel];
+    if (std::fabs(mine - theirs) <= kLopsidedWidthLog * width) {
+      shared_px = std::max(0.0, std::min(mine, theirs));
+    }
+  }
+  const double ratio =
+      shared_px > 0.0 ? fit.width_ratio[k] * width / (width + shared_px) : fit.width_ratio[k];
+  return !(std::fabs(std::log(ratio)) > kMaxFittedWidthLog);
 }
 
 // The first stripe (0-3) whose kept runs are not as wide as it; -1 when none.
-int MergedStripe(const StripeFit& fit) {
+int MergedStripe(const StripeFit& fit, const TargetLayout& layout) {
   for (std::size_t k = 0; k < 4; ++k) {
-    if (!RunsAsWideAsStripe(fit, k)) return static_cast<int>(k);
+    if (!RunsAsWideAsStripe(fit, layout, k)) return static_cast<int>(k);
   }
   return -1;
 }
@@ -484,7 +502,7 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
     frame_.fit = FitStripes(frame_.pose.cMo, layout_, detector_.feature_points(), camera_,
                             detector_.Undistorts(), options_.stripe_fit);
     if (frame_.fit.ok && !prior) frame_.fit = OtherTiltIfBetter(frame_.fit);
-    const int merged = frame_.fit.ok ? MergedStripe(frame_.fit) : -1;
+    const int merged = frame_.fit.ok ? MergedStripe(frame_.fit, layout_) : -1;
     if (merged >= 0 && source != ScanSource::kImage) {
       // A stripe whose runs are not as wide as it: most of them merged with something beside
       // it (a cable along it, a glare's slope), their middles off its centre line.
@@ -592,7 +610,7 @@ bool TargetPoseTracker::FitExpected(const Expected& expected) {
   // each stripe seen over a good part of it: the lines' identification and support, for a pose
   // that has no four lines.
   for (std::size_t k = 0; k < 4; ++k) {
-    if (!RunsAsWideAsStripe(*best, k) || best->extent[k] < kMinFittedExtent) {
+    if (!RunsAsWideAsStripe(*best, layout_, k) || best->extent[k] < kMinFittedExtent) {
       std::ostringstream message;
       message << why << "; fitted to the stripes' points, line " << k + 1 << "'s runs are "
               << best->width_ratio[k] << " times its width and span " << best->extent[k]
