@@ -41,6 +41,11 @@ constexpr int kMiddleBordersPerPair = 4;
 constexpr double kWeakStripeExtent = 0.3;
 // Points along a stripe's centre line tested for being in view.
 constexpr int kInViewSamples = 32;
+// A whole image's pose whose stripe fit finds too few runs as wide as a stripe lying at least
+// this much in view is not taken (a pale cable along the wide stripe of a sheet running out of
+// view merged with all its runs, and the lines' pose was 2 degrees off); the 2 m board seen
+// from near shows at most 0.72 of such a stripe.
+constexpr double kStarvedInViewFraction = 0.9;
 // A stripe keeping fewer than this fraction of the median of the others' points is checked
 // against the pose the other three hold. Its points are not its stripe's when they move the pose
 // by more than kMaxPullRad or kMaxPullFraction of the distance at a cost to the others: their RMS
@@ -514,11 +519,12 @@ bool TargetPoseTracker::Attempt(const GrayImageView& image, const ScanBorders& b
       frame_.pose.message = message.str();
     } else if (frame_.fit.ok) {
       ReplacePose(frame_.fit.cMo, target_, &frame_.pose);
-    } else if (source != ScanSource::kImage) {
+    } else if (source != ScanSource::kImage || StarvedStripeInView()) {
       // The lines' pose puts a stripe where too few runs as wide as it lie, or where its runs
       // cannot hold the pose (a line drawn through runs merged with fingers or a pen beside
       // the stripe): not taken. (A whole image's pose is scanned again on the target's plane,
-      // where this applies.)
+      // where this applies; its stripes' runs tell against it only for a stripe in view: a
+      // board seen from near shows too little of a stripe to fit.)
       frame_.pose.status = PoseStatus::kDegenerate;
       frame_.pose.message =
           "the stripes' points do not hold the lines' pose: " + frame_.fit.message;
@@ -946,6 +952,11 @@ bool TargetPoseTracker::RescanWeakStripe(const GrayImageView& image, ScanSource 
     return true;
   }
   return EachStripeSeenOverEnough(false, ", and its middle scanned again gave no pose");
+}
+
+bool TargetPoseTracker::StarvedStripeInView() const {
+  return frame_.fit.starved_line >= 0 &&
+         InViewFraction(frame_.fit.starved_line) >= kStarvedInViewFraction;
 }
 
 double TargetPoseTracker::InViewFraction(int line) const {

@@ -368,6 +368,9 @@ class TargetPoseTracker {
   bool EachStripeSeenOverEnough(bool of_its_view, const std::string& tried);
   /// The fraction of stripe `line`'s centre line that the frame's pose puts in the image.
   double InViewFraction(int line) const;
+  /// Whether the stripe fit left a stripe with too few runs as wide as it (StripeFit::
+  /// starved_line) while the pose puts that stripe in view over kStarvedInViewFraction.
+  bool StarvedStripeInView() const;
   /// The whole image's accepted pose scanned again on the target's plane (step 3): false when
   /// the two poses disagree; the frame keeps the better fitting one.
   bool ConfirmOnTarget(const GrayImageView& image);
