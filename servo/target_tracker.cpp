@@ -317,19 +317,25 @@ std::size_t ParallelStripe(const TargetLayout& layout, std::size_t k) {
   return k;
 }
 
+// Whether stripe k's runs are widened by about as many pixels as those of its parallel stripe
+// `parallel`: their median excess widths within kLopsidedWidthLog of its width. Blur and the
+// threshold widen both alike (a motion blur across one pair of stripes widens that pair alone);
+// something along one side of one of them widens or narrows it by its own width.
+bool WidenedAlike(const StripeFit& fit, std::size_t k, std::size_t parallel) {
+  return !(std::fabs(fit.width_excess_px[k] - fit.width_excess_px[parallel]) >
+           kLopsidedWidthLog * fit.width_px[k]);
+}
+
 // The runs of `line` nearer the median excess width of its parallel stripe's runs than its
-// own: the band about the parallel stripe's excess reaching half way to it. Blur and the
-// threshold widen a stripe's runs by about as many pixels as its parallel one's (a motion blur
-// across one pair of stripes widens that pair alone); something along one side of it, by its
-// width. None when the two excesses differ by less than kLopsidedWidthLog of its width.
+// own: the band about the parallel stripe's excess reaching half way to it. None when the two
+// are widened alike.
 std::optional<RunWidthBand> AsWideAsItsParallel(const StripeFit& fit, const TargetLayout& layout,
                                                 int line) {
   const auto k = static_cast<std::size_t>(line);
   const std::size_t parallel = ParallelStripe(layout, k);
-  if (parallel == k) return std::nullopt;
+  if (parallel == k || WidenedAlike(fit, k, parallel)) return std::nullopt;
   const double reference = fit.width_excess_px[parallel];
   const double apart = std::fabs(fit.width_excess_px[k] - reference);
-  if (!(apart > kLopsidedWidthLog * fit.width_px[k])) return std::nullopt;
   return RunWidthBand{line, reference - 0.5 * apart, reference + 0.5 * apart};
 }
 
@@ -341,11 +347,8 @@ bool RunsAsWideAsStripe(const StripeFit& fit, const TargetLayout& layout, std::s
   const std::size_t parallel = ParallelStripe(layout, k);
   const double width = fit.width_px[k];
   double shared_px = 0.0;
-  if (parallel != k && width > 0.0) {
-    const double mine = fit.width_excess_px[k], theirs = fit.width_excess_px[parallel];
-    if (std::fabs(mine - theirs) <= kLopsidedWidthLog * width) {
-      shared_px = std::max(0.0, std::min(mine, theirs));
-    }
+  if (parallel != k && width > 0.0 && WidenedAlike(fit, k, parallel)) {
+    shared_px = std::max(0.0, std::min(fit.width_excess_px[k], fit.width_excess_px[parallel]));
   }
   const double ratio =
       shared_px > 0.0 ? fit.width_ratio[k] * width / (width + shared_px) : fit.width_ratio[k];
