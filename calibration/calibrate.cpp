@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -54,6 +55,8 @@ constexpr int kMaxPairingRounds = 40;
 // blurred stripe are a few tenths of a pixel short).
 constexpr double kRunEndMarginWidths = 0.5;
 constexpr double kRunSpanTolerance = 0.3;
+// calibrateCamera's share of each view's line points (see gather).
+constexpr std::size_t kSolverLinePointsPerView = 256;
 // Runs' middles are moved again after each solve (CentreRuns) until none moves by more than
 // this, pixels.
 constexpr double kCentringSettledPx = 1e-3;
@@ -674,8 +677,9 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
   // outliers, their pairing) remains.
   std::vector<LinePairing> first_pairings(views.size());  // by index in `views`
   for (std::size_t i = 0; i < used.size(); ++i) first_pairings[used[i]] = pairings[i];
-  // The solver's points: the known points and the line points used, paired.
-  const auto gather = [&]() {
+  // The solver's points: the known points and the line points used, paired; every
+  // `line_stride`-th line point of a view when it has more than `max_line_points`.
+  const auto gather = [&](std::size_t max_line_points) {
     object_points.clear();
     image_points.clear();
     for (std::size_t i = 0; i < used_views.size(); ++i) {
@@ -685,8 +689,12 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
         object.emplace_back(static_cast<float>(point.x), static_cast<float>(point.y), 0.0f);
         image.emplace_back(static_cast<float>(point.u), static_cast<float>(point.v));
       }
-      for (std::size_t k = 0; k < pairings[i].seen.size(); ++k) {
+      const std::size_t line_points = pairings[i].kept();
+      const std::size_t line_stride =
+          line_points > max_line_points ? (line_points + max_line_points - 1) / max_line_points : 1;
+      for (std::size_t k = 0, used_index = 0; k < pairings[i].seen.size(); ++k) {
         if (!pairings[i].used(k)) continue;
+        if (used_index++ % line_stride != 0) continue;
         object.emplace_back(static_cast<float>(pairings[i].paired[k].x),
                             static_cast<float>(pairings[i].paired[k].y), 0.0f);
         image.emplace_back(static_cast<float>(pairings[i].seen[k].x),
@@ -725,7 +733,9 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
         pairings.clear();
         for (const std::size_t k : used) pairings.push_back(first_pairings[k]);
       }
-      gather();
+      // calibrateCamera's time grows faster than its points: it starts the polish from a
+      // share of each view's line points, the polish fits them all.
+      gather(kSolverLinePointsPerView);
       const bool guess = (round > 0 && !left_out) || from_previous;
       result.rms_px = cv::calibrateCamera(
           object_points, image_points, cv::Size(options.width, options.height), camera_matrix,
@@ -745,7 +755,7 @@ CalibrationResult Calibrate(const std::vector<CalibrationView>& views,
       sd_intrinsics = solution.sd_intrinsics;
       view_errors = solution.view_errors;
       result.rms_px = solution.rms_px;
-      gather();
+      gather(std::numeric_limits<std::size_t>::max());
       // A view that disagrees as a whole goes first, before the point cut could whittle it
       // down to its points that happen to fit.
       if (MarkDisagreeingView(view_errors, used, &result)) continue;

@@ -34,7 +34,7 @@ class SheetViewFinder {
  private:
   /// The view `tracker` found in the frame it last tracked; nullopt when it found none.
   std::optional<CalibrationView> ViewOf(const TargetPoseTracker& tracker,
-                                        const std::string& name) const;
+                                        const GrayImageView& image, const std::string& name) const;
 
   LineTarget target_;
   DetectorOptions detector_;
