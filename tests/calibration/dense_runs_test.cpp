@@ -24,6 +24,14 @@ struct DrawnStripe {
   double u0 = 160.0, v0 = 120.0, du = 1.0, dv = 0.0, width = 8.0;
   std::vector<std::uint8_t> pixels;
 
+  // The stripe drawn at `angle` (radians from the image's rows).
+  static DrawnStripe At(double angle) {
+    DrawnStripe stripe;
+    stripe.du = std::cos(angle);
+    stripe.dv = std::sin(angle);
+    stripe.Draw();
+    return stripe;
+  }
   double Across(double u, double v) const { return (u - u0) * dv - (v - v0) * du; }
   GrayImageView View() const {
     return GrayImageView{pixels.data(), width_px, height_px, static_cast<std::ptrdiff_t>(width_px)};
@@ -90,11 +98,7 @@ struct DrawnStripe {
 };
 
 TEST(DenseStripeRuns, ReadsEveryColumnOnTheCentreLineAsWideAsTheStripe) {
-  DrawnStripe stripe;
-  const double angle = 0.35;  // 20 deg: read down the columns
-  stripe.du = std::cos(angle);
-  stripe.dv = std::sin(angle);
-  stripe.Draw();
+  const DrawnStripe stripe = DrawnStripe::At(0.35);  // 20 deg: read down the columns
   const StripeRuns found = stripe.Found(20.0, -120.0, 120.0);
   const StripeRuns dense = DenseStripeRuns(stripe.View(), found);
   // From the first found run's column to the last's: 2 * 120 * cos(20 deg) = 225 columns.
@@ -114,11 +118,7 @@ TEST(DenseStripeRuns, ReadsEveryColumnOnTheCentreLineAsWideAsTheStripe) {
 }
 
 TEST(DenseStripeRuns, ReadsEveryRowOfAStripeNearerTheColumns) {
-  DrawnStripe stripe;
-  const double angle = 1.9;  // 109 deg: read along the rows
-  stripe.du = std::cos(angle);
-  stripe.dv = std::sin(angle);
-  stripe.Draw();
+  const DrawnStripe stripe = DrawnStripe::At(1.9);  // 109 deg: read along the rows
   const StripeRuns dense = DenseStripeRuns(stripe.View(), stripe.Found(16.0, -96.0, 96.0));
   ASSERT_GE(dense.middles.size(), 175u);
   for (std::size_t i = 0; i < dense.middles.size(); ++i) {
@@ -128,10 +128,7 @@ TEST(DenseStripeRuns, ReadsEveryRowOfAStripeNearerTheColumns) {
 }
 
 TEST(DenseStripeRuns, ReadsNothingUnderAHandOrAPen) {
-  DrawnStripe stripe;
-  stripe.du = std::cos(0.2);
-  stripe.dv = std::sin(0.2);
-  stripe.Draw();
+  DrawnStripe stripe = DrawnStripe::At(0.2);
   stripe.Paint(100, 130, 60, 180, 70);    // a hand: dark over the stripe and the paper
   stripe.Paint(200, 202, 20, 220, 60);    // a pen across the stripe
   stripe.Paint(240, 250, 100, 200, 250);  // a glare spot over the stripe
@@ -146,8 +143,7 @@ TEST(DenseStripeRuns, ReadsNothingUnderAHandOrAPen) {
 }
 
 TEST(DenseStripeRuns, KeepsTooFewRunsAsTheyAre) {
-  DrawnStripe stripe;
-  stripe.Draw();
+  const DrawnStripe stripe = DrawnStripe::At(0.0);
   const StripeRuns found = stripe.Found(20.0, -10.0, 10.0);  // two runs
   const StripeRuns dense = DenseStripeRuns(stripe.View(), found);
   ASSERT_EQ(dense.middles.size(), 2u);
