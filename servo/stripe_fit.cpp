@@ -1,5 +1,7 @@
 #include "servo/stripe_fit.h"
 
+#include <visp3/core/vpThetaUVector.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -473,6 +475,46 @@ bool SameFitPose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
   return d.rotation_rad < kSameFitRad && d.translation_m < kSameFitRad * depth;
 }
 
+namespace {
+
+// The covariance of the pose's rotation (the motion's w, radians squared, row-major): the
+// motion (v, w) has scale^2 times the inverse of the weighted normal matrix, its w block the
+// rotation's with the translation free to follow. Infinite when the normal matrix is singular.
+std::array<double, 9> RotationCovariance(const Eigen::Matrix<double, 6, 6>& normal,
+                                         double scale_px) {
+  std::array<double, 9> covariance;
+  covariance.fill(HUGE_VAL);
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
+  if (solver.info() != Eigen::Success) return covariance;
+  const Eigen::Matrix<double, 6, 6> inverse = solver.solve(Eigen::Matrix<double, 6, 6>::Identity());
+  const Mat3 rotation = scale_px * scale_px * inverse.bottomRightCorner<3, 3>();
+  if (!rotation.allFinite()) return covariance;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) covariance[static_cast<std::size_t>(3 * i + j)] = rotation(i, j);
+  }
+  return covariance;
+}
+
+}  // namespace
+
+double StripeFit::RotationDeviation() const {
+  const Mat3 covariance =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation_covariance.data());
+  if (!covariance.allFinite()) return HUGE_VAL;
+  const Eigen::SelfAdjointEigenSolver<Mat3> axes(covariance, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(axes.eigenvalues().maxCoeff(), 0.0));
+}
+
+double StripeFit::RotationDistance(const vpHomogeneousMatrix& other_cMo) const {
+  const Mat3 covariance =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation_covariance.data());
+  const vpThetaUVector turn((other_cMo * cMo.inverse()).getRotationMatrix());
+  const Vec3 w(turn[0], turn[1], turn[2]);
+  const Eigen::LDLT<Mat3> solver(covariance);
+  if (!covariance.allFinite() || solver.info() != Eigen::Success) return 0.0;
+  return std::sqrt(std::max(w.dot(solver.solve(w)), 0.0));
+}
+
 StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layout,
                      const std::vector<FramePoint>& points, const Lens& camera,
                      bool points_undistorted, const StripeFitOptions& options,
@@ -494,6 +536,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
 
   std::vector<double> magnitudes;
   double scale = options.min_scale_px;
+  Eigen::Matrix<double, 6, 6> last_normal = Eigen::Matrix<double, 6, 6>::Zero();
   std::array<Vec3, 4> centre_a, centre_b;  // the centre lines' ends on the plane
   for (int k = 0; k < 4; ++k) {
     const StripeSpan& span = layout.stripes[static_cast<std::size_t>(k)];
@@ -555,6 +598,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
       normal.noalias() += (s * s) * (m.transpose() * sum * m);
       gradient.noalias() += s * (m.transpose() * weighted_r);
     }
+    last_normal = normal;
     const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
     const Vec6 step = solver.solve(-gradient);
     if (solver.info() != Eigen::Success || !step.allFinite() ||
@@ -607,6 +651,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }
   fit.scale_px = scale;
+  fit.rotation_covariance = RotationCovariance(last_normal, scale);
   fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;
   fit.cMo = pose.Matrix();
   for (int k = 0; k < 4; ++k) {

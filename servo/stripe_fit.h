@@ -90,6 +90,15 @@ struct StripeFit {
   double rms_px = 0.0;                  ///< of the kept points' distances to their lines, pixels
   std::array<double, 4> line_rms_px{};  ///< the same for each line's kept points
   double scale_px = 0.0;                ///< the residuals' robust scale at the end, pixels
+  /// The covariance of the pose's rotation (radians squared, row-major, about the camera's
+  /// axes) from the points' spread (scale_px) and where they lie: a far or face-on sheet seen
+  /// on short stretches of its stripes has its tilt poorly fixed.
+  std::array<double, 9> rotation_covariance{};
+  /// Its standard deviation about its worst-fixed axis, radians.
+  double RotationDeviation() const;
+  /// How many standard deviations (Mahalanobis, under rotation_covariance) the rotation of
+  /// `other_cMo` lies from this fit's.
+  double RotationDistance(const vpHomogeneousMatrix& other_cMo) const;
   /// The line (0-3) that kept fewer than min_points, when that is why the fit is not ok; -1
   /// otherwise.
   int starved_line = -1;

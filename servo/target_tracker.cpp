@@ -62,6 +62,21 @@ constexpr double kMaxPullRad = 1.0 * kRadPerDeg;
 constexpr double kMaxPullFraction = 0.01;
 constexpr double kMaxOthersRmsGrowth = 2.0;
 constexpr double kOthersRmsMarginPx = 0.05;
+// A fit whose rotation its points fix to more than this about some axis (one standard
+// deviation) has each stripe checked against the pose the other three hold: with stripes seen
+// over short stretches, a few runs biased alike (merged with a cable along a stripe) turn it by
+// degrees and fit as well as the truth. A stripe that moves the pose by more than kMaxPullRad
+// and more than kMaxPullDeviations standard deviations of the three's own rotation
+// (Mahalanobis, StripeFit::RotationDistance) disagrees with them, and neither pose is sure: no
+// pose is taken (a cable along a stripe under motion blur: its 6-7 runs turned the pose by 2-3
+// degrees from the three's, 1.9-3 of their deviations, and the four's was 2-3.5 degrees off).
+// A tidy frame's fit fixes its rotation to 0.02-0.1 degrees: nothing is checked there.
+constexpr double kLooseRotationRad = 0.15 * kRadPerDeg;
+constexpr double kMaxPullDeviations = 1.8;
+// ... when the three's rotation deviation is under this (a far sheet's three stripes, one of
+// them seen over an eighth of its length, fixed it to 14 degrees and their fit settled 38
+// degrees away).
+constexpr double kMaxThreesDeviationRad = 3.0 * kRadPerDeg;
 // A stripe whose runs' median width over its own differs from the others' median by more than
 // this (log of the ratio: 8 %) is lopsided: something light or dark lies along one side of it
 // (a white cable over an edge narrows its runs), their middles off its centre line all the same
@@ -765,6 +780,37 @@ std::optional<std::string> TargetPoseTracker::PullAgainstTheOthers(int line) con
   return message.str();
 }
 
+std::string TargetPoseTracker::LensNote() {
+  if (!measure_lens_) MeasureLens();
+  if (!ContradictsLens(frame_.lens)) return "";
+  std::ostringstream note;
+  note << "; the stripes bend as a lens the camera model misses would (its kdu off by "
+       << -frame_.lens.kdu_error << ")";
+  return note.str();
+}
+
+std::optional<std::string> TargetPoseTracker::DisagreeingStripe() const {
+  const StripeFit& fit = frame_.fit;
+  if (!fit.ok || !(fit.RotationDeviation() > kLooseRotationRad)) return std::nullopt;
+  for (int line = 0; line < 4; ++line) {
+    const Pull pull = PullOf(line);
+    // Three stripes that fix the rotation to degrees only (their fit may settle tens of
+    // degrees away) say nothing against the fourth.
+    if (!pull.without.ok || !(pull.angle_rad > kMaxPullRad) ||
+        !(pull.without.RotationDeviation() < kMaxThreesDeviationRad)) {
+      continue;
+    }
+    const double deviations = pull.without.RotationDistance(fit.cMo);
+    if (!(deviations > kMaxPullDeviations)) continue;
+    std::ostringstream message;
+    message << "line " << line + 1 << "'s points " << pull.Describe() << ", " << deviations
+            << " standard deviations of those three's rotation (at most " << kMaxPullDeviations
+            << "): the stripes disagree";
+    return message.str();
+  }
+  return std::nullopt;
+}
+
 std::optional<std::string> TargetPoseTracker::LopsidedStripePull(const GrayImageView& image) {
   const StripeFit& fit = frame_.fit;
   if (!fit.ok) return std::nullopt;
@@ -843,6 +889,13 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
     frame_.message = *pull;
     return false;
   }
+  if (const std::optional<std::string> pull = DisagreeingStripe()) {
+    // Stripes bent by a lens the camera file misses disagree too: said when they bend so.
+    const std::string lens = LensNote();
+    frame_.status = lens.empty() ? TargetStatus::kNotFound : TargetStatus::kModelMismatch;
+    frame_.message = *pull + lens;
+    return false;
+  }
   if (frame_.pose.method == PoseMethod::kStripes) {
     // The four stripes held together: their points in all (each stripe has its fit's minimum).
     const int points = frame_.fit.TotalPoints();
@@ -882,11 +935,7 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
     }
     message << " (min_stripe_agreement = " << options_.min_stripe_agreement
             << ", min_stripe_seen = " << options_.min_stripe_seen << ")";
-    if (!measure_lens_) MeasureLens();
-    if (ContradictsLens(frame_.lens)) {
-      message << "; the stripes bend as a lens the camera model misses would (its kdu off by "
-              << -frame_.lens.kdu_error << ")";
-    }
+    message << LensNote();
     frame_.status = TargetStatus::kModelMismatch;
     frame_.message = message.str();
     return false;

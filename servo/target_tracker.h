@@ -293,9 +293,17 @@ class TargetPoseTracker {
   /// `fit`, or the fit from the pose tilted the other way (MirroredTilt) when it keeps more of
   /// the stripes' points, or as many closer: without a prior, the planar ambiguity.
   StripeFit OtherTiltIfBetter(const StripeFit& fit) const;
-  /// The checks on the frame's pose: enough points on each line, the model check; the lens
-  /// told from the lines (set_measure_lens, or a pose the check refuses).
+  /// The checks on the frame's pose: enough points on each line, the stripes agreeing with
+  /// each other, the model check; the lens told from the lines (set_measure_lens, or a pose
+  /// the check refuses).
   bool Verify(const GrayImageView& image);
+  /// When the frame's fit fixes its rotation loosely: the stripe whose points turn the pose
+  /// from where the other three put it by more than those three's points allow, said as the
+  /// reason not to take it.
+  std::optional<std::string> DisagreeingStripe() const;
+  /// The lens told from the frame's lines (measured now if it was not), as a note to a
+  /// refusal when the stripes bend as a lens the camera file misses would; empty otherwise.
+  std::string LensNote();
   /// The pose the three stripes other than `line` hold (the frame's fit without its points),
   /// and how far it lies from the frame's.
   struct Pull {

@@ -4,9 +4,16 @@
 
 #include <gtest/gtest.h>
 #include <visp3/core/vpMath.h>
+#include <visp3/core/vpMatrix.h>
+#include <visp3/core/vpThetaUVector.h>
+#include <visp3/core/vpUniRand.h>
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "base/pose_distance.h"
 #include "scene/scene.h"
@@ -140,6 +147,82 @@ TEST(StripeFit, LeavesOutRunsWithALighterSide) {
   }();
   ASSERT_TRUE(unmarked.ok);
   EXPECT_GT(PoseError(unmarked.cMo, rendered.cMo).second, r);
+}
+
+// The rotation's deviation the fit gives is what the points' scatter leaves: the same frame's
+// points moved by fresh noise along their runs, fit after fit, turn the pose by about as much,
+// and each fit's rotation lies about sqrt(3) to 2 of its own deviations (Mahalanobis, three
+// axes) from the truth. The points of the stripes' middles alone fix the tilt less well, and say
+// so.
+TEST(StripeFit, TheRotationsDeviationIsWhatThePointsScatterLeaves) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(Tilted(), 11);
+  const Tracked tracked = Track(rendered);
+  ASSERT_EQ(tracked.frame.status, TargetStatus::kOk) << tracked.frame.message;
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  constexpr double kNoisePx = 0.4;
+  vpUniRand random(12);
+  const auto noisy_fit = [&](const std::vector<FramePoint>& points) {
+    std::vector<FramePoint> moved = points;
+    for (FramePoint& point : moved) {
+      const double length = std::hypot(point.across_u, point.across_v);
+      if (length <= 0.0) continue;
+      // A sum of twelve uniforms: near enough a Gaussian of unit deviation.
+      double gauss = -6.0;
+      for (int i = 0; i < 12; ++i) gauss += random();
+      point.p.u += kNoisePx * gauss * point.across_u / length;
+      point.p.v += kNoisePx * gauss * point.across_v / length;
+    }
+    return FitStripes(rendered.cMo, layout, moved, kCamera, true);
+  };
+  // The spread of the fits' rotations about the truth, along its largest axis, against the
+  // deviation the fits give (their median).
+  const auto spread_and_deviation = [&](const std::vector<FramePoint>& points) {
+    vpMatrix scatter(3, 3, 0.0);
+    std::vector<double> deviations;
+    double distance2 = 0.0;
+    constexpr int kFits = 200;
+    for (int i = 0; i < kFits; ++i) {
+      const StripeFit fit = noisy_fit(points);
+      EXPECT_TRUE(fit.ok) << fit.message;
+      const vpThetaUVector turn((fit.cMo * rendered.cMo.inverse()).getRotationMatrix());
+      for (unsigned r = 0; r < 3; ++r) {
+        for (unsigned c = 0; c < 3; ++c) scatter[r][c] += turn[r] * turn[c] / kFits;
+      }
+      deviations.push_back(fit.RotationDeviation());
+      distance2 += std::pow(fit.RotationDistance(rendered.cMo), 2) / kFits;
+    }
+    // Three axes: a mean square of 3 for an exact covariance; the robust scale and the weights
+    // leave it a little small.
+    EXPECT_GT(distance2, 2.0);
+    EXPECT_LT(distance2, 6.0);
+    std::sort(deviations.begin(), deviations.end());
+    const double spread = std::sqrt(scatter.eigenValues().getMaxValue());
+    return std::make_pair(spread, deviations[deviations.size() / 2]);
+  };
+  const auto [spread, deviation] = spread_and_deviation(tracked.points);
+  EXPECT_GT(deviation, 0.0);
+  EXPECT_NEAR(deviation / spread, 1.0, 0.3)
+      << "spread " << spread << " rad, deviation " << deviation << " rad";
+  // The stripes' middles only: the points within 0.15 m of the sheet's centre across it and
+  // 0.11 m along it (the stripes' arms reach 0.2 and 0.14 m).
+  std::vector<FramePoint> middles;
+  const vpHomogeneousMatrix oMc = rendered.cMo.inverse();
+  for (const FramePoint& point : tracked.points) {
+    const Point2d x{(point.p.u - kCamera.u0()) / kCamera.px(),
+                    (point.p.v - kCamera.v0()) / kCamera.py()};
+    const vpColVector ray = oMc.getRotationMatrix() * vpColVector({x.u, x.v, 1.0});
+    const vpTranslationVector centre = oMc.getTranslationVector();
+    const double s = -centre[2] / ray[2];
+    if (std::fabs(centre[0] + s * ray[0]) < 0.15 && std::fabs(centre[1] + s * ray[1]) < 0.11) {
+      middles.push_back(point);
+    }
+  }
+  const auto [middles_spread, middles_deviation] = spread_and_deviation(middles);
+  EXPECT_GT(middles_deviation, 1.3 * deviation)
+      << middles.size() << " of " << tracked.points.size() << " points: " << middles_deviation
+      << " against " << deviation << " rad";
+  EXPECT_NEAR(middles_deviation / middles_spread, 1.0, 0.3);
 }
 
 // Points of something dark lying along one side of a stripe beyond where the stripe is
