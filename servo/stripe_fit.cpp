@@ -477,37 +477,29 @@ bool SameFitPose(const vpHomogeneousMatrix& a, const vpHomogeneousMatrix& b) {
 
 namespace {
 
-// The covariance of the pose's rotation (the motion's w, radians squared, row-major): the
-// motion (v, w) has scale^2 times the inverse of the weighted normal matrix, its w block the
-// rotation's with the translation free to follow. Infinite when the normal matrix is singular.
-std::array<double, 9> RotationCovariance(const Eigen::Matrix<double, 6, 6>& normal,
-                                         double scale_px) {
-  std::array<double, 9> covariance;
-  covariance.fill(HUGE_VAL);
-  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
-  if (solver.info() != Eigen::Success) return covariance;
+// The covariance of the pose's rotation (the motion's w, radians squared): the motion (v, w) has
+// scale^2 times the inverse of the weighted normal matrix, its w block the rotation's with the
+// translation free to follow. Not finite when the normal matrix is singular.
+Mat3 RotationCovariance(const std::array<double, 36>& normal, double scale_px) {
+  const Eigen::Matrix<double, 6, 6> matrix =
+      Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(normal.data());
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(matrix);
+  if (solver.info() != Eigen::Success) return Mat3::Constant(HUGE_VAL);
   const Eigen::Matrix<double, 6, 6> inverse = solver.solve(Eigen::Matrix<double, 6, 6>::Identity());
-  const Mat3 rotation = scale_px * scale_px * inverse.bottomRightCorner<3, 3>();
-  if (!rotation.allFinite()) return covariance;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) covariance[static_cast<std::size_t>(3 * i + j)] = rotation(i, j);
-  }
-  return covariance;
+  return scale_px * scale_px * inverse.bottomRightCorner<3, 3>();
 }
 
 }  // namespace
 
 double StripeFit::RotationDeviation() const {
-  const Mat3 covariance =
-      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation_covariance.data());
+  const Mat3 covariance = RotationCovariance(normal, scale_px);
   if (!covariance.allFinite()) return HUGE_VAL;
   const Eigen::SelfAdjointEigenSolver<Mat3> axes(covariance, Eigen::EigenvaluesOnly);
   return std::sqrt(std::max(axes.eigenvalues().maxCoeff(), 0.0));
 }
 
 double StripeFit::RotationDistance(const vpHomogeneousMatrix& other_cMo) const {
-  const Mat3 covariance =
-      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation_covariance.data());
+  const Mat3 covariance = RotationCovariance(normal, scale_px);
   const vpThetaUVector turn((other_cMo * cMo.inverse()).getRotationMatrix());
   const Vec3 w(turn[0], turn[1], turn[2]);
   const Eigen::LDLT<Mat3> solver(covariance);
@@ -651,7 +643,9 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }
   fit.scale_px = scale;
-  fit.rotation_covariance = RotationCovariance(last_normal, scale);
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) fit.normal[static_cast<std::size_t>(6 * i + j)] = last_normal(i, j);
+  }
   fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;
   fit.cMo = pose.Matrix();
   for (int k = 0; k < 4; ++k) {

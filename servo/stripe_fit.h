@@ -90,11 +90,12 @@ struct StripeFit {
   double rms_px = 0.0;                  ///< of the kept points' distances to their lines, pixels
   std::array<double, 4> line_rms_px{};  ///< the same for each line's kept points
   double scale_px = 0.0;                ///< the residuals' robust scale at the end, pixels
-  /// The covariance of the pose's rotation (radians squared, row-major, about the camera's
-  /// axes) from the points' spread (scale_px) and where they lie: a far or face-on sheet seen
-  /// on short stretches of its stripes has its tilt poorly fixed.
-  std::array<double, 9> rotation_covariance{};
-  /// Its standard deviation about its worst-fixed axis, radians.
+  /// The last step's weighted normal matrix of the motion (v, w) in the camera's frame,
+  /// row-major, per pixel squared: with scale_px, the pose's covariance. Where the points lie
+  /// and how they scatter fix the rotation: a far or face-on sheet seen on short stretches of
+  /// its stripes has its tilt poorly fixed.
+  std::array<double, 36> normal{};
+  /// The rotation's standard deviation about its worst-fixed axis, radians.
   double RotationDeviation() const;
   /// How many standard deviations (Mahalanobis, under rotation_covariance) the rotation of
   /// `other_cMo` lies from this fit's.
