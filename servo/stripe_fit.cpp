@@ -643,9 +643,7 @@ StripeFit FitStripes(const vpHomogeneousMatrix& start, const TargetLayout& layou
     fit.extent[k] = SupportedExtent(&along, span.along.hi - span.along.lo);
   }
   fit.scale_px = scale;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) fit.normal[static_cast<std::size_t>(6 * i + j)] = last_normal(i, j);
-  }
+  Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(fit.normal.data()) = last_normal;
   fit.rms_px = kept > 0 ? std::sqrt(sum2 / kept) : 0.0;
   fit.cMo = pose.Matrix();
   for (int k = 0; k < 4; ++k) {

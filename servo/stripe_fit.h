@@ -97,7 +97,7 @@ struct StripeFit {
   std::array<double, 36> normal{};
   /// The rotation's standard deviation about its worst-fixed axis, radians.
   double RotationDeviation() const;
-  /// How many standard deviations (Mahalanobis, under rotation_covariance) the rotation of
+  /// How many standard deviations (Mahalanobis, under the rotation's covariance) the rotation of
   /// `other_cMo` lies from this fit's.
   double RotationDistance(const vpHomogeneousMatrix& other_cMo) const;
   /// The line (0-3) that kept fewer than min_points, when that is why the fit is not ok; -1
