@@ -77,6 +77,24 @@ constexpr double kMaxPullDeviations = 1.8;
 // them seen over an eighth of its length, fixed it to 14 degrees and their fit settled 38
 // degrees away).
 constexpr double kMaxThreesDeviationRad = 3.0 * kRadPerDeg;
+// Before that, a stripe seen over less than kHeldExtent of its length, or keeping fewer than
+// kFewPointsRatio of the others' median points, is not taken when it holds the pose's rotation:
+// the other three alone fix it more than kHeldDeviationRatio times as loosely (one standard
+// deviation about its loosest axis: the stripe gives nine tenths of what is known there) and
+// looser than kMinHeldDeviationRad. The four's deviation counts its points' scatter only; a
+// few points along a short stretch, shifted alike by a fraction of a pixel (a cable lying along
+// the rest of the stripe, a blur), turn such a pose by degrees (a sheet at 0.85-0.9 m under
+// motion blur, a cable along a stripe: its 6 points over a third of it, the four fixed to
+// 0.25-0.5 degrees, the three to 1.1-6, the pose 2-3.3 degrees off, in 12 of 33 poses).
+constexpr double kHeldExtent = 0.4;
+constexpr double kHeldDeviationRatio = 3.0;
+constexpr double kMinHeldDeviationRad = 1.0 * kRadPerDeg;
+// Once the stripes of this many readings of one frame (the scans of its borders its attempts
+// make) have disagreed, no later reading's pose is taken: the image's stripes are what an
+// occluder or a blur corrupted, and one reading of them passing after others failed is chance
+// (a grey sheet's edge blurred across a stripe: 15 readings refused, the 16th, 2.9 degrees off,
+// passed; a corner cell's pose 5 degrees off, fixed to 0.09 degrees, after nine refused).
+constexpr int kMaxDisagreeingReadings = 3;
 // A stripe whose runs' median width over its own differs from the others' median by more than
 // this (log of the ratio: 8 %) is lopsided: something light or dark lies along one side of it
 // (a white cable over an edge narrows its runs), their middles off its centre line all the same
@@ -748,19 +766,46 @@ std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
       static_cast<int>(std::min_element(fit.points.begin(), fit.points.end()) - fit.points.begin());
   if (fit.points[static_cast<std::size_t>(weakest)] <
       kFewPointsRatio * MedianOfOthers(fit.points, weakest)) {
-    return PullAgainstTheOthers(weakest);
+    return PullAgainstTheOthers(weakest, PullOf(weakest));
   }
   if (!(fit.rms_px > kPoorFitRmsPx) || !options_.check_stripes_on_poor_fit) return std::nullopt;
   for (int line = 0; line < 4; ++line) {
-    if (std::optional<std::string> why = PullAgainstTheOthers(line)) return why;
+    if (std::optional<std::string> why = PullAgainstTheOthers(line, PullOf(line))) return why;
   }
   return std::nullopt;
 }
 
-std::optional<std::string> TargetPoseTracker::PullAgainstTheOthers(int line) const {
+std::optional<std::string> TargetPoseTracker::RotationHeldByFew(int line, const Pull& pull) const {
   const StripeFit& fit = frame_.fit;
-  const Pull pull = PullOf(line);  // without.ok: the other three fix the pose
-  if (!pull.Matters()) return std::nullopt;
+  const auto k = static_cast<std::size_t>(line);
+  if (!(fit.extent[k] < kHeldExtent) &&
+      !(fit.points[k] < kFewPointsRatio * MedianOfOthers(fit.points, line))) {
+    return std::nullopt;
+  }
+  const double four = fit.RotationDeviation();
+  const double three = pull.without.ok ? pull.without.RotationDeviation() : HUGE_VAL;
+  if (!(three > kHeldDeviationRatio * four) || !(three > kMinHeldDeviationRad)) {
+    return std::nullopt;
+  }
+  std::ostringstream message;
+  message << "line " << line + 1 << "'s " << fit.points[k] << " points (the others keep "
+          << MedianOfOthers(fit.points, line) << ") along " << 100.0 * fit.extent[k]
+          << " % of its stripe hold the pose's rotation: ";
+  if (pull.without.ok) {
+    message << "the other three stripes fix it to " << three * kDegPerRad << " deg, with them "
+            << four * kDegPerRad << " deg";
+  } else {
+    message << "the other three stripes do not fix it";
+  }
+  message << " (at most " << kHeldDeviationRatio
+          << " times as loosely): too few to trust, a fraction of a pixel turns it by degrees";
+  return message.str();
+}
+
+std::optional<std::string> TargetPoseTracker::PullAgainstTheOthers(int line,
+                                                                   const Pull& pull) const {
+  const StripeFit& fit = frame_.fit;
+  if (!pull.Matters()) return std::nullopt;  // Matters: the other three fix the pose
   double others_sum2 = 0.0;
   int others_points = 0;
   for (std::size_t k = 0; k < 4; ++k) {
@@ -791,9 +836,16 @@ std::string TargetPoseTracker::LensNote() {
 
 std::optional<std::string> TargetPoseTracker::DisagreeingStripe() const {
   const StripeFit& fit = frame_.fit;
-  if (!fit.ok || !(fit.RotationDeviation() > kLooseRotationRad)) return std::nullopt;
+  if (!fit.ok) return std::nullopt;
+  if (disagreeing_readings_ >= kMaxDisagreeingReadings) {
+    return "the stripes disagreed in " + std::to_string(disagreeing_readings_) +
+           " readings of this frame: a later reading's pose is not taken (at most " +
+           std::to_string(kMaxDisagreeingReadings - 1) + ")";
+  }
+  if (!(fit.RotationDeviation() > kLooseRotationRad)) return std::nullopt;
   for (int line = 0; line < 4; ++line) {
     const Pull pull = PullOf(line);
+    if (std::optional<std::string> why = RotationHeldByFew(line, pull)) return why;
     // Three stripes that fix the rotation to degrees only (their fit may settle tens of
     // degrees away) say nothing against the fourth.
     if (!pull.without.ok || !(pull.angle_rad > kMaxPullRad) ||
@@ -890,6 +942,7 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
     return false;
   }
   if (const std::optional<std::string> pull = DisagreeingStripe()) {
+    ++disagreeing_readings_;
     // Stripes bent by a lens the camera file misses disagree too: said when they bend so.
     const std::string lens = LensNote();
     frame_.status = lens.empty() ? TargetStatus::kNotFound : TargetStatus::kModelMismatch;
@@ -1153,6 +1206,7 @@ const TargetFrame& TargetPoseTracker::Track(
     const GrayImageView& image, const std::optional<vpHomogeneousMatrix>& predicted_cMo) {
   frame_ = TargetFrame{};
   corner_guesses_.clear();
+  disagreeing_readings_ = 0;
   pose_options_.image_width = image.width;
   pose_options_.image_height = image.height;
   const std::optional<vpHomogeneousMatrix> prior = predicted_cMo ? predicted_cMo : last_cMo_;

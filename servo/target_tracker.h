@@ -297,9 +297,11 @@ class TargetPoseTracker {
   /// each other, the model check; the lens told from the lines (set_measure_lens, or a pose
   /// the check refuses).
   bool Verify(const GrayImageView& image);
-  /// When the frame's fit fixes its rotation loosely: the stripe whose points turn the pose
-  /// from where the other three put it by more than those three's points allow, said as the
-  /// reason not to take it.
+  /// Why the frame's pose is not taken: its stripes disagreed in earlier readings of the frame
+  /// (kMaxDisagreeingReadings), or, when its fit fixes its rotation loosely, a stripe seen over
+  /// a short stretch whose points alone hold the rotation (RotationHeldByFew), or the stripe
+  /// whose points turn the pose from where the other three put it by more than those three's
+  /// points allow.
   std::optional<std::string> DisagreeingStripe() const;
   /// The lens told from the frame's lines (measured now if it was not), as a note to a
   /// refusal when the stripes bend as a lens the camera file misses would; empty otherwise.
@@ -318,9 +320,13 @@ class TargetPoseTracker {
   /// others' (or any stripe, when the fit is poor) pulls the pose away from where the other
   /// three stripes alone put it.
   std::optional<std::string> WeakStripePull() const;
-  /// Why, when stripe `line`'s points move the pose from the other three's at a cost to
-  /// their RMS (see kMaxOthersRmsGrowth).
-  std::optional<std::string> PullAgainstTheOthers(int line) const;
+  /// Why, when stripe `line`'s points (`pull`: the fit without them) move the pose from the
+  /// other three's at a cost to their RMS (see kMaxOthersRmsGrowth).
+  std::optional<std::string> PullAgainstTheOthers(int line, const Pull& pull) const;
+  /// Why, when stripe `line`, seen over a short stretch or keeping few points, holds the
+  /// pose's rotation: without its points (`pull`) the other three fix it far more loosely (see
+  /// kHeldDeviationRatio).
+  std::optional<std::string> RotationHeldByFew(int line, const Pull& pull) const;
   /// A stripe whose runs are narrower or wider than the others' (something light or dark
   /// along one side of it) and pull the pose away from where the other three stripes put it:
   /// why the frame's stripe fit is not taken, when the image's stripes lie where the three put
@@ -411,6 +417,8 @@ class TargetPoseTracker {
   std::vector<DetectedLine> lines_;
   /// This frame's candidates closed in on two sides, for AttemptCornerCells.
   std::vector<LightQuad> corner_guesses_;
+  /// This frame's readings (attempts) whose stripes disagreed (DisagreeingStripe).
+  int disagreeing_readings_ = 0;
   ScanBorders borders_;  ///< working memory for each attempt's borders
   TargetFrame frame_;
   GrayImageView image_{};
