@@ -500,10 +500,11 @@ double StripeFit::RotationDeviation() const {
 
 double StripeFit::RotationDistance(const vpHomogeneousMatrix& other_cMo) const {
   const Mat3 covariance = RotationCovariance(normal, scale_px);
+  if (!covariance.allFinite()) return 0.0;
+  const Eigen::LDLT<Mat3> solver(covariance);
+  if (solver.info() != Eigen::Success) return 0.0;
   const vpThetaUVector turn((other_cMo * cMo.inverse()).getRotationMatrix());
   const Vec3 w(turn[0], turn[1], turn[2]);
-  const Eigen::LDLT<Mat3> solver(covariance);
-  if (!covariance.allFinite() || solver.info() != Eigen::Success) return 0.0;
   return std::sqrt(std::max(w.dot(solver.solve(w)), 0.0));
 }
 

@@ -775,15 +775,14 @@ std::optional<std::string> TargetPoseTracker::WeakStripePull() const {
   return std::nullopt;
 }
 
-std::optional<std::string> TargetPoseTracker::RotationHeldByFew(int line, const Pull& pull) const {
+std::optional<std::string> TargetPoseTracker::RotationHeldByFew(int line, double four,
+                                                                double three) const {
   const StripeFit& fit = frame_.fit;
   const auto k = static_cast<std::size_t>(line);
   if (!(fit.extent[k] < kHeldExtent) &&
       !(fit.points[k] < kFewPointsRatio * MedianOfOthers(fit.points, line))) {
     return std::nullopt;
   }
-  const double four = fit.RotationDeviation();
-  const double three = pull.without.ok ? pull.without.RotationDeviation() : HUGE_VAL;
   if (!(three > kHeldDeviationRatio * four) || !(three > kMinHeldDeviationRad)) {
     return std::nullopt;
   }
@@ -791,7 +790,7 @@ std::optional<std::string> TargetPoseTracker::RotationHeldByFew(int line, const 
   message << "line " << line + 1 << "'s " << fit.points[k] << " points (the others keep "
           << MedianOfOthers(fit.points, line) << ") along " << 100.0 * fit.extent[k]
           << " % of its stripe hold the pose's rotation: ";
-  if (pull.without.ok) {
+  if (std::isfinite(three)) {
     message << "the other three stripes fix it to " << three * kDegPerRad << " deg, with them "
             << four * kDegPerRad << " deg";
   } else {
@@ -842,14 +841,15 @@ std::optional<std::string> TargetPoseTracker::DisagreeingStripe() const {
            " readings of this frame: a later reading's pose is not taken (at most " +
            std::to_string(kMaxDisagreeingReadings - 1) + ")";
   }
-  if (!(fit.RotationDeviation() > kLooseRotationRad)) return std::nullopt;
+  const double four = fit.RotationDeviation();
+  if (!(four > kLooseRotationRad)) return std::nullopt;
   for (int line = 0; line < 4; ++line) {
     const Pull pull = PullOf(line);
-    if (std::optional<std::string> why = RotationHeldByFew(line, pull)) return why;
+    const double three = pull.without.ok ? pull.without.RotationDeviation() : HUGE_VAL;
+    if (std::optional<std::string> why = RotationHeldByFew(line, four, three)) return why;
     // Three stripes that fix the rotation to degrees only (their fit may settle tens of
     // degrees away) say nothing against the fourth.
-    if (!pull.without.ok || !(pull.angle_rad > kMaxPullRad) ||
-        !(pull.without.RotationDeviation() < kMaxThreesDeviationRad)) {
+    if (!pull.without.ok || !(pull.angle_rad > kMaxPullRad) || !(three < kMaxThreesDeviationRad)) {
       continue;
     }
     const double deviations = pull.without.RotationDistance(fit.cMo);

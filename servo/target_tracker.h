@@ -324,9 +324,10 @@ class TargetPoseTracker {
   /// other three's at a cost to their RMS (see kMaxOthersRmsGrowth).
   std::optional<std::string> PullAgainstTheOthers(int line, const Pull& pull) const;
   /// Why, when stripe `line`, seen over a short stretch or keeping few points, holds the
-  /// pose's rotation: without its points (`pull`) the other three fix it far more loosely (see
+  /// pose's rotation: the frame's fit fixes it to `four` (StripeFit::RotationDeviation), the
+  /// other three alone to `three` (infinite when they do not fix it), far more loosely (see
   /// kHeldDeviationRatio).
-  std::optional<std::string> RotationHeldByFew(int line, const Pull& pull) const;
+  std::optional<std::string> RotationHeldByFew(int line, double four, double three) const;
   /// A stripe whose runs are narrower or wider than the others' (something light or dark
   /// along one side of it) and pull the pose away from where the other three stripes put it:
   /// why the frame's stripe fit is not taken, when the image's stripes lie where the three put
