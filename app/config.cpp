@@ -247,6 +247,7 @@ const std::vector<Field<DetectorOptions>>& DetectorFields() {
        }},
       IntField("fixed_threshold", &O::fixed_threshold),
       IntField("min_contrast", &O::min_contrast),
+      DoubleField("min_relative_contrast", &O::min_relative_contrast),
       DoubleField("min_width_px", &O::min_width_px),
       DoubleField("max_width_px", &O::max_width_px),
       DoubleField("min_crossing_angle_deg", &O::min_crossing_angle_deg),

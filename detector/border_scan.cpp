@@ -206,7 +206,7 @@ std::array<int, kBins> SampledHistogram(const std::vector<std::uint8_t>& samples
 
 }  // namespace
 
-int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
+int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast, int* light) {
   // A histogram of every fourth pixel in 32 bins of 8 grey levels is plenty: the threshold
   // only has to fall between the two classes, and the sub-pixel run ends interpolate grey
   // levels anyway.
@@ -243,13 +243,16 @@ int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast) {
       best_sum_low = sum_low;
     }
   }
-  if (contrast) {
-    *contrast = 0;
-    if (best_weight_low > 0 && best_weight_low < total) {
-      const double gap = static_cast<double>(sum_all - best_sum_low) / (total - best_weight_low) -
-                         static_cast<double>(best_sum_low) / best_weight_low;
+  if (contrast) *contrast = 0;
+  if (light) *light = 0;
+  if (best_weight_low > 0 && best_weight_low < total) {
+    const double light_mean =
+        static_cast<double>(sum_all - best_sum_low) / (total - best_weight_low);
+    if (contrast) {
+      const double gap = light_mean - static_cast<double>(best_sum_low) / best_weight_low;
       *contrast = static_cast<int>(gap * (1 << kShift));
     }
+    if (light) *light = static_cast<int>(light_mean * (1 << kShift));
   }
   return best << kShift;
 }

@@ -88,8 +88,9 @@ class BorderLoops {
   std::vector<std::uint8_t*> right_at_, left_at_;  ///< Read's working memory
 };
 
-/// Otsu's threshold of `samples`; `contrast` receives the difference of the two class means.
-int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast);
+/// Otsu's threshold of `samples`; `contrast` receives the difference of the two class means
+/// and `light`, when given, the light class's mean.
+int OtsuThreshold(const std::vector<std::uint8_t>& samples, int* contrast, int* light = nullptr);
 
 /// Finds the feature points of one border's samples (as GatherBorder wrote them) and appends
 /// them to `points`, at most options.max_points_per_border. Returns the number appended.

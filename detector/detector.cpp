@@ -275,9 +275,10 @@ const std::vector<DetectedLine>& OalDetector::DetectInRegion(const GrayImageView
 bool OalDetector::BorderThreshold(const std::vector<std::uint8_t>& samples, int* threshold) const {
   *threshold = options_.fixed_threshold;
   if (options_.threshold_mode != ThresholdMode::kOtsu) return true;
-  int contrast = 0;
-  *threshold = OtsuThreshold(samples, &contrast);
-  return contrast >= options_.min_contrast;
+  int contrast = 0, light = 0;
+  *threshold = OtsuThreshold(samples, &contrast, &light);
+  // A dim frame's paper is too dark for min_contrast: its ink differs by a fraction of it.
+  return contrast >= options_.ContrastNeededAt(light);
 }
 
 void OalDetector::AddBorderPoints(int border) {

@@ -13,6 +13,10 @@
 // Where the paper is vague, the choices made here:
 //   - Borders: d = start, start + step, ... while the rectangle is at least 2 x 2 pixels; a
 //     centre border that degenerates to a line or a point is not scanned.
+//   - Step 1's threshold: Otsu's per border (or a fixed one); a border whose two classes differ
+//     by less than min_contrast, or than min_relative_contrast of the light class's level
+//     where that is less (a dim frame's ink differs from its paper by a fraction of the paper),
+//     gives no point.
 //   - Step 2: pairs of points on the same side of a border are skipped when
 //     skip_same_side_pairs (they cannot belong to a line crossing the rectangle).
 //   - Step 3: "weighted by the number of votes prior to this iteration" is read per vote (the

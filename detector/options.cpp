@@ -51,6 +51,8 @@ void DetectorOptions::Check() const {
           "1 <= fixed_threshold <= 255");
   Require(min_contrast >= 0 && min_contrast <= 255, "min_contrast", min_contrast,
           "0 <= min_contrast <= 255");
+  Require(min_relative_contrast >= 0.0 && min_relative_contrast <= 1.0, "min_relative_contrast",
+          min_relative_contrast, "0 <= min_relative_contrast <= 1");
   Require(min_width_px > 0 && min_width_px <= 1000, "min_width_px", min_width_px,
           "0 < min_width_px <= 1000");
   Require(max_width_px >= min_width_px && max_width_px <= 1000, "max_width_px", max_width_px,
@@ -84,6 +86,10 @@ void DetectorOptions::Check() const {
           duplicate_angle_deg, "0 < duplicate_angle_deg <= 90");
   Require(duplicate_r_px > 0 && duplicate_r_px <= 1000, "duplicate_r_px", duplicate_r_px,
           "0 < duplicate_r_px <= 1000");
+}
+
+double DetectorOptions::ContrastNeededAt(double light) const {
+  return std::min(static_cast<double>(min_contrast), min_relative_contrast * light);
 }
 
 DetectorOptions DetectorOptions::ScaledBy(double scale) const {

@@ -39,6 +39,13 @@ struct DetectorOptions {
   /// With kOtsu, a border whose two classes differ by fewer grey levels holds no line.
   /// Range [0, 255].
   int min_contrast = 40;
+  /// ... or, where this fraction of the light class's grey level is less (a frame exposed at a
+  /// third: its paper at 70-90, ink and a hand both dark), by fewer than that: at 0.35 a border
+  /// whose light class is under 114 needs less than min_contrast. Range [0, 1].
+  double min_relative_contrast = 0.35;
+  /// The contrast a border of light class grey level `light` needs: the smaller of
+  /// min_contrast and min_relative_contrast times `light`.
+  double ContrastNeededAt(double light) const;
   /// Runs narrower than this (along the border) are noise or dead pixels, pixels. Range (0, 1000].
   double min_width_px = 2.0;
   /// Widest line, measured across the line, pixels (the 2 m board's 30 mm line is 60 px wide

@@ -263,6 +263,7 @@ PYBIND11_MODULE(_oalservo, m) {
           })
       .def_readwrite("fixed_threshold", &DetectorOptions::fixed_threshold)
       .def_readwrite("min_contrast", &DetectorOptions::min_contrast)
+      .def_readwrite("min_relative_contrast", &DetectorOptions::min_relative_contrast)
       .def_readwrite("min_width_px", &DetectorOptions::min_width_px)
       .def_readwrite("max_width_px", &DetectorOptions::max_width_px)
       .def_readwrite("min_crossing_angle_deg", &DetectorOptions::min_crossing_angle_deg)

@@ -202,9 +202,15 @@ TEST(PoseAccuracy, TheLivedInFramesThatOnceGaveWrongPosesGiveARightOneOrNone) {
 // Dim frames of the lived-in evaluation give a pose: exposed at 0.43 of the right level,
 // the sheet finder's classes differ by less than min_contrast (seed 131, frame 713, on
 // opencv-doc's photographs); a dim frame with a hand over a crossing, whose middle cell is
-// closed in on four sides only at the finder's last pass (seed 91, frame 259).
+// closed in on four sides only at the finder's last pass (seed 91, frame 259); frames exposed at
+// a third whose borders on the target's plane have classes 36-38 grey levels apart, under the
+// detector's min_contrast, one with a tool over a crossing (seed 196, frame 518, on opencv-doc's
+// photographs), one smeared by 11 px (frame 220).
 TEST(PoseAccuracy, DimLivedInFramesGiveAPose) {
-  ExpectRightPosesOrNone({{91, 259, "", true}, {131, 713, "", true, &kSevenPhotographs}});
+  ExpectRightPosesOrNone({{91, 259, "", true},
+                          {131, 713, "", true, &kSevenPhotographs},
+                          {196, 518, "", true, &kTwelvePhotographs},
+                          {196, 220, "", true, &kTwelvePhotographs}});
 }
 
 // Lived-in frames whose glare washes out a stripe over several of the finder's cells give a

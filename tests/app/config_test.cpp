@@ -27,6 +27,7 @@ void ExpectSameOptions(const DetectorOptions& a, const DetectorOptions& b) {
   EXPECT_EQ(a.threshold_mode, b.threshold_mode);
   EXPECT_EQ(a.fixed_threshold, b.fixed_threshold);
   EXPECT_EQ(a.min_contrast, b.min_contrast);
+  EXPECT_EQ(a.min_relative_contrast, b.min_relative_contrast);
   EXPECT_EQ(a.min_width_px, b.min_width_px);
   EXPECT_EQ(a.max_width_px, b.max_width_px);
   EXPECT_EQ(a.min_crossing_angle_deg, b.min_crossing_angle_deg);
@@ -59,7 +60,8 @@ TEST(Config, ReadsEveryKey) {
   const AppConfig config = ParseConfig(
       "detector:\n"
       "  start_px: 4\n  step_px: 3\n  polarity: edges\n  threshold_mode: fixed\n"
-      "  fixed_threshold: 100\n  min_contrast: 20\n  min_width_px: 1.5\n  max_width_px: 30\n"
+      "  fixed_threshold: 100\n  min_contrast: 20\n  min_relative_contrast: 0.25\n"
+      "  min_width_px: 1.5\n  max_width_px: 30\n"
       "  min_crossing_angle_deg: 20\n  max_points_per_border: 16\n"
       "  skip_same_side_pairs: false\n  max_pair_width_ratio: 2.5\n  angle_change_deg: 1.5\n  "
       "r_change_px: 3.5\n"
@@ -74,6 +76,7 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_EQ(o.threshold_mode, ThresholdMode::kFixed);
   EXPECT_EQ(o.fixed_threshold, 100);
   EXPECT_EQ(o.min_contrast, 20);
+  EXPECT_EQ(o.min_relative_contrast, 0.25);
   EXPECT_EQ(o.min_width_px, 1.5);
   EXPECT_EQ(o.max_width_px, 30.0);
   EXPECT_EQ(o.min_crossing_angle_deg, 20.0);
@@ -142,6 +145,8 @@ TEST(Config, OutOfRangeValueNamesFileLineAndField) {
   const std::string error = ErrorOf("detector:\n  start_px: 5\n  step_px: 0\n");
   EXPECT_THAT(error, HasSubstr("cfg.yaml:3: 'detector.step_px' is invalid: "));
   EXPECT_THAT(error, HasSubstr("1 <= step_px <= 1000"));
+  EXPECT_THAT(ErrorOf("detector:\n  min_relative_contrast: 1.5\n"),
+              HasSubstr("cfg.yaml:2: 'detector.min_relative_contrast' is invalid"));
   // A constraint between two fields: the line of the field Check() names, if the file set it.
   EXPECT_THAT(ErrorOf("detector:\n  min_width_px: 10\n  max_width_px: 5\n"),
               HasSubstr("cfg.yaml:3: 'detector.max_width_px' is invalid"));

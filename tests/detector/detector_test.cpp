@@ -147,6 +147,33 @@ TEST(OalDetector, UniformAndNoiseOnlyImagesGiveNoLine) {
   EXPECT_TRUE(detector.Detect(noisy.View()).empty());
 }
 
+// A frame exposed at a third of the right level: paper at 60, ink at 28, their classes 32 grey
+// levels apart, under min_contrast. The contrast needed falls with the paper's level; a noise-only
+// frame as dim still gives no line.
+TEST(OalDetector, ADimFrameNeedsLessContrastInProportionToItsPaper) {
+  testing::TestImage image(320, 240, 60);
+  const LineParams first{100.0, 0.2}, second = Normalized(-60.0, 2.5);
+  testing::PaintStripe(&image, first, 8.0, 28);
+  testing::PaintStripe(&image, second, 6.0, 28);
+  testing::AddNoise(&image, 3.0, 3);
+  EXPECT_GE(OalDetector().Detect(image.View()).size(), 2u);
+  DetectorOptions absolute;
+  absolute.min_relative_contrast = 1.0;  // min_contrast wherever the paper is lighter than it
+  EXPECT_TRUE(OalDetector(absolute).Detect(image.View()).empty());
+
+  testing::TestImage noisy(320, 240, 40);
+  testing::AddNoise(&noisy, 8.0, 7);
+  EXPECT_TRUE(OalDetector().Detect(noisy.View()).empty());
+}
+
+TEST(OalDetector, TheContrastNeededFollowsADimLightButNeverExceedsMinContrast) {
+  DetectorOptions options;
+  EXPECT_DOUBLE_EQ(options.ContrastNeededAt(200.0), options.min_contrast);
+  EXPECT_NEAR(options.ContrastNeededAt(66.0), 66.0 * options.min_relative_contrast, 1e-12);
+  options.min_relative_contrast = 0.0;
+  EXPECT_DOUBLE_EQ(options.ContrastNeededAt(66.0), 0.0);
+}
+
 TEST(OalDetector, FindsTwoStripesWithSubPixelAccuracyAndWidth) {
   testing::TestImage image(320, 240, 210);
   const LineParams first{100.0, 0.2}, second = Normalized(-60.0, 2.5);
