@@ -263,6 +263,20 @@ double StripeAgreement::Worst() const {
   return worst;
 }
 
+int StripeAgreement::Unseen(double min_agreement) const {
+  int unseen = -1;
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t i = static_cast<std::size_t>(k);
+    if (dark[i] >= kMinAgreeing) {
+      if (static_cast<double>(dark[i]) / (dark[i] + contradict[i]) < min_agreement) return -1;
+      continue;
+    }
+    if (unseen >= 0 || contradict[i] > 0) return -1;
+    unseen = k;
+  }
+  return unseen;
+}
+
 double StripeAgreement::ShiftRms() const {
   double sum2 = 0.0;
   int agreeing = 0;

@@ -95,6 +95,10 @@ struct StripeAgreement {
   double Worst() const;
   /// Of all the samples in view, the fraction that agree.
   double Seen() const;
+  /// The one line (0-3) with fewer than 3 agreeing samples and none contradicting (hidden under
+  /// something, or out of view) while each other line has 3 or more and agrees in at least
+  /// `min_agreement` of the samples that agree or contradict; -1 when there is no such line.
+  int Unseen(double min_agreement) const;
 };
 
 /// The model check of `layout` at cMo in `image` (`camera`'s lens: distorted pixels).

@@ -60,6 +60,12 @@ constexpr double kFewPointsRatio = 0.5;
 constexpr double kPoorFitRmsPx = 0.2;
 constexpr double kMaxPullRad = 1.0 * kRadPerDeg;
 constexpr double kMaxPullFraction = 0.01;
+// A stripe the model check cannot see (under a hand, out of view: fewer than 3 of its samples
+// agree, none contradicts) is excused when the pose does not rest on it: the other three alone fix
+// the rotation to this (one standard deviation) and put the pose within these of it.
+constexpr double kUnseenMaxThreesDeviationRad = 0.25 * kRadPerDeg;
+constexpr double kUnseenMaxMoveRad = 0.5 * kRadPerDeg;
+constexpr double kUnseenMaxMoveFraction = 0.005;
 constexpr double kMaxOthersRmsGrowth = 2.0;
 constexpr double kOthersRmsMarginPx = 0.05;
 // A fit whose rotation its points fix to more than this about some axis (one standard
@@ -833,6 +839,14 @@ std::string TargetPoseTracker::LensNote() {
   return note.str();
 }
 
+bool TargetPoseTracker::UnseenStripeExcused() const {
+  const int line = frame_.agreement.Unseen(options_.min_stripe_agreement);
+  if (line < 0 || !frame_.fit.ok) return false;
+  const Pull pull = PullOf(line);
+  return pull.without.ok && pull.without.RotationDeviation() < kUnseenMaxThreesDeviationRad &&
+         pull.angle_rad < kUnseenMaxMoveRad && pull.shift < kUnseenMaxMoveFraction;
+}
+
 std::optional<std::string> TargetPoseTracker::DisagreeingStripe() const {
   const StripeFit& fit = frame_.fit;
   if (!fit.ok) return std::nullopt;
@@ -976,8 +990,9 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
   StripeCheckOptions check = options_.StripeCheck();
   check.short_profiles_at_edge = frame_.pose.method != PoseMethod::kStripes;
   frame_.agreement = CheckStripes(image, layout_, frame_.pose.cMo, camera_, check);
-  if (frame_.agreement.Worst() < options_.min_stripe_agreement ||
-      frame_.agreement.Seen() < options_.min_stripe_seen) {
+  const bool stripes_agree =
+      frame_.agreement.Worst() >= options_.min_stripe_agreement || UnseenStripeExcused();
+  if (!stripes_agree || frame_.agreement.Seen() < options_.min_stripe_seen) {
     std::ostringstream message;
     message << "the image does not show the target where the pose puts it: ";
     for (int k = 0; k < 4; ++k) {

@@ -44,12 +44,14 @@
 // shows the target where it says (stripe_check.h): across each stripe, between the crossings
 // and the printed ends, its dark run where the pose puts it
 // (min_stripe_agreement of the samples that agree or contradict, min_stripe_seen of all the
-// samples in view); otherwise the frame's status is kModelMismatch. Without a caller's prediction,
-// a pose found on the borders of the last accepted one (step 1) that moved more than max_jump_m /
-// max_jump_deg from it is held (kJump) and accepted only when the next frame agrees with it:
-// one bad frame is refused, a real fast move costs one frame. A pose found afresh (steps 2-3,
-// after the last pose's borders showed nothing) is not held: the target has moved. ScanMode::kImage
-// is the paper's condition: the whole image every frame (steps 1-2 skipped), the same checks.
+// samples in view; one stripe with fewer than 3 agreeing samples and none contradicting, under a
+// hand or out of view, only when the other three alone fix the pose tightly where it is); otherwise
+// the frame's status is kModelMismatch. Without a caller's prediction, a pose found on the borders
+// of the last accepted one (step 1) that moved more than max_jump_m / max_jump_deg from it is held
+// (kJump) and accepted only when the next frame agrees with it: one bad frame is refused, a real
+// fast move costs one frame. A pose found afresh (steps 2-3, after the last pose's borders showed
+// nothing) is not held: the target has moved. ScanMode::kImage is the paper's condition: the whole
+// image every frame (steps 1-2 skipped), the same checks.
 //
 // Coordinates: the lines and corners are in undistorted pixels when the camera has
 // distortion (the detector undistorts the feature points), as pose.h states.
@@ -303,6 +305,9 @@ class TargetPoseTracker {
   /// whose points turn the pose from where the other three put it by more than those three's
   /// points allow.
   std::optional<std::string> DisagreeingStripe() const;
+  /// Whether the model check's one unseen stripe (StripeAgreement::Unseen: under a hand, out of
+  /// view) leaves the pose standing: the other three stripes alone fix it tightly, where it is.
+  bool UnseenStripeExcused() const;
   /// The lens told from the frame's lines (measured now if it was not), as a note to a
   /// refusal when the stripes bend as a lens the camera file misses would; empty otherwise.
   std::string LensNote();

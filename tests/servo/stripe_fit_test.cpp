@@ -418,6 +418,33 @@ TEST(StripeCheck, AStripeAlongTheImagesEdgeIsReadWithShorterProfiles) {
   EXPECT_EQ(full_profiles.Worst(), 0.0);
 }
 
+// Line 1 along the image's edge read with the full profiles only: nothing of it is read, and
+// the other three agree: it is the one stripe unseen. Not so when a second stripe is unseen
+// too, when one of its samples contradicts, or for a pose a degree and a half off (its stripes
+// contradicted).
+TEST(StripeCheck, TheOneStripeNoSampleTellsOfIsUnseen) {
+  const SceneRenderer renderer(FourLineA3Target(), Render());
+  const RenderedFrame rendered = renderer.Render(FrontoParallel(0.4, 0.09967, 0.0, 0.0), 8);
+  const TargetLayout layout = TargetLayout::Of(FourLineA3Target());
+  StripeCheckOptions full_only;
+  full_only.short_profiles_at_edge = false;
+  const StripeAgreement agreement =
+      CheckStripes(ViewOf(rendered.image), layout, rendered.cMo, kCamera, full_only);
+  EXPECT_EQ(agreement.Unseen(0.75), 0);
+  StripeAgreement two_unseen = agreement;
+  two_unseen.dark[2] = 2;
+  two_unseen.contradict[2] = 0;
+  EXPECT_EQ(two_unseen.Unseen(0.75), -1);
+  StripeAgreement contradicted = agreement;
+  contradicted.contradict[0] = 1;
+  EXPECT_EQ(contradicted.Unseen(0.75), -1);
+
+  const RenderedFrame tilted = renderer.Render(Tilted(), 7);
+  const vpHomogeneousMatrix off =
+      vpHomogeneousMatrix(0.0, 0.0, 0.0, 0.0, vpMath::rad(1.5), 0.0) * tilted.cMo;
+  EXPECT_EQ(CheckStripes(ViewOf(tilted.image), layout, off, kCamera).Unseen(0.75), -1);
+}
+
 // A pose a degree and a half off moves the stripes' far ends off their ink: contradicted.
 TEST(StripeCheck, APoseADegreeAndAHalfOffIsContradicted) {
   const SceneRenderer renderer(FourLineA3Target(), Render());
