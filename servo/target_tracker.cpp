@@ -61,8 +61,9 @@ constexpr double kPoorFitRmsPx = 0.2;
 constexpr double kMaxPullRad = 1.0 * kRadPerDeg;
 constexpr double kMaxPullFraction = 0.01;
 // A stripe the model check cannot see (under a hand, out of view: fewer than 3 of its samples
-// agree, none contradicts) is excused when the pose does not rest on it: the other three alone fix
-// the rotation to this (one standard deviation) and put the pose within these of it.
+// agree, none contradicts), or one line with too few feature points, is excused when the pose
+// does not rest on it: the other three stripes alone fix the rotation to this (one standard
+// deviation) and put the pose within these of it.
 constexpr double kUnseenMaxThreesDeviationRad = 0.25 * kRadPerDeg;
 constexpr double kUnseenMaxMoveRad = 0.5 * kRadPerDeg;
 constexpr double kUnseenMaxMoveFraction = 0.005;
@@ -839,8 +840,7 @@ std::string TargetPoseTracker::LensNote() {
   return note.str();
 }
 
-bool TargetPoseTracker::UnseenStripeExcused() const {
-  const int line = frame_.agreement.Unseen(options_.min_stripe_agreement);
+bool TargetPoseTracker::HeldByTheOtherThree(int line) const {
   if (line < 0 || !frame_.fit.ok) return false;
   const Pull pull = PullOf(line);
   return pull.without.ok && pull.without.RotationDeviation() < kUnseenMaxThreesDeviationRad &&
@@ -975,23 +975,33 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
       return false;
     }
   } else {
+    // One line with too few points (its stripe mostly hidden) may stand when the other three
+    // hold the pose; two may not.
+    int weak = -1, weak_lines = 0;
     for (int k = 0; k < 4; ++k) {
       const DetectedLine& line =
           lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
-      if (line.support < options_.min_line_support) {
-        frame_.status = TargetStatus::kNotFound;
-        frame_.message = "line " + std::to_string(k + 1) + " has " + std::to_string(line.support) +
-                         " feature points on it (min_line_support = " +
-                         std::to_string(options_.min_line_support) + "): too few to trust the pose";
-        return false;
-      }
+      if (line.support >= options_.min_line_support) continue;
+      if (weak < 0) weak = k;
+      ++weak_lines;
+    }
+    if (weak >= 0 && (weak_lines > 1 || !HeldByTheOtherThree(weak))) {
+      const DetectedLine& line =
+          lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(weak)])];
+      frame_.status = TargetStatus::kNotFound;
+      frame_.message =
+          "line " + std::to_string(weak + 1) + " has " + std::to_string(line.support) +
+          " feature points on it (min_line_support = " + std::to_string(options_.min_line_support) +
+          "): too few to trust the pose";
+      return false;
     }
   }
   StripeCheckOptions check = options_.StripeCheck();
   check.short_profiles_at_edge = frame_.pose.method != PoseMethod::kStripes;
   frame_.agreement = CheckStripes(image, layout_, frame_.pose.cMo, camera_, check);
   const bool stripes_agree =
-      frame_.agreement.Worst() >= options_.min_stripe_agreement || UnseenStripeExcused();
+      frame_.agreement.Worst() >= options_.min_stripe_agreement ||
+      HeldByTheOtherThree(frame_.agreement.Unseen(options_.min_stripe_agreement));
   if (!stripes_agree || frame_.agreement.Seen() < options_.min_stripe_seen) {
     std::ostringstream message;
     message << "the image does not show the target where the pose puts it: ";

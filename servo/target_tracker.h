@@ -144,8 +144,9 @@ struct TargetTrackerOptions {
   bool image_fallback = true;
   /// Each of the four lines the pose uses needs at least this many feature points on it
   /// (DetectedLine::support): a line seen on a few borders only is too poorly placed to
-  /// trust; a pose fitted to the stripes' points alone (no four lines) needs twice this in
-  /// all. Range [0, 1000].
+  /// trust, unless it is the only one and the other three stripes hold the pose alone
+  /// (HeldByTheOtherThree); a pose fitted to the stripes' points alone (no four lines) needs
+  /// twice this in all. Range [0, 1000].
   int min_line_support = 12;
   /// The model check (stripe_check.h): of each stripe's samples that agree with the pose or
   /// contradict it, the fraction that must agree (a sample under a hand or a glare does
@@ -305,9 +306,10 @@ class TargetPoseTracker {
   /// whose points turn the pose from where the other three put it by more than those three's
   /// points allow.
   std::optional<std::string> DisagreeingStripe() const;
-  /// Whether the model check's one unseen stripe (StripeAgreement::Unseen: under a hand, out of
-  /// view) leaves the pose standing: the other three stripes alone fix it tightly, where it is.
-  bool UnseenStripeExcused() const;
+  /// Whether the pose does not rest on stripe `line` (0-3; false for -1): the other three
+  /// stripes alone fix it tightly, where it is. Excuses the model check's one unseen stripe
+  /// (StripeAgreement::Unseen: under a hand, out of view) and one line with too few points.
+  bool HeldByTheOtherThree(int line) const;
   /// The lens told from the frame's lines (measured now if it was not), as a note to a
   /// refusal when the stripes bend as a lens the camera file misses would; empty otherwise.
   std::string LensNote();
