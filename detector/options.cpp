@@ -88,8 +88,12 @@ void DetectorOptions::Check() const {
           "0 < duplicate_r_px <= 1000");
 }
 
-double DetectorOptions::ContrastNeededAt(double light) const {
+double ContrastNeeded(int min_contrast, double min_relative_contrast, double light) {
   return std::min(static_cast<double>(min_contrast), min_relative_contrast * light);
+}
+
+double DetectorOptions::ContrastNeededAt(double light) const {
+  return ContrastNeeded(min_contrast, min_relative_contrast, light);
 }
 
 DetectorOptions DetectorOptions::ScaledBy(double scale) const {

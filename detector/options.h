@@ -26,6 +26,12 @@ std::string ToString(ThresholdMode mode);
 Polarity PolarityFromString(const std::string& text);
 ThresholdMode ThresholdModeFromString(const std::string& text);
 
+/// The least difference from `light` (a grey level) that counts as contrast: the lesser of
+/// `min_contrast` and `min_relative_contrast` times `light` (a dim frame's ink differs from its
+/// paper by a fraction of the paper). The detector's borders and the sheet finder's cells both
+/// judge by it.
+double ContrastNeeded(int min_contrast, double min_relative_contrast, double light);
+
 struct DetectorOptions {
   // --- Step 1: concentric border scans -------------------------------------------------
   /// Distance of the first border from the image edge, pixels. Paper: 10. Range [0, 1000].
@@ -43,8 +49,7 @@ struct DetectorOptions {
   /// third: its paper at 70-90, ink and a hand both dark), by fewer than that: at 0.35 a border
   /// whose light class is under 114 needs less than min_contrast. Range [0, 1].
   double min_relative_contrast = 0.35;
-  /// The contrast a border of light class grey level `light` needs: the smaller of
-  /// min_contrast and min_relative_contrast times `light`.
+  /// The contrast a border of light class grey level `light` needs (ContrastNeeded).
   double ContrastNeededAt(double light) const;
   /// Runs narrower than this (along the border) are noise or dead pixels, pixels. Range (0, 1000].
   double min_width_px = 2.0;

@@ -352,7 +352,7 @@ void SheetFinderOptions::Check() const {
 }
 
 double SheetFinderOptions::ContrastNeededAt(double light) const {
-  return std::min(static_cast<double>(min_contrast), min_relative_contrast * light);
+  return ContrastNeeded(min_contrast, min_relative_contrast, light);
 }
 
 SheetFinderOptions SheetFinderOptions::ScaledBy(double scale) const {

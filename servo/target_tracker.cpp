@@ -64,9 +64,9 @@ constexpr double kMaxPullFraction = 0.01;
 // agree, none contradicts), or one line with too few feature points, is excused when the pose
 // does not rest on it: the other three stripes alone fix the rotation to this (one standard
 // deviation) and put the pose within these of it.
-constexpr double kUnseenMaxThreesDeviationRad = 0.25 * kRadPerDeg;
-constexpr double kUnseenMaxMoveRad = 0.5 * kRadPerDeg;
-constexpr double kUnseenMaxMoveFraction = 0.005;
+constexpr double kHeldByThreeMaxDeviationRad = 0.25 * kRadPerDeg;
+constexpr double kHeldByThreeMaxMoveRad = 0.5 * kRadPerDeg;
+constexpr double kHeldByThreeMaxMoveFraction = 0.005;
 constexpr double kMaxOthersRmsGrowth = 2.0;
 constexpr double kOthersRmsMarginPx = 0.05;
 // A fit whose rotation its points fix to more than this about some axis (one standard
@@ -843,8 +843,8 @@ std::string TargetPoseTracker::LensNote() {
 bool TargetPoseTracker::HeldByTheOtherThree(int line) const {
   if (line < 0 || !frame_.fit.ok) return false;
   const Pull pull = PullOf(line);
-  return pull.without.ok && pull.without.RotationDeviation() < kUnseenMaxThreesDeviationRad &&
-         pull.angle_rad < kUnseenMaxMoveRad && pull.shift < kUnseenMaxMoveFraction;
+  return pull.without.ok && pull.without.RotationDeviation() < kHeldByThreeMaxDeviationRad &&
+         pull.angle_rad < kHeldByThreeMaxMoveRad && pull.shift < kHeldByThreeMaxMoveFraction;
 }
 
 std::optional<std::string> TargetPoseTracker::DisagreeingStripe() const {
@@ -977,20 +977,18 @@ bool TargetPoseTracker::Verify(const GrayImageView& image) {
   } else {
     // One line with too few points (its stripe mostly hidden) may stand when the other three
     // hold the pose; two may not.
-    int weak = -1, weak_lines = 0;
+    int weak = -1, weak_support = 0, weak_lines = 0;
     for (int k = 0; k < 4; ++k) {
       const DetectedLine& line =
           lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(k)])];
       if (line.support >= options_.min_line_support) continue;
-      if (weak < 0) weak = k;
+      if (weak < 0) weak = k, weak_support = line.support;
       ++weak_lines;
     }
     if (weak >= 0 && (weak_lines > 1 || !HeldByTheOtherThree(weak))) {
-      const DetectedLine& line =
-          lines_[static_cast<std::size_t>(frame_.pose.line_index[static_cast<std::size_t>(weak)])];
       frame_.status = TargetStatus::kNotFound;
       frame_.message =
-          "line " + std::to_string(weak + 1) + " has " + std::to_string(line.support) +
+          "line " + std::to_string(weak + 1) + " has " + std::to_string(weak_support) +
           " feature points on it (min_line_support = " + std::to_string(options_.min_line_support) +
           "): too few to trust the pose";
       return false;
